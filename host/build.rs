@@ -1,0 +1,16 @@
+//! Compiles `kernel/` to one SPIR-V module with rust-gpu on every build; the module's path
+//! reaches the host as the env var `kernel.spv` (see `vulkan::KERNEL_SPV`).
+use spirv_builder::{Capability, SpirvBuilder};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let kernel = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../kernel");
+    let mut builder = SpirvBuilder::new(kernel, "spirv-unknown-vulkan1.2")
+        .capability(Capability::RayTracingKHR)
+        .capability(Capability::RayQueryKHR)
+        .extension("SPV_KHR_ray_tracing")
+        .extension("SPV_KHR_ray_query");
+    builder.build_script.defaults = true;
+    builder.build_script.env_shader_spv_path = Some(true);
+    builder.build()?;
+    Ok(())
+}

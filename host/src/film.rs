@@ -1,0 +1,195 @@
+//! The film: per-pixel sums of samples and of their squares (so every pixel knows its own
+//! variance), and image files: EXR (linear float32 RGB) and PNG (sRGB, clamped).
+
+use crate::cpu::PixelSums;
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+
+/// Accumulated samples of an image.
+#[derive(Clone, Debug)]
+pub struct Film {
+    pub width: u32,
+    pub height: u32,
+    pub sum: Vec<[f64; 3]>,
+    pub sum_sq: Vec<[f64; 3]>,
+    /// Samples added per pixel.
+    pub count: Vec<u32>,
+    /// Non-finite samples dropped (expected: 0).
+    pub discarded: u64,
+}
+
+impl Film {
+    pub fn new(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        Self {
+            width,
+            height,
+            sum: vec![[0.0; 3]; n],
+            sum_sq: vec![[0.0; 3]; n],
+            count: vec![0; n],
+            discarded: 0,
+        }
+    }
+
+    pub fn add_sums(&mut self, px: u32, py: u32, s: &PixelSums) {
+        let i = (py * self.width + px) as usize;
+        for c in 0..3 {
+            self.sum[i][c] += s.sum[c];
+            self.sum_sq[i][c] += s.sum_sq[c];
+        }
+        self.count[i] += s.count;
+        self.discarded += s.discarded as u64;
+    }
+
+    /// The pixel values: the plain mean of each pixel's samples (box filter).
+    pub fn mean(&self) -> Vec<[f32; 3]> {
+        self.sum
+            .iter()
+            .zip(&self.count)
+            .map(|(s, &n)| {
+                let n = n.max(1) as f64;
+                [(s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32]
+            })
+            .collect()
+    }
+
+    /// Estimated variance of each pixel's mean: the unbiased sample variance over n.
+    pub fn variance_of_mean(&self) -> Vec<[f32; 3]> {
+        (0..self.sum.len())
+            .map(|i| {
+                let n = self.count[i] as f64;
+                let mut v = [0.0f32; 3];
+                if n >= 2.0 {
+                    for (c, vc) in v.iter_mut().enumerate() {
+                        let m = self.sum[i][c] / n;
+                        let var = ((self.sum_sq[i][c] - n * m * m) / (n - 1.0)).max(0.0);
+                        *vc = (var / n) as f32;
+                    }
+                }
+                v
+            })
+            .collect()
+    }
+
+    /// Total samples over all pixels.
+    pub fn total_samples(&self) -> u64 {
+        self.count.iter().map(|&c| c as u64).sum()
+    }
+}
+
+/// An RGB float image in memory.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RgbImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 3]>,
+}
+
+impl RgbImage {
+    pub fn from_film(film: &Film) -> Self {
+        Self {
+            width: film.width,
+            height: film.height,
+            pixels: film.mean(),
+        }
+    }
+
+    /// Reads an EXR (or any format the `image` crate reads) as linear float RGB.
+    pub fn read(path: &Path) -> Result<Self> {
+        let img = image::open(path)
+            .with_context(|| format!("{}: cannot read image", path.display()))?
+            .to_rgb32f();
+        let (width, height) = img.dimensions();
+        let pixels = img.pixels().map(|p| p.0).collect();
+        Ok(Self {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    /// Writes by extension: `.exr` linear float32 RGB, `.png` 8-bit sRGB (clamped to [0, 1]).
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("exr") => {
+                let flat: Vec<f32> = self.pixels.iter().flatten().copied().collect();
+                let img = image::Rgb32FImage::from_raw(self.width, self.height, flat)
+                    .context("image size mismatch")?;
+                img.save_with_format(path, image::ImageFormat::OpenExr)
+                    .with_context(|| format!("{}: cannot write EXR", path.display()))
+            }
+            Some("png") => {
+                let bytes: Vec<u8> = self
+                    .pixels
+                    .iter()
+                    .flatten()
+                    .map(|&v| (linear_to_srgb(v) * 255.0 + 0.5) as u8)
+                    .collect();
+                let img = image::RgbImage::from_raw(self.width, self.height, bytes)
+                    .context("image size mismatch")?;
+                img.save_with_format(path, image::ImageFormat::Png)
+                    .with_context(|| format!("{}: cannot write PNG", path.display()))
+            }
+            _ => bail!(
+                "{}: unknown output format (use .exr or .png)",
+                path.display()
+            ),
+        }
+    }
+}
+
+/// The sRGB transfer function (IEC 61966-2-1), input clamped to [0, 1]; NaN maps to 0.
+pub fn linear_to_srgb(v: f32) -> f32 {
+    let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Differences between two images of the same size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageDiff {
+    pub rmse: f64,
+    /// Mean over pixels and channels of (a - b)^2 / (b^2 + 0.01).
+    pub relmse: f64,
+    /// Mean over pixels and channels of a - b.
+    pub mean_signed: f64,
+    pub max_abs: f64,
+}
+
+/// Compares `a` against reference `b`.
+pub fn diff_images(a: &RgbImage, b: &RgbImage) -> Result<ImageDiff> {
+    if (a.width, a.height) != (b.width, b.height) {
+        bail!(
+            "image sizes differ: {}x{} vs {}x{}",
+            a.width,
+            a.height,
+            b.width,
+            b.height
+        );
+    }
+    let (mut se, mut rel, mut signed, mut max_abs) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for (pa, pb) in a.pixels.iter().zip(&b.pixels) {
+        for c in 0..3 {
+            let (x, y) = (pa[c] as f64, pb[c] as f64);
+            let d = x - y;
+            se += d * d;
+            rel += d * d / (y * y + 0.01);
+            signed += d;
+            max_abs = max_abs.max(d.abs());
+        }
+    }
+    let n = (a.pixels.len() * 3).max(1) as f64;
+    Ok(ImageDiff {
+        rmse: (se / n).sqrt(),
+        relmse: rel / n,
+        mean_signed: signed / n,
+        max_abs,
+    })
+}

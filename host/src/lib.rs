@@ -1,0 +1,11 @@
+//! twinpath's host: scenes, the CPU backend, the film and image files, and the render driver.
+//! Everything here is "not a pixel's value"; the kernel crate decides those.
+
+pub mod cpu;
+pub mod film;
+pub mod render;
+pub mod scene;
+pub mod stats;
+
+/// The SPIR-V module rust-gpu compiled from `kernel/` at build time (host/build.rs).
+pub const KERNEL_SPV: &[u8] = include_bytes!(env!("kernel.spv"));

@@ -1,0 +1,494 @@
+//! The TOML scene format (see README "Scene format"), parsed with serde and checked field by
+//! field; every error carries the file, the line of the offending value and the field's path.
+
+use super::error::{line_of, SceneError};
+use super::mesh::load_mesh;
+use super::{CameraDesc, RenderSettings, Scene, TriangleGroup};
+use glam::Vec3;
+use kernel::scene::{light_sampling, mis, roulette, Material, Sphere, SphereLight, Triangle, NONE};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+use toml::Spanned;
+
+/// The built-in default scene: the Cornell scene of `scenes/cornell.toml`, embedded.
+pub const DEFAULT_SCENE_TOML: &str = include_str!("../../../scenes/cornell.toml");
+/// The name errors and outputs use for the built-in scene.
+pub const DEFAULT_SCENE_NAME: &str = "cornell.toml";
+
+/// Largest image side accepted (a typo like 1e9 must not try to allocate the film).
+pub const MAX_IMAGE_SIDE: i64 = 1 << 15;
+
+type V3 = Spanned<[f32; 3]>;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    camera: Spanned<CameraFile>,
+    #[serde(default)]
+    render: Option<RenderFile>,
+    #[serde(default)]
+    materials: BTreeMap<String, Spanned<MaterialFile>>,
+    #[serde(default)]
+    sphere: Vec<Spanned<SphereFile>>,
+    #[serde(default)]
+    quad: Vec<Spanned<QuadFile>>,
+    #[serde(default)]
+    mesh: Vec<Spanned<MeshFile>>,
+    #[serde(default)]
+    background: Option<BackgroundFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraFile {
+    eye: V3,
+    look_at: V3,
+    up: V3,
+    vfov: Spanned<f32>,
+    width: Spanned<i64>,
+    height: Spanned<i64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RenderFile {
+    spp: Option<Spanned<i64>>,
+    seed: Option<Spanned<i64>>,
+    /// Constant survival probability (the seed's RussianRoulette).
+    russian_roulette: Option<Spanned<f32>>,
+    /// "constant" (default) or "throughput".
+    roulette: Option<Spanned<String>>,
+    rr_start_depth: Option<Spanned<i64>>,
+    /// "power" (default) or "half" (the seed's fixed weights).
+    mis: Option<Spanned<String>>,
+    max_depth: Option<Spanned<i64>>,
+    /// "cone" (default) or "area" (the seed's uniform point on the sphere).
+    light_sampling: Option<Spanned<String>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialFile {
+    kd: Option<V3>,
+    emission: Option<V3>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SphereFile {
+    center: V3,
+    radius: Spanned<f32>,
+    material: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct QuadFile {
+    corner: V3,
+    edge1: V3,
+    edge2: V3,
+    material: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeshFile {
+    file: Spanned<String>,
+    material: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BackgroundFile {
+    radiance: V3,
+}
+
+/// Checks values and reports errors at their line.
+struct Checker<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Checker<'_> {
+    fn err(&self, span: std::ops::Range<usize>, field: &str, msg: impl Into<String>) -> SceneError {
+        SceneError::new(self.path, Some(line_of(self.text, span.start)), field, msg)
+    }
+
+    fn vec3(&self, v: &V3, field: &str) -> Result<Vec3, SceneError> {
+        let a = *v.get_ref();
+        if a.iter().all(|c| c.is_finite()) {
+            Ok(Vec3::from(a))
+        } else {
+            Err(self.err(v.span(), field, format!("{a:?} is not finite")))
+        }
+    }
+
+    fn color(&self, v: &V3, field: &str, max: Option<f32>) -> Result<Vec3, SceneError> {
+        let c = self.vec3(v, field)?;
+        if c.min_element() < 0.0 {
+            return Err(self.err(
+                v.span(),
+                field,
+                format!("{:?} has a negative component", c.to_array()),
+            ));
+        }
+        if let Some(max) = max {
+            if c.max_element() > max {
+                return Err(self.err(
+                    v.span(),
+                    field,
+                    format!("{:?} has a component above {max} (a surface cannot reflect more than it receives)", c.to_array()),
+                ));
+            }
+        }
+        Ok(c)
+    }
+
+    fn int(&self, v: &Spanned<i64>, field: &str, min: i64, max: i64) -> Result<u32, SceneError> {
+        let x = *v.get_ref();
+        if x < min || x > max {
+            Err(self.err(v.span(), field, format!("{x} is outside {min}..={max}")))
+        } else {
+            Ok(x as u32)
+        }
+    }
+}
+
+/// Parses and validates scene text; `path` names the file in errors and anchors mesh paths.
+pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    let file: SceneFile = toml::from_str(text).map_err(|e| {
+        let line = e.span().map(|s| line_of(text, s.start));
+        let field = "syntax";
+        SceneError::new(path, line, field, e.message().trim().to_string())
+    })?;
+    let ck = Checker { path, text };
+
+    // Camera.
+    let cam = file.camera.get_ref();
+    let eye = ck.vec3(&cam.eye, "camera.eye")?;
+    let look_at = ck.vec3(&cam.look_at, "camera.look_at")?;
+    let up = ck.vec3(&cam.up, "camera.up")?;
+    let vfov = *cam.vfov.get_ref();
+    if !(vfov > 0.0 && vfov < 180.0) {
+        return Err(ck.err(
+            cam.vfov.span(),
+            "camera.vfov",
+            format!("{vfov} is not in (0, 180) degrees"),
+        ));
+    }
+    let width = ck.int(&cam.width, "camera.width", 1, MAX_IMAGE_SIDE)?;
+    let height = ck.int(&cam.height, "camera.height", 1, MAX_IMAGE_SIDE)?;
+    let forward = look_at - eye;
+    if !(forward.length() > 0.0) || !forward.normalize().is_finite() {
+        return Err(ck.err(
+            cam.look_at.span(),
+            "camera.look_at",
+            "equals camera.eye: no viewing direction",
+        ));
+    }
+    let right = forward.normalize().cross(up);
+    if !(right.length() > 1e-6 * up.length()) || !right.normalize().is_finite() {
+        return Err(ck.err(
+            cam.up.span(),
+            "camera.up",
+            "is zero or parallel to the viewing direction",
+        ));
+    }
+    let camera = CameraDesc {
+        eye,
+        look_at,
+        up,
+        vfov_degrees: vfov,
+        width,
+        height,
+    };
+
+    // Render settings.
+    let mut render = RenderSettings::default();
+    if let Some(r) = &file.render {
+        if let Some(v) = &r.spp {
+            render.spp = ck.int(v, "render.spp", 1, u32::MAX as i64)?;
+        }
+        if let Some(v) = &r.seed {
+            render.seed = ck.int(v, "render.seed", 0, u32::MAX as i64)?;
+        }
+        if let Some(v) = &r.roulette {
+            render.rr_mode = match v.get_ref().as_str() {
+                "constant" => roulette::CONSTANT,
+                "throughput" => {
+                    render.rr_start_depth = 5;
+                    roulette::THROUGHPUT
+                }
+                other => {
+                    return Err(ck.err(
+                        v.span(),
+                        "render.roulette",
+                        format!("'{other}' is not \"constant\" or \"throughput\""),
+                    ))
+                }
+            };
+        }
+        if let Some(v) = &r.russian_roulette {
+            let q = *v.get_ref();
+            if !(q > 0.0 && q <= 1.0) {
+                return Err(ck.err(
+                    v.span(),
+                    "render.russian_roulette",
+                    format!("{q} is not a probability in (0, 1]"),
+                ));
+            }
+            render.rr_probability = q;
+        }
+        if let Some(v) = &r.rr_start_depth {
+            render.rr_start_depth = ck.int(v, "render.rr_start_depth", 0, u32::MAX as i64)?;
+        }
+        if let Some(v) = &r.mis {
+            render.mis_mode = match v.get_ref().as_str() {
+                "power" => mis::POWER,
+                "half" => mis::HALF,
+                other => {
+                    return Err(ck.err(
+                        v.span(),
+                        "render.mis",
+                        format!("'{other}' is not \"power\" or \"half\""),
+                    ))
+                }
+            };
+        }
+        if let Some(v) = &r.light_sampling {
+            render.light_sampling = match v.get_ref().as_str() {
+                "cone" => light_sampling::CONE,
+                "area" => light_sampling::AREA,
+                other => {
+                    return Err(ck.err(
+                        v.span(),
+                        "render.light_sampling",
+                        format!("'{other}' is not \"cone\" or \"area\""),
+                    ))
+                }
+            };
+        }
+        if let Some(v) = &r.max_depth {
+            render.max_depth = ck.int(v, "render.max_depth", 1, u32::MAX as i64)?;
+        }
+    }
+
+    // Materials, in name order.
+    let mut materials = Vec::new();
+    let mut material_names = Vec::new();
+    for (name, m) in &file.materials {
+        let field = format!("materials.{name}");
+        let mf = m.get_ref();
+        let material = match (&mf.kd, &mf.emission) {
+            (Some(kd), None) => Material {
+                albedo: ck.color(kd, &format!("{field}.kd"), Some(1.0))?.to_array(),
+                _pad0: 0.0,
+                emission: [0.0; 3],
+                _pad1: 0.0,
+            },
+            (None, Some(e)) => {
+                let e = ck.color(e, &format!("{field}.emission"), None)?;
+                Material {
+                    albedo: [0.0; 3],
+                    _pad0: 0.0,
+                    emission: e.to_array(),
+                    _pad1: 0.0,
+                }
+            }
+            (Some(_), Some(_)) => {
+                return Err(ck.err(
+                    m.span(),
+                    &field,
+                    "has both kd and emission: a light reflects nothing, give one of them",
+                ))
+            }
+            (None, None) => {
+                return Err(ck.err(
+                    m.span(),
+                    &field,
+                    "needs kd = [r, g, b] or emission = [r, g, b]",
+                ))
+            }
+        };
+        materials.push(material);
+        material_names.push(name.clone());
+    }
+    let find_material = |s: &Spanned<String>, field: &str| -> Result<u32, SceneError> {
+        material_names
+            .iter()
+            .position(|n| n == s.get_ref())
+            .map(|i| i as u32)
+            .ok_or_else(|| {
+                ck.err(
+                    s.span(),
+                    field,
+                    format!(
+                        "unknown material '{}' (defined: {})",
+                        s.get_ref(),
+                        material_names.join(", ")
+                    ),
+                )
+            })
+    };
+    let is_emissive = |m: u32| materials[m as usize].emission.iter().any(|&c| c > 0.0);
+
+    // Spheres; emissive ones become lights.
+    let mut spheres = Vec::new();
+    let mut lights = Vec::new();
+    for (i, s) in file.sphere.iter().enumerate() {
+        let sf = s.get_ref();
+        let center = ck.vec3(&sf.center, &format!("sphere[{i}].center"))?;
+        let radius = *sf.radius.get_ref();
+        if !(radius > 0.0 && radius.is_finite()) {
+            return Err(ck.err(
+                sf.radius.span(),
+                &format!("sphere[{i}].radius"),
+                format!("{radius} must be a positive finite number"),
+            ));
+        }
+        let material = find_material(&sf.material, &format!("sphere[{i}].material"))?;
+        let light = if is_emissive(material) {
+            lights.push(SphereLight {
+                center: center.to_array(),
+                radius,
+                radiance: materials[material as usize].emission,
+                select_pmf: 0.0,
+                select_cdf: 0.0,
+                _pad: [0.0; 3],
+            });
+            (lights.len() - 1) as u32
+        } else {
+            NONE
+        };
+        spheres.push(Sphere {
+            center: center.to_array(),
+            radius,
+            material,
+            light,
+            _pad: [0; 2],
+        });
+    }
+    // Uniform light selection, as the seed's SampleLight.
+    let n = lights.len();
+    for (i, l) in lights.iter_mut().enumerate() {
+        l.select_pmf = 1.0 / n as f32;
+        l.select_cdf = if i + 1 == n {
+            1.0
+        } else {
+            (i + 1) as f32 / n as f32
+        };
+    }
+
+    // Quads (two triangles each) and meshes.
+    let mut triangles = Vec::new();
+    let mut triangle_groups = Vec::new();
+    let push_triangle = |triangles: &mut Vec<Triangle>, p: [Vec3; 3], material: u32| {
+        triangles.push(Triangle {
+            p0: p[0].to_array(),
+            material,
+            edge1: (p[1] - p[0]).to_array(),
+            _pad0: 0,
+            edge2: (p[2] - p[0]).to_array(),
+            _pad1: 0,
+        });
+    };
+    let quads_start = triangles.len();
+    for (i, q) in file.quad.iter().enumerate() {
+        let qf = q.get_ref();
+        let field = format!("quad[{i}]");
+        let corner = ck.vec3(&qf.corner, &format!("{field}.corner"))?;
+        let e1 = ck.vec3(&qf.edge1, &format!("{field}.edge1"))?;
+        let e2 = ck.vec3(&qf.edge2, &format!("{field}.edge2"))?;
+        let area = e1.cross(e2).length();
+        if !(area > 0.0) || !area.is_finite() {
+            return Err(ck.err(
+                qf.edge2.span(),
+                &format!("{field}.edge2"),
+                "edges are zero or parallel: the quad has zero area",
+            ));
+        }
+        let material = find_material(&qf.material, &format!("{field}.material"))?;
+        if is_emissive(material) {
+            return Err(ck.err(
+                qf.material.span(),
+                &format!("{field}.material"),
+                format!(
+                    "'{}' is emissive: only spheres can be lights so far",
+                    qf.material.get_ref()
+                ),
+            ));
+        }
+        push_triangle(
+            &mut triangles,
+            [corner, corner + e1, corner + e1 + e2],
+            material,
+        );
+        push_triangle(
+            &mut triangles,
+            [corner, corner + e1 + e2, corner + e2],
+            material,
+        );
+    }
+    if triangles.len() > quads_start {
+        triangle_groups.push(TriangleGroup {
+            name: "quads".into(),
+            range: quads_start..triangles.len(),
+        });
+    }
+    let base_dir = path.parent().unwrap_or(Path::new("."));
+    for (i, m) in file.mesh.iter().enumerate() {
+        let mf = m.get_ref();
+        let field = format!("mesh[{i}]");
+        let material = find_material(&mf.material, &format!("{field}.material"))?;
+        if is_emissive(material) {
+            return Err(ck.err(
+                mf.material.span(),
+                &format!("{field}.material"),
+                format!(
+                    "'{}' is emissive: only spheres can be lights so far",
+                    mf.material.get_ref()
+                ),
+            ));
+        }
+        let mesh_path = base_dir.join(mf.file.get_ref());
+        if !mesh_path.is_file() {
+            return Err(ck.err(
+                mf.file.span(),
+                &format!("{field}.file"),
+                format!("mesh file {} does not exist", mesh_path.display()),
+            ));
+        }
+        let soup = load_mesh(&mesh_path)?;
+        let start = triangles.len();
+        for t in &soup.triangles {
+            let p = t.map(Vec3::from);
+            // Degenerate (zero-area) triangles cannot be hit; they are dropped.
+            if (p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0 {
+                push_triangle(&mut triangles, p, material);
+            }
+        }
+        triangle_groups.push(TriangleGroup {
+            name: mf.file.get_ref().clone(),
+            range: start..triangles.len(),
+        });
+    }
+
+    let background = match &file.background {
+        Some(b) => ck.color(&b.radiance, "background.radiance", None)?,
+        None => Vec3::ZERO,
+    };
+
+    Ok(Scene {
+        name: path.display().to_string(),
+        camera,
+        render,
+        background,
+        materials,
+        material_names,
+        spheres,
+        triangles,
+        triangle_groups,
+        lights,
+    })
+}

@@ -1,0 +1,151 @@
+//! Scenes: TOML files (and the meshes they name) validated and flattened into the kernel's
+//! `#[repr(C)]` tables. Neither backend knows the file format.
+
+mod error;
+mod file;
+pub mod mesh;
+
+pub use error::SceneError;
+pub use file::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
+
+use glam::Vec3;
+use kernel::scene::{
+    light_sampling, mis, roulette, Camera, Material, RenderParams, Sphere, SphereLight, Triangle,
+};
+use std::ops::Range;
+use std::path::Path;
+
+/// The camera as the scene file gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDesc {
+    pub eye: Vec3,
+    pub look_at: Vec3,
+    pub up: Vec3,
+    /// Full vertical field of view, degrees.
+    pub vfov_degrees: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl CameraDesc {
+    /// The kernel's camera: forward, and right/up scaled by the image plane's half-extents.
+    pub fn to_kernel(&self) -> Camera {
+        let forward = (self.look_at - self.eye).normalize();
+        let right = forward.cross(self.up).normalize();
+        let up = right.cross(forward);
+        let half_h = (0.5 * self.vfov_degrees.to_radians()).tan();
+        let half_w = half_h * self.width as f32 / self.height as f32;
+        let v4 = |v: Vec3| [v.x, v.y, v.z, 0.0];
+        Camera {
+            eye: v4(self.eye),
+            forward: v4(forward),
+            right: v4(right * half_w),
+            up: v4(up * half_h),
+        }
+    }
+}
+
+/// Integrator settings: from the scene's `[render]` table, overridable on the command line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub spp: u32,
+    pub seed: u32,
+    /// One of `kernel::scene::roulette`.
+    pub rr_mode: u32,
+    /// Survival probability of the constant roulette (the seed's 0.8 by default).
+    pub rr_probability: f32,
+    /// First path vertex (1 = the camera ray's hit) whose extension roulette decides.
+    pub rr_start_depth: u32,
+    /// One of `kernel::scene::mis`.
+    pub mis_mode: u32,
+    pub max_depth: u32,
+    /// One of `kernel::scene::light_sampling`.
+    pub light_sampling: u32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            spp: 64,
+            seed: 0,
+            rr_mode: roulette::CONSTANT,
+            rr_probability: 0.8,
+            rr_start_depth: 1,
+            mis_mode: mis::POWER,
+            max_depth: u32::MAX,
+            light_sampling: light_sampling::CONE,
+        }
+    }
+}
+
+/// A contiguous run of triangles from one source (a mesh, or the scene's quads).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleGroup {
+    pub name: String,
+    pub range: Range<usize>,
+}
+
+/// A validated scene in the kernel's flat layout.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Where it came from (a file path, or the built-in scene's name).
+    pub name: String,
+    pub camera: CameraDesc,
+    pub render: RenderSettings,
+    pub background: Vec3,
+    pub materials: Vec<Material>,
+    pub material_names: Vec<String>,
+    pub spheres: Vec<Sphere>,
+    pub triangles: Vec<Triangle>,
+    pub triangle_groups: Vec<TriangleGroup>,
+    pub lights: Vec<SphereLight>,
+}
+
+impl Scene {
+    /// Reads and validates a scene file; meshes are resolved relative to its folder.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read(path)
+            .map_err(|e| SceneError::new(path, None, "file", format!("cannot read: {e}")))?;
+        let text = String::from_utf8(text).map_err(|e| {
+            let line = error::line_of(
+                &String::from_utf8_lossy(e.as_bytes()),
+                e.utf8_error().valid_up_to(),
+            );
+            SceneError::new(path, Some(line), "file", "not valid UTF-8 text")
+        })?;
+        parse_scene(&text, path)
+    }
+
+    /// The built-in default scene (the Cornell scene of `scenes/cornell.toml`).
+    pub fn builtin_default() -> Scene {
+        parse_scene(DEFAULT_SCENE_TOML, Path::new(DEFAULT_SCENE_NAME))
+            .expect("the built-in scene is valid (checked by a test)")
+    }
+
+    /// The kernel parameters for a launch of `samples_per_launch` samples starting at sample
+    /// index `sample_offset`.
+    pub fn params(&self, sample_offset: u32, samples_per_launch: u32) -> RenderParams {
+        let r = &self.render;
+        RenderParams {
+            camera: self.camera.to_kernel(),
+            background: [self.background.x, self.background.y, self.background.z, 0.0],
+            width: self.camera.width,
+            height: self.camera.height,
+            seed: r.seed,
+            sample_offset,
+            samples_per_launch,
+            light_count: self.lights.len() as u32,
+            rr_mode: r.rr_mode,
+            rr_probability: r.rr_probability,
+            rr_start_depth: r.rr_start_depth,
+            mis_mode: r.mis_mode,
+            max_depth: r.max_depth,
+            light_sampling: r.light_sampling,
+        }
+    }
+
+    /// Number of pixels.
+    pub fn pixel_count(&self) -> usize {
+        self.camera.width as usize * self.camera.height as usize
+    }
+}

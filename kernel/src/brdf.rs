@@ -1,0 +1,36 @@
+//! The two-sided Lambertian BRDF, f = Kd / pi. `n` is always the normal flipped to the side the
+//! light leaves toward (the side of the outgoing direction), so both sides reflect alike.
+
+use crate::sampling::{pdf_cosine_hemisphere, sample_cosine_hemisphere};
+use core::f32::consts::PI;
+use spirv_std::glam::Vec3;
+
+/// Seed: `EvalScattering(N, w_i)`. The BRDF times the cosine at the receiver,
+/// f(w_i) max(0, n . w_i) = Kd / pi * max(0, n . w_i): the factor the rendering equation
+/// integrates against incoming radiance per unit solid angle. The seed's |n . w_i| would let
+/// light arrive through the back of the surface; with `n` on the outgoing side it must be zero.
+#[inline]
+pub fn eval_scattering(n: Vec3, wi: Vec3, albedo: Vec3) -> Vec3 {
+    albedo * (n.dot(wi).max(0.0) * (1.0 / PI))
+}
+
+/// Seed: `SampleBrdf(N)`. Direction w_i = SampleLobe(n, sqrt(u1), 2 pi u2): cosine-weighted, the
+/// importance sampling of the Lambertian `eval_scattering`.
+#[inline]
+pub fn sample_brdf(n: Vec3, u1: f32, u2: f32) -> Vec3 {
+    sample_cosine_hemisphere(n, u1, u2)
+}
+
+/// Seed: `PdfBrdf(N, w_i)`. Solid-angle density of [`sample_brdf`]: max(0, n . w_i) / pi.
+#[inline]
+pub fn pdf_brdf(n: Vec3, wi: Vec3) -> f32 {
+    pdf_cosine_hemisphere(n, wi)
+}
+
+/// The throughput factor f cos(theta) / p for a direction drawn by [`sample_brdf`], simplified
+/// analytically: (Kd/pi cos) / (cos/pi) = Kd. Computing the ratio numerically would leave
+/// rounding of the cancelling cosines in it (a white furnace would drift from exactly 1).
+#[inline]
+pub fn sampled_brdf_weight(albedo: Vec3) -> Vec3 {
+    albedo
+}

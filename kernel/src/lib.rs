@@ -1,0 +1,26 @@
+//! twinpath's rendering kernel: everything that decides a pixel's value.
+//!
+//! Written once in `no_std` Rust and compiled twice: to SPIR-V by rust-gpu (the `shaders` module
+//! holds the entry points) and to native code for the CPU backend and the tests. The kernel
+//! reaches the scene only through [`path::Tracer`], so it knows neither backend.
+#![cfg_attr(target_arch = "spirv", no_std)]
+
+pub mod brdf;
+pub mod camera;
+pub mod frame;
+pub mod geometry;
+pub mod light;
+pub mod path;
+pub mod rng;
+pub mod sampling;
+pub mod scene;
+#[cfg(target_arch = "spirv")]
+pub mod shaders;
+
+pub use path::{trace_path, SurfaceHit, Tracer};
+pub use spirv_std::glam;
+
+/// `f32` methods (sqrt, sin, ...) on the GPU come from this trait; natively they are inherent.
+#[cfg(target_arch = "spirv")]
+#[allow(unused_imports)]
+pub(crate) use spirv_std::num_traits::Float;

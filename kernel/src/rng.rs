@@ -1,0 +1,80 @@
+//! Counter-based random numbers: a value is a pure function of (seed, pixel, sample, dimension),
+//! so any backend, thread or dispatch order reproduces any sample exactly.
+//!
+//! The hash is `pcg4d` from Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 9(3),
+//! 2020: a 4D-to-4D permutation with good avalanche that costs a few integer multiply-adds.
+
+/// Jarzynski and Olano's pcg4d: bijective mixing of four 32-bit words.
+#[inline]
+pub fn pcg4d(mut v: [u32; 4]) -> [u32; 4] {
+    v[0] = v[0].wrapping_mul(1664525).wrapping_add(1013904223);
+    v[1] = v[1].wrapping_mul(1664525).wrapping_add(1013904223);
+    v[2] = v[2].wrapping_mul(1664525).wrapping_add(1013904223);
+    v[3] = v[3].wrapping_mul(1664525).wrapping_add(1013904223);
+    v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[3]));
+    v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
+    v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
+    v[3] = v[3].wrapping_add(v[1].wrapping_mul(v[2]));
+    v[0] ^= v[0] >> 16;
+    v[1] ^= v[1] >> 16;
+    v[2] ^= v[2] >> 16;
+    v[3] ^= v[3] >> 16;
+    v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[3]));
+    v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
+    v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
+    v[3] = v[3].wrapping_add(v[1].wrapping_mul(v[2]));
+    v
+}
+
+/// Maps 32 random bits to a float uniform in [0, 1): the top 24 bits times 2^-24, so every value
+/// is exactly representable and 1.0 is never returned.
+#[inline]
+pub fn u32_to_unit_f32(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// The random stream of one sample of one pixel; each call to [`SampleRng::next_f32`] consumes
+/// the next dimension.
+#[derive(Clone, Copy, Debug)]
+pub struct SampleRng {
+    pub seed: u32,
+    pub pixel: u32,
+    pub sample: u32,
+    pub dimension: u32,
+}
+
+impl SampleRng {
+    /// The stream of sample `sample` of pixel `pixel` (row-major index) under `seed`.
+    #[inline]
+    pub fn new(seed: u32, pixel: u32, sample: u32) -> Self {
+        Self {
+            seed,
+            pixel,
+            sample,
+            dimension: 0,
+        }
+    }
+
+    /// 32 random bits for (seed, pixel, sample, dimension), then advances the dimension.
+    #[inline]
+    pub fn next_u32(&mut self) -> u32 {
+        let h = pcg4d([self.pixel, self.sample, self.dimension, self.seed]);
+        self.dimension = self.dimension.wrapping_add(1);
+        h[0]
+    }
+
+    /// A float uniform in [0, 1), then advances the dimension.
+    #[inline]
+    pub fn next_f32(&mut self) -> f32 {
+        u32_to_unit_f32(self.next_u32())
+    }
+}
+
+impl SampleRng {
+    /// Jumps to dimension `dimension`, so each path vertex reads a fixed block of dimensions
+    /// whatever branches earlier vertices took.
+    #[inline]
+    pub fn seek(&mut self, dimension: u32) {
+        self.dimension = dimension;
+    }
+}

@@ -1,0 +1,147 @@
+//! Sampling routines: directions around an axis and points on spheres.
+
+use crate::frame::orthonormal_basis;
+#[cfg(target_arch = "spirv")]
+use crate::Float;
+use core::f32::consts::PI;
+use spirv_std::glam::Vec3;
+
+/// Seed: `SampleLobe(A, c, phi)`. The unit direction whose cosine with the unit axis `a` is `c`
+/// (clamped to [-1, 1]) and whose azimuth around `a` is `phi`: `K = (s cos phi, s sin phi, c)`
+/// with `s = sqrt(1 - c^2)`, expressed in an orthonormal frame whose third axis is `a`.
+/// The frame is Duff et al.'s (see [`orthonormal_basis`]), which stays accurate near -Z where the
+/// seed special-cases the poles.
+#[inline]
+pub fn sample_lobe(a: Vec3, c: f32, phi: f32) -> Vec3 {
+    let c = c.clamp(-1.0, 1.0);
+    let s = (1.0 - c * c).max(0.0).sqrt();
+    let (t, b) = orthonormal_basis(a);
+    t * (s * phi.cos()) + b * (s * phi.sin()) + a * c
+}
+
+/// Cosine-weighted direction in the hemisphere around unit `n` from two uniform numbers
+/// (cos(theta) = sqrt(u1), phi = 2 pi u2); its solid-angle pdf is [`pdf_cosine_hemisphere`].
+#[inline]
+pub fn sample_cosine_hemisphere(n: Vec3, u1: f32, u2: f32) -> Vec3 {
+    sample_lobe(n, u1.sqrt(), 2.0 * PI * u2)
+}
+
+/// Solid-angle density of [`sample_cosine_hemisphere`]: max(0, n . w) / pi.
+#[inline]
+pub fn pdf_cosine_hemisphere(n: Vec3, w: Vec3) -> f32 {
+    n.dot(w).max(0.0) * (1.0 / PI)
+}
+
+/// A point on a sphere and its outward unit normal.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    pub position: Vec3,
+    pub normal: Vec3,
+}
+
+/// Seed: `SampleSphere(C, R)`. A point uniformly distributed over the sphere's area
+/// (z = 2 u1 - 1, phi = 2 pi u2; Archimedes' hat-box theorem makes z uniform), with density
+/// 1 / (4 pi R^2) per unit area.
+#[inline]
+pub fn sample_sphere(center: Vec3, radius: f32, u1: f32, u2: f32) -> SurfacePoint {
+    let z = 2.0 * u1 - 1.0;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u2;
+    let normal = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+    SurfacePoint {
+        position: center + radius * normal,
+        normal,
+    }
+}
+
+/// Area density of [`sample_sphere`]: 1 / (4 pi R^2).
+#[inline]
+pub fn pdf_sphere_area(radius: f32) -> f32 {
+    1.0 / (4.0 * PI * radius * radius)
+}
+
+/// Veach's power heuristic with beta = 2 for two strategies with one sample each:
+/// w_a = p_a^2 / (p_a^2 + p_b^2) (Veach's thesis, section 9.2.4). Zero when both pdfs are zero.
+#[inline]
+pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
+    let a = pdf_a * pdf_a;
+    let b = pdf_b * pdf_b;
+    if a + b > 0.0 {
+        a / (a + b)
+    } else {
+        0.0
+    }
+}
+
+/// A direction toward a sphere light, the point it reaches, and the solid-angle density.
+#[derive(Clone, Copy, Debug)]
+pub struct ConeSample {
+    pub point: SurfacePoint,
+    /// Density per unit solid angle seen from the reference point.
+    pub pdf_solid_angle: f32,
+}
+
+/// sin^2 of 1.5 degrees: below it, 1 - cos(theta_max) is computed by its Taylor expansion
+/// sin^2/2 (the subtraction would cancel), as pbrt-v4 does in `Sphere::Sample`.
+pub const SMALL_CONE_SIN2: f32 = 0.000_685_23;
+
+/// 1 - cos(theta_max) of the cone a sphere (center, radius) subtends from a point at squared
+/// distance `dist2` from its centre; the Taylor form sin^2/2 for tiny cones.
+#[inline]
+pub fn cone_one_minus_cos(radius: f32, dist2: f32) -> f32 {
+    let sin2_max = radius * radius / dist2;
+    if sin2_max < SMALL_CONE_SIN2 {
+        0.5 * sin2_max
+    } else {
+        1.0 - (1.0 - sin2_max).max(0.0).sqrt()
+    }
+}
+
+/// Samples the sphere (center, radius) as seen from outside point `p`: a direction uniform in
+/// the cone the sphere subtends (cos theta = 1 - u1 (1 - cos theta_max), phi = 2 pi u2) and the
+/// point where it first meets the sphere (pbrt-v4 6.2.4 `Sphere::Sample`). The point is placed
+/// by its angle alpha at the centre, measured from the axis toward `p`:
+/// with d the distance to the centre and the near intersection at distance
+/// s = d cos(theta) - sqrt(r^2 - d^2 sin^2(theta)), cos(alpha) = (d - s cos(theta)) / r
+/// = sin^2(theta) / sin(theta_max) + cos(theta) sqrt(1 - sin^2(theta) / sin^2(theta_max)),
+/// which avoids intersecting a ray with the sphere. Density: 1 / (2 pi (1 - cos theta_max)).
+/// `p` must be outside the sphere (see [`pdf_sphere_cone`] for the caller's fallback).
+#[inline]
+pub fn sample_sphere_cone(center: Vec3, radius: f32, p: Vec3, u1: f32, u2: f32) -> ConeSample {
+    let to_center = center - p;
+    let dist2 = to_center.dot(to_center);
+    let dist = dist2.sqrt();
+    let axis = to_center / dist;
+    let sin_max = radius / dist;
+    let sin2_max = sin_max * sin_max;
+    let one_minus_cos_max = cone_one_minus_cos(radius, dist2);
+    // sin^2(theta) from u1, uniformly in 1 - cos(theta).
+    let (sin2, cos) = if sin2_max < SMALL_CONE_SIN2 {
+        let s2 = sin2_max * u1;
+        (s2, (1.0 - s2).max(0.0).sqrt())
+    } else {
+        let c = 1.0 - u1 * one_minus_cos_max;
+        ((1.0 - c * c).max(0.0), c)
+    };
+    let cos_alpha =
+        (sin2 / sin_max + cos * (1.0 - sin2 / sin2_max).max(0.0).sqrt()).clamp(-1.0, 1.0);
+    let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+    let phi = 2.0 * PI * u2;
+    let (t, b) = orthonormal_basis(axis);
+    let normal = t * (sin_alpha * phi.cos()) + b * (sin_alpha * phi.sin()) - axis * cos_alpha;
+    ConeSample {
+        point: SurfacePoint {
+            position: center + radius * normal,
+            normal,
+        },
+        pdf_solid_angle: 1.0 / (2.0 * PI * one_minus_cos_max),
+    }
+}
+
+/// Solid-angle density of [`sample_sphere_cone`] from outside point `p`, for any direction
+/// that meets the sphere: 1 / (2 pi (1 - cos theta_max)).
+#[inline]
+pub fn pdf_sphere_cone(center: Vec3, radius: f32, p: Vec3) -> f32 {
+    let d = center - p;
+    1.0 / (2.0 * PI * cone_one_minus_cos(radius, d.dot(d)))
+}

@@ -1,0 +1,130 @@
+//! `#[repr(C)]` plain-old-data types shared by the host and the device (storage buffers and push
+//! constants). Layout rules: only `f32`/`u32` and arrays of them, every struct a multiple of 16
+//! bytes, no `Vec3` (its size has differed between host and device), so std430 and the native
+//! layout agree. The host checks sizes and offsets in a test.
+
+/// Index meaning "none" in `u32` index fields (no light, no hit).
+pub const NONE: u32 = u32::MAX;
+
+/// A sphere, the only shape that can be a light. 32 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct Sphere {
+    pub center: [f32; 3],
+    pub radius: f32,
+    /// Index into the material table.
+    pub material: u32,
+    /// Index into the light table when the sphere emits, else [`NONE`].
+    pub light: u32,
+    pub _pad: [u32; 2],
+}
+
+/// One triangle with its precomputed edges (p1 = p0 + edge1, p2 = p0 + edge2). 48 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct Triangle {
+    pub p0: [f32; 3],
+    pub material: u32,
+    pub edge1: [f32; 3],
+    pub _pad0: u32,
+    pub edge2: [f32; 3],
+    pub _pad1: u32,
+}
+
+/// A two-sided Lambertian surface, or a light (emission > 0 and no reflection). 32 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct Material {
+    /// Diffuse reflectance Kd (albedo), linear RGB; the BRDF is Kd / pi.
+    pub albedo: [f32; 3],
+    pub _pad0: f32,
+    /// Emitted radiance, linear RGB (zero for non-emitters).
+    pub emission: [f32; 3],
+    pub _pad1: f32,
+}
+
+/// A spherical area light: the light table lists every emissive sphere. 48 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct SphereLight {
+    pub center: [f32; 3],
+    pub radius: f32,
+    /// Emitted radiance, uniform over the outer surface and all outgoing directions.
+    pub radiance: [f32; 3],
+    /// Probability of choosing this light in next-event estimation.
+    pub select_pmf: f32,
+    /// Cumulative selection probability up to and including this light (for sampling).
+    pub select_cdf: f32,
+    pub _pad: [f32; 3],
+}
+
+/// Pinhole camera: a ray through image-plane point (x, y) in [-1, 1]^2 (y up) has direction
+/// `forward + x * right + y * up`, where `right` and `up` already carry the half-extents
+/// tan(vfov/2) * aspect and tan(vfov/2). 64 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct Camera {
+    pub eye: [f32; 4],
+    pub forward: [f32; 4],
+    pub right: [f32; 4],
+    pub up: [f32; 4],
+}
+
+/// How Russian roulette picks the survival probability q of a path's extension.
+pub mod roulette {
+    /// The seed's constant q (`RenderParams::rr_probability`) at every vertex.
+    pub const CONSTANT: u32 = 0;
+    /// q = min(1, max component of the path throughput), from `rr_start_depth` on.
+    pub const THROUGHPUT: u32 = 1;
+}
+
+/// How next-event estimation and BRDF sampling of lights are combined.
+pub mod mis {
+    /// The seed's constant weights: 1/2 for each strategy.
+    pub const HALF: u32 = 0;
+    /// Veach's power heuristic (beta = 2).
+    pub const POWER: u32 = 1;
+}
+
+/// How a point on a sphere light is chosen for next-event estimation.
+pub mod light_sampling {
+    /// The seed's uniform point on the whole sphere (half of them face away).
+    pub const AREA: u32 = 0;
+    /// A direction uniform in the cone the sphere subtends (pbrt-v4 `Sphere::Sample`);
+    /// area sampling from inside the sphere.
+    pub const CONE: u32 = 1;
+}
+
+/// Everything a path needs besides the scene geometry and tables. 144 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct RenderParams {
+    pub camera: Camera,
+    /// Uniform environment radiance seen by rays that leave the scene.
+    pub background: [f32; 4],
+    pub width: u32,
+    pub height: u32,
+    pub seed: u32,
+    /// Index of the first sample of this launch (progressive rendering).
+    pub sample_offset: u32,
+    pub samples_per_launch: u32,
+    pub light_count: u32,
+    /// One of [`roulette`].
+    pub rr_mode: u32,
+    /// Constant survival probability for [`roulette::CONSTANT`], in (0, 1].
+    pub rr_probability: f32,
+    /// Number of path vertices that always continue before roulette applies (0: from the first).
+    pub rr_start_depth: u32,
+    /// One of [`mis`].
+    pub mis_mode: u32,
+    /// Hard bound on path vertices, a guard against endless paths (`u32::MAX`: none).
+    pub max_depth: u32,
+    /// One of [`light_sampling`].
+    pub light_sampling: u32,
+}

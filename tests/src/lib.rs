@@ -1,0 +1,65 @@
+//! Helpers shared by twinpath's integration tests (in `tests/tests/`): statistics and small
+//! programmatic scenes.
+
+use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
+use twinpath::scene::{parse_scene, Scene};
+
+/// Two-sided critical |z| for a family of `tests` z-tests at family-wise error rate `alpha`
+/// (Bonferroni): a correct estimator fails any of them with probability at most `alpha`.
+pub fn z_critical(alpha: f64, tests: usize) -> f64 {
+    let per_test = alpha / tests as f64;
+    Normal::new(0.0, 1.0)
+        .unwrap()
+        .inverse_cdf(1.0 - per_test / 2.0)
+}
+
+/// Pearson's chi-square goodness-of-fit test of observed bin counts against expected ones.
+/// Bins with expected count below 5 are pooled (as Mitsuba's `ChiSquareTest` does). Returns
+/// (statistic, degrees of freedom, p-value).
+pub fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, usize, f64) {
+    let mut order: Vec<usize> = (0..expected.len()).collect();
+    order.sort_by(|&a, &b| expected[a].total_cmp(&expected[b]));
+    let (mut stat, mut dof) = (0.0, 0usize);
+    let (mut pool_o, mut pool_e) = (0.0, 0.0);
+    for &i in &order {
+        if expected[i] == 0.0 {
+            assert!(
+                observed[i] == 0.0,
+                "bin {i}: {} samples where the pdf integrates to 0",
+                observed[i]
+            );
+            continue;
+        }
+        if expected[i] < 5.0 || pool_e > 0.0 && pool_e < 5.0 {
+            pool_o += observed[i];
+            pool_e += expected[i];
+            if pool_e >= 5.0 {
+                stat += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+                dof += 1;
+                pool_o = 0.0;
+                pool_e = 0.0;
+            }
+            continue;
+        }
+        stat += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+        dof += 1;
+    }
+    if pool_e > 0.0 {
+        stat += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+        dof += 1;
+    }
+    let dof = dof.saturating_sub(1).max(1);
+    let p = 1.0 - ChiSquared::new(dof as f64).unwrap().cdf(stat);
+    (stat, dof, p)
+}
+
+/// Parses scene text as if it were the file `name` in the `scenes/` folder.
+pub fn scene_from_toml(text: &str) -> Scene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/test.toml");
+    parse_scene(text, &path).unwrap_or_else(|e| panic!("test scene invalid: {e}"))
+}
+
+/// The repository root.
+pub fn repo_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}

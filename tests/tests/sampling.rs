@@ -1,0 +1,246 @@
+//! Chi-square goodness-of-fit tests of every sampler against the pdf the estimator divides by.
+//! Expected bin counts come from integrating the *pdf functions* numerically over each bin, so
+//! a sampler and its pdf that disagree fail, whichever of the two is wrong.
+
+use glam::Vec3;
+use kernel::brdf::{pdf_brdf, sample_brdf};
+use kernel::light::{pdf_light, sample_light};
+use kernel::rng::SampleRng;
+use kernel::sampling::{
+    pdf_sphere_area, pdf_sphere_cone, sample_lobe, sample_sphere, sample_sphere_cone,
+};
+use kernel::scene::SphereLight;
+use std::f64::consts::PI;
+use twinpath_tests::chi_square;
+
+/// Family-wise significance of all chi-square tests in this file (Sidak-style split below).
+const ALPHA: f64 = 0.01;
+const TESTS: f64 = 10.0;
+const SAMPLES: u32 = 1_000_000;
+
+fn assert_fits(name: &str, observed: &[f64], expected: &[f64]) {
+    let (stat, dof, p) = chi_square(observed, expected);
+    let threshold = 1.0 - (1.0 - ALPHA).powf(1.0 / TESTS);
+    println!("{name}: chi2 = {stat:.1}, dof = {dof}, p = {p:.4}");
+    assert!(
+        p > threshold,
+        "{name}: samples do not follow the pdf (chi2 {stat:.1}, dof {dof}, p {p:.2e} < {threshold:.2e})"
+    );
+}
+
+/// Bins over (cos theta in [-1, 1], phi in [0, 2pi)) around the frame of axis `n`.
+const THETA_BINS: usize = 20;
+const PHI_BINS: usize = 40;
+
+fn spherical_bin(n: Vec3, w: Vec3) -> usize {
+    let (t, b) = kernel::frame::orthonormal_basis(n);
+    let c = w.dot(n).clamp(-1.0, 1.0) as f64;
+    let phi = (w.dot(b) as f64)
+        .atan2(w.dot(t) as f64)
+        .rem_euclid(2.0 * PI);
+    let i = (((c + 1.0) / 2.0 * THETA_BINS as f64) as usize).min(THETA_BINS - 1);
+    let j = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
+    i * PHI_BINS + j
+}
+
+/// Expected counts: the integral of `pdf` (solid-angle density) over each bin, by midpoint
+/// quadrature in (cos theta, phi), where dw = d(cos theta) dphi.
+fn expected_spherical(n: Vec3, pdf: impl Fn(Vec3) -> f64, samples: f64) -> Vec<f64> {
+    let (t, b) = kernel::frame::orthonormal_basis(n);
+    let q = 8; // quadrature points per bin side
+    let mut expected = vec![0.0; THETA_BINS * PHI_BINS];
+    let dc = 2.0 / THETA_BINS as f64 / q as f64;
+    let dphi = 2.0 * PI / PHI_BINS as f64 / q as f64;
+    for i in 0..THETA_BINS * q {
+        let c = -1.0 + (i as f64 + 0.5) * dc;
+        let s = (1.0 - c * c).max(0.0).sqrt();
+        for j in 0..PHI_BINS * q {
+            let phi = (j as f64 + 0.5) * dphi;
+            let w = t * (s * phi.cos()) as f32 + b * (s * phi.sin()) as f32 + n * c as f32;
+            expected[(i / q) * PHI_BINS + j / q] += pdf(w) * dc * dphi * samples;
+        }
+    }
+    let total: f64 = expected.iter().sum::<f64>() / samples;
+    assert!(
+        (total - 1.0).abs() < 1e-3,
+        "pdf integrates to {total}, not 1"
+    );
+    expected
+}
+
+fn rng(stream: u32) -> SampleRng {
+    SampleRng::new(12345, stream, 0)
+}
+
+#[test]
+fn sample_brdf_follows_pdf_brdf() {
+    for (k, n) in [
+        Vec3::Z,
+        -Vec3::Z,
+        Vec3::new(0.3, -0.5, 0.81).normalize(),
+        Vec3::new(-1e-4, 1e-4, -1.0).normalize(),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut observed = vec![0.0; THETA_BINS * PHI_BINS];
+        let mut r = rng(k as u32);
+        for _ in 0..SAMPLES {
+            let w = sample_brdf(n, r.next_f32(), r.next_f32());
+            assert!((w.length() - 1.0).abs() < 1e-5);
+            observed[spherical_bin(n, w)] += 1.0;
+        }
+        let expected = expected_spherical(n, |w| pdf_brdf(n, w) as f64, SAMPLES as f64);
+        assert_fits(&format!("sample_brdf, n = {n}"), &observed, &expected);
+    }
+}
+
+#[test]
+fn sample_lobe_has_the_requested_cosine_and_uniform_azimuth() {
+    // The seed's contract: cos(angle to A) = c exactly, phi the azimuth around A.
+    let a = Vec3::new(0.2, 0.9, -0.3).normalize();
+    let mut observed = vec![0.0; PHI_BINS];
+    let mut r = rng(99);
+    for _ in 0..SAMPLES {
+        let c = 2.0 * r.next_f32() - 1.0;
+        let phi = 2.0 * std::f32::consts::PI * r.next_f32();
+        let w = sample_lobe(a, c, phi);
+        assert!((w.dot(a) - c).abs() < 2e-6, "cosine {} != {c}", w.dot(a));
+        observed[spherical_bin(a, w) % PHI_BINS] += 1.0;
+    }
+    let expected = vec![SAMPLES as f64 / PHI_BINS as f64; PHI_BINS];
+    assert_fits("sample_lobe azimuth", &observed, &expected);
+}
+
+#[test]
+fn sample_sphere_is_uniform_in_area() {
+    let (center, radius) = (Vec3::new(1.0, -2.0, 0.5), 0.7f32);
+    let mut observed = vec![0.0; THETA_BINS * PHI_BINS];
+    let mut r = rng(7);
+    for _ in 0..SAMPLES {
+        let p = sample_sphere(center, radius, r.next_f32(), r.next_f32());
+        assert!(((p.position - center).length() - radius).abs() < 1e-5);
+        assert!((p.normal - (p.position - center) / radius).length() < 1e-5);
+        observed[spherical_bin(Vec3::Z, p.normal)] += 1.0;
+    }
+    // Area of a bin on the sphere is r^2 d(cos) dphi, times the area density.
+    let area_pdf = pdf_sphere_area(radius) as f64;
+    let r2 = (radius * radius) as f64;
+    let expected = expected_spherical(Vec3::Z, |_| area_pdf * r2, SAMPLES as f64);
+    assert_fits("sample_sphere", &observed, &expected);
+}
+
+#[test]
+fn sample_light_selects_by_pmf_and_pdf_light_matches() {
+    let mk = |x: f32, radius: f32| SphereLight {
+        center: [x, 0.0, 0.0],
+        radius,
+        radiance: [1.0; 3],
+        select_pmf: 0.0,
+        select_cdf: 0.0,
+        _pad: [0.0; 3],
+    };
+    let mut lights = vec![mk(0.0, 0.5), mk(3.0, 1.0), mk(-3.0, 0.25)];
+    let n = lights.len();
+    for (i, l) in lights.iter_mut().enumerate() {
+        l.select_pmf = 1.0 / n as f32;
+        l.select_cdf = if i + 1 == n {
+            1.0
+        } else {
+            (i + 1) as f32 / n as f32
+        };
+    }
+    let mut observed = vec![0.0; n];
+    let mut r = rng(3);
+    for _ in 0..SAMPLES {
+        let s = sample_light(&lights, n as u32, r.next_f32(), r.next_f32(), r.next_f32());
+        observed[s.light as usize] += 1.0;
+        let l = lights[s.light as usize];
+        assert!(((s.point.position - Vec3::from(l.center)).length() - l.radius).abs() < 1e-5);
+        assert_eq!(s.pdf_area, pdf_light(&lights, s.light));
+        let want = 1.0 / (n as f64 * 4.0 * PI * (l.radius as f64).powi(2));
+        assert!((s.pdf_area as f64 / want - 1.0).abs() < 1e-6);
+    }
+    let expected = vec![SAMPLES as f64 / n as f64; n];
+    assert_fits("sample_light selection", &observed, &expected);
+}
+
+#[test]
+fn chi_square_detects_a_wrong_pdf() {
+    // Power check: cosine samples tested against the *uniform hemisphere* pdf must fail.
+    let n = Vec3::Z;
+    let mut observed = vec![0.0; THETA_BINS * PHI_BINS];
+    let mut r = rng(11);
+    for _ in 0..SAMPLES {
+        observed[spherical_bin(n, sample_brdf(n, r.next_f32(), r.next_f32()))] += 1.0;
+    }
+    let wrong = expected_spherical(
+        n,
+        |w| if w.z > 0.0 { 1.0 / (2.0 * PI) } else { 0.0 },
+        SAMPLES as f64,
+    );
+    let (_, _, p) = chi_square(&observed, &wrong);
+    assert!(
+        p < 1e-6,
+        "the chi-square test cannot tell cosine from uniform (p = {p})"
+    );
+}
+
+#[test]
+fn sample_sphere_cone_follows_its_pdf() {
+    // Large, medium and tiny cones (the last below the Taylor-branch threshold of 1.5 degrees).
+    for (k, (center, radius)) in [
+        (Vec3::new(0.0, 1.0, 0.5), 0.8f32),
+        (Vec3::new(3.0, -2.0, 1.0), 0.5),
+        (Vec3::new(0.0, 0.0, 40.0), 0.5),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let p = Vec3::ZERO;
+        let axis = (center - p).normalize();
+        let mut observed = vec![0.0; THETA_BINS * PHI_BINS];
+        let mut r = rng(100 + k as u32);
+        // Bins in the cone's own (cos theta, phi) coordinates, cos theta rescaled to the cone.
+        let one_minus_cos_max =
+            kernel::sampling::cone_one_minus_cos(radius, (center - p).length_squared()) as f64;
+        let bin = |w: Vec3| {
+            let (t, b) = kernel::frame::orthonormal_basis(axis);
+            let c = w.dot(axis) as f64;
+            let x = ((1.0 - c) / one_minus_cos_max).clamp(0.0, 1.0);
+            let phi = (w.dot(b) as f64)
+                .atan2(w.dot(t) as f64)
+                .rem_euclid(2.0 * PI);
+            let i = ((x * THETA_BINS as f64) as usize).min(THETA_BINS - 1);
+            let j = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
+            i * PHI_BINS + j
+        };
+        for _ in 0..SAMPLES {
+            let s = sample_sphere_cone(center, radius, p, r.next_f32(), r.next_f32());
+            let y = s.point.position;
+            // On the sphere, facing the receiver, and the pdf matches pdf_sphere_cone.
+            assert!(
+                ((y - center).length() / radius - 1.0).abs() < 1e-4,
+                "{y} not on the sphere"
+            );
+            let w = (y - p).normalize();
+            assert!(s.point.normal.dot(w) <= 1e-3, "sampled point faces away");
+            assert_eq!(s.pdf_solid_angle, pdf_sphere_cone(center, radius, p));
+            observed[bin(w)] += 1.0;
+        }
+        // The pdf is constant in solid angle over the cone, so each bin (equal steps in
+        // 1 - cos theta and phi) holds the same solid angle: uniform expected counts. That the
+        // constant is right is checked by pdf * cone solid angle = 1.
+        let pdf = pdf_sphere_cone(center, radius, p) as f64;
+        assert!((pdf * 2.0 * PI * one_minus_cos_max - 1.0).abs() < 1e-5);
+        let expected = vec![SAMPLES as f64 / (THETA_BINS * PHI_BINS) as f64; THETA_BINS * PHI_BINS];
+        assert_fits(
+            &format!(
+                "sample_sphere_cone, radius {radius}, distance {}",
+                center.length()
+            ),
+            &observed,
+            &expected,
+        );
+    }
+}

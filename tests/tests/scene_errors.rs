@@ -1,0 +1,332 @@
+//! Bad input of every class is an error naming the file, the line and the field; never a panic.
+
+use std::path::{Path, PathBuf};
+use twinpath::scene::{mesh::parse_ply, parse_scene, Scene, SceneError};
+
+const GOOD: &str = r#"
+[camera]
+eye = [0, 1, 4]
+look_at = [0, 1, 0]
+up = [0, 1, 0]
+vfov = 40
+width = 32
+height = 24
+
+[materials]
+white = { kd = [0.5, 0.5, 0.5] }
+lamp = { emission = [4, 4, 4] }
+
+[[sphere]]
+center = [0, 1, 0]
+radius = 0.5
+material = "white"
+
+[[quad]]
+corner = [-1, 0, 1]
+edge1 = [2, 0, 0]
+edge2 = [0, 0, -2]
+material = "white"
+"#;
+
+fn scene_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/bad.toml")
+}
+
+fn error_of(text: &str) -> SceneError {
+    match parse_scene(text, &scene_path()) {
+        Ok(_) => panic!("accepted bad scene:\n{text}"),
+        Err(e) => {
+            println!("{e}");
+            e
+        }
+    }
+}
+
+/// Replaces the first occurrence of `from` in the good scene.
+fn with(from: &str, to: &str) -> String {
+    assert!(GOOD.contains(from), "{from}");
+    GOOD.replacen(from, to, 1)
+}
+
+fn line_containing(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).unwrap() + 1
+}
+
+fn assert_error(text: &str, line_needle: &str, field: &str, message_part: &str) {
+    let e = error_of(text);
+    assert_eq!(e.file, scene_path());
+    assert_eq!(e.line, Some(line_containing(text, line_needle)), "{e}");
+    assert!(
+        e.field.contains(field),
+        "field {:?} should name {field:?}: {e}",
+        e.field
+    );
+    assert!(
+        e.message
+            .to_lowercase()
+            .contains(&message_part.to_lowercase()),
+        "message {:?} should say {message_part:?}",
+        e.message
+    );
+    let shown = e.to_string();
+    assert!(shown.starts_with(&format!("{}:{}: ", scene_path().display(), e.line.unwrap())));
+}
+
+#[test]
+fn good_scene_parses() {
+    let s = parse_scene(GOOD, &scene_path()).unwrap();
+    assert_eq!(s.spheres.len(), 1);
+    assert_eq!(s.triangles.len(), 2);
+    assert!(s.lights.is_empty());
+}
+
+#[test]
+fn builtin_scene_is_the_shipped_cornell_file() {
+    let builtin = Scene::builtin_default();
+    let file =
+        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell.toml")).unwrap();
+    assert_eq!(builtin.spheres, file.spheres);
+    assert_eq!(builtin.triangles, file.triangles);
+    assert_eq!(builtin.lights.len(), 1);
+    assert_eq!(builtin.triangles.len(), 10);
+}
+
+#[test]
+fn syntax_error() {
+    assert_error(
+        &with("vfov = 40", "vfov = = 40"),
+        "vfov = = 40",
+        "syntax",
+        "",
+    );
+}
+
+#[test]
+fn unknown_key() {
+    assert_error(
+        &with("vfov = 40", "vfov = 40\nfocal = 3"),
+        "focal",
+        "syntax",
+        "unknown field",
+    );
+}
+
+#[test]
+fn unknown_material() {
+    assert_error(
+        &with("material = \"white\"", "material = \"chalk\""),
+        "chalk",
+        "sphere[0].material",
+        "unknown material 'chalk'",
+    );
+}
+
+#[test]
+fn negative_radius() {
+    assert_error(
+        &with("radius = 0.5", "radius = -0.5"),
+        "radius",
+        "sphere[0].radius",
+        "positive",
+    );
+}
+
+#[test]
+fn zero_radius_light() {
+    let t = with(
+        "radius = 0.5\nmaterial = \"white\"",
+        "radius = 0.0\nmaterial = \"lamp\"",
+    );
+    assert_error(&t, "radius", "sphere[0].radius", "positive");
+}
+
+#[test]
+fn zero_area_quad() {
+    assert_error(
+        &with("edge2 = [0, 0, -2]", "edge2 = [4, 0, 0]"),
+        "edge2",
+        "quad[0].edge2",
+        "zero area",
+    );
+}
+
+#[test]
+fn nan_value() {
+    assert_error(
+        &with("center = [0, 1, 0]", "center = [0, nan, 0]"),
+        "center",
+        "sphere[0].center",
+        "not finite",
+    );
+    assert_error(&with("vfov = 40", "vfov = nan"), "vfov", "camera.vfov", "");
+    assert_error(
+        &with("kd = [0.5, 0.5, 0.5]", "kd = [0.5, inf, 0.5]"),
+        "white",
+        "materials.white.kd",
+        "not finite",
+    );
+}
+
+#[test]
+fn zero_width() {
+    assert_error(
+        &with("width = 32", "width = 0"),
+        "width",
+        "camera.width",
+        "outside",
+    );
+}
+
+#[test]
+fn emissive_quad_is_rejected() {
+    let t = with(
+        "edge2 = [0, 0, -2]\nmaterial = \"white\"",
+        "edge2 = [0, 0, -2]\nmaterial = \"lamp\"",
+    );
+    assert_error(
+        &t,
+        "\"lamp\"",
+        "quad[0].material",
+        "only spheres can be lights",
+    );
+}
+
+#[test]
+fn albedo_above_one_and_negative_emission() {
+    assert_error(
+        &with("kd = [0.5, 0.5, 0.5]", "kd = [1.5, 0.5, 0.5]"),
+        "white",
+        "materials.white.kd",
+        "above 1",
+    );
+    assert_error(
+        &with("emission = [4, 4, 4]", "emission = [4, -4, 4]"),
+        "lamp",
+        "materials.lamp.emission",
+        "negative",
+    );
+}
+
+#[test]
+fn camera_degenerate() {
+    assert_error(
+        &with("look_at = [0, 1, 0]", "look_at = [0, 1, 4]"),
+        "look_at",
+        "camera.look_at",
+        "equals camera.eye",
+    );
+    assert_error(
+        &with("up = [0, 1, 0]", "up = [0, 0, 2]"),
+        "up =",
+        "camera.up",
+        "parallel",
+    );
+}
+
+#[test]
+fn missing_mesh_file() {
+    let t = format!("{GOOD}\n[[mesh]]\nfile = \"no_such_mesh.obj\"\nmaterial = \"white\"\n");
+    assert_error(&t, "no_such_mesh", "mesh[0].file", "does not exist");
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("twinpath-test-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn malformed_obj_names_the_mesh_file() {
+    let dir = temp_dir("obj");
+    std::fs::write(
+        dir.join("broken.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+    )
+    .unwrap();
+    let scene = format!("{GOOD}\n[[mesh]]\nfile = \"broken.obj\"\nmaterial = \"white\"\n");
+    let e = parse_scene(&scene, &dir.join("s.toml")).unwrap_err();
+    println!("{e}");
+    assert_eq!(e.file, dir.join("broken.obj"));
+    std::fs::write(
+        dir.join("nan.obj"),
+        "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let scene = format!("{GOOD}\n[[mesh]]\nfile = \"nan.obj\"\nmaterial = \"white\"\n");
+    let e = parse_scene(&scene, &dir.join("s.toml")).unwrap_err();
+    println!("{e}");
+    assert_eq!(e.file, dir.join("nan.obj"));
+    assert!(
+        e.message.contains("finite") || e.message.contains("malformed"),
+        "{e}"
+    );
+}
+
+#[test]
+fn good_meshes_load() {
+    let dir = temp_dir("mesh");
+    std::fs::write(
+        dir.join("tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("tri.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+    )
+    .unwrap();
+    let scene = format!(
+        "{GOOD}\n[[mesh]]\nfile = \"tri.obj\"\nmaterial = \"white\"\n[[mesh]]\nfile = \"tri.ply\"\nmaterial = \"white\"\n"
+    );
+    let s = parse_scene(&scene, &dir.join("s.toml")).unwrap();
+    assert_eq!(s.triangles.len(), 2 + 2 + 1);
+    assert_eq!(s.triangle_groups.len(), 3);
+}
+
+#[test]
+fn malformed_ply() {
+    let p = Path::new("m.ply");
+    let header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    // index out of range, on line 14
+    let e = parse_ply(
+        p,
+        format!("{header}0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n").as_bytes(),
+    )
+    .unwrap_err();
+    println!("{e}");
+    assert_eq!((e.line, e.field.as_str()), (Some(13), "face 0"));
+    assert!(e.message.contains("out of range"));
+    // NaN vertex on line 11
+    let e = parse_ply(
+        p,
+        format!("{header}0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n").as_bytes(),
+    )
+    .unwrap_err();
+    assert_eq!((e.line, e.field.as_str()), (Some(11), "vertex 1"));
+    // truncated body
+    let e = parse_ply(p, format!("{header}0 0 0\n1 0 0\n").as_bytes()).unwrap_err();
+    println!("{e}");
+    // huge declared count: rejected before allocating
+    let huge = header.replace("element vertex 3", "element vertex 4000000000");
+    let e = parse_ply(p, format!("{huge}0 0 0\n").as_bytes()).unwrap_err();
+    println!("{e}");
+    assert!(e.message.contains("exceeds") || e.message.contains("too short"));
+    let big = header.replace("element vertex 3", "element vertex 100000000");
+    let e = parse_ply(p, format!("{big}0 0 0\n").as_bytes()).unwrap_err();
+    assert!(e.message.contains("too short"), "{e}");
+    // not a ply, binary garbage
+    assert!(parse_ply(p, b"\xff\xfe\x00garbage").is_err());
+    assert!(parse_ply(p, b"ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nend_header\n\x00").is_err());
+}
+
+#[test]
+fn not_utf8_scene_file() {
+    let dir = temp_dir("utf8");
+    let path = dir.join("bin.toml");
+    std::fs::write(&path, b"[camera]\neye = [0, 1, 4]\n\xff\xfe\n").unwrap();
+    let e = Scene::load(&path).unwrap_err();
+    println!("{e}");
+    assert_eq!(e.line, Some(3));
+    let e = Scene::load(&dir.join("missing.toml")).unwrap_err();
+    assert!(e.message.contains("cannot read"));
+}
