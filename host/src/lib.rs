@@ -6,6 +6,7 @@ pub mod film;
 pub mod render;
 pub mod scene;
 pub mod stats;
+pub mod vulkan;
 
 /// The SPIR-V module rust-gpu compiled from `kernel/` at build time (host/build.rs).
 pub const KERNEL_SPV: &[u8] = include_bytes!(env!("kernel.spv"));

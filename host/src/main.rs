@@ -4,7 +4,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
 use twinpath::film::{diff_images, RgbImage};
-use twinpath::render::{render, Backend};
+use twinpath::render::{install_interrupt_handler, render, Backend, RenderOptions};
 use twinpath::scene::{Scene, DEFAULT_SCENE_NAME};
 
 #[derive(Parser)]
@@ -50,6 +50,12 @@ enum Command {
         scene: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = Backend::Auto)]
         backend: Backend,
+        /// Vulkan device index for the GPU backend (see `twinpath info`).
+        #[arg(long)]
+        device: Option<usize>,
+        /// Enable the Vulkan validation layers (Debian package vulkan-validationlayers).
+        #[arg(long)]
+        validation: bool,
         /// Samples per pixel (overrides the scene's [render] spp).
         #[arg(long)]
         spp: Option<u32>,
@@ -104,6 +110,8 @@ fn run() -> Result<()> {
         Command::Render {
             scene,
             backend,
+            device,
+            validation,
             spp,
             seed,
             out,
@@ -196,17 +204,38 @@ fn run() -> Result<()> {
                 scene.render.spp,
                 scene.render.seed
             );
-            let result = render(&scene, backend, !quiet)?;
+            install_interrupt_handler();
+            let opts = RenderOptions {
+                backend,
+                device,
+                validation,
+                progress: !quiet,
+            };
+            let result = render(&scene, &opts)?;
             let samples = result.film.total_samples();
             let secs = result.render.as_secs_f64();
+            let setup = match result.backend {
+                Backend::Gpu => format!(
+                    "setup {:.3} s (acceleration structures {:.3} s, pipeline {:.3} s)",
+                    result.setup.as_secs_f64(),
+                    result.accel_build.as_secs_f64(),
+                    result.pipeline.as_secs_f64()
+                ),
+                _ => format!("setup {:.3} s (BVH)", result.setup.as_secs_f64()),
+            };
             eprintln!(
-                "twinpath: {:?} backend: setup {:.3} s, render {:.3} s, {:.3} M samples/s, {} non-finite samples discarded",
+                "twinpath: {:?} backend: {setup}, render {:.3} s, {:.3} M samples/s, {} non-finite samples discarded",
                 result.backend,
-                result.setup.as_secs_f64(),
                 secs,
                 samples as f64 / secs.max(1e-9) / 1e6,
                 result.film.discarded
             );
+            if result.interrupted {
+                eprintln!(
+                    "twinpath: interrupted: writing the image so far, {} of {} samples per pixel",
+                    result.spp_done, scene.render.spp
+                );
+            }
             let image = RgbImage::from_film(&result.film);
             for o in &outputs {
                 image.write(o)?;
@@ -230,10 +259,26 @@ fn run() -> Result<()> {
                 "kernel SPIR-V module: {} bytes (compiled by rust-gpu at build time)",
                 twinpath::KERNEL_SPV.len()
             );
-            println!(
-                "backends: cpu ({} threads); gpu: not yet implemented",
-                rayon::current_num_threads()
-            );
+            println!("cpu backend: {} threads", rayon::current_num_threads());
+            match twinpath::vulkan::device::list_devices() {
+                Ok(devices) if devices.is_empty() => println!("gpu backend: no Vulkan devices"),
+                Ok(devices) => {
+                    println!("gpu backend: Vulkan devices (use --device N):");
+                    for d in devices {
+                        let (ma, mi, pa) = d.api_version;
+                        let status = if d.usable() {
+                            "usable".to_string()
+                        } else {
+                            format!("lacks {}", d.missing.join(", "))
+                        };
+                        println!(
+                            "  [{}] {} ({:?}, Vulkan {ma}.{mi}.{pa}): {status}",
+                            d.index, d.name, d.device_type
+                        );
+                    }
+                }
+                Err(e) => println!("gpu backend: unavailable: {e:#}"),
+            }
             Ok(())
         }
     }

@@ -1,10 +1,13 @@
-//! The render driver: a scene, a backend, a sample count in, a film out, with progress.
+//! The render driver: a scene, a backend, a sample count in, a film out, with progress and
+//! Ctrl-C (the samples finished so far are kept and written).
 
 use crate::cpu::CpuRenderer;
 use crate::film::Film;
 use crate::scene::Scene;
-use anyhow::{bail, Result};
+use crate::vulkan::GpuRenderer;
+use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Which backend renders.
@@ -16,53 +19,133 @@ pub enum Backend {
     Gpu,
 }
 
+/// Options of a render besides the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderOptions {
+    pub backend: Backend,
+    /// Vulkan device index (`twinpath info` lists them).
+    pub device: Option<usize>,
+    pub validation: bool,
+    pub progress: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            backend: Backend::Auto,
+            device: None,
+            validation: false,
+            progress: false,
+        }
+    }
+}
+
 /// What a render produced and what it cost.
 pub struct RenderOutput {
     pub film: Film,
+    /// The backend that actually rendered (never `Auto`).
     pub backend: Backend,
-    /// Acceleration-structure build (and other set-up) time.
+    /// Set-up before the first sample (BVH, or acceleration structures + pipeline).
     pub setup: Duration,
+    /// Of `setup` on the GPU: acceleration-structure build and pipeline creation.
+    pub accel_build: Duration,
+    pub pipeline: Duration,
     /// Time spent rendering samples.
     pub render: Duration,
+    /// Samples per pixel actually rendered (fewer than asked after Ctrl-C).
+    pub spp_done: u32,
+    pub interrupted: bool,
 }
 
-/// Renders `scene.render.spp` samples per pixel on the chosen backend.
-pub fn render(scene: &Scene, backend: Backend, show_progress: bool) -> Result<RenderOutput> {
-    let backend = match backend {
-        Backend::Auto => {
-            eprintln!("twinpath: --backend auto: the GPU backend is not built yet, using the CPU");
-            Backend::Cpu
-        }
-        Backend::Gpu => bail!("the GPU (Vulkan) backend is not implemented yet; use --backend cpu"),
-        Backend::Cpu => Backend::Cpu,
-    };
-    let t0 = Instant::now();
-    let renderer = CpuRenderer::new(scene);
-    let setup = t0.elapsed();
+/// Set by Ctrl-C (after `install_interrupt_handler`); renders stop between passes.
+pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
+/// Makes Ctrl-C stop the render after the current pass instead of killing the process.
+pub fn install_interrupt_handler() {
+    let _ = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130); // second Ctrl-C: give up at once
+        }
+    });
+}
+
+/// Renders `scene.render.spp` samples per pixel.
+pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
+    let t0 = Instant::now();
+    let gpu = match opts.backend {
+        Backend::Cpu => None,
+        Backend::Gpu => Some(GpuRenderer::new(scene, opts.device, opts.validation)?),
+        Backend::Auto => match GpuRenderer::new(scene, opts.device, opts.validation) {
+            Ok(g) => Some(g),
+            Err(e) => {
+                eprintln!("twinpath: --backend auto: no usable GPU ({e:#}); using the CPU");
+                None
+            }
+        },
+    };
     let spp = scene.render.spp;
-    let mut film = Film::new(scene.camera.width, scene.camera.height);
-    let progress = show_progress.then(|| progress_bar(scene.pixel_count() as u64 * spp as u64));
-    let t1 = Instant::now();
-    // Passes of a few samples per pixel, so the progress bar moves evenly.
-    let pass = spp.clamp(1, 16);
-    let mut first = 0;
-    while first < spp {
-        let count = pass.min(spp - first);
-        let params = scene.params(first, count);
-        renderer.render_into(&params, first, count, &mut film, progress.as_ref());
-        first += count;
-    }
-    let render = t1.elapsed();
+    let progress = opts
+        .progress
+        .then(|| progress_bar(scene.pixel_count() as u64 * spp as u64));
+    let mut spp_done = 0;
+    let output = match gpu {
+        Some(mut g) => {
+            let setup = t0.elapsed();
+            let t1 = Instant::now();
+            // Dispatches sized to about a quarter second each (a display GPU must not hang).
+            let mut launch = 1u32;
+            while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
+                let count = launch.min(spp - spp_done);
+                let ts = Instant::now();
+                g.dispatch(&scene.params(spp_done, count))?;
+                spp_done += count;
+                if let Some(p) = &progress {
+                    p.inc(scene.pixel_count() as u64 * count as u64);
+                }
+                let per_sample = ts.elapsed().as_secs_f64() / count as f64;
+                launch = ((0.25 / per_sample.max(1e-9)) as u32).clamp(1, 64);
+            }
+            let film = g.read_film()?;
+            RenderOutput {
+                film,
+                backend: Backend::Gpu,
+                setup,
+                accel_build: g.accel_build_time,
+                pipeline: g.pipeline_time,
+                render: t1.elapsed(),
+                spp_done,
+                interrupted: spp_done < spp,
+            }
+        }
+        None => {
+            let renderer = CpuRenderer::new(scene);
+            let setup = t0.elapsed();
+            let mut film = Film::new(scene.camera.width, scene.camera.height);
+            let t1 = Instant::now();
+            // Passes of a few samples per pixel, so progress moves and Ctrl-C is prompt.
+            let pass = spp.clamp(1, 8);
+            while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
+                let count = pass.min(spp - spp_done);
+                let params = scene.params(spp_done, count);
+                renderer.render_into(&params, spp_done, count, &mut film, progress.as_ref());
+                spp_done += count;
+            }
+            RenderOutput {
+                film,
+                backend: Backend::Cpu,
+                setup,
+                accel_build: setup,
+                pipeline: Duration::ZERO,
+                render: t1.elapsed(),
+                spp_done,
+                interrupted: spp_done < spp,
+            }
+        }
+    };
     if let Some(p) = progress {
         p.finish_and_clear();
     }
-    Ok(RenderOutput {
-        film,
-        backend,
-        setup,
-        render,
-    })
+    Ok(output)
 }
 
 /// A progress bar on stderr counting samples (drawn only when stderr is a terminal).

@@ -2,8 +2,9 @@
 //! are GPU-only). The ray-generation shader runs [`crate::path::render_sample`] with a
 //! [`Tracer`] built on `trace_ray`; the other shaders answer its rays.
 //!
-//! Bindings (descriptor set 0): 0 TLAS, 1 accumulation image (rgba32f), 2 params
-//! ([`RenderParams`]), 3 materials, 4 lights, 5 triangles, 6 spheres.
+//! Bindings (descriptor set 0): 0 TLAS, 1 accumulated sums (rgba32f: rgb sum, a count),
+//! 2 params ([`RenderParams`]), 3 materials, 4 lights, 5 triangles, 6 spheres,
+//! 7 accumulated squares (rgba32f: rgb sum of squared samples).
 //! Hit groups: 0 triangles (closest hit), 1 spheres (intersection + closest hit).
 //! Miss shader 0 serves both kinds of ray.
 
@@ -88,8 +89,9 @@ impl Tracer for RayTracer<'_> {
     }
 }
 
-/// Ray generation: `samples_per_launch` samples of this pixel, added to the running sum in the
-/// accumulation image (rgb: sum of radiance, a: number of samples).
+/// Ray generation: `samples_per_launch` samples of this pixel, added to the running sums in the
+/// accumulation images (sums of radiance and sample count; sums of squared radiance, for each
+/// pixel's variance). Non-finite samples are not added; they are counted in `accum_sq.a`.
 #[spirv(ray_generation)]
 pub fn raygen(
     #[spirv(launch_id)] launch_id: UVec3,
@@ -98,15 +100,23 @@ pub fn raygen(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] params: &RenderParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] materials: &[Material],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] lights: &[SphereLight],
+    #[spirv(descriptor_set = 0, binding = 7)] accum_sq: &Image!(
+        2D,
+        format = rgba32f,
+        sampled = false
+    ),
     #[spirv(ray_payload)] payload: &mut HitPayload,
 ) {
     let px = launch_id.x;
     let py = launch_id.y;
     let mut tracer = RayTracer { tlas, payload };
     let mut sum = Vec3::ZERO;
+    let mut sum_sq = Vec3::ZERO;
+    let mut count = 0.0;
+    let mut discarded = 0.0;
     let mut s = 0;
     while s < params.samples_per_launch {
-        sum += render_sample(
+        let l = render_sample(
             &mut tracer,
             params,
             materials,
@@ -115,15 +125,21 @@ pub fn raygen(
             py,
             params.sample_offset + s,
         );
+        if l.is_finite() {
+            sum += l;
+            sum_sq += l * l;
+            count += 1.0;
+        } else {
+            discarded += 1.0;
+        }
         s += 1;
     }
     let coord = UVec2::new(px, py);
     let previous: Vec4 = accum.read(coord);
+    let previous_sq: Vec4 = accum_sq.read(coord);
     unsafe {
-        accum.write(
-            coord,
-            previous + sum.extend(params.samples_per_launch as f32),
-        );
+        accum.write(coord, previous + sum.extend(count));
+        accum_sq.write(coord, previous_sq + sum_sq.extend(discarded));
     }
 }
 

@@ -1,0 +1,1 @@
+//! Compute entry points for function-level CPU-vs-GPU equivalence tests (filled in below).

@@ -1,0 +1,277 @@
+//! The GPU backend: the kernel's SPIR-V in a Vulkan ray-tracing pipeline (ash), dispatched with
+//! `vkCmdTraceRaysKHR`, accumulating progressively in float storage images.
+
+pub mod accel;
+pub mod compute;
+pub mod device;
+pub mod memory;
+pub mod pipeline;
+
+use crate::film::Film;
+use crate::scene::Scene;
+use accel::SceneAccel;
+use anyhow::{Context as _, Result};
+use ash::vk;
+use device::Context;
+use gpu_allocator::MemoryLocation;
+use kernel::scene::RenderParams;
+use memory::{Buffer, Image};
+use pipeline::{binding, RtPipeline};
+use std::time::{Duration, Instant};
+
+/// A scene uploaded to a Vulkan device, ready to trace.
+pub struct GpuRenderer {
+    // Field order matters only for Drop below, which releases everything before `ctx`.
+    resources: Option<Resources>,
+    /// Time to build the acceleration structures.
+    pub accel_build_time: Duration,
+    /// Time to create the pipeline (the driver compiles the shaders here).
+    pub pipeline_time: Duration,
+    pub width: u32,
+    pub height: u32,
+    pub ctx: Context,
+}
+
+struct Resources {
+    pipeline: RtPipeline,
+    accel: SceneAccel,
+    params: Buffer,
+    tables: Vec<Buffer>,
+    accum: Image,
+    accum_sq: Image,
+    pool: vk::DescriptorPool,
+    set: vk::DescriptorSet,
+}
+
+const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
+
+impl GpuRenderer {
+    /// Opens a device (see [`Context::new`]) and uploads `scene`.
+    pub fn new(scene: &Scene, device: Option<usize>, validation: bool) -> Result<GpuRenderer> {
+        let ctx = Context::new(device, validation)?;
+        let (w, h) = (scene.camera.width, scene.camera.height);
+        let t0 = Instant::now();
+        let accel = ctx.build_scene_accel(scene)?;
+        let accel_build_time = t0.elapsed();
+        let t1 = Instant::now();
+        let pipeline = RtPipeline::new(&ctx, crate::KERNEL_SPV)?;
+        let pipeline_time = t1.elapsed();
+
+        let params = ctx.create_buffer(
+            "params",
+            std::mem::size_of::<RenderParams>() as u64,
+            STORAGE,
+            MemoryLocation::CpuToGpu,
+        )?;
+        // Empty tables still need a buffer behind their binding.
+        let tables = vec![
+            ctx.upload_buffer("materials", bytemuck::cast_slice(&scene.materials), STORAGE)?,
+            ctx.upload_buffer("lights", bytemuck::cast_slice(&scene.lights), STORAGE)?,
+            ctx.upload_buffer("triangles", bytemuck::cast_slice(&scene.triangles), STORAGE)?,
+            ctx.upload_buffer("spheres", bytemuck::cast_slice(&scene.spheres), STORAGE)?,
+        ];
+        let accum = ctx.create_storage_image("accum", w, h)?;
+        let accum_sq = ctx.create_storage_image("accum_sq", w, h)?;
+
+        let sizes = [
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
+                descriptor_count: 1,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_IMAGE,
+                descriptor_count: 2,
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_BUFFER,
+                descriptor_count: 5,
+            },
+        ];
+        let pool = unsafe {
+            ctx.device.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(1)
+                    .pool_sizes(&sizes),
+                None,
+            )
+        }?;
+        let layouts = [pipeline.set_layout];
+        let set = unsafe {
+            ctx.device.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pool)
+                    .set_layouts(&layouts),
+            )
+        }?[0];
+        let tlas = [accel.tlas.handle];
+        let mut as_write = vk::WriteDescriptorSetAccelerationStructureKHR::default()
+            .acceleration_structures(&tlas);
+        let image_info = |i: &Image| {
+            [vk::DescriptorImageInfo::default()
+                .image_view(i.view)
+                .image_layout(vk::ImageLayout::GENERAL)]
+        };
+        let accum_info = image_info(&accum);
+        let accum_sq_info = image_info(&accum_sq);
+        let buffer_info = |b: &Buffer| {
+            [vk::DescriptorBufferInfo::default()
+                .buffer(b.buffer)
+                .offset(0)
+                .range(vk::WHOLE_SIZE)]
+        };
+        let infos = [
+            buffer_info(&params),
+            buffer_info(&tables[0]),
+            buffer_info(&tables[1]),
+            buffer_info(&tables[2]),
+            buffer_info(&tables[3]),
+        ];
+        let buffer_bindings = [
+            binding::PARAMS,
+            binding::MATERIALS,
+            binding::LIGHTS,
+            binding::TRIANGLES,
+            binding::SPHERES,
+        ];
+        let mut writes = vec![
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(binding::TLAS)
+                .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
+                .descriptor_count(1)
+                .push_next(&mut as_write),
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(binding::ACCUM)
+                .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                .image_info(&accum_info),
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(binding::ACCUM_SQ)
+                .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                .image_info(&accum_sq_info),
+        ];
+        for (b, info) in buffer_bindings.iter().zip(&infos) {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(*b)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .buffer_info(info),
+            );
+        }
+        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        Ok(GpuRenderer {
+            resources: Some(Resources {
+                pipeline,
+                accel,
+                params,
+                tables,
+                accum,
+                accum_sq,
+                pool,
+                set,
+            }),
+            accel_build_time,
+            pipeline_time,
+            width: w,
+            height: h,
+            ctx,
+        })
+    }
+
+    fn res(&self) -> &Resources {
+        self.resources.as_ref().expect("resources live until drop")
+    }
+
+    /// One dispatch: `params.samples_per_launch` samples per pixel starting at
+    /// `params.sample_offset`, added to the accumulation images.
+    pub fn dispatch(&mut self, params: &RenderParams) -> Result<()> {
+        let (w, h) = (self.width, self.height);
+        let res = self.resources.as_mut().expect("resources live until drop");
+        self.ctx
+            .write_buffer(&mut res.params, bytemuck::bytes_of(params))?;
+        let res = self.res();
+        let ctx = &self.ctx;
+        ctx.submit_and_wait(|cmd| unsafe {
+            // Earlier dispatches' image writes (and the host's params write) before this one.
+            let barrier = vk::MemoryBarrier::default()
+                .src_access_mask(
+                    vk::AccessFlags::SHADER_WRITE
+                        | vk::AccessFlags::TRANSFER_WRITE
+                        | vk::AccessFlags::HOST_WRITE,
+                )
+                .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE);
+            ctx.device.cmd_pipeline_barrier(
+                cmd,
+                vk::PipelineStageFlags::ALL_COMMANDS | vk::PipelineStageFlags::HOST,
+                vk::PipelineStageFlags::RAY_TRACING_SHADER_KHR,
+                vk::DependencyFlags::empty(),
+                &[barrier],
+                &[],
+                &[],
+            );
+            ctx.device.cmd_bind_pipeline(
+                cmd,
+                vk::PipelineBindPoint::RAY_TRACING_KHR,
+                res.pipeline.pipeline,
+            );
+            ctx.device.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::RAY_TRACING_KHR,
+                res.pipeline.layout,
+                0,
+                &[res.set],
+                &[],
+            );
+            ctx.rt.cmd_trace_rays(
+                cmd,
+                &res.pipeline.raygen_region,
+                &res.pipeline.miss_region,
+                &res.pipeline.hit_region,
+                &vk::StridedDeviceAddressRegionKHR::default(),
+                w,
+                h,
+                1,
+            );
+        })
+        .context("ray-tracing dispatch failed")
+    }
+
+    /// Reads the accumulated sums back into a film (one readback per image).
+    pub fn read_film(&self) -> Result<Film> {
+        let res = self.res();
+        let sums = self.ctx.read_image(&res.accum, self.width, self.height)?;
+        let squares = self
+            .ctx
+            .read_image(&res.accum_sq, self.width, self.height)?;
+        let mut film = Film::new(self.width, self.height);
+        for (i, (s, q)) in sums.iter().zip(&squares).enumerate() {
+            film.sum[i] = [s[0] as f64, s[1] as f64, s[2] as f64];
+            film.sum_sq[i] = [q[0] as f64, q[1] as f64, q[2] as f64];
+            film.count[i] = s[3] as u32;
+            film.discarded += q[3] as u64;
+        }
+        Ok(film)
+    }
+}
+
+impl Drop for GpuRenderer {
+    fn drop(&mut self) {
+        if let Some(r) = self.resources.take() {
+            let ctx = &self.ctx;
+            unsafe {
+                let _ = ctx.device.device_wait_idle();
+                ctx.device.destroy_descriptor_pool(r.pool, None);
+            }
+            r.pipeline.destroy(ctx);
+            ctx.destroy_scene_accel(r.accel);
+            ctx.destroy_buffer(r.params);
+            for b in r.tables {
+                ctx.destroy_buffer(b);
+            }
+            ctx.destroy_image(r.accum);
+            ctx.destroy_image(r.accum_sq);
+        }
+    }
+}

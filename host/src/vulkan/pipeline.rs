@@ -1,0 +1,224 @@
+//! The ray-tracing pipeline over the kernel's SPIR-V module, its descriptor set layout and the
+//! shader binding table laid out from the device's handle size and alignments.
+
+use super::device::Context;
+use super::memory::Buffer;
+use anyhow::{anyhow, Context as _, Result};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use std::ffi::CStr;
+
+/// Entry points of the kernel module the pipeline uses (asserted by a test on the module).
+pub const RAYGEN: &CStr = c"shaders::raygen";
+pub const MISS: &CStr = c"shaders::miss";
+pub const CLOSEST_HIT_TRIANGLE: &CStr = c"shaders::closest_hit_triangle";
+pub const CLOSEST_HIT_SPHERE: &CStr = c"shaders::closest_hit_sphere";
+pub const INTERSECT_SPHERE: &CStr = c"shaders::intersect_sphere_shader";
+
+/// Descriptor bindings, as `kernel::shaders` declares them.
+pub mod binding {
+    pub const TLAS: u32 = 0;
+    pub const ACCUM: u32 = 1;
+    pub const PARAMS: u32 = 2;
+    pub const MATERIALS: u32 = 3;
+    pub const LIGHTS: u32 = 4;
+    pub const TRIANGLES: u32 = 5;
+    pub const SPHERES: u32 = 6;
+    pub const ACCUM_SQ: u32 = 7;
+}
+
+/// The pipeline and the objects it owns.
+pub struct RtPipeline {
+    pub module: vk::ShaderModule,
+    pub set_layout: vk::DescriptorSetLayout,
+    pub layout: vk::PipelineLayout,
+    pub pipeline: vk::Pipeline,
+    pub sbt: Buffer,
+    pub raygen_region: vk::StridedDeviceAddressRegionKHR,
+    pub miss_region: vk::StridedDeviceAddressRegionKHR,
+    pub hit_region: vk::StridedDeviceAddressRegionKHR,
+}
+
+fn align_up(x: u64, a: u64) -> u64 {
+    x.div_ceil(a) * a
+}
+
+/// Creates a shader module from SPIR-V bytes.
+pub fn shader_module(ctx: &Context, spv: &[u8]) -> Result<vk::ShaderModule> {
+    let words = ash::util::read_spv(&mut std::io::Cursor::new(spv)).context("malformed SPIR-V")?;
+    unsafe {
+        ctx.device
+            .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)
+    }
+    .context("cannot create the shader module")
+}
+
+impl RtPipeline {
+    pub fn new(ctx: &Context, spv: &[u8]) -> Result<RtPipeline> {
+        let module = shader_module(ctx, spv)?;
+        let all = vk::ShaderStageFlags::RAYGEN_KHR
+            | vk::ShaderStageFlags::CLOSEST_HIT_KHR
+            | vk::ShaderStageFlags::INTERSECTION_KHR
+            | vk::ShaderStageFlags::MISS_KHR;
+        let b = |binding: u32, ty: vk::DescriptorType| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(binding)
+                .descriptor_type(ty)
+                .descriptor_count(1)
+                .stage_flags(all)
+        };
+        let bindings = [
+            b(
+                binding::TLAS,
+                vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
+            ),
+            b(binding::ACCUM, vk::DescriptorType::STORAGE_IMAGE),
+            b(binding::PARAMS, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::MATERIALS, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::LIGHTS, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::TRIANGLES, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::SPHERES, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::ACCUM_SQ, vk::DescriptorType::STORAGE_IMAGE),
+        ];
+        let set_layout = unsafe {
+            ctx.device.create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
+                None,
+            )
+        }?;
+        let set_layouts = [set_layout];
+        let layout = unsafe {
+            ctx.device.create_pipeline_layout(
+                &vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts),
+                None,
+            )
+        }?;
+        let stage = |flags: vk::ShaderStageFlags, name: &'static CStr| {
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(flags)
+                .module(module)
+                .name(name)
+        };
+        let stages = [
+            stage(vk::ShaderStageFlags::RAYGEN_KHR, RAYGEN),
+            stage(vk::ShaderStageFlags::MISS_KHR, MISS),
+            stage(vk::ShaderStageFlags::CLOSEST_HIT_KHR, CLOSEST_HIT_TRIANGLE),
+            stage(vk::ShaderStageFlags::CLOSEST_HIT_KHR, CLOSEST_HIT_SPHERE),
+            stage(vk::ShaderStageFlags::INTERSECTION_KHR, INTERSECT_SPHERE),
+        ];
+        let unused = vk::SHADER_UNUSED_KHR;
+        let group = |ty, general, chit, isect| {
+            vk::RayTracingShaderGroupCreateInfoKHR::default()
+                .ty(ty)
+                .general_shader(general)
+                .closest_hit_shader(chit)
+                .any_hit_shader(unused)
+                .intersection_shader(isect)
+        };
+        let groups = [
+            group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 0, unused, unused),
+            group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 1, unused, unused),
+            group(
+                vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP,
+                unused,
+                2,
+                unused,
+            ),
+            group(
+                vk::RayTracingShaderGroupTypeKHR::PROCEDURAL_HIT_GROUP,
+                unused,
+                3,
+                4,
+            ),
+        ];
+        let info = vk::RayTracingPipelineCreateInfoKHR::default()
+            .stages(&stages)
+            .groups(&groups)
+            .max_pipeline_ray_recursion_depth(1)
+            .layout(layout);
+        let pipeline = unsafe {
+            ctx.rt.create_ray_tracing_pipelines(
+                vk::DeferredOperationKHR::null(),
+                vk::PipelineCache::null(),
+                &[info],
+                None,
+            )
+        }
+        .map_err(|(_, e)| anyhow!("cannot create the ray-tracing pipeline: {e}"))?[0];
+
+        // Shader binding table: raygen | miss | hit (triangles, spheres), each region starting
+        // at the base alignment, records at the handle alignment.
+        let p = ctx.rt_properties;
+        let handle_size = p.shader_group_handle_size as u64;
+        let stride = align_up(handle_size, p.shader_group_handle_alignment as u64);
+        let base = p.shader_group_base_alignment as u64;
+        let raygen_size = align_up(stride, base);
+        let miss_size = align_up(stride, base);
+        let hit_size = align_up(2 * stride, base);
+        let handles = unsafe {
+            ctx.rt.get_ray_tracing_shader_group_handles(
+                pipeline,
+                0,
+                groups.len() as u32,
+                groups.len() * handle_size as usize,
+            )
+        }?;
+        let mut table = vec![0u8; (raygen_size + miss_size + hit_size + base) as usize];
+        let mut sbt = ctx.create_buffer(
+            "shader binding table",
+            table.len() as u64,
+            vk::BufferUsageFlags::SHADER_BINDING_TABLE_KHR
+                | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+            MemoryLocation::CpuToGpu,
+        )?;
+        // The buffer's address need not be base-aligned: start the table at the next multiple.
+        let start = align_up(sbt.address, base) - sbt.address;
+        let hs = handle_size as usize;
+        let mut put = |offset: u64, group: usize| {
+            let o = (start + offset) as usize;
+            table[o..o + hs].copy_from_slice(&handles[group * hs..(group + 1) * hs]);
+        };
+        put(0, 0);
+        put(raygen_size, 1);
+        put(raygen_size + miss_size, 2);
+        put(raygen_size + miss_size + stride, 3);
+        ctx.write_buffer(&mut sbt, &table)?;
+        let at = sbt.address + start;
+        let raygen_region = vk::StridedDeviceAddressRegionKHR {
+            device_address: at,
+            stride: raygen_size,
+            size: raygen_size,
+        };
+        let miss_region = vk::StridedDeviceAddressRegionKHR {
+            device_address: at + raygen_size,
+            stride,
+            size: miss_size,
+        };
+        let hit_region = vk::StridedDeviceAddressRegionKHR {
+            device_address: at + raygen_size + miss_size,
+            stride,
+            size: hit_size,
+        };
+        Ok(RtPipeline {
+            module,
+            set_layout,
+            layout,
+            pipeline,
+            sbt,
+            raygen_region,
+            miss_region,
+            hit_region,
+        })
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+            ctx.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
+            ctx.device.destroy_shader_module(self.module, None);
+        }
+        ctx.destroy_buffer(self.sbt);
+    }
+}
