@@ -11,6 +11,7 @@ pub mod frame;
 pub mod geometry;
 pub mod light;
 pub mod path;
+pub mod probe;
 pub mod rng;
 pub mod sampling;
 pub mod scene;

@@ -81,20 +81,14 @@ pub struct ConeSample {
     pub pdf_solid_angle: f32,
 }
 
-/// sin^2 of 1.5 degrees: below it, 1 - cos(theta_max) is computed by its Taylor expansion
-/// sin^2/2 (the subtraction would cancel), as pbrt-v4 does in `Sphere::Sample`.
-pub const SMALL_CONE_SIN2: f32 = 0.000_685_23;
-
-/// 1 - cos(theta_max) of the cone a sphere (center, radius) subtends from a point at squared
-/// distance `dist2` from its centre; the Taylor form sin^2/2 for tiny cones.
+/// 1 - cos(theta_max) of the cone a sphere of `radius` subtends from a point at squared
+/// distance `dist2` from its centre, as sin^2 / (1 + cos): the same value as 1 - cos without
+/// its cancellation, accurate for cones of any size (pbrt-v4 switches to a Taylor expansion
+/// below 1.5 degrees instead; this form needs no branch).
 #[inline]
 pub fn cone_one_minus_cos(radius: f32, dist2: f32) -> f32 {
-    let sin2_max = radius * radius / dist2;
-    if sin2_max < SMALL_CONE_SIN2 {
-        0.5 * sin2_max
-    } else {
-        1.0 - (1.0 - sin2_max).max(0.0).sqrt()
-    }
+    let sin2_max = (radius * radius / dist2).min(1.0);
+    sin2_max / (1.0 + (1.0 - sin2_max).sqrt())
 }
 
 /// Samples the sphere (center, radius) as seen from outside point `p`: a direction uniform in
@@ -115,14 +109,10 @@ pub fn sample_sphere_cone(center: Vec3, radius: f32, p: Vec3, u1: f32, u2: f32) 
     let sin_max = radius / dist;
     let sin2_max = sin_max * sin_max;
     let one_minus_cos_max = cone_one_minus_cos(radius, dist2);
-    // sin^2(theta) from u1, uniformly in 1 - cos(theta).
-    let (sin2, cos) = if sin2_max < SMALL_CONE_SIN2 {
-        let s2 = sin2_max * u1;
-        (s2, (1.0 - s2).max(0.0).sqrt())
-    } else {
-        let c = 1.0 - u1 * one_minus_cos_max;
-        ((1.0 - c * c).max(0.0), c)
-    };
+    // Uniform in 1 - cos(theta); sin^2 = (1 - cos)(1 + cos) keeps full precision in tiny cones.
+    let one_minus_cos = u1 * one_minus_cos_max;
+    let cos = 1.0 - one_minus_cos;
+    let sin2 = one_minus_cos * (2.0 - one_minus_cos);
     let cos_alpha =
         (sin2 / sin_max + cos * (1.0 - sin2 / sin2_max).max(0.0).sqrt()).clamp(-1.0, 1.0);
     let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();

@@ -2,16 +2,16 @@
 //! are GPU-only). The ray-generation shader runs [`crate::path::render_sample`] with a
 //! [`Tracer`] built on `trace_ray`; the other shaders answer its rays.
 //!
-//! Bindings (descriptor set 0): 0 TLAS, 1 accumulated sums (rgba32f: rgb sum, a count),
+//! Bindings (descriptor set 0): 0 TLAS, 1 running mean (rgba32f: rgb mean, a sample count),
 //! 2 params ([`RenderParams`]), 3 materials, 4 lights, 5 triangles, 6 spheres,
-//! 7 accumulated squares (rgba32f: rgb sum of squared samples).
+//! 7 running M2 (rgba32f: rgb sum of squared deviations from the mean, a discarded samples).
 //! Hit groups: 0 triangles (closest hit), 1 spheres (intersection + closest hit).
 //! Miss shader 0 serves both kinds of ray.
 
 use crate::geometry::{intersect_sphere, reproject_to_sphere, triangle_normal};
 use crate::path::{render_sample, SurfaceHit, Tracer};
 use crate::scene::{Material, RenderParams, Sphere, SphereLight, Triangle, NONE};
-use spirv_std::glam::{UVec2, UVec3, Vec3, Vec4};
+use spirv_std::glam::{UVec2, UVec3, UVec4, Vec3, Vec4};
 use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
 use spirv_std::spirv;
@@ -89,18 +89,24 @@ impl Tracer for RayTracer<'_> {
     }
 }
 
-/// Ray generation: `samples_per_launch` samples of this pixel, added to the running sums in the
-/// accumulation images (sums of radiance and sample count; sums of squared radiance, for each
-/// pixel's variance). Non-finite samples are not added; they are counted in `accum_sq.a`.
+/// Ray generation: `samples_per_launch` samples of this pixel, merged into the running mean and
+/// M2 (sum of squared deviations) of the accumulation images: Welford's update within the
+/// launch, Chan, Golub and LeVeque's pairwise combination with the earlier launches. Both stay
+/// accurate in f32 where a sum of squares minus n mean^2 would cancel. Non-finite samples are
+/// not merged; they are counted in `accum_m2.a`.
 #[spirv(ray_generation)]
 pub fn raygen(
     #[spirv(launch_id)] launch_id: UVec3,
     #[spirv(descriptor_set = 0, binding = 0)] tlas: &AccelerationStructure,
-    #[spirv(descriptor_set = 0, binding = 1)] accum: &Image!(2D, format = rgba32f, sampled = false),
+    #[spirv(descriptor_set = 0, binding = 1)] accum_mean: &Image!(
+        2D,
+        format = rgba32f,
+        sampled = false
+    ),
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] params: &RenderParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] materials: &[Material],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] lights: &[SphereLight],
-    #[spirv(descriptor_set = 0, binding = 7)] accum_sq: &Image!(
+    #[spirv(descriptor_set = 0, binding = 7)] accum_m2: &Image!(
         2D,
         format = rgba32f,
         sampled = false
@@ -110,9 +116,9 @@ pub fn raygen(
     let px = launch_id.x;
     let py = launch_id.y;
     let mut tracer = RayTracer { tlas, payload };
-    let mut sum = Vec3::ZERO;
-    let mut sum_sq = Vec3::ZERO;
-    let mut count = 0.0;
+    let mut n_b = 0.0;
+    let mut mean_b = Vec3::ZERO;
+    let mut m2_b = Vec3::ZERO;
     let mut discarded = 0.0;
     let mut s = 0;
     while s < params.samples_per_launch {
@@ -126,20 +132,28 @@ pub fn raygen(
             params.sample_offset + s,
         );
         if l.is_finite() {
-            sum += l;
-            sum_sq += l * l;
-            count += 1.0;
+            n_b += 1.0;
+            let d = l - mean_b;
+            mean_b += d / n_b;
+            m2_b += d * (l - mean_b);
         } else {
             discarded += 1.0;
         }
         s += 1;
     }
     let coord = UVec2::new(px, py);
-    let previous: Vec4 = accum.read(coord);
-    let previous_sq: Vec4 = accum_sq.read(coord);
+    let a: Vec4 = accum_mean.read(coord);
+    let a_m2: Vec4 = accum_m2.read(coord);
+    let n_a = a.w;
+    let n = n_a + n_b;
+    // Share of this launch in the merged mean (0 when nothing at all has been merged yet).
+    let w = if n > 0.0 { n_b / n } else { 0.0 };
+    let delta = mean_b - a.truncate();
+    let mean = a.truncate() + delta * w;
+    let m2 = a_m2.truncate() + m2_b + delta * delta * (n_a * w);
     unsafe {
-        accum.write(coord, previous + sum.extend(count));
-        accum_sq.write(coord, previous_sq + sum_sq.extend(discarded));
+        accum_mean.write(coord, mean.extend(n));
+        accum_m2.write(coord, m2.extend(a_m2.w + discarded));
     }
 }
 
@@ -210,4 +224,35 @@ pub fn closest_hit_sphere(
     payload.material = s.material;
     payload.light = s.light;
     payload.hit = 1;
+}
+
+/// Push constants of [`probe`].
+#[derive(Clone, Copy)]
+#[repr(C)]
+pub struct ProbeArgs {
+    /// One of `crate::probe::function`.
+    pub function: u32,
+    /// Number of records.
+    pub count: u32,
+}
+
+/// Compute entry point for the equivalence tests: record i of `input` (four `UVec4`) through
+/// [`crate::probe::evaluate`] into record i of `output` (two `UVec4`).
+#[spirv(compute(threads(64)))]
+pub fn probe(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(push_constant)] args: &ProbeArgs,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] input: &[UVec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] output: &mut [UVec4],
+) {
+    let i = id.x;
+    if i < args.count {
+        let b = (4 * i) as usize;
+        let out = crate::probe::evaluate(
+            args.function,
+            [input[b], input[b + 1], input[b + 2], input[b + 3]],
+        );
+        output[(2 * i) as usize] = out[0];
+        output[(2 * i + 1) as usize] = out[1];
+    }
 }

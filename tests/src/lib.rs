@@ -63,3 +63,44 @@ pub fn scene_from_toml(text: &str) -> Scene {
 pub fn repo_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
+pub mod gpu;
+pub mod spirv;
+
+/// Renders `scene` at `spp` on `backend` (the GPU with validation layers on).
+pub fn render_film(
+    scene: &Scene,
+    backend: twinpath::render::Backend,
+    spp: u32,
+) -> twinpath::film::Film {
+    let mut s = scene.clone();
+    s.render.spp = spp;
+    let opts = twinpath::render::RenderOptions {
+        backend,
+        device: None,
+        validation: backend == twinpath::render::Backend::Gpu,
+        progress: false,
+    };
+    let out = twinpath::render::render(&s, &opts).expect("render");
+    assert_eq!(out.backend, backend);
+    assert_eq!(out.spp_done, spp);
+    out.film
+}
+
+/// z of the difference between two images' overall means, each with the variance of its mean
+/// (the sum of the per-pixel variances of the means over n^2): for independent renders.
+pub fn image_mean_z(a: &twinpath::film::Film, b: &twinpath::film::Film) -> f64 {
+    let stats = |f: &twinpath::film::Film| {
+        let n = (3 * f.count.len()) as f64;
+        let mean = f.mean().iter().flatten().map(|&x| x as f64).sum::<f64>() / n;
+        let var = f
+            .variance_of_mean()
+            .iter()
+            .flatten()
+            .map(|&v| v as f64)
+            .sum::<f64>()
+            / (n * n);
+        (mean, var)
+    };
+    let ((ma, va), (mb, vb)) = (stats(a), stats(b));
+    (ma - mb) / (va + vb).sqrt()
+}

@@ -1,58 +1,47 @@
-//! The SPIR-V module rust-gpu builds from `kernel/`: valid for Vulkan 1.2 (spirv-val) and
-//! holding exactly the entry points the Vulkan backend binds (rust-gpu can silently drop one).
+//! The SPIR-V module rust-gpu builds from `kernel/`: valid for Vulkan 1.2 (spirv-val), holding
+//! exactly the entry points the Vulkan backend binds (rust-gpu can silently drop one), and laying
+//! out every shared struct exactly as the host does.
 
+use kernel::scene::{Material, RenderParams, Sphere, SphereLight, Triangle};
 use std::collections::BTreeSet;
+use std::mem::{offset_of, size_of};
 use std::process::Command;
-
-const OP_ENTRY_POINT: u32 = 15;
-
-/// (execution model, name) of every OpEntryPoint in a SPIR-V binary.
-fn entry_points(spv: &[u8]) -> BTreeSet<(u32, String)> {
-    assert_eq!(spv.len() % 4, 0);
-    let words: Vec<u32> = spv
-        .as_chunks::<4>()
-        .0
-        .iter()
-        .map(|c| u32::from_le_bytes(*c))
-        .collect();
-    assert_eq!(words[0], 0x0723_0203, "not a SPIR-V module");
-    let mut out = BTreeSet::new();
-    let mut i = 5;
-    while i < words.len() {
-        let count = (words[i] >> 16) as usize;
-        let opcode = words[i] & 0xffff;
-        assert!(count > 0, "malformed instruction at word {i}");
-        if opcode == OP_ENTRY_POINT {
-            let model = words[i + 1];
-            let bytes: Vec<u8> = words[i + 3..i + count]
-                .iter()
-                .flat_map(|w| w.to_le_bytes())
-                .collect();
-            let end = bytes.iter().position(|&b| b == 0).unwrap();
-            out.insert((model, String::from_utf8(bytes[..end].to_vec()).unwrap()));
-        }
-        i += count;
-    }
-    out
-}
+use twinpath::vulkan::pipeline::binding;
+use twinpath_tests::spirv::{Module, StructLayout};
 
 #[test]
-fn module_has_the_ray_tracing_entry_points() {
-    // Execution models: RayGenerationKHR 5313, IntersectionKHR 5314, ClosestHitKHR 5316,
-    // MissKHR 5317.
+fn module_has_the_ray_tracing_and_probe_entry_points() {
+    // Execution models: GLCompute 5, RayGenerationKHR 5313, IntersectionKHR 5314,
+    // ClosestHitKHR 5316, MissKHR 5317.
     let want: BTreeSet<(u32, String)> = [
         (5313, "shaders::raygen"),
         (5317, "shaders::miss"),
         (5316, "shaders::closest_hit_triangle"),
         (5316, "shaders::closest_hit_sphere"),
         (5314, "shaders::intersect_sphere_shader"),
+        (5, "shaders::probe"),
     ]
     .into_iter()
     .map(|(m, n)| (m, n.to_string()))
     .collect();
-    let got = entry_points(twinpath::KERNEL_SPV);
+    let got = Module::parse(twinpath::KERNEL_SPV).entry_points;
     println!("entry points: {got:?}");
     assert_eq!(got, want);
+    // The names the host binds are the module's.
+    use twinpath::vulkan::pipeline as p;
+    for name in [
+        p::RAYGEN,
+        p::MISS,
+        p::CLOSEST_HIT_TRIANGLE,
+        p::CLOSEST_HIT_SPHERE,
+        p::INTERSECT_SPHERE,
+        twinpath::vulkan::compute::PROBE,
+    ] {
+        assert!(
+            got.iter().any(|(_, n)| n.as_bytes() == name.to_bytes()),
+            "{name:?}"
+        );
+    }
 }
 
 #[test]
@@ -71,4 +60,74 @@ fn module_passes_spirv_val() {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+macro_rules! host_layout {
+    ($t:ty, [$($f:ident),*], $array:expr) => {
+        StructLayout {
+            offsets: vec![$(offset_of!($t, $f) as u32),*],
+            stride: $array.then_some(size_of::<$t>() as u32),
+        }
+    };
+}
+
+#[test]
+fn shared_structs_have_the_same_layout_on_host_and_device() {
+    let m = Module::parse(twinpath::KERNEL_SPV);
+    let cases = [
+        (
+            "RenderParams",
+            binding::PARAMS,
+            host_layout!(
+                RenderParams,
+                [
+                    camera,
+                    background,
+                    width,
+                    height,
+                    seed,
+                    sample_offset,
+                    samples_per_launch,
+                    light_count,
+                    rr_mode,
+                    rr_probability,
+                    rr_start_depth,
+                    mis_mode,
+                    max_depth,
+                    light_sampling
+                ],
+                false
+            ),
+        ),
+        (
+            "Material",
+            binding::MATERIALS,
+            host_layout!(Material, [albedo, _pad0, emission, _pad1], true),
+        ),
+        (
+            "SphereLight",
+            binding::LIGHTS,
+            host_layout!(
+                SphereLight,
+                [center, radius, radiance, select_pmf, select_cdf, _pad],
+                true
+            ),
+        ),
+        (
+            "Triangle",
+            binding::TRIANGLES,
+            host_layout!(Triangle, [p0, material, edge1, _pad0, edge2, _pad1], true),
+        ),
+        (
+            "Sphere",
+            binding::SPHERES,
+            host_layout!(Sphere, [center, radius, material, light, _pad], true),
+        ),
+    ];
+    for (name, b, host) in cases {
+        let device = m.binding_layout(0, b);
+        println!("{name}: host {host:?}, device {device:?}");
+        assert_eq!(host, device, "{name} differs between host and device");
+    }
+    assert_eq!(size_of::<RenderParams>() % 16, 0);
 }

@@ -96,6 +96,10 @@ struct QuadFile {
 struct MeshFile {
     file: Spanned<String>,
     material: Spanned<String>,
+    /// Uniform scale applied to the vertices first (default 1).
+    scale: Option<Spanned<f32>>,
+    /// Translation applied after the scale (default 0).
+    translate: Option<V3>,
 }
 
 #[derive(Deserialize)]
@@ -459,10 +463,28 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 format!("mesh file {} does not exist", mesh_path.display()),
             ));
         }
+        let scale = match &mf.scale {
+            Some(s) => {
+                let k = *s.get_ref();
+                if !(k > 0.0 && k.is_finite()) {
+                    return Err(ck.err(
+                        s.span(),
+                        &format!("{field}.scale"),
+                        format!("{k} must be a positive finite number"),
+                    ));
+                }
+                k
+            }
+            None => 1.0,
+        };
+        let translate = match &mf.translate {
+            Some(t) => ck.vec3(t, &format!("{field}.translate"))?,
+            None => Vec3::ZERO,
+        };
         let soup = load_mesh(&mesh_path)?;
         let start = triangles.len();
         for t in &soup.triangles {
-            let p = t.map(Vec3::from);
+            let p = t.map(|v| Vec3::from(v) * scale + translate);
             // Degenerate (zero-area) triangles cannot be hit; they are dropped.
             if (p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0 {
                 push_triangle(&mut triangles, p, material);

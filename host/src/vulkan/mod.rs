@@ -238,18 +238,23 @@ impl GpuRenderer {
         .context("ray-tracing dispatch failed")
     }
 
-    /// Reads the accumulated sums back into a film (one readback per image).
+    /// Reads the running means and M2 back (one readback per image) into a film of sums:
+    /// sum = n mean, sum of squares = M2 + n mean^2 (in f64, where this loses nothing).
     pub fn read_film(&self) -> Result<Film> {
         let res = self.res();
-        let sums = self.ctx.read_image(&res.accum, self.width, self.height)?;
-        let squares = self
+        let means = self.ctx.read_image(&res.accum, self.width, self.height)?;
+        let m2s = self
             .ctx
             .read_image(&res.accum_sq, self.width, self.height)?;
         let mut film = Film::new(self.width, self.height);
-        for (i, (s, q)) in sums.iter().zip(&squares).enumerate() {
-            film.sum[i] = [s[0] as f64, s[1] as f64, s[2] as f64];
-            film.sum_sq[i] = [q[0] as f64, q[1] as f64, q[2] as f64];
-            film.count[i] = s[3] as u32;
+        for (i, (m, q)) in means.iter().zip(&m2s).enumerate() {
+            let n = m[3] as f64;
+            for c in 0..3 {
+                let mean = m[c] as f64;
+                film.sum[i][c] = n * mean;
+                film.sum_sq[i][c] = q[c] as f64 + n * mean * mean;
+            }
+            film.count[i] = m[3] as u32;
             film.discarded += q[3] as u64;
         }
         Ok(film)

@@ -1,0 +1,152 @@
+//! Kernel functions evaluated record by record, for the CPU-vs-GPU equivalence tests: the
+//! compute entry point `shaders::probe` and the native tests call this same [`evaluate`].
+//! Records are four `[u32; 4]` in, two out; floats travel as their bits, so no load or store
+//! on either side can touch a value (denormals, NaN payloads) before the function sees it.
+
+use crate::brdf::{eval_scattering, pdf_brdf, sample_brdf};
+use crate::camera::camera_ray_direction;
+use crate::frame::orthonormal_basis;
+use crate::geometry::{
+    geometry_factor, intersect_sphere, intersect_triangle, offset_ray_origin, reproject_to_sphere,
+    shadow_ray_end, triangle_normal,
+};
+use crate::rng::{pcg4d, u32_to_unit_f32};
+use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
+use crate::scene::Camera;
+use spirv_std::glam::{UVec4, Vec3, Vec4};
+
+/// Which function a probe record evaluates (input layout -> output layout).
+pub mod function {
+    /// a = in0.xyz, c = in1.x, phi = in1.y -> out0.xyz = sample_lobe(a, c, phi)
+    pub const SAMPLE_LOBE: u32 = 0;
+    /// n = in0.xyz -> out0.xyz, out1.xyz = orthonormal_basis(n)
+    pub const ORTHONORMAL_BASIS: u32 = 1;
+    /// c = in0.xyz, r = in0.w, u = in1.xy -> out0.xyz position, out1.xyz normal
+    pub const SAMPLE_SPHERE: u32 = 2;
+    /// c = in0.xyz, r = in0.w, p = in1.xyz, u = in2.xy -> out0.xyz position, out0.w pdf,
+    /// out1.xyz normal
+    pub const SAMPLE_SPHERE_CONE: u32 = 3;
+    /// p_a, n_a, p_b, n_b = in0..in3 .xyz -> out0.x
+    pub const GEOMETRY_FACTOR: u32 = 4;
+    /// o = in0.xyz, d = in1.xyz, c = in2.xyz, r = in2.w, t_min = in3.x, t_max = in3.y
+    /// -> out0.x = t, out1.xyz = the hit re-projected onto the sphere (when t >= 0)
+    pub const INTERSECT_SPHERE: u32 = 5;
+    /// o = in0.xyz, t_max = in0.w, d = in1.xyz, p0 = in2.xyz, e1 = in3.xyz,
+    /// e2 = (in1.w, in2.w, in3.w) -> out0.x = t, out1.xyz = triangle_normal(e1, e2)
+    pub const INTERSECT_TRIANGLE: u32 = 6;
+    /// p = in0.xyz, n = in1.xyz, target = in2.xyz -> out0.xyz = offset_ray_origin(p, n),
+    /// out1.xyz = shadow_ray_end(p, target)
+    pub const OFFSET_RAY_ORIGIN: u32 = 7;
+    /// n = in0.xyz, w = in1.xyz, albedo = in2.xyz, u = in3.xy -> out0.xyz eval_scattering,
+    /// out0.w pdf_brdf(n, w), out1.xyz sample_brdf(n, u), out1.w its pdf
+    pub const BRDF: u32 = 8;
+    /// in0 as four u32 -> out0 = pcg4d(in0), out1.x = u32_to_unit_f32(in0.x)
+    pub const RNG: u32 = 9;
+    /// forward = in0.xyz, right = in1.xyz, up = in2.xyz, (u, v) = in3.xy,
+    /// (width, height, px, py) = (in0.w, in1.w, in2.w, in3.z) as u32 -> out0.xyz direction
+    pub const CAMERA_RAY: u32 = 10;
+    pub const COUNT: u32 = 11;
+}
+
+#[inline]
+fn f(v: UVec4) -> Vec4 {
+    Vec4::new(
+        f32::from_bits(v.x),
+        f32::from_bits(v.y),
+        f32::from_bits(v.z),
+        f32::from_bits(v.w),
+    )
+}
+
+#[inline]
+fn bits(v: Vec4) -> UVec4 {
+    UVec4::new(v.x.to_bits(), v.y.to_bits(), v.z.to_bits(), v.w.to_bits())
+}
+
+#[inline]
+fn v3(v: Vec3) -> Vec4 {
+    v.extend(0.0)
+}
+
+/// Evaluates `function` on one input record; see [`function`] for the layouts.
+#[inline]
+pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
+    let i0 = f(input[0]);
+    let i1 = f(input[1]);
+    let i2 = f(input[2]);
+    let i3 = f(input[3]);
+    let (o0, o1) = if function == function::SAMPLE_LOBE {
+        (v3(sample_lobe(i0.truncate(), i1.x, i1.y)), Vec4::ZERO)
+    } else if function == function::ORTHONORMAL_BASIS {
+        let (t, b) = orthonormal_basis(i0.truncate());
+        (v3(t), v3(b))
+    } else if function == function::SAMPLE_SPHERE {
+        let s = sample_sphere(i0.truncate(), i0.w, i1.x, i1.y);
+        (v3(s.position), v3(s.normal))
+    } else if function == function::SAMPLE_SPHERE_CONE {
+        let s = sample_sphere_cone(i0.truncate(), i0.w, i1.truncate(), i2.x, i2.y);
+        (
+            s.point.position.extend(s.pdf_solid_angle),
+            v3(s.point.normal),
+        )
+    } else if function == function::GEOMETRY_FACTOR {
+        let g = geometry_factor(i0.truncate(), i1.truncate(), i2.truncate(), i3.truncate());
+        (Vec4::new(g, 0.0, 0.0, 0.0), Vec4::ZERO)
+    } else if function == function::INTERSECT_SPHERE {
+        let (o, d, c) = (i0.truncate(), i1.truncate(), i2.truncate());
+        let t = intersect_sphere(o, d, c, i2.w, i3.x, i3.y);
+        let p = if t >= 0.0 {
+            reproject_to_sphere(o + t * d, c, i2.w)
+        } else {
+            Vec3::ZERO
+        };
+        (Vec4::new(t, 0.0, 0.0, 0.0), v3(p))
+    } else if function == function::INTERSECT_TRIANGLE {
+        let e2 = Vec3::new(i1.w, i2.w, i3.w);
+        let t = intersect_triangle(
+            i0.truncate(),
+            i1.truncate(),
+            i2.truncate(),
+            i3.truncate(),
+            e2,
+            0.0,
+            i0.w,
+        );
+        (
+            Vec4::new(t, 0.0, 0.0, 0.0),
+            v3(triangle_normal(i3.truncate(), e2)),
+        )
+    } else if function == function::OFFSET_RAY_ORIGIN {
+        (
+            v3(offset_ray_origin(i0.truncate(), i1.truncate())),
+            v3(shadow_ray_end(i0.truncate(), i2.truncate())),
+        )
+    } else if function == function::BRDF {
+        let (n, w) = (i0.truncate(), i1.truncate());
+        let s = sample_brdf(n, i3.x, i3.y);
+        (
+            eval_scattering(n, w, i2.truncate()).extend(pdf_brdf(n, w)),
+            s.extend(pdf_brdf(n, s)),
+        )
+    } else if function == function::RNG {
+        let h = pcg4d([input[0].x, input[0].y, input[0].z, input[0].w]);
+        return [
+            UVec4::new(h[0], h[1], h[2], h[3]),
+            UVec4::new(u32_to_unit_f32(input[0].x).to_bits(), 0, 0, 0),
+        ];
+    } else if function == function::CAMERA_RAY {
+        let camera = Camera {
+            eye: [0.0; 4],
+            forward: [i0.x, i0.y, i0.z, 0.0],
+            right: [i1.x, i1.y, i1.z, 0.0],
+            up: [i2.x, i2.y, i2.z, 0.0],
+        };
+        let d = camera_ray_direction(
+            &camera, input[0].w, input[1].w, input[2].w, input[3].z, i3.x, i3.y,
+        );
+        (v3(d), Vec4::ZERO)
+    } else {
+        (Vec4::ZERO, Vec4::ZERO)
+    };
+    [bits(o0), bits(o1)]
+}

@@ -1,0 +1,343 @@
+//! Function-level CPU-vs-GPU equivalence: every kernel function through `kernel::probe` on the
+//! same 100,000 inputs natively and in the `shaders::probe` compute entry point (validation on).
+//! Inputs favour the edges: normals on and near the axes (including exactly -Z), grazing
+//! directions, points on the surface, magnitudes from 1e-6 to 1e6.
+
+use glam::Vec3;
+use kernel::probe::{evaluate, function};
+use twinpath::vulkan::compute::ProbeRunner;
+use twinpath_tests::gpu::{assert_validation_clean, context};
+
+const N: usize = 100_000;
+
+/// splitmix64: the test's own input generator (independent of the kernel's RNG under test).
+struct Gen(u64);
+impl Gen {
+    fn u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn unit(&mut self) -> f32 {
+        (self.u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.unit()
+    }
+    fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
+        xs[(self.u64() % xs.len() as u64) as usize]
+    }
+    /// A magnitude 10^U(-6, 6).
+    fn scale(&mut self) -> f32 {
+        10f32.powf(self.range(-6.0, 6.0))
+    }
+    fn vec(&mut self) -> Vec3 {
+        Vec3::new(
+            self.range(-1.0, 1.0),
+            self.range(-1.0, 1.0),
+            self.range(-1.0, 1.0),
+        )
+    }
+    /// Unit vectors: uniform, exactly on an axis, or within 1e-4..1e-7 of one.
+    fn dir(&mut self) -> Vec3 {
+        let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+        match self.u64() % 4 {
+            0 => self.pick(&axes),
+            1 => {
+                let eps = 10f32.powf(self.range(-7.0, -4.0));
+                (self.pick(&axes) + eps * self.vec()).normalize()
+            }
+            _ => loop {
+                let v = self.vec();
+                if v.length_squared() > 1e-6 && v.length_squared() <= 1.0 {
+                    break v.normalize();
+                }
+            },
+        }
+    }
+    /// A unit direction grazing the plane of `n` (within 1e-3 .. 1e-7 radians), or any.
+    fn grazing(&mut self, n: Vec3) -> Vec3 {
+        let d = self.dir();
+        if self.u64().is_multiple_of(2) {
+            let t = (d - n * d.dot(n)).normalize_or(Vec3::X);
+            (t + n * 10f32.powf(self.range(-7.0, -3.0)) * self.pick(&[1.0, -1.0])).normalize()
+        } else {
+            d
+        }
+    }
+}
+
+fn rec(v: [[f32; 4]; 4]) -> [[u32; 4]; 4] {
+    v.map(|r| r.map(f32::to_bits))
+}
+fn w(v: Vec3, w: f32) -> [f32; 4] {
+    [v.x, v.y, v.z, w]
+}
+
+fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
+    (0..N)
+        .map(|_| match func {
+            function::SAMPLE_LOBE => {
+                let (a, b) = (g.range(-1.0, 1.0), g.unit().sqrt());
+                let c = g.pick(&[0.0, 1.0, -1.0, a, b]);
+                rec([
+                    w(g.dir(), 0.0),
+                    [c, g.range(0.0, 6.2831855), 0.0, 0.0],
+                    [0.0; 4],
+                    [0.0; 4],
+                ])
+            }
+            function::ORTHONORMAL_BASIS => rec([w(g.dir(), 0.0), [0.0; 4], [0.0; 4], [0.0; 4]]),
+            function::SAMPLE_SPHERE => {
+                let s = g.scale();
+                rec([
+                    w(g.vec() * s, g.scale()),
+                    [g.unit(), g.unit(), 0.0, 0.0],
+                    [0.0; 4],
+                    [0.0; 4],
+                ])
+            }
+            function::SAMPLE_SPHERE_CONE => {
+                let r = g.scale();
+                let c = g.vec() * g.scale();
+                // The receiver from just outside the surface to 1e6 radii away.
+                let p = c + g.dir() * r * (1.0 + g.pick(&[1e-4, 1e-2, 1.0, 1e3, 1e6]));
+                rec([w(c, r), w(p, 0.0), [g.unit(), g.unit(), 0.0, 0.0], [0.0; 4]])
+            }
+            function::GEOMETRY_FACTOR => {
+                let s = g.scale();
+                let pa = g.vec() * s;
+                let pb = if g.u64().is_multiple_of(8) {
+                    pa
+                } else {
+                    pa + g.dir() * g.scale()
+                };
+                rec([w(pa, 0.0), w(g.dir(), 0.0), w(pb, 0.0), w(g.dir(), 0.0)])
+            }
+            function::INTERSECT_SPHERE => {
+                let r = g.scale();
+                let c = g.vec() * g.scale();
+                // Origins on the surface, inside, or far; directions toward, grazing or away.
+                let n = g.dir();
+                let o = match g.u64() % 3 {
+                    0 => c + n * r,
+                    1 => c + g.vec() * r * 0.5,
+                    _ => c + n * r * g.range(1.5, 1e4),
+                };
+                let d = if g.u64().is_multiple_of(2) {
+                    g.grazing(n)
+                } else {
+                    (c - o + g.vec() * r).normalize_or(n)
+                };
+                rec([
+                    w(o, 0.0),
+                    w(d, 0.0),
+                    w(c, r),
+                    [0.0, f32::INFINITY, 0.0, 0.0],
+                ])
+            }
+            function::INTERSECT_TRIANGLE => {
+                let s = g.scale();
+                let p0 = g.vec() * s;
+                let (e1, e2) = (g.vec() * s, g.vec() * s);
+                let n = e1.cross(e2).normalize_or(Vec3::Z);
+                let target = p0 + e1 * g.unit() + e2 * g.unit();
+                let o = target + g.grazing(n) * s * g.range(0.0, 10.0);
+                let d = (target - o).normalize_or(g.dir());
+                rec([w(o, f32::INFINITY), w(d, e2.x), w(p0, e2.y), w(e1, e2.z)])
+            }
+            function::OFFSET_RAY_ORIGIN => {
+                let s = g.scale();
+                let m = g.pick(&[s, 1e-3, 0.03, 1.0, 1e4]);
+                let p = g.vec() * m;
+                rec([
+                    w(p, 0.0),
+                    w(g.dir(), 0.0),
+                    w(p + g.dir() * g.scale(), 0.0),
+                    [0.0; 4],
+                ])
+            }
+            function::BRDF => {
+                let n = g.dir();
+                rec([
+                    w(n, 0.0),
+                    w(g.grazing(n), 0.0),
+                    [g.unit(), g.unit(), g.unit(), 0.0],
+                    [g.unit(), g.unit(), 0.0, 0.0],
+                ])
+            }
+            function::RNG => {
+                let words = [
+                    g.u64() as u32,
+                    g.u64() as u32 % 4096,
+                    g.u64() as u32 % 64,
+                    g.u64() as u32,
+                ];
+                [words, [0; 4], [0; 4], [0; 4]]
+            }
+            function::CAMERA_RAY => {
+                let f = g.dir();
+                let r = f.cross(g.dir()).normalize_or(Vec3::X);
+                let u = r.cross(f);
+                let h = g.range(0.01, 10.0);
+                let (wd, ht) = (1 + g.u64() as u32 % 4096, 1 + g.u64() as u32 % 4096);
+                let (px, py) = (g.u64() as u32 % wd, g.u64() as u32 % ht);
+                let mut x = rec([
+                    w(f, 0.0),
+                    w(r * h, 0.0),
+                    w(u * h, 0.0),
+                    [g.unit(), g.unit(), 0.0, 0.0],
+                ]);
+                x[0][3] = wd;
+                x[1][3] = ht;
+                x[2][3] = px;
+                x[3][2] = py;
+                x
+            }
+            _ => unreachable!(),
+        })
+        .collect()
+}
+
+/// Distance in units in the last place between two floats (0 when the bits are equal or both
+/// are NaN; u32::MAX when only one is NaN).
+fn ulps(a: f32, b: f32) -> u32 {
+    if a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()) {
+        return 0;
+    }
+    if a.is_nan() || b.is_nan() {
+        return u32::MAX;
+    }
+    let ord = |x: f32| {
+        let i = x.to_bits() as i32;
+        if i < 0 {
+            i32::MIN.wrapping_sub(i) as i64
+        } else {
+            i as i64
+        }
+    };
+    (ord(a) - ord(b)).unsigned_abs().min(u32::MAX as u64) as u32
+}
+
+/// How closely a function's outputs must agree, and why.
+struct Bound {
+    name: &'static str,
+    func: u32,
+    /// A component passes if within `max_ulps` or within `abs` absolutely.
+    max_ulps: u32,
+    abs: f32,
+    /// Output components that are hit distances: a hit on one side and a miss on the other
+    /// (t < 0) is a "flip", allowed for at most this fraction of records.
+    flip_fraction: f64,
+    why: &'static str,
+}
+
+const BOUNDS: &[Bound] = &[
+    Bound { name: "rng (pcg4d, u32 -> float)", func: function::RNG, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, why: "integer arithmetic: bit-exact" },
+    Bound { name: "offset_ray_origin / shadow_ray_end", func: function::OFFSET_RAY_ORIGIN, max_ulps: 1, abs: 0.0, flip_fraction: 0.0, why: "integer ULP steps are exact; p + s n may be fused into one FMA on the GPU: 1 ULP" },
+    Bound { name: "orthonormal_basis", func: function::ORTHONORMAL_BASIS, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "a few multiply-adds (FMA contraction): 4 ULP, or 4 eps absolute near zero" },
+    Bound { name: "sample_lobe", func: function::SAMPLE_LOBE, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos differ by 1 ULP (GLSL.std.450 vs libm) plus the frame: 8 eps absolute on unit vectors" },
+    Bound { name: "sample_sphere", func: function::SAMPLE_SPHERE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos differ by 1 ULP: normals 4 eps, positions 4 eps x (|centre| + radius)" },
+    Bound { name: "sample_sphere_cone", func: function::SAMPLE_SPHERE_CONE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos 1 ULP, dot products under FMA: pdf 4 ULP, normals 4 eps, positions 4 eps x (|centre| + radius)" },
+    Bound { name: "geometry_factor", func: function::GEOMETRY_FACTOR, max_ulps: 8, abs: 0.0, flip_fraction: 0.0, why: "dot products (FMA contraction): 8 ULP" },
+    Bound { name: "intersect_sphere (+ re-projection)", func: function::INTERSECT_SPHERE, max_ulps: 64, abs: 0.0, flip_fraction: 1e-3, why: "sqrt and FMA contraction; hit/miss may flip for rays within rounding of tangent or of the origin's surface" },
+    Bound { name: "intersect_triangle", func: function::INTERSECT_TRIANGLE, max_ulps: 64, abs: 0.0, flip_fraction: 1e-3, why: "cross/dot products under FMA contraction; hit/miss may flip for rays within rounding of an edge" },
+    Bound { name: "eval_scattering / pdf_brdf / sample_brdf", func: function::BRDF, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos and sqrt in sampling: 8 eps absolute on unit vectors and pdfs <= 1/pi" },
+    Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
+];
+
+/// The absolute error allowed for output component (k, j) of record `r` under bound `b`:
+/// unit vectors and pdfs take `b.abs`; positions on a sphere take `b.abs` times the size of
+/// the geometry (|centre| + radius), since a unit-vector error scales with it.
+fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize) -> f32 {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
+    match b.func {
+        function::SAMPLE_SPHERE | function::SAMPLE_SPHERE_CONE if k == 0 && j < 3 => {
+            let c = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2));
+            b.abs * (c.length() + f(0, 3))
+        }
+        _ => b.abs,
+    }
+}
+
+#[test]
+fn kernel_functions_agree_between_cpu_and_gpu() {
+    let ctx = context().lock().unwrap();
+    let runner = ProbeRunner::new(&ctx).unwrap();
+    assert_eq!(
+        BOUNDS.len() as u32,
+        function::COUNT,
+        "every probe function has a bound"
+    );
+    let mut failures = Vec::new();
+    for b in BOUNDS {
+        let mut g = Gen(0x5eed_0000 + b.func as u64);
+        let input = inputs(b.func, &mut g);
+        let gpu = runner.run(&ctx, b.func, &input).unwrap();
+        let (mut max_ulps, mut max_abs, mut max_rel_scale) = (0u32, 0f32, 0f32);
+        let (mut flips, mut bad) = (0usize, 0usize);
+        for (r, g_out) in input.iter().zip(&gpu) {
+            let c_out = evaluate(b.func, r.map(glam::UVec4::from_array)).map(|v| v.to_array());
+            let is_t = matches!(
+                b.func,
+                function::INTERSECT_SPHERE | function::INTERSECT_TRIANGLE
+            );
+            if is_t {
+                let (tc, tg) = (f32::from_bits(c_out[0][0]), f32::from_bits(g_out[0][0]));
+                if (tc >= 0.0) != (tg >= 0.0) {
+                    flips += 1;
+                    continue;
+                }
+            }
+            for k in 0..2 {
+                for j in 0..4 {
+                    let (x, y) = (f32::from_bits(c_out[k][j]), f32::from_bits(g_out[k][j]));
+                    let u = ulps(x, y);
+                    let d = (x - y).abs();
+                    max_ulps = max_ulps.max(u);
+                    if d.is_finite() {
+                        max_abs = max_abs.max(d);
+                    }
+                    let allowed = allowed_abs(b, r, k, j);
+                    if allowed > b.abs && d.is_finite() {
+                        max_rel_scale = max_rel_scale.max(d / (allowed / b.abs));
+                    }
+                    let ok = u <= b.max_ulps || d <= allowed;
+                    if !ok {
+                        bad += 1;
+                        if bad <= 3 {
+                            println!(
+                                "  {}: record {:?}: cpu {x:e} gpu {y:e} ({u} ulp)",
+                                b.name, r
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        let flip_frac = flips as f64 / N as f64;
+        println!(
+            "{:<42} max {:>10} ulp, max abs {:.3e}{}, hit/miss flips {flips} / {N}; bound: {}",
+            b.name,
+            max_ulps,
+            max_abs,
+            if max_rel_scale > 0.0 {
+                format!(" (positions: max {:.2e} x geometry size)", max_rel_scale)
+            } else {
+                String::new()
+            },
+            b.why
+        );
+        if bad > 0 || flip_frac > b.flip_fraction {
+            failures.push(format!(
+                "{}: {bad} components out of bound, {flips} flips",
+                b.name
+            ));
+        }
+    }
+    runner.destroy(&ctx);
+    assert_validation_clean();
+    assert!(failures.is_empty(), "{failures:#?}");
+}
