@@ -8,4 +8,4 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
-cargo test --workspace -- --nocapture "$@" 2>&1 | tee target/test-output.log
+cargo test --workspace -- --nocapture "$@"
