@@ -3,7 +3,7 @@
 
 use crate::brdf::{eval_scattering, pdf_brdf, sample_brdf, sampled_brdf_weight};
 use crate::camera::{camera_origin, camera_ray_direction};
-use crate::geometry::{offset_ray_origin, shadow_ray_end};
+use crate::geometry::{offset_ray_origin, shadow_ray_end, sphere_point_error};
 use crate::light::{eval_radiance, pdf_light_from, sample_light_from};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
@@ -22,6 +22,9 @@ pub struct SurfaceHit {
     pub material: u32,
     /// Index into the light table if the surface is a light, else [`NONE`].
     pub light: u32,
+    /// Absolute bound on the rounding error of `position` (per component), which sizes the
+    /// offset of rays leaving it (`geometry::offset_ray_origin`).
+    pub error: f32,
 }
 
 impl SurfaceHit {
@@ -34,6 +37,7 @@ impl SurfaceHit {
             normal: Vec3::ZERO,
             material: NONE,
             light: NONE,
+            error: 0.0,
         }
     }
 
@@ -140,7 +144,7 @@ pub fn trace_path<T: Tracer>(
         };
         let x = hit.position;
         let albedo = Vec3::from(material.albedo);
-        let ray_origin = offset_ray_origin(x, n);
+        let ray_origin = offset_ray_origin(x, n, hit.error);
         rng.seek(CAMERA_DIMENSIONS + (depth - 1) * DIMENSIONS_PER_VERTEX);
 
         // 2(a): next-event estimation.
@@ -165,7 +169,15 @@ pub fn trace_path<T: Tracer>(
             if cos_x > 0.0
                 && cos_y > 0.0
                 && pdf_w > 0.0
-                && !tracer.occluded(ray_origin, shadow_ray_end(ray_origin, y))
+                && !tracer.occluded(
+                    ray_origin,
+                    shadow_ray_end(
+                        ray_origin,
+                        y,
+                        ls.point.normal,
+                        light_point_error(lights, ls.light),
+                    ),
+                )
             {
                 let emitted = Vec3::from(lights[ls.light as usize].radiance);
                 let weight = if params.mis_mode == mis::POWER {
@@ -241,6 +253,13 @@ pub fn trace_path<T: Tracer>(
         depth += 1;
     }
     radiance
+}
+
+/// Rounding-error bound of a point sampled on light `light` (c + r n).
+#[inline]
+fn light_point_error(lights: &[SphereLight], light: u32) -> f32 {
+    let l = lights[light as usize];
+    sphere_point_error(Vec3::from(l.center), l.radius)
 }
 
 /// One sample of pixel (px, py) (column from the left, row from the top): a uniformly random

@@ -7,8 +7,8 @@ use crate::brdf::{eval_scattering, pdf_brdf, sample_brdf};
 use crate::camera::camera_ray_direction;
 use crate::frame::orthonormal_basis;
 use crate::geometry::{
-    geometry_factor, intersect_sphere, intersect_triangle, offset_ray_origin, reproject_to_sphere,
-    shadow_ray_end, triangle_normal,
+    geometry_factor, intersect_sphere, intersect_triangle_uv, offset_ray_origin,
+    reproject_to_sphere, shadow_ray_end, triangle_point, triangle_point_error,
 };
 use crate::rng::{pcg4d, u32_to_unit_f32};
 use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
@@ -32,10 +32,12 @@ pub mod function {
     /// -> out0.x = t, out1.xyz = the hit re-projected onto the sphere (when t >= 0)
     pub const INTERSECT_SPHERE: u32 = 5;
     /// o = in0.xyz, t_max = in0.w, d = in1.xyz, p0 = in2.xyz, e1 = in3.xyz,
-    /// e2 = (in1.w, in2.w, in3.w) -> out0.x = t, out1.xyz = triangle_normal(e1, e2)
+    /// e2 = (in1.w, in2.w, in3.w) -> out0 = (t, u, v, triangle point error),
+    /// out1.xyz = triangle_point(p0, e1, e2, u, v) (when t >= 0)
     pub const INTERSECT_TRIANGLE: u32 = 6;
-    /// p = in0.xyz, n = in1.xyz, target = in2.xyz -> out0.xyz = offset_ray_origin(p, n),
-    /// out1.xyz = shadow_ray_end(p, target)
+    /// p = in0.xyz, n = in1.xyz, error = in1.w, target = in2.xyz, target normal = in3.xyz,
+    /// target error = in3.w -> out0.xyz = offset_ray_origin(p, n, error),
+    /// out1.xyz = shadow_ray_end(p, target, target normal, target error)
     pub const OFFSET_RAY_ORIGIN: u32 = 7;
     /// n = in0.xyz, w = in1.xyz, albedo = in2.xyz, u = in3.xy -> out0.xyz eval_scattering,
     /// out0.w pdf_brdf(n, w), out1.xyz sample_brdf(n, u), out1.w its pdf
@@ -102,24 +104,25 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
         };
         (Vec4::new(t, 0.0, 0.0, 0.0), v3(p))
     } else if function == function::INTERSECT_TRIANGLE {
-        let e2 = Vec3::new(i1.w, i2.w, i3.w);
-        let t = intersect_triangle(
-            i0.truncate(),
-            i1.truncate(),
-            i2.truncate(),
-            i3.truncate(),
-            e2,
-            0.0,
-            i0.w,
-        );
-        (
-            Vec4::new(t, 0.0, 0.0, 0.0),
-            v3(triangle_normal(i3.truncate(), e2)),
-        )
+        let (p0, e1, e2) = (i2.truncate(), i3.truncate(), Vec3::new(i1.w, i2.w, i3.w));
+        let h = intersect_triangle_uv(i0.truncate(), i1.truncate(), p0, e1, e2, 0.0, i0.w);
+        if h.t >= 0.0 {
+            (
+                Vec4::new(h.t, h.u, h.v, triangle_point_error(p0, e1, e2, h.u, h.v)),
+                v3(triangle_point(p0, e1, e2, h.u, h.v)),
+            )
+        } else {
+            (Vec4::new(h.t, 0.0, 0.0, 0.0), Vec4::ZERO)
+        }
     } else if function == function::OFFSET_RAY_ORIGIN {
         (
-            v3(offset_ray_origin(i0.truncate(), i1.truncate())),
-            v3(shadow_ray_end(i0.truncate(), i2.truncate())),
+            v3(offset_ray_origin(i0.truncate(), i1.truncate(), i1.w)),
+            v3(shadow_ray_end(
+                i0.truncate(),
+                i2.truncate(),
+                i3.truncate(),
+                i3.w,
+            )),
         )
     } else if function == function::BRDF {
         let (n, w) = (i0.truncate(), i1.truncate());

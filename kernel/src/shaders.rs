@@ -8,10 +8,13 @@
 //! Hit groups: 0 triangles (closest hit), 1 spheres (intersection + closest hit).
 //! Miss shader 0 serves both kinds of ray.
 
-use crate::geometry::{intersect_sphere, reproject_to_sphere, triangle_normal};
+use crate::geometry::{
+    intersect_sphere, reproject_to_sphere, sphere_point_error, triangle_normal, triangle_point,
+    triangle_point_error,
+};
 use crate::path::{render_sample, SurfaceHit, Tracer};
 use crate::scene::{Material, RenderParams, Sphere, SphereLight, Triangle, NONE};
-use spirv_std::glam::{UVec2, UVec3, UVec4, Vec3, Vec4};
+use spirv_std::glam::{UVec2, UVec3, UVec4, Vec2, Vec3, Vec4};
 use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
 use spirv_std::spirv;
@@ -22,7 +25,7 @@ use spirv_std::spirv;
 pub struct HitPayload {
     /// xyz: hit position, w: ray parameter t (negative: miss).
     pub position_t: Vec4,
-    /// xyz: unit geometric normal.
+    /// xyz: unit geometric normal, w: rounding-error bound of the position.
     pub normal: Vec4,
     pub material: u32,
     pub light: u32,
@@ -63,6 +66,7 @@ impl Tracer for RayTracer<'_> {
             normal: self.payload.normal.truncate(),
             material: self.payload.material,
             light: self.payload.light,
+            error: self.payload.normal.w,
         }
     }
 
@@ -163,22 +167,28 @@ pub fn miss(#[spirv(incoming_ray_payload)] payload: &mut HitPayload) {
     payload.hit = 0;
 }
 
-/// Closest hit on a triangle: position from the ray, normal and material from the triangle
-/// table (`instance_custom_index` is the instance's first triangle).
+/// Closest hit on a triangle: position from the barycentrics (`geometry::triangle_point`, as on
+/// the CPU), normal and material from the triangle table (`instance_custom_index` is the
+/// instance's first triangle).
 #[spirv(closest_hit)]
 pub fn closest_hit_triangle(
     #[spirv(incoming_ray_payload)] payload: &mut HitPayload,
+    #[spirv(hit_attribute)] barycentrics: &Vec2,
     #[spirv(primitive_id)] primitive: u32,
     #[spirv(instance_custom_index)] first: u32,
-    #[spirv(world_ray_origin)] origin: Vec3,
-    #[spirv(world_ray_direction)] dir: Vec3,
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
 ) {
     let tri = triangles[(first + primitive) as usize];
-    let n = triangle_normal(Vec3::from(tri.edge1), Vec3::from(tri.edge2));
-    payload.position_t = (origin + t * dir).extend(t);
-    payload.normal = n.extend(0.0);
+    let (p0, e1, e2) = (
+        Vec3::from(tri.p0),
+        Vec3::from(tri.edge1),
+        Vec3::from(tri.edge2),
+    );
+    let (u, v) = (barycentrics.x, barycentrics.y);
+    let p = triangle_point(p0, e1, e2, u, v);
+    payload.position_t = p.extend(t);
+    payload.normal = triangle_normal(e1, e2).extend(triangle_point_error(p0, e1, e2, u, v));
     payload.material = tri.material;
     payload.light = NONE;
     payload.hit = 1;
@@ -220,7 +230,7 @@ pub fn closest_hit_sphere(
     let center = Vec3::from(s.center);
     let p = reproject_to_sphere(origin + t * dir, center, s.radius);
     payload.position_t = p.extend(t);
-    payload.normal = ((p - center) / s.radius).extend(0.0);
+    payload.normal = ((p - center) / s.radius).extend(sphere_point_error(center, s.radius));
     payload.material = s.material;
     payload.light = s.light;
     payload.hit = 1;

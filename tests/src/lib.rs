@@ -104,3 +104,28 @@ pub fn image_mean_z(a: &twinpath::film::Film, b: &twinpath::film::Film) -> f64 {
     let ((ma, va), (mb, vb)) = (stats(a), stats(b));
     (ma - mb) / (va + vb).sqrt()
 }
+
+/// The scene scaled by `scale` about the origin, then translated by `translate`: positions,
+/// radii, edges and the camera. Radiance is scale-invariant, so the image must not change.
+pub fn transform_scene(scene: &Scene, scale: f32, translate: glam::Vec3) -> Scene {
+    use glam::Vec3;
+    let p = |v: [f32; 3]| (Vec3::from(v) * scale + translate).to_array();
+    let e = |v: [f32; 3]| (Vec3::from(v) * scale).to_array();
+    let mut s = scene.clone();
+    s.camera.eye = s.camera.eye * scale + translate;
+    s.camera.look_at = s.camera.look_at * scale + translate;
+    for sp in &mut s.spheres {
+        sp.center = p(sp.center);
+        sp.radius *= scale;
+    }
+    for l in &mut s.lights {
+        l.center = p(l.center);
+        l.radius *= scale;
+    }
+    for t in &mut s.triangles {
+        t.p0 = p(t.p0);
+        t.edge1 = e(t.edge1);
+        t.edge2 = e(t.edge2);
+    }
+    s
+}

@@ -243,7 +243,7 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "sample_sphere_cone", func: function::SAMPLE_SPHERE_CONE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos 1 ULP, dot products under FMA: pdf 4 ULP, normals 4 eps, positions 4 eps x (|centre| + radius)" },
     Bound { name: "geometry_factor", func: function::GEOMETRY_FACTOR, max_ulps: 8, abs: 0.0, flip_fraction: 0.0, why: "dot products (FMA contraction): 8 ULP" },
     Bound { name: "intersect_sphere (+ re-projection)", func: function::INTERSECT_SPHERE, max_ulps: 64, abs: 0.0, flip_fraction: 1e-3, why: "sqrt and FMA contraction; hit/miss may flip for rays within rounding of tangent or of the origin's surface" },
-    Bound { name: "intersect_triangle", func: function::INTERSECT_TRIANGLE, max_ulps: 64, abs: 0.0, flip_fraction: 1e-3, why: "cross/dot products under FMA contraction; hit/miss may flip for rays within rounding of an edge" },
+    Bound { name: "intersect_triangle (t, u, v, point, error bound)", func: function::INTERSECT_TRIANGLE, max_ulps: 64, abs: 4.0 * f32::EPSILON, flip_fraction: 1e-3, why: "cross/dot products under FMA contraction: 64 ULP, u and v 4 eps, points 4 eps x (|p0| + |e1| + |e2|); hit/miss may flip for rays within rounding of an edge" },
     Bound { name: "eval_scattering / pdf_brdf / sample_brdf", func: function::BRDF, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos and sqrt in sampling: 8 eps absolute on unit vectors and pdfs <= 1/pi" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
@@ -254,6 +254,13 @@ const BOUNDS: &[Bound] = &[
 fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize) -> f32 {
     let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
     match b.func {
+        // Triangle points (out1.xyz): relative to |p0| + |e1| + |e2|.
+        function::INTERSECT_TRIANGLE if k == 1 && j < 3 => {
+            let p0 = glam::Vec3::new(f(2, 0), f(2, 1), f(2, 2));
+            let e1 = glam::Vec3::new(f(3, 0), f(3, 1), f(3, 2));
+            let e2 = glam::Vec3::new(f(1, 3), f(2, 3), f(3, 3));
+            b.abs * (p0.length() + e1.length() + e2.length())
+        }
         function::SAMPLE_SPHERE | function::SAMPLE_SPHERE_CONE if k == 0 && j < 3 => {
             let c = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2));
             b.abs * (c.length() + f(0, 3))

@@ -4,7 +4,8 @@
 
 use glam::Vec3;
 use kernel::geometry::{
-    intersect_sphere, intersect_triangle, reproject_to_sphere, triangle_normal,
+    intersect_sphere, intersect_triangle, intersect_triangle_uv, reproject_to_sphere,
+    sphere_point_error, triangle_normal, triangle_point, triangle_point_error,
 };
 use kernel::scene::{Sphere, Triangle, NONE};
 use kernel::SurfaceHit;
@@ -265,15 +266,24 @@ impl Bvh {
                 normal: (p - c) / s.radius,
                 material: s.material,
                 light: s.light,
+                error: sphere_point_error(c, s.radius),
             }
         } else {
             let tri = &self.triangles[id - self.spheres.len()];
+            let (p0, e1, e2) = (
+                Vec3::from(tri.p0),
+                Vec3::from(tri.edge1),
+                Vec3::from(tri.edge2),
+            );
+            // The winning triangle again, for its barycentrics (once per ray).
+            let h = intersect_triangle_uv(origin, dir, p0, e1, e2, 0.0, f32::INFINITY);
             SurfaceHit {
-                position: origin + t * dir,
+                position: triangle_point(p0, e1, e2, h.u, h.v),
                 t,
-                normal: triangle_normal(Vec3::from(tri.edge1), Vec3::from(tri.edge2)),
+                normal: triangle_normal(e1, e2),
                 material: tri.material,
                 light: NONE,
+                error: triangle_point_error(p0, e1, e2, h.u, h.v),
             }
         }
     }

@@ -1,0 +1,208 @@
+//! Re-intersection (in the style of pbrt-v4's `Reintersect` tests): random spheres, quads and
+//! triangles at scales 10^U(-4, 5) under random translations; a ray hits a random point; rays
+//! spawned from that hit (continuation rays in random directions on the side they leave from,
+//! and shadow rays toward random points on that side) never hit the same surface again. And a
+//! shadow ray toward a point sampled on a sphere light never hits that light.
+//!
+//! Hits are computed as the renderer computes them: triangle points from barycentrics with
+//! `triangle_point_error`, sphere points re-projected with `sphere_point_error`, offsets by
+//! `offset_ray_origin`, shadow-ray ends by `shadow_ray_end`.
+
+use glam::Vec3;
+use kernel::geometry::{
+    intersect_sphere, intersect_triangle, intersect_triangle_uv, offset_ray_origin,
+    reproject_to_sphere, shadow_ray_end, sphere_point_error, triangle_normal, triangle_point,
+    triangle_point_error,
+};
+use kernel::sampling::{sample_cosine_hemisphere, sample_sphere_cone};
+
+struct Gen(u64);
+impl Gen {
+    fn u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn unit(&mut self) -> f32 {
+        (self.u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn pow10(&mut self, lo: f32, hi: f32) -> f32 {
+        10f32.powf(lo + (hi - lo) * self.unit())
+    }
+    fn dir(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(
+                2.0 * self.unit() - 1.0,
+                2.0 * self.unit() - 1.0,
+                2.0 * self.unit() - 1.0,
+            );
+            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+    /// A random placement: scale 10^U(-4, 5), translated by up to 10^3 times that.
+    fn placement(&mut self) -> (f32, Vec3) {
+        let s = self.pow10(-4.0, 5.0);
+        let t = self.dir() * s * self.pow10(-4.0, 5.0).min(1e3);
+        (s, t)
+    }
+}
+
+/// Cases per test: 10^6 by default; `REINTERSECT_CASES=10000000` for the long run.
+fn cases() -> usize {
+    std::env::var("REINTERSECT_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1_000_000)
+}
+
+/// Rays spawned from a hit at `p` (normal `n_side` on the leaving side, error bound `err`, size
+/// of the surface `size`): whether a continuation ray and a shadow ray hit it again (`hits`).
+fn spawned_self_hits(
+    g: &mut Gen,
+    p: Vec3,
+    n_side: Vec3,
+    err: f32,
+    size: f32,
+    hits: &dyn Fn(Vec3, Vec3, f32) -> bool,
+) -> (bool, bool) {
+    let o = offset_ray_origin(p, n_side, err);
+    let w = sample_cosine_hemisphere(n_side, g.unit(), g.unit());
+    let continuation = w.dot(n_side) > 0.0 && hits(o, w, f32::INFINITY);
+    // Shadow ray toward a point on the leaving side, as far as 10 sizes. The target must be
+    // farther from the surface than the surface's own rounding (`err`): closer, which side it
+    // is on is not defined in f32.
+    let target = p + (n_side * g.unit().max(1e-3) + g.dir() * 0.5) * size * g.pow10(-2.0, 1.0);
+    let shadow = (target - p).dot(n_side) > err && hits(o, target - o, 1.0);
+    (continuation, shadow)
+}
+
+#[test]
+fn rays_leaving_triangles_and_quads_never_hit_them_again() {
+    let mut g = Gen(1);
+    let (mut tested, mut cont_fail, mut shadow_fail) = (0, 0, 0);
+    for case in 0..cases() {
+        let (s, t) = g.placement();
+        let p0 = t + g.dir() * s;
+        let (e1, e2) = (
+            g.dir() * s * g.pow10(-1.0, 0.0),
+            g.dir() * s * g.pow10(-1.0, 0.0),
+        );
+        if !e1.cross(e2).normalize().is_finite() {
+            continue;
+        }
+        // A quad is two triangles sharing the diagonal, as the scene loader makes it.
+        let quad = case % 2 == 0;
+        let (a, b) = (g.unit(), g.unit());
+        let (a, b) = if !quad && a + b > 1.0 {
+            (1.0 - a, 1.0 - b)
+        } else {
+            (a, b)
+        };
+        let target = p0 + e1 * a + e2 * b;
+        let origin = target + g.dir() * s * g.pow10(-1.0, 2.0);
+        let dir = (target - origin).normalize();
+        let tris = if quad {
+            vec![(p0, e1, e1 + e2), (p0, e1 + e2, e2)]
+        } else {
+            vec![(p0, e1, e2)]
+        };
+        let hit = |o: Vec3, d: Vec3, t_max: f32| {
+            tris.iter()
+                .any(|&(q, f1, f2)| intersect_triangle(o, d, q, f1, f2, 0.0, t_max) >= 0.0)
+        };
+        let best = tris
+            .iter()
+            .map(|&(q, f1, f2)| {
+                let h = intersect_triangle_uv(origin, dir, q, f1, f2, 0.0, f32::INFINITY);
+                (h, q, f1, f2)
+            })
+            .filter(|(h, ..)| h.t >= 0.0)
+            .min_by(|a, b| a.0.t.total_cmp(&b.0.t));
+        let Some((h, q, f1, f2)) = best else {
+            continue; // the ray slipped past an edge
+        };
+        tested += 1;
+        let p = triangle_point(q, f1, f2, h.u, h.v);
+        // The hit triangle's own normal, as the renderer stores it.
+        let nn = triangle_normal(f1, f2);
+        let n_side = if nn.dot(dir) < 0.0 { nn } else { -nn };
+        let err = triangle_point_error(q, f1, f2, h.u, h.v);
+        let (c, sh) = spawned_self_hits(&mut g, p, n_side, err, s, &hit);
+        cont_fail += c as usize;
+        shadow_fail += sh as usize;
+    }
+    println!("triangles/quads: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
+    assert!(tested > cases() / 2);
+    assert_eq!((cont_fail, shadow_fail), (0, 0));
+}
+
+#[test]
+fn rays_leaving_spheres_never_hit_them_again() {
+    let mut g = Gen(2);
+    let (mut tested, mut cont_fail, mut shadow_fail) = (0, 0, 0);
+    for _ in 0..cases() {
+        let (s, t) = g.placement();
+        let (c, r) = (t, s);
+        let target = c + g.dir() * r;
+        let origin = target + g.dir() * r * g.pow10(-1.0, 2.0);
+        let dir = (target - origin).normalize();
+        let th = intersect_sphere(origin, dir, c, r, 0.0, f32::INFINITY);
+        if th < 0.0 {
+            continue;
+        }
+        tested += 1;
+        let p = reproject_to_sphere(origin + th * dir, c, r);
+        let n = (p - c) / r;
+        // Rays arriving from outside leave outward; from inside, inward.
+        let n_side = if n.dot(dir) < 0.0 { n } else { -n };
+        let err = sphere_point_error(c, r);
+        let inward = n_side.dot(n) < 0.0;
+        let hits = |o: Vec3, d: Vec3, tm: f32| {
+            let t = intersect_sphere(o, d, c, r, 0.0, tm);
+            // From inside, the far wall is a legitimate hit: only a hit within a few error
+            // bounds of the start counts as a self-hit.
+            if inward {
+                t >= 0.0 && t * d.length() <= 4.0 * err
+            } else {
+                t >= 0.0
+            }
+        };
+        let (cf, sf) = spawned_self_hits(&mut g, p, n_side, err, r, &hits);
+        cont_fail += cf as usize;
+        shadow_fail += sf as usize;
+    }
+    println!("spheres: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
+    assert!(tested > cases() / 2);
+    assert_eq!((cont_fail, shadow_fail), (0, 0));
+}
+
+#[test]
+fn shadow_rays_never_hit_the_light_they_sample() {
+    let mut g = Gen(3);
+    let mut fails = 0;
+    for _ in 0..cases() {
+        let (s, t) = g.placement();
+        let (c, r) = (t, s);
+        // Receivers from 1e-3 radii off the surface to 1e4 radii away.
+        let x = c + g.dir() * r * (1.0 + g.pow10(-3.0, 4.0));
+        let ls = sample_sphere_cone(c, r, x, g.unit(), g.unit());
+        let end = shadow_ray_end(
+            x,
+            ls.point.position,
+            ls.point.normal,
+            sphere_point_error(c, r),
+        );
+        if intersect_sphere(x, end - x, c, r, 0.0, 1.0) >= 0.0 {
+            fails += 1;
+        }
+    }
+    println!(
+        "light samples: {fails} of {} shadow rays hit their own light",
+        cases()
+    );
+    assert_eq!(fails, 0);
+}
