@@ -126,17 +126,20 @@ pub fn intersect_triangle_uv(
     }
     let inv_det = 1.0 / det;
     let tvec = origin - p0;
+    // Negated tests so that NaN (from inf * 0 with extreme inputs) is a miss, not a hit.
     let u = tvec.dot(pvec) * inv_det;
-    if u < 0.0 || u > 1.0 {
+    // Not `(0.0..=1.0).contains(&u)`: rust-gpu cannot compile the reference to a local range.
+    #[allow(clippy::manual_range_contains)]
+    if !(u >= 0.0 && u <= 1.0) {
         return miss;
     }
     let qvec = tvec.cross(edge1);
     let v = dir.dot(qvec) * inv_det;
-    if v < 0.0 || u + v > 1.0 {
+    if !(v >= 0.0 && u + v <= 1.0) {
         return miss;
     }
     let t = edge2.dot(qvec) * inv_det;
-    if t > t_min && t < t_max {
+    if t > t_min && t < t_max && t.is_finite() {
         TriangleHit { t, u, v }
     } else {
         miss

@@ -61,15 +61,22 @@ pub fn pdf_sphere_area(radius: f32) -> f32 {
 }
 
 /// Veach's power heuristic with beta = 2 for two strategies with one sample each:
-/// w_a = p_a^2 / (p_a^2 + p_b^2) (Veach's thesis, section 9.2.4). Zero when both pdfs are zero.
+/// w_a = p_a^2 / (p_a^2 + p_b^2) (Veach's thesis, section 9.2.4), evaluated through the ratio of
+/// the smaller pdf to the larger so that no square overflows (p_a = 6e37 gave NaN as inf / inf).
+/// Zero when both pdfs are zero.
 #[inline]
 pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
-    let a = pdf_a * pdf_a;
-    let b = pdf_b * pdf_b;
-    if a + b > 0.0 {
-        a / (a + b)
+    if pdf_a >= pdf_b {
+        if pdf_a > 0.0 {
+            let r = pdf_b / pdf_a;
+            1.0 / (1.0 + r * r)
+        } else {
+            0.0
+        }
     } else {
-        0.0
+        let r = pdf_a / pdf_b;
+        let r2 = r * r;
+        r2 / (1.0 + r2)
     }
 }
 

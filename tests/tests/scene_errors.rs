@@ -168,6 +168,28 @@ fn nan_value() {
 }
 
 #[test]
+fn coordinates_and_radii_outside_the_supported_range() {
+    assert_error(
+        &with("center = [0, 1, 0]", "center = [0, 1e20, 0]"),
+        "center",
+        "sphere[0].center",
+        "beyond",
+    );
+    assert_error(
+        &with("radius = 0.5", "radius = 1e-20"),
+        "radius",
+        "sphere[0].radius",
+        "outside",
+    );
+    assert_error(
+        &with("eye = [0, 1, 4]", "eye = [0, 1, 4e16]"),
+        "eye",
+        "camera.eye",
+        "beyond",
+    );
+}
+
+#[test]
 fn zero_width() {
     assert_error(
         &with("width = 32", "width = 0"),

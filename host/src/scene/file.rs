@@ -16,6 +16,12 @@ pub const DEFAULT_SCENE_TOML: &str = include_str!("../../../scenes/cornell.toml"
 /// The name errors and outputs use for the built-in scene.
 pub const DEFAULT_SCENE_NAME: &str = "cornell.toml";
 
+/// Largest coordinate magnitude (and sphere radius) accepted: the kernel's f32 arithmetic
+/// squares distances, and (3.5e15)^2 stays far below f32's 3.4e38 (property tests).
+pub const MAX_COORDINATE: f32 = 1e15;
+/// Smallest sphere radius accepted: below it, 1 / (4 pi r^2) overflows f32.
+pub const MIN_RADIUS: f32 = 1e-15;
+
 /// Largest image side accepted (a typo like 1e9 must not try to allocate the film).
 pub const MAX_IMAGE_SIDE: i64 = 1 << 15;
 
@@ -121,10 +127,16 @@ impl Checker<'_> {
 
     fn vec3(&self, v: &V3, field: &str) -> Result<Vec3, SceneError> {
         let a = *v.get_ref();
-        if a.iter().all(|c| c.is_finite()) {
-            Ok(Vec3::from(a))
-        } else {
+        if !a.iter().all(|c| c.is_finite()) {
             Err(self.err(v.span(), field, format!("{a:?} is not finite")))
+        } else if !a.iter().all(|c| c.abs() <= MAX_COORDINATE) {
+            Err(self.err(
+                v.span(),
+                field,
+                format!("{a:?} has a component beyond {MAX_COORDINATE:e} (the range the renderer supports)"),
+            ))
+        } else {
+            Ok(Vec3::from(a))
         }
     }
 
@@ -351,6 +363,13 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 format!("{radius} must be a positive finite number"),
             ));
         }
+        if !(MIN_RADIUS..=MAX_COORDINATE).contains(&radius) {
+            return Err(ck.err(
+                sf.radius.span(),
+                &format!("sphere[{i}].radius"),
+                format!("{radius:e} is outside {MIN_RADIUS:e}..={MAX_COORDINATE:e} (the range the renderer supports)"),
+            ));
+        }
         let material = find_material(&sf.material, &format!("sphere[{i}].material"))?;
         let light = if is_emissive(material) {
             lights.push(SphereLight {
@@ -483,8 +502,15 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         };
         let soup = load_mesh(&mesh_path)?;
         let start = triangles.len();
-        for t in &soup.triangles {
+        for (k, t) in soup.triangles.iter().enumerate() {
             let p = t.map(|v| Vec3::from(v) * scale + translate);
+            if p.iter().any(|v| v.abs().max_element() > MAX_COORDINATE) {
+                return Err(ck.err(
+                    mf.file.span(),
+                    &format!("{field} triangle {k}"),
+                    format!("a vertex lies beyond {MAX_COORDINATE:e} after scale and translate"),
+                ));
+            }
             // Degenerate (zero-area) triangles cannot be hit; they are dropped.
             if (p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0 {
                 push_triangle(&mut triangles, p, material);

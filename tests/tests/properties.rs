@@ -1,0 +1,186 @@
+//! Property tests of every kernel function (proptest), with generators that favour the edges:
+//! unit vectors on and near the axes (including exactly -Z), grazing directions, denormals and
+//! magnitudes from 1e-30 to 1e30, coincident points. 10^6 cases per property by default;
+//! `TWINPATH_PROP_CASES=100000000 cargo test --test properties` is the long run.
+//! Invariants: unit results stay unit (within 8 eps), cosines in [-1, 1], pdfs finite and
+//! non-negative, samples inside their domain, no NaN or infinity out of finite input.
+
+use glam::Vec3;
+use kernel::brdf::{eval_scattering, pdf_brdf, sample_brdf};
+use kernel::frame::orthonormal_basis;
+use kernel::geometry::{
+    area_to_solid_angle_pdf, geometry_factor, intersect_sphere, intersect_triangle_uv,
+    offset_ray_origin, shadow_ray_end, sphere_point_error, triangle_point, triangle_point_error,
+};
+use kernel::rng::{pcg4d, u32_to_unit_f32};
+use kernel::sampling::{
+    cone_one_minus_cos, pdf_sphere_cone, power_heuristic, sample_lobe, sample_sphere,
+    sample_sphere_cone,
+};
+use proptest::prelude::*;
+
+fn config() -> ProptestConfig {
+    let cases = std::env::var("TWINPATH_PROP_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1_000_000);
+    ProptestConfig {
+        cases,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    }
+}
+
+const UNIT_TOL: f32 = 8.0 * f32::EPSILON;
+
+/// Magnitudes 10^U(lo, hi) with either sign, plus exact zeros and denormals.
+fn scalar(lo: f32, hi: f32) -> impl Strategy<Value = f32> {
+    prop_oneof![
+        8 => (lo..hi, any::<bool>()).prop_map(|(e, neg)| if neg { -(10f32.powf(e)) } else { 10f32.powf(e) }),
+        1 => Just(0.0f32),
+        1 => (1u32..0x0080_0000).prop_map(f32::from_bits), // denormals
+    ]
+}
+
+/// Unit vectors: exactly on an axis, within 1e-7..1e-2 of one, or anywhere.
+fn unit() -> impl Strategy<Value = Vec3> {
+    let axes = prop_oneof![
+        Just(Vec3::X),
+        Just(-Vec3::X),
+        Just(Vec3::Y),
+        Just(-Vec3::Y),
+        Just(Vec3::Z),
+        Just(-Vec3::Z)
+    ];
+    prop_oneof![
+        2 => axes.clone(),
+        3 => (axes, -7.0f32..-2.0, -1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0)
+            .prop_map(|(a, e, x, y, z)| (a + 10f32.powf(e) * Vec3::new(x, y, z)).normalize()),
+        5 => (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0)
+            .prop_filter("nonzero", |(x, y, z)| x * x + y * y + z * z > 1e-6)
+            .prop_map(|(x, y, z)| Vec3::new(x, y, z).normalize()),
+    ]
+}
+
+/// Points with coordinates spanning 1e-30..1e30 (and zeros, denormals).
+fn point(lo: f32, hi: f32) -> impl Strategy<Value = Vec3> {
+    (scalar(lo, hi), scalar(lo, hi), scalar(lo, hi)).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+fn is_unit(v: Vec3) -> bool {
+    (v.length() - 1.0).abs() <= UNIT_TOL
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn orthonormal_basis_is_orthonormal(n in unit()) {
+        let (t, b) = orthonormal_basis(n);
+        prop_assert!(is_unit(t) && is_unit(b), "{t} {b}");
+        prop_assert!(t.dot(n).abs() <= UNIT_TOL && b.dot(n).abs() <= UNIT_TOL && t.dot(b).abs() <= UNIT_TOL);
+        prop_assert!((t.cross(b) - n).length() <= 2.0 * UNIT_TOL);
+    }
+
+    #[test]
+    fn sample_lobe_is_unit_with_the_requested_cosine(a in unit(), c in -1.0f32..=1.0, phi in 0.0f32..std::f32::consts::TAU) {
+        let w = sample_lobe(a, c, phi);
+        prop_assert!(is_unit(w), "{w}");
+        prop_assert!((w.dot(a) - c).abs() <= 2.0 * UNIT_TOL, "cos {} vs {c}", w.dot(a));
+    }
+
+    #[test]
+    fn brdf_sampling_stays_in_the_hemisphere(n in unit(), u1 in 0.0f32..1.0, u2 in 0.0f32..1.0, wi in unit(), albedo in 0.0f32..=1.0) {
+        let w = sample_brdf(n, u1, u2);
+        prop_assert!(is_unit(w));
+        prop_assert!(w.dot(n) >= -UNIT_TOL);
+        let pdf = pdf_brdf(n, w);
+        prop_assert!((0.0..=std::f32::consts::FRAC_1_PI * (1.0 + UNIT_TOL)).contains(&pdf));
+        let f = eval_scattering(n, wi, Vec3::splat(albedo));
+        prop_assert!(f.is_finite() && f.min_element() >= 0.0 && f.max_element() <= albedo * std::f32::consts::FRAC_1_PI * (1.0 + UNIT_TOL));
+        let p = pdf_brdf(n, wi);
+        prop_assert!(p.is_finite() && p >= 0.0);
+    }
+
+    #[test]
+    fn sphere_samples_are_on_the_sphere(c in point(-15.0, 15.0), r in 1e-15f32..1e15, u1 in 0.0f32..1.0, u2 in 0.0f32..1.0) {
+        let s = sample_sphere(c, r, u1, u2);
+        prop_assert!(s.position.is_finite() && is_unit(s.normal), "{:?}", s);
+        // On the sphere to within the rounding of c + r n.
+        let err = sphere_point_error(c, r);
+        prop_assert!(((s.position - c) - r * s.normal).abs().max_element() <= err);
+    }
+
+    #[test]
+    fn cone_samples_face_the_receiver_with_finite_pdf(c in point(-15.0, 15.0), r in 1e-15f32..1e9, d in unit(), k in -5.0f32..6.0, u1 in 0.0f32..1.0, u2 in 0.0f32..1.0) {
+        // Within the scene domain: coordinates and distances up to 1e15 (scene validation), and
+        // a radius above the precision of the light's own position (0.1 of |c|).
+        let r = r.max(0.1 * c.abs().max_element());
+        let x = c + d * r * (1.0 + 10f32.powf(k)).min(1e15 / r);
+        prop_assume!((x - c).length() > r);
+        let s = sample_sphere_cone(c, r, x, u1, u2);
+        prop_assert!(s.point.position.is_finite() && is_unit(s.point.normal));
+        prop_assert!(s.pdf_solid_angle.is_finite() && s.pdf_solid_angle > 0.0, "pdf {}", s.pdf_solid_angle);
+        prop_assert_eq!(s.pdf_solid_angle, pdf_sphere_cone(c, r, x));
+        let omc = cone_one_minus_cos(r, (x - c).length_squared());
+        prop_assert!(omc > 0.0 && omc <= 1.0);
+        // The sampled point faces the receiver (up to the point's rounding).
+        let to_x = x - s.point.position;
+        prop_assert!(s.point.normal.dot(to_x) >= -2.0 * sphere_point_error(c, r));
+    }
+
+    #[test]
+    fn geometry_factor_and_pdf_conversion_are_finite(pa in point(-30.0, 30.0), na in unit(), pb in point(-30.0, 30.0), nb in unit(), same in any::<bool>(), pdf in 0.0f32..1e6) {
+        let pb = if same { pa } else { pb };
+        let g = geometry_factor(pa, na, pb, nb);
+        prop_assert!(g.is_finite() && g >= 0.0, "G = {g}");
+        let p = area_to_solid_angle_pdf(pdf, pa, pb, nb);
+        prop_assert!(p.is_finite() && p >= 0.0, "pdf = {p}");
+    }
+
+    #[test]
+    fn power_heuristic_is_a_weight(a in 0.0f32..f32::MAX, b in 0.0f32..f32::MAX) {
+        let w = power_heuristic(a, b);
+        prop_assert!(w.is_finite() && (0.0..=1.0).contains(&w), "w({a}, {b}) = {w}");
+    }
+
+    #[test]
+    fn ray_sphere_returns_a_root_in_range_or_none(o in point(-30.0, 30.0), d in unit(), c in point(-30.0, 30.0), r in 1e-30f32..1e30) {
+        let t = intersect_sphere(o, d, c, r, 0.0, f32::INFINITY);
+        prop_assert!(t == -1.0 || (t > 0.0 && t.is_finite()), "t = {t}");
+    }
+
+    #[test]
+    fn ray_triangle_returns_barycentrics_inside(o in point(-30.0, 30.0), d in unit(), p0 in point(-30.0, 30.0), e1 in point(-30.0, 30.0), e2 in point(-30.0, 30.0)) {
+        let h = intersect_triangle_uv(o, d, p0, e1, e2, 0.0, f32::INFINITY);
+        prop_assert!(h.t == -1.0 || (h.t > 0.0 && h.t.is_finite()));
+        if h.t > 0.0 {
+            prop_assert!(h.u >= 0.0 && h.v >= 0.0 && h.u + h.v <= 1.0);
+            let err = triangle_point_error(p0, e1, e2, h.u, h.v);
+            let p = triangle_point(p0, e1, e2, h.u, h.v);
+            prop_assert!(!err.is_nan() && err >= 0.0 && !p.is_nan());
+        }
+    }
+
+    #[test]
+    fn offsets_leave_on_the_normal_side(p in point(-30.0, 30.0), n in unit(), e in scalar(-30.0, 25.0), target in point(-30.0, 30.0)) {
+        // Error bounds are at most a few eps of the coordinates: up to 1e25 against 1e30.
+        let err = e.abs();
+        let q = offset_ray_origin(p, n, err);
+        prop_assert!(q.is_finite(), "{q}");
+        prop_assert!((q - p).dot(n) > 0.0, "{p} -> {q} along {n}");
+        // Shadow rays join two points of a scene: within the domain (1e15), their end is finite.
+        let (p, target) = (p.clamp(Vec3::splat(-1e15), Vec3::splat(1e15)), target.clamp(Vec3::splat(-1e15), Vec3::splat(1e15)));
+        let end = shadow_ray_end(p, target, n, err.min(1e10));
+        prop_assert!(end.is_finite(), "{end}");
+    }
+
+    #[test]
+    fn random_numbers_are_in_the_unit_interval(w in any::<[u32; 4]>()) {
+        let h = pcg4d(w);
+        for x in h {
+            let u = u32_to_unit_f32(x);
+            prop_assert!((0.0..1.0).contains(&u));
+        }
+    }
+}
