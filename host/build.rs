@@ -1,8 +1,14 @@
 //! Compiles `kernel/` to one SPIR-V module with rust-gpu on every build; the module's path
 //! reaches the host as the env var `kernel.spv` (see `vulkan::KERNEL_SPV`).
-use spirv_builder::{Capability, SpirvBuilder};
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    #[cfg(feature = "gpu")]
+    build_kernel()?;
+    Ok(())
+}
+
+#[cfg(feature = "gpu")]
+fn build_kernel() -> Result<(), Box<dyn std::error::Error>> {
+    use spirv_builder::{Capability, SpirvBuilder};
     let kernel = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../kernel");
     let mut builder = SpirvBuilder::new(kernel, "spirv-unknown-vulkan1.2")
         .capability(Capability::RayTracingKHR)

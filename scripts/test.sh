@@ -1,11 +1,17 @@
 #!/usr/bin/env bash
 # Runs every twinpath test: installs what is missing (scripts/setup.sh), then formatting,
-# clippy (warnings are errors), and the whole test suite (kernel properties, samplers,
-# closed-form scenes, the Mitsuba comparison, scene errors, the SPIR-V module).
+# clippy (warnings are errors), the whole test suite (samplers, closed-form scenes, the Mitsuba
+# comparison, CPU-vs-GPU equivalence on lavapipe, numerical robustness, scene errors, the SPIR-V
+# module), and a bounded fuzzing run of the scene and mesh parsers.
 # One build profile (dev, optimised) serves tests and renders alike.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
-cargo test --workspace -- --nocapture "$@"
+mkdir -p target
+cargo test --workspace -- --nocapture "$@" 2>&1 | tee target/test.log
+# libFuzzer on the scene parser and the mesh loaders, 60 s each (cargo-fuzz; see scripts/fuzz.sh).
+bash scripts/fuzz.sh 60
+# One closing line with the totals of every cargo test binary above.
+awk '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p, f }' target/test.log

@@ -3,10 +3,13 @@
 
 pub mod cpu;
 pub mod film;
+#[cfg(feature = "gpu")]
 pub mod render;
 pub mod scene;
 pub mod stats;
+#[cfg(feature = "gpu")]
 pub mod vulkan;
 
 /// The SPIR-V module rust-gpu compiled from `kernel/` at build time (host/build.rs).
+#[cfg(feature = "gpu")]
 pub const KERNEL_SPV: &[u8] = include_bytes!(env!("kernel.spv"));

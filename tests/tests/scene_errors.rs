@@ -336,6 +336,15 @@ fn malformed_ply() {
     let big = header.replace("element vertex 3", "element vertex 100000000");
     let e = parse_ply(p, format!("{big}0 0 0\n").as_bytes()).unwrap_err();
     assert!(e.message.contains("too short"), "{e}");
+    // an element with no properties and a huge count has nothing to read (found by the fuzzer
+    // as its slowest input: it used to loop over the whole declared count)
+    let empty = header.replace("element face 1", "element blob 268435455\nelement face 1");
+    let s = parse_ply(
+        p,
+        format!("{empty}0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").as_bytes(),
+    )
+    .unwrap();
+    assert_eq!(s.triangles.len(), 1);
     // not a ply, binary garbage
     assert!(parse_ply(p, b"\xff\xfe\x00garbage").is_err());
     assert!(parse_ply(p, b"ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nend_header\n\x00").is_err());
