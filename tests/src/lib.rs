@@ -129,3 +129,20 @@ pub fn transform_scene(scene: &Scene, scale: f32, translate: glam::Vec3) -> Scen
     }
     s
 }
+
+/// splitmix64: the tests' own input generator, independent of the kernel's RNG under test.
+pub struct SplitMix(pub u64);
+
+impl SplitMix {
+    pub fn u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1) with 24 random bits.
+    pub fn unit(&mut self) -> f32 {
+        (self.u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}

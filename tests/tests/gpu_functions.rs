@@ -11,17 +11,14 @@ use twinpath_tests::gpu::{assert_validation_clean, context};
 const N: usize = 100_000;
 
 /// splitmix64: the test's own input generator (independent of the kernel's RNG under test).
-struct Gen(u64);
+/// Edge-favouring inputs on top of the shared splitmix64 generator.
+struct Gen(twinpath_tests::SplitMix);
 impl Gen {
     fn u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0.u64()
     }
     fn unit(&mut self) -> f32 {
-        (self.u64() >> 40) as f32 / (1u64 << 24) as f32
+        self.0.unit()
     }
     fn range(&mut self, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * self.unit()
@@ -280,7 +277,7 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
     );
     let mut failures = Vec::new();
     for b in BOUNDS {
-        let mut g = Gen(0x5eed_0000 + b.func as u64);
+        let mut g = Gen(twinpath_tests::SplitMix(0x5eed_0000 + b.func as u64));
         let input = inputs(b.func, &mut g);
         let gpu = runner.run(&ctx, b.func, &input).unwrap();
         let (mut max_ulps, mut max_abs, mut max_rel_scale) = (0u32, 0f32, 0f32);

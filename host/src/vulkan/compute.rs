@@ -96,22 +96,7 @@ impl ProbeRunner {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
                 descriptor_count: 2,
             }];
-            let pool = unsafe {
-                ctx.device.create_descriptor_pool(
-                    &vk::DescriptorPoolCreateInfo::default()
-                        .max_sets(1)
-                        .pool_sizes(&sizes),
-                    None,
-                )
-            }?;
-            let layouts = [self.set_layout];
-            let set = unsafe {
-                ctx.device.allocate_descriptor_sets(
-                    &vk::DescriptorSetAllocateInfo::default()
-                        .descriptor_pool(pool)
-                        .set_layouts(&layouts),
-                )
-            }?[0];
+            let (pool, set) = ctx.create_descriptor_set(self.set_layout, &sizes)?;
             let infos = [&in_buf, &out_buf].map(|b| {
                 [vk::DescriptorBufferInfo::default()
                     .buffer(b.buffer)

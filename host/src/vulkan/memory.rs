@@ -170,21 +170,15 @@ impl Context {
             )
         }?;
         self.submit_and_wait(|cmd| unsafe {
-            let barrier = vk::ImageMemoryBarrier::default()
-                .image(image)
-                .old_layout(vk::ImageLayout::UNDEFINED)
-                .new_layout(vk::ImageLayout::GENERAL)
-                .src_access_mask(vk::AccessFlags::empty())
-                .dst_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                .subresource_range(color_range());
-            self.device.cmd_pipeline_barrier(
+            self.image_barrier(
                 cmd,
-                vk::PipelineStageFlags::TOP_OF_PIPE,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::DependencyFlags::empty(),
-                &[],
-                &[],
-                &[barrier],
+                image,
+                (vk::ImageLayout::UNDEFINED, vk::ImageLayout::GENERAL),
+                (vk::AccessFlags::empty(), vk::AccessFlags::TRANSFER_WRITE),
+                (
+                    vk::PipelineStageFlags::TOP_OF_PIPE,
+                    vk::PipelineStageFlags::TRANSFER,
+                ),
             );
             self.device.cmd_clear_color_image(
                 cmd,
@@ -212,23 +206,21 @@ impl Context {
         )?;
         let result = self
             .submit_and_wait(|cmd| unsafe {
-                let to_src = vk::ImageMemoryBarrier::default()
-                    .image(image.image)
-                    .old_layout(vk::ImageLayout::GENERAL)
-                    .new_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-                    .src_access_mask(
-                        vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
-                    )
-                    .dst_access_mask(vk::AccessFlags::TRANSFER_READ)
-                    .subresource_range(color_range());
-                self.device.cmd_pipeline_barrier(
+                self.image_barrier(
                     cmd,
-                    vk::PipelineStageFlags::ALL_COMMANDS,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::DependencyFlags::empty(),
-                    &[],
-                    &[],
-                    &[to_src],
+                    image.image,
+                    (
+                        vk::ImageLayout::GENERAL,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    ),
+                    (
+                        vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
+                        vk::AccessFlags::TRANSFER_READ,
+                    ),
+                    (
+                        vk::PipelineStageFlags::ALL_COMMANDS,
+                        vk::PipelineStageFlags::TRANSFER,
+                    ),
                 );
                 let region = vk::BufferImageCopy::default()
                     .image_subresource(vk::ImageSubresourceLayers {
@@ -249,21 +241,21 @@ impl Context {
                     staging.buffer,
                     &[region],
                 );
-                let back = vk::ImageMemoryBarrier::default()
-                    .image(image.image)
-                    .old_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-                    .new_layout(vk::ImageLayout::GENERAL)
-                    .src_access_mask(vk::AccessFlags::TRANSFER_READ)
-                    .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE)
-                    .subresource_range(color_range());
-                self.device.cmd_pipeline_barrier(
+                self.image_barrier(
                     cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::ALL_COMMANDS,
-                    vk::DependencyFlags::empty(),
-                    &[],
-                    &[],
-                    &[back],
+                    image.image,
+                    (
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        vk::ImageLayout::GENERAL,
+                    ),
+                    (
+                        vk::AccessFlags::TRANSFER_READ,
+                        vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+                    ),
+                    (
+                        vk::PipelineStageFlags::TRANSFER,
+                        vk::PipelineStageFlags::ALL_COMMANDS,
+                    ),
                 );
             })
             .and_then(|_| self.read_buffer(&staging));
@@ -272,6 +264,67 @@ impl Context {
         Ok(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(
             &raw[..bytes as usize],
         ))
+    }
+
+    /// Records a layout transition of a whole colour image: (old, new) layouts, (source,
+    /// destination) access masks and (source, destination) pipeline stages.
+    fn image_barrier(
+        &self,
+        cmd: vk::CommandBuffer,
+        image: vk::Image,
+        layouts: (vk::ImageLayout, vk::ImageLayout),
+        access: (vk::AccessFlags, vk::AccessFlags),
+        stages: (vk::PipelineStageFlags, vk::PipelineStageFlags),
+    ) {
+        let barrier = vk::ImageMemoryBarrier::default()
+            .image(image)
+            .old_layout(layouts.0)
+            .new_layout(layouts.1)
+            .src_access_mask(access.0)
+            .dst_access_mask(access.1)
+            .subresource_range(color_range());
+        unsafe {
+            self.device.cmd_pipeline_barrier(
+                cmd,
+                stages.0,
+                stages.1,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &[barrier],
+            );
+        }
+    }
+
+    /// A descriptor pool sized by `sizes` holding one set of `layout`.
+    pub fn create_descriptor_set(
+        &self,
+        layout: vk::DescriptorSetLayout,
+        sizes: &[vk::DescriptorPoolSize],
+    ) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
+        let pool = unsafe {
+            self.device.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(1)
+                    .pool_sizes(sizes),
+                None,
+            )
+        }?;
+        let layouts = [layout];
+        let set = unsafe {
+            self.device.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pool)
+                    .set_layouts(&layouts),
+            )
+        };
+        match set {
+            Ok(sets) => Ok((pool, sets[0])),
+            Err(e) => {
+                unsafe { self.device.destroy_descriptor_pool(pool, None) };
+                Err(e.into())
+            }
+        }
     }
 
     pub fn destroy_image(&self, mut image: Image) {

@@ -87,22 +87,7 @@ impl GpuRenderer {
                 descriptor_count: 5,
             },
         ];
-        let pool = unsafe {
-            ctx.device.create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(1)
-                    .pool_sizes(&sizes),
-                None,
-            )
-        }?;
-        let layouts = [pipeline.set_layout];
-        let set = unsafe {
-            ctx.device.allocate_descriptor_sets(
-                &vk::DescriptorSetAllocateInfo::default()
-                    .descriptor_pool(pool)
-                    .set_layouts(&layouts),
-            )
-        }?[0];
+        let (pool, set) = ctx.create_descriptor_set(pipeline.set_layout, &sizes)?;
         let tlas = [accel.tlas.handle];
         let mut as_write = vk::WriteDescriptorSetAccelerationStructureKHR::default()
             .acceleration_structures(&tlas);
