@@ -2,7 +2,7 @@
 # Installs everything twinpath needs on Debian 12 (idempotent):
 #   - the pinned nightly toolchain rust-gpu 0.11 needs, with its components (rustup);
 #   - Vulkan loader, lavapipe (Mesa 25 from bookworm-backports, for the GPU backend without a GPU),
-#     vulkan-tools, validation layers, spirv-tools (spirv-val).
+#     vulkan-tools, validation layers, spirv-tools (spirv-val), DejaVu fonts (bench plot text).
 # Apt steps run only as root or via sudo; they are skipped when everything is already installed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,7 +18,7 @@ else
 fi
 
 need_pkgs=()
-for p in libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools mesa-vulkan-drivers; do
+for p in libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools mesa-vulkan-drivers fonts-dejavu-core; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || need_pkgs+=("$p")
 done
 # lavapipe must come from backports (Mesa >= 25 exposes the ray-tracing extensions)
@@ -41,5 +41,5 @@ if [ ${#need_pkgs[@]} -gt 0 ] || [ -n "${need_mesa:-}" ]; then
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -q
   $SUDO apt-get install -y -q -t bookworm-backports mesa-vulkan-drivers
-  $SUDO apt-get install -y -q libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools
+  $SUDO apt-get install -y -q libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools fonts-dejavu-core
 fi

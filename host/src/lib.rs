@@ -1,6 +1,8 @@
 //! twinpath's host: scenes, the CPU backend, the film and image files, and the render driver.
 //! Everything here is "not a pixel's value"; the kernel crate decides those.
 
+#[cfg(feature = "gpu")]
+pub mod bench;
 pub mod cpu;
 pub mod film;
 #[cfg(feature = "gpu")]

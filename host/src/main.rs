@@ -3,6 +3,7 @@
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
+use twinpath::bench::{run_bench, write_csv, write_plot, BenchConfig, Variant};
 use twinpath::film::{diff_images, RgbImage};
 use twinpath::render::{install_interrupt_handler, render, Backend, RenderOptions};
 use twinpath::scene::{Scene, DEFAULT_SCENE_NAME};
@@ -40,6 +41,13 @@ enum LightSampling {
     Cone,
     /// The seed's uniform point on the light's whole surface.
     Area,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum BenchBackends {
+    Cpu,
+    Gpu,
+    Both,
 }
 
 #[derive(Subcommand)]
@@ -87,6 +95,45 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Time against error: render at 1, 2, 4, ... spp per variant and backend; CSV and a plot.
+    Bench {
+        /// Scene file (TOML). Without it, the built-in Cornell scene.
+        scene: Option<PathBuf>,
+        /// Converged reference image (EXR) of the same scene, e.g. from `twinpath reference`.
+        #[arg(long)]
+        reference: PathBuf,
+        #[arg(long, value_enum, default_value_t = BenchBackends::Cpu)]
+        backend: BenchBackends,
+        /// NAME or NAME:key=value,... (mis=power|half, light_sampling=cone|area,
+        /// roulette=constant|throughput, rr=P, rr_start_depth=D), on top of the scene's
+        /// settings; repeat to compare. Default: one variant, the scene's settings.
+        #[arg(long = "variant")]
+        variants: Vec<String>,
+        /// Largest spp of the sweep.
+        #[arg(long, default_value_t = 256)]
+        max_spp: u32,
+        /// Stop a curve after a render slower than this (seconds).
+        #[arg(long, default_value_t = 60.0)]
+        max_seconds: f64,
+        /// Independent seeds per point at spp <= 8.
+        #[arg(long, default_value_t = 4)]
+        seeds: u32,
+        /// Output folder for bench.csv and bench.png.
+        #[arg(long, default_value = "bench")]
+        out_dir: PathBuf,
+    },
+    /// Render a converged reference as the mean of two independent halves, and estimate its noise.
+    Reference {
+        scene: Option<PathBuf>,
+        /// Total samples per pixel (each half renders half of them).
+        #[arg(long)]
+        spp: u32,
+        #[arg(long, value_enum, default_value_t = Backend::Auto)]
+        backend: Backend,
+        /// Output EXR; the halves go beside it as <stem>_half_a.exr and <stem>_half_b.exr.
+        #[arg(long, short = 'o', default_value = "reference.exr")]
+        out: PathBuf,
+    },
     /// Compare two images: RMSE, relMSE, mean signed difference, max abs difference.
     Diff {
         /// The image to judge.
@@ -129,10 +176,7 @@ fn run() -> Result<()> {
                     .build_global()
                     .context("cannot set the thread count")?;
             }
-            let mut scene = match &scene {
-                Some(path) => Scene::load(path)?,
-                None => Scene::builtin_default(),
-            };
+            let mut scene = load_scene(scene.as_deref())?;
             let r = &mut scene.render;
             if let Some(s) = spp {
                 if s == 0 {
@@ -243,6 +287,115 @@ fn run() -> Result<()> {
             }
             Ok(())
         }
+        Command::Bench {
+            scene,
+            reference,
+            backend,
+            variants,
+            max_spp,
+            max_seconds,
+            seeds,
+            out_dir,
+        } => {
+            install_interrupt_handler();
+            let scene = load_scene(scene.as_deref())?;
+            let reference_image = RgbImage::read(&reference)?;
+            let variants = if variants.is_empty() {
+                vec![Variant {
+                    name: "scene".into(),
+                    settings: scene.render,
+                }]
+            } else {
+                variants
+                    .iter()
+                    .map(|v| Variant::parse(v, &scene.render))
+                    .collect::<Result<_>>()?
+            };
+            let backends = match backend {
+                BenchBackends::Cpu => vec![Backend::Cpu],
+                BenchBackends::Gpu => vec![Backend::Gpu],
+                BenchBackends::Both => vec![Backend::Cpu, Backend::Gpu],
+            };
+            let cfg = BenchConfig {
+                variants,
+                backends,
+                max_spp,
+                max_seconds,
+                seeds,
+            };
+            std::fs::create_dir_all(&out_dir)
+                .with_context(|| format!("{}: cannot create", out_dir.display()))?;
+            let rows = run_bench(&scene, &reference_image, &cfg, |r| {
+                eprintln!(
+                    "bench: {} {:?} {:>5} spp seed {:>3}: render {:>8.3} s, relMSE {:.4e}, efficiency {:.4e}",
+                    r.variant, r.backend, r.spp, r.seed, r.render_s, r.relmse, r.efficiency
+                )
+            })?;
+            let csv = out_dir.join("bench.csv");
+            write_csv(&rows, &csv)?;
+            eprintln!("bench: wrote {}", csv.display());
+            let png = out_dir.join("bench.png");
+            write_plot(
+                &rows,
+                &format!("{}: relMSE against render time", scene.name),
+                &png,
+            )?;
+            eprintln!("bench: wrote {}", png.display());
+            Ok(())
+        }
+        Command::Reference {
+            scene,
+            spp,
+            backend,
+            out,
+        } => {
+            install_interrupt_handler();
+            if spp < 2 {
+                bail!("--spp must be at least 2 (two halves)");
+            }
+            let mut scene = load_scene(scene.as_deref())?;
+            scene.render.spp = spp / 2;
+            let opts = RenderOptions {
+                backend,
+                device: None,
+                validation: false,
+                progress: true,
+            };
+            let a = render(&scene, &opts)?;
+            scene.render.seed = scene.render.seed.wrapping_add(0x9e37_79b9);
+            let b = render(&scene, &opts)?;
+            if a.interrupted || b.interrupted {
+                bail!("interrupted: no reference written");
+            }
+            let (ia, ib) = (RgbImage::from_film(&a.film), RgbImage::from_film(&b.film));
+            let mean = RgbImage {
+                width: ia.width,
+                height: ia.height,
+                pixels: ia
+                    .pixels
+                    .iter()
+                    .zip(&ib.pixels)
+                    .map(|(p, q)| std::array::from_fn(|c| 0.5 * (p[c] + q[c])))
+                    .collect(),
+            };
+            let stem = out
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("reference");
+            let half = |tag: &str| out.with_file_name(format!("{stem}_half_{tag}.exr"));
+            mean.write(&out)?;
+            ia.write(&half("a"))?;
+            ib.write(&half("b"))?;
+            // The mean of two halves has a quarter of their squared difference as its error.
+            let d = diff_images(&ia, &ib)?;
+            eprintln!(
+                "reference: wrote {} ({spp} spp) and its halves; estimated noise: RMSE {:.3e}, relMSE {:.3e}",
+                out.display(),
+                d.rmse / 2.0,
+                d.relmse / 4.0
+            );
+            Ok(())
+        }
         Command::Diff { a, b } => {
             let ia = RgbImage::read(&a)?;
             let ib = RgbImage::read(&b)?;
@@ -282,6 +435,14 @@ fn run() -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// The scene file, or the built-in Cornell scene.
+fn load_scene(path: Option<&Path>) -> Result<Scene> {
+    Ok(match path {
+        Some(p) => Scene::load(p)?,
+        None => Scene::builtin_default(),
+    })
 }
 
 /// `scenes/cornell.toml` -> `cornell`; the built-in scene -> `cornell`.

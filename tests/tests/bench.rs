@@ -1,0 +1,90 @@
+//! The bench harness: a sweep's rows, its CSV and its plot, and that error falls with spp.
+
+use twinpath::bench::{run_bench, write_csv, write_plot, BenchConfig, Variant};
+use twinpath::film::{diff_images, RgbImage};
+use twinpath::render::{render, Backend, RenderOptions};
+use twinpath::scene::Scene;
+
+#[test]
+fn bench_sweeps_writes_csv_and_plot() {
+    let mut scene = Scene::builtin_default();
+    scene.camera.width = 32;
+    scene.camera.height = 32;
+    // A reference for the test: 256 spp of the same small scene.
+    let mut r = scene.clone();
+    r.render.spp = 256;
+    r.render.seed = 999;
+    let reference = RgbImage::from_film(
+        &render(
+            &r,
+            &RenderOptions {
+                backend: Backend::Cpu,
+                ..Default::default()
+            },
+        )
+        .unwrap()
+        .film,
+    );
+    let variants = vec![
+        Variant::parse("seed:mis=half,light_sampling=area", &scene.render).unwrap(),
+        Variant::parse("default", &scene.render).unwrap(),
+    ];
+    assert!(Variant::parse("x:mis=sometimes", &scene.render).is_err());
+    assert!(Variant::parse("x:rr=1.5", &scene.render).is_err());
+    let cfg = BenchConfig {
+        variants,
+        backends: vec![Backend::Cpu],
+        max_spp: 8,
+        max_seconds: 1e9,
+        seeds: 2,
+    };
+    let rows = run_bench(&scene, &reference, &cfg, |_| {}).unwrap();
+    // 2 variants x spp 1, 2, 4, 8 x 2 seeds.
+    assert_eq!(rows.len(), 2 * 4 * 2);
+    for row in &rows {
+        assert!(row.relmse > 0.0 && row.render_s > 0.0);
+        assert!((row.efficiency * row.relmse * row.render_s - 1.0).abs() < 1e-9);
+    }
+    // The error is the one `twinpath diff` reports, for the same render.
+    let first = &rows[0];
+    let mut s = scene.clone();
+    s.render = cfg.variants[0].settings;
+    s.render.spp = first.spp;
+    s.render.seed = first.seed;
+    let again = render(
+        &s,
+        &RenderOptions {
+            backend: Backend::Cpu,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let d = diff_images(&RgbImage::from_film(&again.film), &reference).unwrap();
+    assert_eq!(d.relmse, first.relmse);
+    // Error falls with samples: each variant's mean relMSE at 8 spp is below its 1 spp one.
+    for v in ["seed", "default"] {
+        let mean_at = |spp| {
+            let r: Vec<f64> = rows
+                .iter()
+                .filter(|r| r.variant == v && r.spp == spp)
+                .map(|r| r.relmse)
+                .collect();
+            r.iter().sum::<f64>() / r.len() as f64
+        };
+        assert!(
+            mean_at(8) < mean_at(1),
+            "{v}: {} vs {}",
+            mean_at(8),
+            mean_at(1)
+        );
+    }
+    let dir = std::env::temp_dir().join(format!("twinpath-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    write_csv(&rows, &dir.join("bench.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.join("bench.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + rows.len());
+    assert!(csv.starts_with("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n"));
+    write_plot(&rows, "test", &dir.join("bench.png")).unwrap();
+    let png = image::open(dir.join("bench.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (900, 600));
+}
