@@ -1,0 +1,140 @@
+//! The `twinpath` binary end to end: errors, outputs, and Ctrl-C keeping the image so far.
+
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_twinpath");
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("twinpath-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A small copy of the Cornell scene.
+fn small_scene(dir: &std::path::Path, side: u32) -> PathBuf {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/cornell.toml"
+    ))
+    .unwrap()
+    .replace("width = 256", &format!("width = {side}"))
+    .replace("height = 256", &format!("height = {side}"));
+    let path = dir.join("small.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn bad_scene_is_an_error_naming_file_line_and_field() {
+    let dir = temp_dir("bad");
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, "[camera]\neye = [0, 1, 4]\nlook_at = [0, 1, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 0\nheight = 8\n").unwrap();
+    let out = Command::new(BIN)
+        .args(["render", "--backend", "cpu"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    println!("{err}");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        err.contains(&format!("{}:6: camera.width:", path.display())),
+        "{err}"
+    );
+}
+
+#[test]
+fn render_writes_exr_and_png() {
+    let dir = temp_dir("out");
+    let scene = small_scene(&dir, 16);
+    let (exr, png) = (dir.join("a.exr"), dir.join("a.png"));
+    let out = Command::new(BIN)
+        .args(["render", "--backend", "cpu", "--spp", "2", "--quiet", "-o"])
+        .arg(&exr)
+        .arg("-o")
+        .arg(&png)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let e = image::open(&exr).unwrap();
+    let p = image::open(&png).unwrap();
+    assert_eq!(
+        (e.width(), e.height(), p.width(), p.height()),
+        (16, 16, 16, 16)
+    );
+    // An unknown extension is an error before rendering.
+    let out = Command::new(BIN)
+        .args(["render", "--spp", "1", "-o", "x.jpg"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}
+
+/// Starts a render that would take hours, sends SIGINT, and expects the image so far.
+fn interrupt(backend: &str) {
+    let dir = temp_dir(backend);
+    let scene = small_scene(&dir, 64);
+    let exr = dir.join("partial.exr");
+    let mut child = Command::new(BIN)
+        .args([
+            "render",
+            "--backend",
+            backend,
+            "--spp",
+            "1000000",
+            "--quiet",
+            "-o",
+        ])
+        .arg(&exr)
+        .arg(&scene)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_secs(3));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    // Not a speed limit: a safety net in case SIGINT were ignored.
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(300) {
+            child.kill().unwrap();
+            panic!("{backend}: the render ignored SIGINT");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    println!("{err}");
+    assert!(out.status.success(), "{backend}: {err}");
+    assert!(
+        err.contains("interrupted: writing the image so far"),
+        "{err}"
+    );
+    assert!(err.contains("of 1000000 samples per pixel"), "{err}");
+    let img = image::open(&exr).unwrap().to_rgb32f();
+    assert!(
+        img.pixels().any(|p| p.0[0] > 0.0),
+        "{backend}: the partial image is black"
+    );
+}
+
+#[test]
+fn ctrl_c_writes_the_image_so_far_cpu() {
+    interrupt("cpu");
+}
+
+#[test]
+fn ctrl_c_writes_the_image_so_far_gpu() {
+    interrupt("gpu");
+}
