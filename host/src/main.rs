@@ -237,6 +237,8 @@ fn run() -> Result<()> {
                     _ => bail!("--out {}: unknown format (use .exr or .png)", o.display()),
                 }
             }
+            // From here on Ctrl-C stops the render and keeps the image (the line below says so).
+            install_interrupt_handler();
             eprintln!(
                 "twinpath: {} ({}x{}, {} spheres, {} triangles, {} lights), {} spp, seed {}",
                 scene.name,
@@ -248,7 +250,6 @@ fn run() -> Result<()> {
                 scene.render.spp,
                 scene.render.seed
             );
-            install_interrupt_handler();
             let opts = RenderOptions {
                 backend,
                 device,

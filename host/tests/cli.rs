@@ -1,5 +1,6 @@
 //! The `twinpath` binary end to end: errors, outputs, and Ctrl-C keeping the image so far.
 
+use std::io::{BufRead, BufReader, Read};
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -98,7 +99,18 @@ fn interrupt(backend: &str) {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_secs(3));
+    // The binary installs its Ctrl-C handler before its first log line: wait for that line,
+    // let it render a moment, then interrupt.
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut first = String::new();
+    stderr.read_line(&mut first).unwrap();
+    assert!(first.starts_with("twinpath: "), "{first}");
+    let drain = std::thread::spawn(move || {
+        let mut rest = String::new();
+        stderr.read_to_string(&mut rest).unwrap();
+        rest
+    });
+    std::thread::sleep(Duration::from_secs(2));
     let status = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
@@ -113,10 +125,10 @@ fn interrupt(backend: &str) {
         }
         std::thread::sleep(Duration::from_millis(100));
     }
-    let out = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
+    let status = child.wait().unwrap();
+    let err = first + &drain.join().unwrap();
     println!("{err}");
-    assert!(out.status.success(), "{backend}: {err}");
+    assert!(status.success(), "{backend}: {err}");
     assert!(
         err.contains("interrupted: writing the image so far"),
         "{err}"
