@@ -146,3 +146,29 @@ impl SplitMix {
         (self.u64() >> 40) as f32 / (1u64 << 24) as f32
     }
 }
+
+/// The closed-form test scene: a diffuse plane y = 0 of albedo `kd` (200 x 200 units) under a
+/// sphere light of radius `r` and radiance `l` centred at height `h` above the origin, with the
+/// given `[camera]` and `[render]` table bodies.
+pub fn plane_under_light(camera: &str, render: &str, kd: f32, h: f32, r: f32, l: f32) -> Scene {
+    scene_from_toml(&format!(
+        r#"
+        [camera]
+        {camera}
+        [render]
+        {render}
+        [materials]
+        plane = {{ kd = [{kd}, {kd}, {kd}] }}
+        lamp = {{ emission = [{l}, {l}, {l}] }}
+        [[quad]]
+        corner = [-100, 0, 100]
+        edge1 = [200, 0, 0]
+        edge2 = [0, 0, -200]
+        material = "plane"
+        [[sphere]]
+        center = [0, {h}, 0]
+        radius = {r}
+        material = "lamp"
+        "#
+    ))
+}

@@ -36,32 +36,14 @@ const MAX_BATCHES: u32 = 32;
 
 fn plane_scene(mis_mode: &str, roulette: &str, lamp: Lamp) -> Scene {
     let Lamp { r, l } = lamp;
-    let mut s = scene_from_toml(&format!(
-        r#"
-        [camera]
-        eye = [0, 5, 5]
-        look_at = [0, 0, 0]
-        up = [0, 1, 0]
-        vfov = 40
-        width = 8
-        height = 8
-        [render]
-        mis = "{mis_mode}"
-        roulette = "{roulette}"
-        [materials]
-        plane = {{ kd = [{KD}, {KD}, {KD}] }}
-        lamp = {{ emission = [{l}, {l}, {l}] }}
-        [[quad]]
-        corner = [-100, 0, 100]
-        edge1 = [200, 0, 0]
-        edge2 = [0, 0, -200]
-        material = "plane"
-        [[sphere]]
-        center = [0, {H}, 0]
-        radius = {r}
-        material = "lamp"
-        "#
-    ));
+    let mut s = twinpath_tests::plane_under_light(
+        "eye = [0, 5, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 8\nheight = 8",
+        &format!("mis = \"{mis_mode}\"\nroulette = \"{roulette}\""),
+        KD,
+        H,
+        r,
+        l,
+    );
     // Roulette from the first vertex on, so its division is exercised at every step.
     s.render.rr_start_depth = 1;
     s

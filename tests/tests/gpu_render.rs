@@ -79,31 +79,14 @@ const LAMPS: [(f32, f32); 2] = [(0.5, 5.0), (2e-4, 2.5e7)];
 /// The plane-under-a-sphere-light scene seen from above at an angle, covering plane points up
 /// to about 80 degrees from the foot of the light.
 fn plane_scene((r, l): (f32, f32)) -> Scene {
-    scene_from_toml(&format!(
-        r#"
-        [camera]
-        eye = [0, 9, 9]
-        look_at = [0, 0, -1]
-        up = [0, 1, 0]
-        vfov = 70
-        width = 48
-        height = 48
-        [render]
-        seed = 3
-        [materials]
-        plane = {{ kd = [{KD}, {KD}, {KD}] }}
-        lamp = {{ emission = [{l}, {l}, {l}] }}
-        [[quad]]
-        corner = [-100, 0, 100]
-        edge1 = [200, 0, 0]
-        edge2 = [0, 0, -200]
-        material = "plane"
-        [[sphere]]
-        center = [0, {H}, 0]
-        radius = {r}
-        material = "lamp"
-        "#
-    ))
+    twinpath_tests::plane_under_light(
+        "eye = [0, 9, 9]\nlook_at = [0, 0, -1]\nup = [0, 1, 0]\nvfov = 70\nwidth = 48\nheight = 48",
+        "seed = 3",
+        KD,
+        H,
+        r,
+        l,
+    )
 }
 
 /// The exact pixel values: kd L (r/D)^2 cos(theta) at the plane point each camera ray meets,
