@@ -69,18 +69,48 @@ pub fn install_interrupt_handler() {
     });
 }
 
+/// Why `--backend auto` should render on the CPU without trying a Vulkan device: the best
+/// usable device is itself a CPU implementation (lavapipe/llvmpipe runs the same kernel on the
+/// same cores, about 3x slower than the native backend). None when a real GPU is usable, or a
+/// device was named with `--device`, or no device is usable (then opening one reports why).
+fn auto_prefers_cpu(device: Option<usize>) -> Option<String> {
+    if device.is_some() {
+        return None;
+    }
+    let devices = crate::vulkan::device::list_devices().ok()?;
+    let usable: Vec<_> = devices.iter().filter(|d| d.usable()).collect();
+    if !usable.is_empty()
+        && usable
+            .iter()
+            .all(|d| d.device_type == ash::vk::PhysicalDeviceType::CPU)
+    {
+        Some(format!(
+            "the only ray-tracing Vulkan device is a CPU implementation ({}; --backend gpu uses it)",
+            usable[0].name
+        ))
+    } else {
+        None
+    }
+}
+
 /// Renders `scene.render.spp` samples per pixel.
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
     let t0 = Instant::now();
     let gpu = match opts.backend {
         Backend::Cpu => None,
         Backend::Gpu => Some(GpuRenderer::new(scene, opts.device, opts.validation)?),
-        Backend::Auto => match GpuRenderer::new(scene, opts.device, opts.validation) {
-            Ok(g) => Some(g),
-            Err(e) => {
-                eprintln!("twinpath: --backend auto: no usable GPU ({e:#}); using the CPU");
+        Backend::Auto => match auto_prefers_cpu(opts.device) {
+            Some(reason) => {
+                eprintln!("twinpath: --backend auto: {reason}; using the CPU backend");
                 None
             }
+            None => match GpuRenderer::new(scene, opts.device, opts.validation) {
+                Ok(g) => Some(g),
+                Err(e) => {
+                    eprintln!("twinpath: --backend auto: no usable GPU ({e:#}); using the CPU");
+                    None
+                }
+            },
         },
     };
     let spp = scene.render.spp;
