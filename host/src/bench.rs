@@ -180,30 +180,50 @@ pub fn write_csv(rows: &[BenchRow], path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// One point per (variant, backend, spp): the mean render time and relMSE over its seeds.
+/// One point per (variant, backend, spp): the mean render time and relMSE over its seeds,
+/// curves and points in the order they first appear.
 pub fn curves(rows: &[BenchRow]) -> Vec<(String, Vec<(f64, f64)>)> {
-    let mut out: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    /// Sums over the seeds of one point.
+    struct Point {
+        spp: u32,
+        time: f64,
+        relmse: f64,
+        renders: f64,
+    }
+    let mut sums: Vec<(String, Vec<Point>)> = Vec::new();
     for r in rows {
         let label = format!("{} ({:?})", r.variant, r.backend).to_lowercase();
-        let curve = match out.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, c)) => c,
+        let i = match sums.iter().position(|(l, _)| *l == label) {
+            Some(i) => i,
             None => {
-                out.push((label, Vec::new()));
-                &mut out.last_mut().expect("just pushed").1
+                sums.push((label, Vec::new()));
+                sums.len() - 1
             }
         };
-        let same: Vec<&BenchRow> = rows
-            .iter()
-            .filter(|o| o.variant == r.variant && o.backend == r.backend && o.spp == r.spp)
-            .collect();
-        if same[0].seed == r.seed {
-            let n = same.len() as f64;
-            let t = same.iter().map(|o| o.render_s).sum::<f64>() / n;
-            let e = same.iter().map(|o| o.relmse).sum::<f64>() / n;
-            curve.push((t, e));
+        let points = &mut sums[i].1;
+        match points.iter_mut().find(|p| p.spp == r.spp) {
+            Some(p) => {
+                p.time += r.render_s;
+                p.relmse += r.relmse;
+                p.renders += 1.0;
+            }
+            None => points.push(Point {
+                spp: r.spp,
+                time: r.render_s,
+                relmse: r.relmse,
+                renders: 1.0,
+            }),
         }
     }
-    out
+    sums.into_iter()
+        .map(|(label, points)| {
+            let curve = points
+                .iter()
+                .map(|p| (p.time / p.renders, p.relmse / p.renders))
+                .collect();
+            (label, curve)
+        })
+        .collect()
 }
 
 /// The font the plot's text uses: DejaVu Sans from Debian's fonts-dejavu-core

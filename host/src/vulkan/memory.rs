@@ -22,6 +22,26 @@ pub struct Image {
 }
 
 impl Context {
+    /// Memory from gpu-allocator for a resource with `requirements` (`linear`: a buffer).
+    fn allocate(
+        &self,
+        name: &str,
+        requirements: vk::MemoryRequirements,
+        location: MemoryLocation,
+        linear: bool,
+    ) -> gpu_allocator::Result<Allocation> {
+        self.allocator
+            .lock()
+            .expect("allocator lock")
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+    }
+
     /// A buffer of `size` bytes (at least 1) in `location`.
     pub fn create_buffer(
         &self,
@@ -43,16 +63,7 @@ impl Context {
         .with_context(|| format!("cannot create buffer {name} ({size} bytes)"))?;
         let requirements = unsafe { self.device.get_buffer_memory_requirements(buffer) };
         let allocation = self
-            .allocator
-            .lock()
-            .expect("allocator lock")
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
+            .allocate(name, requirements, location, true)
             .with_context(|| format!("cannot allocate memory for {name} ({size} bytes)"))?;
         unsafe {
             self.device
@@ -144,16 +155,7 @@ impl Context {
         }?;
         let requirements = unsafe { self.device.get_image_memory_requirements(image) };
         let allocation = self
-            .allocator
-            .lock()
-            .expect("allocator lock")
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
+            .allocate(name, requirements, MemoryLocation::GpuOnly, false)
             .with_context(|| format!("cannot allocate image {name} ({width}x{height})"))?;
         unsafe {
             self.device
