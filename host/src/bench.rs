@@ -7,7 +7,7 @@ use crate::film::{diff_images, RgbImage};
 use crate::render::{render, Backend, RenderOptions};
 use crate::scene::{RenderSettings, Scene};
 use anyhow::{anyhow, bail, Context, Result};
-use kernel::scene::{light_sampling, mis, roulette};
+use kernel::scene::{light_sampling, light_selection, mis, roulette};
 use std::io::Write;
 use std::path::Path;
 
@@ -20,8 +20,9 @@ pub struct Variant {
 
 impl Variant {
     /// Parses `NAME` or `NAME:key=value,key=value` on top of `base`; keys: mis (power|half),
-    /// light_sampling (cone|area), roulette (constant|throughput), rr (probability),
-    /// rr_start_depth (vertex).
+    /// light_sampling (cone|area), light_selection (power|uniform), roulette
+    /// (constant|throughput), rr (probability), rr_start_depth (vertex), specialize (on|off),
+    /// adaptive (target relative error, 0: off).
     pub fn parse(spec: &str, base: &RenderSettings) -> Result<Variant> {
         let (name, rest) = spec.split_once(':').unwrap_or((spec, ""));
         if name.is_empty() {
@@ -37,6 +38,17 @@ impl Variant {
                 ("mis", "half") => s.mis_mode = mis::HALF,
                 ("light_sampling", "cone") => s.light_sampling = light_sampling::CONE,
                 ("light_sampling", "area") => s.light_sampling = light_sampling::AREA,
+                ("light_selection", "power") => s.light_selection = light_selection::POWER,
+                ("light_selection", "uniform") => s.light_selection = light_selection::UNIFORM,
+                ("specialize", "on") => s.specialize = true,
+                ("specialize", "off") => s.specialize = false,
+                ("adaptive", t) => {
+                    let t: f32 = t.parse().with_context(|| format!("--variant {spec:?}: adaptive"))?;
+                    if !(t >= 0.0 && t.is_finite()) {
+                        bail!("--variant {spec:?}: adaptive = {t} is not a relative error >= 0");
+                    }
+                    s.adaptive_target = t;
+                }
                 ("roulette", "constant") => s.rr_mode = roulette::CONSTANT,
                 ("roulette", "throughput") => {
                     s.rr_mode = roulette::THROUGHPUT;
@@ -54,7 +66,7 @@ impl Variant {
                         .parse()
                         .with_context(|| format!("--variant {spec:?}: rr_start_depth"))?
                 }
-                _ => bail!("--variant {spec:?}: unknown setting {kv:?} (keys: mis, light_sampling, roulette, rr, rr_start_depth)"),
+                _ => bail!("--variant {spec:?}: unknown setting {kv:?} (keys: mis, light_sampling, light_selection, roulette, rr, rr_start_depth, specialize, adaptive)"),
             }
         }
         Ok(Variant {

@@ -16,6 +16,10 @@ pub struct Film {
     pub count: Vec<u32>,
     /// Non-finite samples dropped (expected: 0).
     pub discarded: u64,
+    /// Adaptive sampling's pilot samples (`kernel::adaptive`): luminance sum and sum of
+    /// squares per pixel, and their number. Not part of the image.
+    pub pilot: Vec<[f64; 2]>,
+    pub pilot_count: Vec<u32>,
 }
 
 impl Film {
@@ -28,7 +32,37 @@ impl Film {
             sum_sq: vec![[0.0; 3]; n],
             count: vec![0; n],
             discarded: 0,
+            pilot: vec![[0.0; 2]; n],
+            pilot_count: vec![0; n],
         }
+    }
+
+    /// Whether adaptive sampling stops pixel (px, py): `kernel::adaptive::pixel_converged` on
+    /// the pilots' mean and sum of squared deviations.
+    pub fn converged(&self, params: &kernel::scene::RenderParams, px: u32, py: u32) -> bool {
+        let i = (py * self.width + px) as usize;
+        let n = self.pilot_count[i] as f64;
+        if n < 1.0 {
+            return false;
+        }
+        let mean = self.pilot[i][0] / n;
+        let m2 = (self.pilot[i][1] - n * mean * mean).max(0.0);
+        kernel::adaptive::pixel_converged(
+            params,
+            mean as f32,
+            m2 as f32,
+            n as f32,
+            self.count[i] as f32,
+        )
+    }
+
+    /// Samples each pixel received (image and pilot samples), row by row.
+    pub fn samples_per_pixel(&self) -> Vec<u32> {
+        self.count
+            .iter()
+            .zip(&self.pilot_count)
+            .map(|(c, p)| c + p)
+            .collect()
     }
 
     pub fn add_sums(&mut self, px: u32, py: u32, s: &PixelSums) {
@@ -39,6 +73,9 @@ impl Film {
         }
         self.count[i] += s.count;
         self.discarded += s.discarded as u64;
+        self.pilot[i][0] += s.pilot[0];
+        self.pilot[i][1] += s.pilot[1];
+        self.pilot_count[i] += s.pilot_count;
     }
 
     /// The pixel values: the plain mean of each pixel's samples (box filter).
@@ -71,9 +108,9 @@ impl Film {
             .collect()
     }
 
-    /// Total samples over all pixels.
+    /// Total samples over all pixels (image and pilot samples).
     pub fn total_samples(&self) -> u64 {
-        self.count.iter().map(|&c| c as u64).sum()
+        self.samples_per_pixel().iter().map(|&c| c as u64).sum()
     }
 }
 

@@ -44,6 +44,14 @@ enum LightSampling {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
+enum LightSelection {
+    /// Proportional to each light's power (alias table).
+    Power,
+    /// The seed's uniform choice.
+    Uniform,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
 enum BenchBackends {
     Cpu,
     Gpu,
@@ -88,6 +96,19 @@ enum Command {
         /// How next-event estimation picks a point on a sphere light.
         #[arg(long, value_enum)]
         light_sampling: Option<LightSampling>,
+        /// How next-event estimation picks one of several lights.
+        #[arg(long, value_enum)]
+        light_selection: Option<LightSelection>,
+        /// Run the generic kernel path instead of one specialized to the scene's features.
+        #[arg(long)]
+        no_specialize: bool,
+        /// Adaptive sampling: stop each pixel once its estimated relative error is below this
+        /// (--spp is then the most a pixel gets). Unbiased: see README "Adaptive sampling".
+        #[arg(long)]
+        target_error: Option<f32>,
+        /// Write the samples each pixel received as an image (EXR: the count in every channel).
+        #[arg(long)]
+        spp_map: Option<PathBuf>,
         /// Worker threads for the CPU backend (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
@@ -105,7 +126,8 @@ enum Command {
         #[arg(long, value_enum, default_value_t = BenchBackends::Cpu)]
         backend: BenchBackends,
         /// NAME or NAME:key=value,... (mis=power|half, light_sampling=cone|area,
-        /// roulette=constant|throughput, rr=P, rr_start_depth=D), on top of the scene's
+        /// light_selection=power|uniform, roulette=constant|throughput, rr=P,
+        /// rr_start_depth=D, specialize=on|off, adaptive=TARGET), on top of the scene's
         /// settings; repeat to compare. Default: one variant, the scene's settings.
         #[arg(long = "variant")]
         variants: Vec<String>,
@@ -167,6 +189,10 @@ fn run() -> Result<()> {
             rr_start_depth,
             mis,
             light_sampling,
+            light_selection,
+            no_specialize,
+            target_error,
+            spp_map,
             threads,
             quiet,
         } => {
@@ -216,6 +242,30 @@ fn run() -> Result<()> {
                     LightSampling::Cone => kernel::scene::light_sampling::CONE,
                     LightSampling::Area => kernel::scene::light_sampling::AREA,
                 };
+            }
+            if let Some(l) = light_selection {
+                r.light_selection = match l {
+                    LightSelection::Power => kernel::scene::light_selection::POWER,
+                    LightSelection::Uniform => kernel::scene::light_selection::UNIFORM,
+                };
+            }
+            if no_specialize {
+                r.specialize = false;
+            }
+            if let Some(t) = target_error {
+                if !(t >= 0.0 && t.is_finite()) {
+                    bail!("--target-error {t}: must be a finite relative error >= 0");
+                }
+                r.adaptive_target = t;
+            }
+            if let Some(m) = &spp_map {
+                if m.extension()
+                    .and_then(|e| e.to_str())
+                    .map(|e| e.to_ascii_lowercase())
+                    != Some("exr".into())
+                {
+                    bail!("--spp-map {}: must be an .exr file", m.display());
+                }
             }
             let outputs = if out.is_empty() {
                 let stem = scene_stem(scene.name.as_str());
@@ -285,6 +335,25 @@ fn run() -> Result<()> {
             for o in &outputs {
                 image.write(o)?;
                 eprintln!("twinpath: wrote {}", o.display());
+            }
+            let spp = result.film.samples_per_pixel();
+            if scene.render.adaptive_target > 0.0 {
+                let mean = spp.iter().map(|&c| c as f64).sum::<f64>() / spp.len().max(1) as f64;
+                eprintln!(
+                    "twinpath: adaptive sampling (target {}): {mean:.1} samples per pixel on average, {} of {} pixels stopped early",
+                    scene.render.adaptive_target,
+                    spp.iter().filter(|&&c| c < result.spp_done).count(),
+                    spp.len()
+                );
+            }
+            if let Some(m) = &spp_map {
+                RgbImage {
+                    width: result.film.width,
+                    height: result.film.height,
+                    pixels: spp.iter().map(|&c| [c as f32; 3]).collect(),
+                }
+                .write(m)?;
+                eprintln!("twinpath: wrote {} (samples per pixel)", m.display());
             }
             Ok(())
         }

@@ -3,7 +3,7 @@
 
 use crate::cpu::CpuRenderer;
 use crate::film::Film;
-use crate::scene::Scene;
+use crate::scene::{Scene, ADAPTIVE_PASS};
 use crate::vulkan::GpuRenderer;
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -56,6 +56,9 @@ pub struct RenderOutput {
     pub spp_done: u32,
     pub interrupted: bool,
 }
+
+/// Largest number of samples (pixels x spp) in one GPU launch.
+const MAX_SAMPLES_PER_LAUNCH: u32 = 1 << 22;
 
 /// Set by Ctrl-C (after `install_interrupt_handler`); renders stop between passes.
 pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
@@ -122,18 +125,24 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
         Some(mut g) => {
             let setup = t0.elapsed();
             let t1 = Instant::now();
-            // Dispatches sized to about a quarter second each (a display GPU must not hang).
-            let mut launch = 1u32;
+            // Dispatch sizes depend only on the image size and spp, never on timing, so a render
+            // is the same bit for bit every time (the running mean's rounding depends on how
+            // samples are split into launches): 1, 2, 4, ... samples per pixel, up to about 4M
+            // samples per launch (a display GPU must not hang). Adaptive sampling decides at
+            // fixed sample indices, the same as the CPU's.
+            let adaptive = scene.render.adaptive_target > 0.0;
+            let cap = (MAX_SAMPLES_PER_LAUNCH / scene.pixel_count().max(1) as u32).clamp(1, 64);
+            let mut launch = if adaptive { ADAPTIVE_PASS } else { 1u32 };
             while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
                 let count = launch.min(spp - spp_done);
-                let ts = Instant::now();
                 g.dispatch(&scene.params(spp_done, count))?;
                 spp_done += count;
                 if let Some(p) = &progress {
                     p.inc(scene.pixel_count() as u64 * count as u64);
                 }
-                let per_sample = ts.elapsed().as_secs_f64() / count as f64;
-                launch = ((0.25 / per_sample.max(1e-9)) as u32).clamp(1, 64);
+                if !adaptive {
+                    launch = (launch * 2).min(cap);
+                }
             }
             let film = g.read_film()?;
             RenderOutput {
@@ -153,7 +162,11 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
             let mut film = Film::new(scene.camera.width, scene.camera.height);
             let t1 = Instant::now();
             // Passes of a few samples per pixel, so progress moves and Ctrl-C is prompt.
-            let pass = spp.clamp(1, 8);
+            let pass = if scene.render.adaptive_target > 0.0 {
+                ADAPTIVE_PASS
+            } else {
+                spp.clamp(1, 8)
+            };
             while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
                 let count = pass.min(spp - spp_done);
                 let params = scene.params(spp_done, count);

@@ -5,8 +5,10 @@
 //! reaches the scene only through [`path::Tracer`], so it knows neither backend.
 #![cfg_attr(target_arch = "spirv", no_std)]
 
+pub mod adaptive;
 pub mod brdf;
 pub mod camera;
+pub mod features;
 pub mod frame;
 pub mod geometry;
 pub mod light;

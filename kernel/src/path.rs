@@ -3,11 +3,12 @@
 
 use crate::brdf::{eval_scattering, pdf_brdf, sample_brdf, sampled_brdf_weight};
 use crate::camera::{camera_origin, camera_ray_direction};
+use crate::features::FeatureSet;
 use crate::geometry::{offset_ray_origin, shadow_ray_end, sphere_point_error};
 use crate::light::{eval_radiance, pdf_light_from, sample_light_from};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
-use crate::scene::{mis, roulette, Material, RenderParams, SphereLight, NONE};
+use crate::scene::{light_sampling, Material, RenderParams, SphereLight, NONE};
 use spirv_std::glam::Vec3;
 
 /// Where a ray meets the scene first. `t < 0` means it met nothing.
@@ -106,10 +107,16 @@ pub const PDF_EPSILON: f32 = 1e-6;
 ///    1/q^(k-1): direct light would come out 20% too dark at q = 0.8. Here the light sample of
 ///    a vertex always happens, and the roulette decision follows it.
 /// 5. A path also ends where its throughput is exactly zero (nothing after can add light) and,
-///    as a guard only, after `max_depth` vertices (`u32::MAX` by default: no bias).
+///    as a guard only, after `max_depth` vertices (`u32::MAX` by default: no bias). No shadow
+///    ray is traced from a black surface (its light sample would add exactly zero).
+///
+/// `features` answers which of these steps the scene needs (`crate::features`): a
+/// [`crate::features::Static`] set compiles the others away, a dynamic one asks `params`.
 #[inline]
-pub fn trace_path<T: Tracer>(
+#[allow(clippy::too_many_arguments)]
+pub fn trace_path<T: Tracer, F: FeatureSet>(
     tracer: &mut T,
+    features: F,
     params: &RenderParams,
     materials: &[Material],
     lights: &[SphereLight],
@@ -131,6 +138,17 @@ pub fn trace_path<T: Tracer>(
         return eval_radiance(Vec3::from(material.emission), hit.normal, -dir);
     }
 
+    let mis_power = features.mis_power(params);
+    let sampling = if features.light_cone(params) {
+        light_sampling::CONE
+    } else {
+        light_sampling::AREA
+    };
+    let light_count = if features.single_light(params) {
+        1
+    } else {
+        params.light_count
+    };
     let mut radiance = Vec3::ZERO;
     let mut throughput = Vec3::ONE;
     let mut w_out = -dir;
@@ -151,11 +169,11 @@ pub fn trace_path<T: Tracer>(
         let u_select = rng.next_f32();
         let u_light1 = rng.next_f32();
         let u_light2 = rng.next_f32();
-        if params.light_count > 0 {
+        if features.lights(params) && albedo.max_element() > 0.0 {
             let ls = sample_light_from(
                 lights,
-                params.light_count,
-                params.light_sampling,
+                light_count,
+                sampling,
                 x,
                 u_select,
                 u_light1,
@@ -180,7 +198,7 @@ pub fn trace_path<T: Tracer>(
                 )
             {
                 let emitted = Vec3::from(lights[ls.light as usize].radiance);
-                let weight = if params.mis_mode == mis::POWER {
+                let weight = if mis_power {
                     power_heuristic(pdf_w, pdf_brdf(n, wi))
                 } else {
                     0.5
@@ -196,7 +214,7 @@ pub fn trace_path<T: Tracer>(
         // 4: Russian roulette on the extension.
         let u_rr = rng.next_f32();
         if depth >= params.rr_start_depth {
-            let q = if params.rr_mode == roulette::THROUGHPUT {
+            let q = if features.rr_throughput(params) {
                 throughput.max_element().min(1.0)
             } else {
                 params.rr_probability
@@ -223,22 +241,18 @@ pub fn trace_path<T: Tracer>(
 
         let next = tracer.closest_hit(ray_origin, wi);
         if !next.is_hit() {
-            radiance += throughput * background;
+            if features.background() {
+                radiance += throughput * background;
+            }
             break;
         }
         let next_material = materials[next.material as usize];
         if next.light != NONE {
             // 2(b): the extension found a light.
             let emitted = eval_radiance(Vec3::from(next_material.emission), next.normal, -wi);
-            let weight = if params.mis_mode == mis::POWER {
-                let pdf_l = pdf_light_from(
-                    lights,
-                    params.light_sampling,
-                    next.light,
-                    x,
-                    next.position,
-                    next.normal,
-                );
+            let weight = if mis_power {
+                let pdf_l =
+                    pdf_light_from(lights, sampling, next.light, x, next.position, next.normal);
                 power_heuristic(pdf_b, pdf_l)
             } else {
                 0.5
@@ -266,8 +280,10 @@ fn light_point_error(lights: &[SphereLight], light: u32) -> f32 {
 /// position inside the pixel (box filter), the camera ray through it, and [`trace_path`].
 /// Both backends call exactly this, so a sample is the same function of (seed, pixel, sample).
 #[inline]
-pub fn render_sample<T: Tracer>(
+#[allow(clippy::too_many_arguments)]
+pub fn render_sample<T: Tracer, F: FeatureSet>(
     tracer: &mut T,
+    features: F,
     params: &RenderParams,
     materials: &[Material],
     lights: &[SphereLight],
@@ -281,6 +297,7 @@ pub fn render_sample<T: Tracer>(
     let dir = camera_ray_direction(&params.camera, params.width, params.height, px, py, u, v);
     trace_path(
         tracer,
+        features,
         params,
         materials,
         lights,

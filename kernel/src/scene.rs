@@ -57,9 +57,12 @@ pub struct SphereLight {
     pub radiance: [f32; 3],
     /// Probability of choosing this light in next-event estimation.
     pub select_pmf: f32,
-    /// Cumulative selection probability up to and including this light (for sampling).
-    pub select_cdf: f32,
-    pub _pad: [f32; 3],
+    /// Alias table (Walker; Vose's construction): slot i of n keeps light i with this
+    /// probability, else gives [`SphereLight::alias`]. See `light::choose_light`.
+    pub alias_threshold: f32,
+    /// The light slot i gives when it does not keep light i.
+    pub alias: u32,
+    pub _pad: [f32; 2],
 }
 
 /// Pinhole camera: a ray through image-plane point (x, y) in [-1, 1]^2 (y up) has direction
@@ -100,6 +103,15 @@ pub mod light_sampling {
     pub const CONE: u32 = 1;
 }
 
+/// How next-event estimation picks one of several lights (the host fills the light table's
+/// `select_pmf` and alias table accordingly; the kernel only reads them).
+pub mod light_selection {
+    /// The seed's uniform choice: 1 / number of lights.
+    pub const UNIFORM: u32 = 0;
+    /// Proportional to emitted power (radiance luminance x area), by an alias table.
+    pub const POWER: u32 = 1;
+}
+
 /// Everything a path needs besides the scene geometry and tables. 144 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
@@ -127,4 +139,13 @@ pub struct RenderParams {
     pub max_depth: u32,
     /// One of [`light_sampling`].
     pub light_sampling: u32,
+    /// Adaptive sampling: target relative standard error of a pixel's mean (0: off, every
+    /// pixel gets every sample). See `adaptive`.
+    pub adaptive_target: f32,
+    /// With adaptive sampling, every `pilot_period`-th sample index is a pilot sample: it
+    /// estimates the pixel's error and is not part of the image (0: no pilots).
+    pub pilot_period: u32,
+    /// Pilot samples a pixel needs before it may be declared converged.
+    pub min_pilot_samples: u32,
+    pub _pad: u32,
 }

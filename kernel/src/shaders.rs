@@ -4,10 +4,14 @@
 //!
 //! Bindings (descriptor set 0): 0 TLAS, 1 running mean (rgba32f: rgb mean, a sample count),
 //! 2 params ([`RenderParams`]), 3 materials, 4 lights, 5 triangles, 6 spheres,
-//! 7 running M2 (rgba32f: rgb sum of squared deviations from the mean, a discarded samples).
+//! 7 running M2 (rgba32f: rgb sum of squared deviations from the mean, a discarded samples),
+//! 8 adaptive-sampling pilots (rgba32f: luminance mean, luminance M2, count, unused).
+//! Specialization constant 0: the feature bits of `crate::features` (0: generic path).
 //! Hit groups: 0 triangles (closest hit), 1 spheres (intersection + closest hit).
 //! Miss shader 0 serves both kinds of ray.
 
+use crate::adaptive::{is_pilot_sample, luminance, pixel_converged};
+use crate::features::Dynamic;
 use crate::geometry::{
     intersect_sphere, reproject_to_sphere, sphere_point_error, triangle_normal, triangle_point,
     triangle_point_error,
@@ -97,10 +101,12 @@ impl Tracer for RayTracer<'_> {
 /// M2 (sum of squared deviations) of the accumulation images: Welford's update within the
 /// launch, Chan, Golub and LeVeque's pairwise combination with the earlier launches. Both stay
 /// accurate in f32 where a sum of squares minus n mean^2 would cancel. Non-finite samples are
-/// not merged; they are counted in `accum_m2.a`.
+/// not merged; they are counted in `accum_m2.a`. With adaptive sampling, a converged pixel
+/// takes no samples, and pilot samples go to the pilot image instead (`crate::adaptive`).
 #[spirv(ray_generation)]
 pub fn raygen(
     #[spirv(launch_id)] launch_id: UVec3,
+    #[spirv(spec_constant(id = 0, default = 0))] features: u32,
     #[spirv(descriptor_set = 0, binding = 0)] tlas: &AccelerationStructure,
     #[spirv(descriptor_set = 0, binding = 1)] accum_mean: &Image!(
         2D,
@@ -115,10 +121,25 @@ pub fn raygen(
         format = rgba32f,
         sampled = false
     ),
+    #[spirv(descriptor_set = 0, binding = 8)] pilots: &Image!(
+        2D,
+        format = rgba32f,
+        sampled = false
+    ),
     #[spirv(ray_payload)] payload: &mut HitPayload,
 ) {
     let px = launch_id.x;
     let py = launch_id.y;
+    let coord = UVec2::new(px, py);
+    let a: Vec4 = accum_mean.read(coord);
+    let adaptive = params.pilot_period > 0;
+    let mut pilot = Vec4::ZERO;
+    if adaptive {
+        pilot = pilots.read(coord);
+        if pixel_converged(params, pilot.x, pilot.y, pilot.z, a.w) {
+            return;
+        }
+    }
     let mut tracer = RayTracer { tlas, payload };
     let mut n_b = 0.0;
     let mut mean_b = Vec3::ZERO;
@@ -126,27 +147,39 @@ pub fn raygen(
     let mut discarded = 0.0;
     let mut s = 0;
     while s < params.samples_per_launch {
+        let index = params.sample_offset + s;
         let l = render_sample(
             &mut tracer,
+            Dynamic(features),
             params,
             materials,
             lights,
             px,
             py,
-            params.sample_offset + s,
+            index,
         );
-        if l.is_finite() {
+        if !l.is_finite() {
+            discarded += 1.0;
+        } else if is_pilot_sample(params, index) {
+            // Welford on the pilots' luminance, straight into the pilot record.
+            let y = luminance(l);
+            pilot.z += 1.0;
+            let d = y - pilot.x;
+            pilot.x += d / pilot.z;
+            pilot.y += d * (y - pilot.x);
+        } else {
             n_b += 1.0;
             let d = l - mean_b;
             mean_b += d / n_b;
             m2_b += d * (l - mean_b);
-        } else {
-            discarded += 1.0;
         }
         s += 1;
     }
-    let coord = UVec2::new(px, py);
-    let a: Vec4 = accum_mean.read(coord);
+    if adaptive {
+        unsafe {
+            pilots.write(coord, pilot);
+        }
+    }
     let a_m2: Vec4 = accum_m2.read(coord);
     let n_a = a.w;
     let n = n_a + n_b;

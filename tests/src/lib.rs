@@ -147,11 +147,48 @@ impl SplitMix {
     }
 }
 
+/// Each pixel's variance of the mean for `film`'s sample counts, from the per-sample variance of
+/// an independent render `other` (another seed, usually more samples).
+pub fn variance_of_mean_from(
+    other: &twinpath::film::Film,
+    film: &twinpath::film::Film,
+) -> Vec<[f32; 3]> {
+    other
+        .variance_of_mean()
+        .iter()
+        .zip(&other.count)
+        .zip(&film.count)
+        .map(|((v, &n_other), &n)| v.map(|x| x * n_other as f32 / n.max(1) as f32))
+        .collect()
+}
+
 /// The closed-form test scene: a diffuse plane y = 0 of albedo `kd` (200 x 200 units) under a
 /// sphere light of radius `r` and radiance `l` centred at height `h` above the origin, with the
 /// given `[camera]` and `[render]` table bodies.
 pub fn plane_under_light(camera: &str, render: &str, kd: f32, h: f32, r: f32, l: f32) -> Scene {
-    scene_from_toml(&format!(
+    plane_under_lamps(
+        camera,
+        render,
+        kd,
+        &[Lamp {
+            center: glam::Vec3::new(0.0, h, 0.0),
+            radius: r,
+            radiance: l,
+        }],
+    )
+}
+
+/// A sphere light of the plane scenes: centre, radius, radiance.
+#[derive(Clone, Copy, Debug)]
+pub struct Lamp {
+    pub center: glam::Vec3,
+    pub radius: f32,
+    pub radiance: f32,
+}
+
+/// The diffuse plane y = 0 of albedo `kd` (200 x 200 units) under several sphere lights.
+pub fn plane_under_lamps(camera: &str, render: &str, kd: f32, lamps: &[Lamp]) -> Scene {
+    let mut text = format!(
         r#"
         [camera]
         {camera}
@@ -159,16 +196,124 @@ pub fn plane_under_light(camera: &str, render: &str, kd: f32, h: f32, r: f32, l:
         {render}
         [materials]
         plane = {{ kd = [{kd}, {kd}, {kd}] }}
-        lamp = {{ emission = [{l}, {l}, {l}] }}
         [[quad]]
         corner = [-100, 0, 100]
         edge1 = [200, 0, 0]
         edge2 = [0, 0, -200]
         material = "plane"
-        [[sphere]]
-        center = [0, {h}, 0]
-        radius = {r}
-        material = "lamp"
         "#
-    ))
+    );
+    for (i, l) in lamps.iter().enumerate() {
+        let c = l.center;
+        text.push_str(&format!(
+            "[materials.lamp{i}]\nemission = [{0}, {0}, {0}]\n[[sphere]]\ncenter = [{1}, {2}, {3}]\nradius = {4}\nmaterial = \"lamp{i}\"\n",
+            l.radiance, c.x, c.y, c.z, l.radius
+        ));
+    }
+    scene_from_toml(&text)
+}
+
+/// Exact pixel values of a plane scene: the sum over lamps of kd L (r/D)^2 cos(theta) at the
+/// plane point each camera ray meets (a sphere's irradiance, pi L (r/D)^2 cos, times kd/pi),
+/// averaged over the pixel by a 24 x 24 midpoint quadrature (the box filter). `None` for pixels
+/// any of whose quadrature rays sees a lamp or misses the plane, or where one lamp could hide
+/// part of another (their cones of directions overlap).
+pub fn plane_exact(scene: &Scene, kd: f32, lamps: &[Lamp]) -> Vec<Option<f64>> {
+    let cam = scene.camera.to_kernel();
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let eye = glam::Vec3::new(cam.eye[0], cam.eye[1], cam.eye[2]);
+    let q = 24;
+    (0..w * h)
+        .map(|i| {
+            let (px, py) = (i % w, i / w);
+            let mut sum = 0.0;
+            for sy in 0..q {
+                for sx in 0..q {
+                    let (u, v) = ((sx as f32 + 0.5) / q as f32, (sy as f32 + 0.5) / q as f32);
+                    let d = kernel::camera::camera_ray_direction(&cam, w, h, px, py, u, v);
+                    if d.y >= 0.0 {
+                        return None;
+                    }
+                    for l in lamps {
+                        let t = kernel::geometry::intersect_sphere(
+                            eye,
+                            d,
+                            l.center,
+                            l.radius,
+                            0.0,
+                            f32::INFINITY,
+                        );
+                        if t >= 0.0 {
+                            return None;
+                        }
+                    }
+                    let x = (eye + d * (-eye.y / d.y)).as_dvec3();
+                    let cones: Vec<(glam::DVec3, f64)> = lamps
+                        .iter()
+                        .map(|l| {
+                            let to = l.center.as_dvec3() - x;
+                            (to.normalize(), (l.radius as f64 / to.length()).asin())
+                        })
+                        .collect();
+                    for (a, ca) in cones.iter().enumerate() {
+                        for cb in &cones[a + 1..] {
+                            let sep = ca.0.dot(cb.0).clamp(-1.0, 1.0).acos();
+                            if sep < 1.01 * (ca.1 + cb.1) {
+                                return None;
+                            }
+                        }
+                    }
+                    for l in lamps {
+                        let dist = (l.center.as_dvec3() - x).length();
+                        let cos = l.center.y as f64 / dist;
+                        sum +=
+                            kd as f64 * l.radiance as f64 * (l.radius as f64 / dist).powi(2) * cos;
+                    }
+                }
+            }
+            Some(sum / (q * q) as f64)
+        })
+        .collect()
+}
+
+/// z-tests a film's red channel against exact pixel values: each pixel (Sidak-corrected for
+/// the number tested) and all pixels together. Returns the overall z.
+pub fn assert_film_matches(film: &twinpath::film::Film, exact: &[Option<f64>], label: &str) -> f64 {
+    assert_film_matches_with_variance(film, exact, film.variance_of_mean(), label)
+}
+
+/// As [`assert_film_matches`], with each pixel's variance of the mean given: for heavy-tailed
+/// pixels, whose own sample variance is low exactly when their rare large samples are missing
+/// (which makes the mean low too and the z-score a false alarm), pass a variance estimated
+/// from an independent render ([`variance_of_mean_from`]).
+pub fn assert_film_matches_with_variance(
+    film: &twinpath::film::Film,
+    exact: &[Option<f64>],
+    var: Vec<[f32; 3]>,
+    label: &str,
+) -> f64 {
+    let mean = film.mean();
+    let tested = exact.iter().filter(|e| e.is_some()).count();
+    let z_max = z_critical(1e-3, tested);
+    let (mut worst, mut sum_d, mut sum_v) = (0.0f64, 0.0, 0.0);
+    for (i, e) in exact.iter().enumerate() {
+        let Some(e) = e else { continue };
+        let (m, v) = (mean[i][0] as f64, var[i][0] as f64);
+        let z = (m - e) / v.sqrt();
+        worst = worst.max(z.abs());
+        sum_d += m - e;
+        sum_v += v;
+        assert!(
+            z.abs() < z_max,
+            "{label}: pixel {i}: {m} vs exact {e}, |z| = {:.2} >= {z_max:.2}",
+            z.abs()
+        );
+    }
+    let z_all = sum_d / sum_v.sqrt();
+    println!("{label}: {tested} pixels vs closed form: max |z| {worst:.2} (bound {z_max:.2}); all pixels together z = {z_all:+.2}");
+    assert!(
+        z_all.abs() < z_critical(1e-3, 1),
+        "{label}: overall z = {z_all:.2}"
+    );
+    z_all
 }

@@ -15,11 +15,14 @@ const DECORATION_ARRAY_STRIDE: u32 = 6;
 const DECORATION_BINDING: u32 = 33;
 const DECORATION_DESCRIPTOR_SET: u32 = 34;
 const DECORATION_OFFSET: u32 = 35;
+const DECORATION_SPEC_ID: u32 = 1;
 
 /// The parts of a module the tests look at.
 #[derive(Default, Debug)]
 pub struct Module {
     pub entry_points: BTreeSet<(u32, String)>,
+    /// SpecId decorations: the module's specialization-constant ids.
+    pub spec_ids: BTreeSet<u32>,
     structs: HashMap<u32, Vec<u32>>,
     runtime_arrays: HashMap<u32, u32>,
     arrays: HashMap<u32, u32>,
@@ -89,6 +92,9 @@ impl Module {
                     }
                     DECORATION_ARRAY_STRIDE => {
                         m.strides.insert(w[1], w[3]);
+                    }
+                    DECORATION_SPEC_ID => {
+                        m.spec_ids.insert(w[3]);
                     }
                     _ => {}
                 },

@@ -70,6 +70,7 @@ fn estimate_at(scene: &Scene, x: Vec3, view_dir: Vec3, stream: u32, batch: u32) 
             rng.seek(kernel::path::CAMERA_DIMENSIONS);
             let l = trace_path(
                 &mut tracer,
+                kernel::features::Dynamic(cpu.features),
                 &params,
                 &cpu.materials,
                 &cpu.lights,

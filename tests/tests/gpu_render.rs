@@ -2,11 +2,13 @@
 //! with the Vulkan validation layers on: any validation message fails the test.
 
 use glam::Vec3;
-use twinpath::film::Film;
 use twinpath::render::Backend;
 use twinpath::scene::Scene;
 use twinpath_tests::gpu::assert_validation_clean;
-use twinpath_tests::{image_mean_z, render_film, repo_root, scene_from_toml, z_critical};
+use twinpath_tests::{
+    assert_film_matches, image_mean_z, plane_exact, plane_under_lamps, render_film, repo_root,
+    scene_from_toml, z_critical, Lamp,
+};
 
 /// Same scene, seed and spp on both backends: the same samples, so nearly every pixel must be
 /// equal; the few others are pixels where one path's ray flips between hit and miss at an edge
@@ -78,89 +80,38 @@ const LAMPS: [(f32, f32); 2] = [(0.5, 5.0), (2e-4, 2.5e7)];
 
 /// The plane-under-a-sphere-light scene seen from above at an angle, covering plane points up
 /// to about 80 degrees from the foot of the light.
-fn plane_scene((r, l): (f32, f32)) -> Scene {
-    twinpath_tests::plane_under_light(
+fn plane_lamp((r, l): (f32, f32)) -> Lamp {
+    Lamp {
+        center: Vec3::new(0.0, H, 0.0),
+        radius: r,
+        radiance: l,
+    }
+}
+
+fn plane_scene(lamp: Lamp) -> Scene {
+    plane_under_lamps(
         "eye = [0, 9, 9]\nlook_at = [0, 0, -1]\nup = [0, 1, 0]\nvfov = 70\nwidth = 48\nheight = 48",
         "seed = 3",
         KD,
-        H,
-        r,
-        l,
+        &[lamp],
     )
-}
-
-/// The exact pixel values: kd L (r/D)^2 cos(theta) at the plane point each camera ray meets,
-/// averaged over the pixel by a 24 x 24 midpoint quadrature (the box filter; 8 x 8 left a
-/// quadrature error visible against the tiny light's small per-pixel noise); `None` for pixels
-/// any of whose quadrature rays sees the light or misses the plane.
-fn plane_exact(scene: &Scene, (r, l): (f32, f32)) -> Vec<Option<f64>> {
-    let cam = scene.camera.to_kernel();
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let eye = Vec3::new(cam.eye[0], cam.eye[1], cam.eye[2]);
-    let centre = Vec3::new(0.0, H, 0.0);
-    let q = 24;
-    (0..w * h)
-        .map(|i| {
-            let (px, py) = (i % w, i / w);
-            let mut sum = 0.0;
-            for sy in 0..q {
-                for sx in 0..q {
-                    let (u, v) = ((sx as f32 + 0.5) / q as f32, (sy as f32 + 0.5) / q as f32);
-                    let d = kernel::camera::camera_ray_direction(&cam, w, h, px, py, u, v);
-                    let t_light =
-                        kernel::geometry::intersect_sphere(eye, d, centre, r, 0.0, f32::INFINITY);
-                    if t_light >= 0.0 || d.y >= 0.0 {
-                        return None;
-                    }
-                    let x = eye + d * (-eye.y / d.y);
-                    let dist = (centre - x).length() as f64;
-                    sum += KD as f64 * l as f64 * (r as f64 / dist).powi(2) * (H as f64 / dist);
-                }
-            }
-            Some(sum / (q * q) as f64)
-        })
-        .collect()
-}
-
-fn assert_plane_matches(film: &Film, exact: &[Option<f64>], label: &str) {
-    let mean = film.mean();
-    let var = film.variance_of_mean();
-    let tested = exact.iter().filter(|e| e.is_some()).count();
-    let z_max = z_critical(1e-3, tested);
-    let (mut worst, mut sum_d, mut sum_v) = (0.0f64, 0.0, 0.0);
-    for (i, e) in exact.iter().enumerate() {
-        let Some(e) = e else { continue };
-        let (m, v) = (mean[i][0] as f64, var[i][0] as f64);
-        let z = (m - e) / v.sqrt();
-        worst = worst.max(z.abs());
-        sum_d += m - e;
-        sum_v += v;
-        assert!(
-            z.abs() < z_max,
-            "{label}: pixel {i}: {m} vs exact {e}, |z| = {:.2} >= {z_max:.2}",
-            z.abs()
-        );
-    }
-    let z_all = sum_d / sum_v.sqrt();
-    println!("{label}: {tested} pixels vs closed form: max |z| {worst:.2} (bound {z_max:.2}); all pixels together z = {z_all:+.2}");
-    assert!(z_all.abs() < z_critical(1e-3, 1));
 }
 
 #[test]
 fn plane_under_sphere_light_closed_form_on_both_backends() {
     // The pixel estimates vary with the sample positions inside each pixel even when the light
     // is tiny, so each has a variance and the z-test applies.
-    for lamp in LAMPS {
+    for lamp in LAMPS.map(plane_lamp) {
         let scene = plane_scene(lamp);
-        let exact = plane_exact(&scene, lamp);
+        let exact = plane_exact(&scene, KD, &[lamp]);
         assert!(exact.iter().filter(|e| e.is_some()).count() > 1500);
         for backend in [Backend::Cpu, Backend::Gpu] {
             let film = render_film(&scene, backend, 256);
             assert_eq!(film.discarded, 0);
-            assert_plane_matches(
+            assert_film_matches(
                 &film,
                 &exact,
-                &format!("{backend:?}, light radius {}", lamp.0),
+                &format!("{backend:?}, light radius {}", lamp.radius),
             );
         }
     }

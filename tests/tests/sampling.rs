@@ -9,8 +9,9 @@ use kernel::rng::SampleRng;
 use kernel::sampling::{
     pdf_sphere_area, pdf_sphere_cone, sample_lobe, sample_sphere, sample_sphere_cone,
 };
-use kernel::scene::SphereLight;
+use kernel::scene::{light_selection, SphereLight};
 use std::f64::consts::PI;
+use twinpath::scene::light_table::assign_light_selection;
 use twinpath_tests::chi_square;
 
 /// Family-wise significance of all chi-square tests in this file (Sidak-style split below).
@@ -137,19 +138,13 @@ fn sample_light_selects_by_pmf_and_pdf_light_matches() {
         radius,
         radiance: [1.0; 3],
         select_pmf: 0.0,
-        select_cdf: 0.0,
-        _pad: [0.0; 3],
+        alias_threshold: 0.0,
+        alias: 0,
+        _pad: [0.0; 2],
     };
     let mut lights = vec![mk(0.0, 0.5), mk(3.0, 1.0), mk(-3.0, 0.25)];
     let n = lights.len();
-    for (i, l) in lights.iter_mut().enumerate() {
-        l.select_pmf = 1.0 / n as f32;
-        l.select_cdf = if i + 1 == n {
-            1.0
-        } else {
-            (i + 1) as f32 / n as f32
-        };
-    }
+    assign_light_selection(&mut lights, light_selection::UNIFORM);
     let mut observed = vec![0.0; n];
     let mut r = rng(3);
     for _ in 0..SAMPLES {

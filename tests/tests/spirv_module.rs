@@ -45,6 +45,13 @@ fn module_has_the_ray_tracing_and_probe_entry_points() {
 }
 
 #[test]
+fn raygen_reads_the_feature_specialization_constant() {
+    // The host specializes constant 0 (`kernel::features`); rust-gpu must have kept it.
+    let m = Module::parse(twinpath::KERNEL_SPV);
+    assert_eq!(m.spec_ids.iter().copied().collect::<Vec<_>>(), vec![0]);
+}
+
+#[test]
 fn module_passes_spirv_val() {
     let path = std::env::temp_dir().join(format!("twinpath-kernel-{}.spv", std::process::id()));
     std::fs::write(&path, twinpath::KERNEL_SPV).unwrap();
@@ -94,7 +101,11 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     rr_start_depth,
                     mis_mode,
                     max_depth,
-                    light_sampling
+                    light_sampling,
+                    adaptive_target,
+                    pilot_period,
+                    min_pilot_samples,
+                    _pad
                 ],
                 false
             ),
@@ -109,7 +120,15 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
             binding::LIGHTS,
             host_layout!(
                 SphereLight,
-                [center, radius, radiance, select_pmf, select_cdf, _pad],
+                [
+                    center,
+                    radius,
+                    radiance,
+                    select_pmf,
+                    alias_threshold,
+                    alias,
+                    _pad
+                ],
                 true
             ),
         ),

@@ -9,6 +9,8 @@ use crate::scene::Scene;
 use bvh::Bvh;
 use glam::Vec3;
 use indicatif::ProgressBar;
+use kernel::adaptive::{is_pilot_sample, luminance};
+use kernel::features::{self, Dynamic, FeatureSet, Static};
 use kernel::path::render_sample;
 use kernel::scene::{Material, RenderParams, SphereLight};
 use kernel::{SurfaceHit, Tracer};
@@ -38,6 +40,76 @@ pub struct CpuRenderer {
     pub bvh: Bvh,
     pub materials: Vec<Material>,
     pub lights: Vec<SphereLight>,
+    /// The kernel's feature bits (`kernel::features`; 0: generic path).
+    pub features: u32,
+}
+
+/// The feature combinations with their own monomorphised `trace_path`: every combination of
+/// the scene features (lights: none, one, several; background; constant or throughput
+/// roulette) under the default MIS (power) and light sampling (cone). Others run the
+/// [`Dynamic`] path with the same bits.
+macro_rules! with_features {
+    ($bits:expr, $f:ident => $body:expr) => {{
+        const BASE: u32 = features::SPECIALIZED | features::MIS_POWER | features::LIGHT_CONE;
+        const L: u32 = features::LIGHTS;
+        const L1: u32 = features::LIGHTS | features::SINGLE_LIGHT;
+        const B: u32 = features::BACKGROUND;
+        const R: u32 = features::RR_THROUGHPUT;
+        match $bits {
+            x if x == BASE => {
+                let $f = Static::<BASE>;
+                $body
+            }
+            x if x == BASE | B => {
+                let $f = Static::<{ BASE | B }>;
+                $body
+            }
+            x if x == BASE | R => {
+                let $f = Static::<{ BASE | R }>;
+                $body
+            }
+            x if x == BASE | B | R => {
+                let $f = Static::<{ BASE | B | R }>;
+                $body
+            }
+            x if x == BASE | L => {
+                let $f = Static::<{ BASE | L }>;
+                $body
+            }
+            x if x == BASE | L | B => {
+                let $f = Static::<{ BASE | L | B }>;
+                $body
+            }
+            x if x == BASE | L | R => {
+                let $f = Static::<{ BASE | L | R }>;
+                $body
+            }
+            x if x == BASE | L | B | R => {
+                let $f = Static::<{ BASE | L | B | R }>;
+                $body
+            }
+            x if x == BASE | L1 => {
+                let $f = Static::<{ BASE | L1 }>;
+                $body
+            }
+            x if x == BASE | L1 | B => {
+                let $f = Static::<{ BASE | L1 | B }>;
+                $body
+            }
+            x if x == BASE | L1 | R => {
+                let $f = Static::<{ BASE | L1 | R }>;
+                $body
+            }
+            x if x == BASE | L1 | B | R => {
+                let $f = Static::<{ BASE | L1 | B | R }>;
+                $body
+            }
+            other => {
+                let $f = Dynamic(other);
+                $body
+            }
+        }
+    }};
 }
 
 impl CpuRenderer {
@@ -46,15 +118,29 @@ impl CpuRenderer {
         Self {
             bvh: Bvh::build(scene.spheres.clone(), scene.triangles.clone()),
             materials: scene.materials.clone(),
-            lights: scene.lights.clone(),
+            lights: scene.light_table(),
+            features: scene.features(),
         }
     }
 
     /// One sample of one pixel, exactly as the GPU's ray-generation shader computes it.
     pub fn sample(&self, params: &RenderParams, px: u32, py: u32, sample: u32) -> Vec3 {
+        with_features!(self.features, f => self.sample_with(f, params, px, py, sample))
+    }
+
+    #[inline]
+    fn sample_with<F: FeatureSet>(
+        &self,
+        features: F,
+        params: &RenderParams,
+        px: u32,
+        py: u32,
+        sample: u32,
+    ) -> Vec3 {
         let mut tracer = BvhTracer { bvh: &self.bvh };
         render_sample(
             &mut tracer,
+            features,
             params,
             &self.materials,
             &self.lights,
@@ -65,9 +151,23 @@ impl CpuRenderer {
     }
 
     /// Adds samples `first..first + count` of every pixel to `film`, tiles in parallel.
-    /// Non-finite samples are not added; they are counted in `film.discarded`.
+    /// Non-finite samples are not added; they are counted in `film.discarded`. With adaptive
+    /// sampling (`params.pilot_period > 0`), pixels the film says have converged are skipped
+    /// and pilot samples go to the film's pilot sums (`kernel::adaptive`).
     pub fn render_into(
         &self,
+        params: &RenderParams,
+        first: u32,
+        count: u32,
+        film: &mut Film,
+        progress: Option<&ProgressBar>,
+    ) {
+        with_features!(self.features, f => self.render_tiles(f, params, first, count, film, progress))
+    }
+
+    fn render_tiles<F: FeatureSet + Sync>(
+        &self,
+        features: F,
         params: &RenderParams,
         first: u32,
         count: u32,
@@ -80,21 +180,32 @@ impl CpuRenderer {
         let tiles: Vec<(u32, u32)> = (0..tiles_y)
             .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
             .collect();
+        let adaptive = params.pilot_period > 0;
+        let film_ref = &*film;
         let results: Vec<((u32, u32), Vec<PixelSums>)> = tiles
             .par_iter()
             .map(|&(tx, ty)| {
                 let mut out = Vec::with_capacity((TILE * TILE) as usize);
+                let mut done = 0u64;
                 for py in ty * TILE..((ty + 1) * TILE).min(h) {
                     for px in tx * TILE..((tx + 1) * TILE).min(w) {
                         let mut acc = PixelSums::default();
-                        for s in first..first + count {
-                            acc.add(self.sample(params, px, py, s));
+                        if !(adaptive && film_ref.converged(params, px, py)) {
+                            for s in first..first + count {
+                                let l = self.sample_with(features, params, px, py, s);
+                                if adaptive && is_pilot_sample(params, s) {
+                                    acc.add_pilot(l);
+                                } else {
+                                    acc.add(l);
+                                }
+                            }
+                            done += count as u64;
                         }
                         out.push(acc);
                     }
                 }
                 if let Some(p) = progress {
-                    p.inc(out.len() as u64 * count as u64);
+                    p.inc(done);
                 }
                 ((tx, ty), out)
             })
@@ -111,13 +222,17 @@ impl CpuRenderer {
     }
 }
 
-/// Per-pixel running sums of samples, their squares, and the counts.
+/// Per-pixel running sums of samples, their squares, and the counts; and of the adaptive
+/// sampler's pilot samples (luminance only).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PixelSums {
     pub sum: [f64; 3],
     pub sum_sq: [f64; 3],
     pub count: u32,
     pub discarded: u32,
+    /// Sum and sum of squares of the pilot samples' luminance, and their number.
+    pub pilot: [f64; 2],
+    pub pilot_count: u32,
 }
 
 impl PixelSums {
@@ -133,5 +248,18 @@ impl PixelSums {
             self.sum_sq[c] += x * x;
         }
         self.count += 1;
+    }
+
+    /// Adds a pilot sample (`kernel::adaptive`).
+    #[inline]
+    pub fn add_pilot(&mut self, v: Vec3) {
+        if !v.is_finite() {
+            self.discarded += 1;
+            return;
+        }
+        let y = luminance(v) as f64;
+        self.pilot[0] += y;
+        self.pilot[1] += y * y;
+        self.pilot_count += 1;
     }
 }

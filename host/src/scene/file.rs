@@ -5,7 +5,9 @@ use super::error::{line_of, SceneError};
 use super::mesh::load_mesh;
 use super::{CameraDesc, RenderSettings, Scene, TriangleGroup};
 use glam::Vec3;
-use kernel::scene::{light_sampling, mis, roulette, Material, Sphere, SphereLight, Triangle, NONE};
+use kernel::scene::{
+    light_sampling, light_selection, mis, roulette, Material, Sphere, SphereLight, Triangle, NONE,
+};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -71,6 +73,10 @@ struct RenderFile {
     max_depth: Option<Spanned<i64>>,
     /// "cone" (default) or "area" (the seed's uniform point on the sphere).
     light_sampling: Option<Spanned<String>>,
+    /// "power" (default) or "uniform" (the seed's choice among several lights).
+    light_selection: Option<Spanned<String>>,
+    /// Adaptive sampling's target relative error per pixel (0 or absent: off).
+    adaptive_target: Option<Spanned<f32>>,
 }
 
 #[derive(Deserialize)]
@@ -288,6 +294,30 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         if let Some(v) = &r.max_depth {
             render.max_depth = ck.int(v, "render.max_depth", 1, u32::MAX as i64)?;
         }
+        if let Some(v) = &r.light_selection {
+            render.light_selection = match v.get_ref().as_str() {
+                "power" => light_selection::POWER,
+                "uniform" => light_selection::UNIFORM,
+                other => {
+                    return Err(ck.err(
+                        v.span(),
+                        "render.light_selection",
+                        format!("'{other}' is not \"power\" or \"uniform\""),
+                    ))
+                }
+            };
+        }
+        if let Some(v) = &r.adaptive_target {
+            let t = *v.get_ref();
+            if !(t >= 0.0 && t.is_finite()) {
+                return Err(ck.err(
+                    v.span(),
+                    "render.adaptive_target",
+                    format!("{t} is not a finite relative error >= 0"),
+                ));
+            }
+            render.adaptive_target = t;
+        }
     }
 
     // Materials, in name order.
@@ -377,8 +407,9 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 radius,
                 radiance: materials[material as usize].emission,
                 select_pmf: 0.0,
-                select_cdf: 0.0,
-                _pad: [0.0; 3],
+                alias_threshold: 0.0,
+                alias: 0,
+                _pad: [0.0; 2],
             });
             (lights.len() - 1) as u32
         } else {
@@ -392,16 +423,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             _pad: [0; 2],
         });
     }
-    // Uniform light selection, as the seed's SampleLight.
-    let n = lights.len();
-    for (i, l) in lights.iter_mut().enumerate() {
-        l.select_pmf = 1.0 / n as f32;
-        l.select_cdf = if i + 1 == n {
-            1.0
-        } else {
-            (i + 1) as f32 / n as f32
-        };
-    }
+    super::light_table::assign_light_selection(&mut lights, render.light_selection);
 
     // Quads (two triangles each) and meshes.
     let mut triangles = Vec::new();

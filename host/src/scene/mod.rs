@@ -3,6 +3,7 @@
 
 mod error;
 mod file;
+pub mod light_table;
 pub mod mesh;
 
 pub use error::SceneError;
@@ -10,7 +11,8 @@ pub use file::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
 
 use glam::Vec3;
 use kernel::scene::{
-    light_sampling, mis, roulette, Camera, Material, RenderParams, Sphere, SphereLight, Triangle,
+    light_sampling, light_selection, mis, roulette, Camera, Material, RenderParams, Sphere,
+    SphereLight, Triangle,
 };
 use std::ops::Range;
 use std::path::Path;
@@ -61,7 +63,20 @@ pub struct RenderSettings {
     pub max_depth: u32,
     /// One of `kernel::scene::light_sampling`.
     pub light_sampling: u32,
+    /// One of `kernel::scene::light_selection`.
+    pub light_selection: u32,
+    /// Compile the kernel for what the scene needs (`kernel::features`); false: generic path.
+    pub specialize: bool,
+    /// Adaptive sampling's target relative error of a pixel (0: off; `kernel::adaptive`).
+    pub adaptive_target: f32,
 }
+
+/// With adaptive sampling, every PILOT_PERIOD-th sample is a pilot (`kernel::adaptive`).
+pub const PILOT_PERIOD: u32 = 4;
+/// Pilot samples before a pixel may stop (16 samples in all).
+pub const MIN_PILOT_SAMPLES: u32 = 4;
+/// Samples per pixel per adaptive pass: both backends decide at the same sample indices.
+pub const ADAPTIVE_PASS: u32 = 8;
 
 impl Default for RenderSettings {
     fn default() -> Self {
@@ -74,6 +89,9 @@ impl Default for RenderSettings {
             mis_mode: mis::POWER,
             max_depth: u32::MAX,
             light_sampling: light_sampling::CONE,
+            light_selection: light_selection::POWER,
+            specialize: true,
+            adaptive_target: 0.0,
         }
     }
 }
@@ -141,7 +159,32 @@ impl Scene {
             mis_mode: r.mis_mode,
             max_depth: r.max_depth,
             light_sampling: r.light_sampling,
+            adaptive_target: r.adaptive_target,
+            pilot_period: if r.adaptive_target > 0.0 {
+                PILOT_PERIOD
+            } else {
+                0
+            },
+            min_pilot_samples: MIN_PILOT_SAMPLES,
+            _pad: 0,
         }
+    }
+
+    /// The kernel's feature bits for this scene and its settings (`kernel::features`; 0 with
+    /// `specialize` off, the generic path).
+    pub fn features(&self) -> u32 {
+        if self.render.specialize {
+            kernel::features::scene_features(&self.params(0, 1))
+        } else {
+            0
+        }
+    }
+
+    /// The light table with selection probabilities for `render.light_selection`.
+    pub fn light_table(&self) -> Vec<SphereLight> {
+        let mut lights = self.lights.clone();
+        light_table::assign_light_selection(&mut lights, self.render.light_selection);
+        lights
     }
 
     /// Number of pixels.

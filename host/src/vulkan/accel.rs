@@ -4,14 +4,11 @@
 
 use super::device::Context;
 use super::memory::Buffer;
+use super::pipeline::HitGroups;
 use crate::scene::Scene;
 use anyhow::{Context as _, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-
-/// Hit-group index (SBT record offset) of triangle instances and of the sphere instance.
-pub const HIT_GROUP_TRIANGLES: u32 = 0;
-pub const HIT_GROUP_SPHERES: u32 = 1;
 
 /// An acceleration structure and the buffer holding it.
 pub struct AccelerationStructure {
@@ -120,7 +117,7 @@ impl Context {
     }
 
     /// Builds the BLASes the scene needs and the TLAS over them.
-    pub fn build_scene_accel(&self, scene: &Scene) -> Result<SceneAccel> {
+    pub fn build_scene_accel(&self, scene: &Scene, hit_groups: HitGroups) -> Result<SceneAccel> {
         let mut blases = Vec::new();
         let mut instances = Vec::new();
         let mut inputs = Vec::new();
@@ -167,7 +164,7 @@ impl Context {
                 instances.push(instance(
                     blas.address,
                     group.range.start as u32,
-                    HIT_GROUP_TRIANGLES,
+                    hit_groups.triangle_offset(),
                 ));
                 blases.push(blas);
             }
@@ -209,7 +206,7 @@ impl Context {
                     scene.spheres.len() as u32,
                 )?;
                 inputs.push(ab);
-                instances.push(instance(blas.address, 0, HIT_GROUP_SPHERES));
+                instances.push(instance(blas.address, 0, hit_groups.sphere_offset()));
                 blases.push(blas);
             }
             Ok(())

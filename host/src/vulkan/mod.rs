@@ -16,7 +16,7 @@ use device::Context;
 use gpu_allocator::MemoryLocation;
 use kernel::scene::RenderParams;
 use memory::{Buffer, Image};
-use pipeline::{binding, RtPipeline};
+use pipeline::{binding, HitGroups, RtPipeline};
 use std::time::{Duration, Instant};
 
 /// A scene uploaded to a Vulkan device, ready to trace.
@@ -39,6 +39,7 @@ struct Resources {
     tables: Vec<Buffer>,
     accum: Image,
     accum_sq: Image,
+    pilots: Image,
     pool: vk::DescriptorPool,
     set: vk::DescriptorSet,
 }
@@ -50,11 +51,20 @@ impl GpuRenderer {
     pub fn new(scene: &Scene, device: Option<usize>, validation: bool) -> Result<GpuRenderer> {
         let ctx = Context::new(device, validation)?;
         let (w, h) = (scene.camera.width, scene.camera.height);
+        let features = scene.features();
+        let hit_groups = if scene.render.specialize {
+            HitGroups {
+                triangles: !scene.triangles.is_empty(),
+                spheres: !scene.spheres.is_empty(),
+            }
+        } else {
+            HitGroups::ALL
+        };
         let t0 = Instant::now();
-        let accel = ctx.build_scene_accel(scene)?;
+        let accel = ctx.build_scene_accel(scene, hit_groups)?;
         let accel_build_time = t0.elapsed();
         let t1 = Instant::now();
-        let pipeline = RtPipeline::new(&ctx, crate::KERNEL_SPV)?;
+        let pipeline = RtPipeline::new(&ctx, crate::KERNEL_SPV, features, hit_groups)?;
         let pipeline_time = t1.elapsed();
 
         let params = ctx.create_buffer(
@@ -66,12 +76,17 @@ impl GpuRenderer {
         // Empty tables still need a buffer behind their binding.
         let tables = vec![
             ctx.upload_buffer("materials", bytemuck::cast_slice(&scene.materials), STORAGE)?,
-            ctx.upload_buffer("lights", bytemuck::cast_slice(&scene.lights), STORAGE)?,
+            ctx.upload_buffer(
+                "lights",
+                bytemuck::cast_slice(&scene.light_table()),
+                STORAGE,
+            )?,
             ctx.upload_buffer("triangles", bytemuck::cast_slice(&scene.triangles), STORAGE)?,
             ctx.upload_buffer("spheres", bytemuck::cast_slice(&scene.spheres), STORAGE)?,
         ];
         let accum = ctx.create_storage_image("accum", w, h)?;
         let accum_sq = ctx.create_storage_image("accum_sq", w, h)?;
+        let pilots = ctx.create_storage_image("pilots", w, h)?;
 
         let sizes = [
             vk::DescriptorPoolSize {
@@ -80,7 +95,7 @@ impl GpuRenderer {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_IMAGE,
-                descriptor_count: 2,
+                descriptor_count: 3,
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
@@ -98,6 +113,7 @@ impl GpuRenderer {
         };
         let accum_info = image_info(&accum);
         let accum_sq_info = image_info(&accum_sq);
+        let pilots_info = image_info(&pilots);
         let buffer_info = |b: &Buffer| {
             [vk::DescriptorBufferInfo::default()
                 .buffer(b.buffer)
@@ -135,6 +151,11 @@ impl GpuRenderer {
                 .dst_binding(binding::ACCUM_SQ)
                 .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
                 .image_info(&accum_sq_info),
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(binding::PILOTS)
+                .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                .image_info(&pilots_info),
         ];
         for (b, info) in buffer_bindings.iter().zip(&infos) {
             writes.push(
@@ -154,6 +175,7 @@ impl GpuRenderer {
                 tables,
                 accum,
                 accum_sq,
+                pilots,
                 pool,
                 set,
             }),
@@ -231,8 +253,13 @@ impl GpuRenderer {
         let m2s = self
             .ctx
             .read_image(&res.accum_sq, self.width, self.height)?;
+        let pilots = self.ctx.read_image(&res.pilots, self.width, self.height)?;
         let mut film = Film::new(self.width, self.height);
-        for (i, (m, q)) in means.iter().zip(&m2s).enumerate() {
+        for (i, ((m, q), p)) in means.iter().zip(&m2s).zip(&pilots).enumerate() {
+            // Pilots: luminance mean, M2 and count back to a sum and a sum of squares.
+            let (mean, n) = (p[0] as f64, p[2] as f64);
+            film.pilot[i] = [n * mean, p[1] as f64 + n * mean * mean];
+            film.pilot_count[i] = p[2] as u32;
             let n = m[3] as f64;
             for c in 0..3 {
                 let mean = m[c] as f64;
@@ -262,6 +289,7 @@ impl Drop for GpuRenderer {
             }
             ctx.destroy_image(r.accum);
             ctx.destroy_image(r.accum_sq);
+            ctx.destroy_image(r.pilots);
         }
     }
 }

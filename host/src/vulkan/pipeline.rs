@@ -25,6 +25,36 @@ pub mod binding {
     pub const TRIANGLES: u32 = 5;
     pub const SPHERES: u32 = 6;
     pub const ACCUM_SQ: u32 = 7;
+    pub const PILOTS: u32 = 8;
+}
+
+/// Which hit groups a pipeline has: a scene without triangles (or spheres) gets no triangle
+/// (or sphere) hit group when specialized; the generic pipeline has both.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HitGroups {
+    pub triangles: bool,
+    pub spheres: bool,
+}
+
+impl HitGroups {
+    pub const ALL: HitGroups = HitGroups {
+        triangles: true,
+        spheres: true,
+    };
+
+    /// SBT record offset of the triangle hit group (instances of triangle BLASes).
+    pub fn triangle_offset(self) -> u32 {
+        0
+    }
+
+    /// SBT record offset of the sphere hit group: after the triangles' when there is one.
+    pub fn sphere_offset(self) -> u32 {
+        self.triangles as u32
+    }
+
+    fn count(self) -> u32 {
+        self.triangles as u32 + self.spheres as u32
+    }
 }
 
 /// The pipeline and the objects it owns.
@@ -54,7 +84,14 @@ pub fn shader_module(ctx: &Context, spv: &[u8]) -> Result<vk::ShaderModule> {
 }
 
 impl RtPipeline {
-    pub fn new(ctx: &Context, spv: &[u8]) -> Result<RtPipeline> {
+    /// The pipeline with `hit_groups`, the raygen shader specialized to `features`
+    /// (specialization constant 0, `kernel::features`; 0 keeps the generic path).
+    pub fn new(
+        ctx: &Context,
+        spv: &[u8],
+        features: u32,
+        hit_groups: HitGroups,
+    ) -> Result<RtPipeline> {
         let module = shader_module(ctx, spv)?;
         let all = vk::ShaderStageFlags::RAYGEN_KHR
             | vk::ShaderStageFlags::CLOSEST_HIT_KHR
@@ -79,6 +116,7 @@ impl RtPipeline {
             b(binding::TRIANGLES, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::SPHERES, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::ACCUM_SQ, vk::DescriptorType::STORAGE_IMAGE),
+            b(binding::PILOTS, vk::DescriptorType::STORAGE_IMAGE),
         ];
         let set_layout = unsafe {
             ctx.device.create_descriptor_set_layout(
@@ -99,12 +137,18 @@ impl RtPipeline {
                 .module(module)
                 .name(name)
         };
-        let stages = [
-            stage(vk::ShaderStageFlags::RAYGEN_KHR, RAYGEN),
+        let spec_entries = [vk::SpecializationMapEntry {
+            constant_id: 0,
+            offset: 0,
+            size: 4,
+        }];
+        let spec_data = features.to_ne_bytes();
+        let spec = vk::SpecializationInfo::default()
+            .map_entries(&spec_entries)
+            .data(&spec_data);
+        let mut stages = vec![
+            stage(vk::ShaderStageFlags::RAYGEN_KHR, RAYGEN).specialization_info(&spec),
             stage(vk::ShaderStageFlags::MISS_KHR, MISS),
-            stage(vk::ShaderStageFlags::CLOSEST_HIT_KHR, CLOSEST_HIT_TRIANGLE),
-            stage(vk::ShaderStageFlags::CLOSEST_HIT_KHR, CLOSEST_HIT_SPHERE),
-            stage(vk::ShaderStageFlags::INTERSECTION_KHR, INTERSECT_SPHERE),
         ];
         let unused = vk::SHADER_UNUSED_KHR;
         let group = |ty, general, chit, isect| {
@@ -115,22 +159,39 @@ impl RtPipeline {
                 .any_hit_shader(unused)
                 .intersection_shader(isect)
         };
-        let groups = [
+        let mut groups = vec![
             group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 0, unused, unused),
             group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 1, unused, unused),
-            group(
+        ];
+        // Hit groups in SBT order (HitGroups::triangle_offset, sphere_offset).
+        if hit_groups.triangles {
+            stages.push(stage(
+                vk::ShaderStageFlags::CLOSEST_HIT_KHR,
+                CLOSEST_HIT_TRIANGLE,
+            ));
+            groups.push(group(
                 vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP,
                 unused,
-                2,
+                stages.len() as u32 - 1,
                 unused,
-            ),
-            group(
+            ));
+        }
+        if hit_groups.spheres {
+            stages.push(stage(
+                vk::ShaderStageFlags::CLOSEST_HIT_KHR,
+                CLOSEST_HIT_SPHERE,
+            ));
+            stages.push(stage(
+                vk::ShaderStageFlags::INTERSECTION_KHR,
+                INTERSECT_SPHERE,
+            ));
+            groups.push(group(
                 vk::RayTracingShaderGroupTypeKHR::PROCEDURAL_HIT_GROUP,
                 unused,
-                3,
-                4,
-            ),
-        ];
+                stages.len() as u32 - 2,
+                stages.len() as u32 - 1,
+            ));
+        }
         let info = vk::RayTracingPipelineCreateInfoKHR::default()
             .stages(&stages)
             .groups(&groups)
@@ -154,7 +215,8 @@ impl RtPipeline {
         let base = p.shader_group_base_alignment as u64;
         let raygen_size = align_up(stride, base);
         let miss_size = align_up(stride, base);
-        let hit_size = align_up(2 * stride, base);
+        let hits = hit_groups.count() as u64;
+        let hit_size = align_up(hits.max(1) * stride, base);
         let handles = unsafe {
             ctx.rt.get_ray_tracing_shader_group_handles(
                 pipeline,
@@ -180,8 +242,9 @@ impl RtPipeline {
         };
         put(0, 0);
         put(raygen_size, 1);
-        put(raygen_size + miss_size, 2);
-        put(raygen_size + miss_size + stride, 3);
+        for k in 0..hits {
+            put(raygen_size + miss_size + k * stride, 2 + k as usize);
+        }
         ctx.write_buffer(&mut sbt, &table)?;
         let at = sbt.address + start;
         let raygen_region = vk::StridedDeviceAddressRegionKHR {
@@ -194,10 +257,15 @@ impl RtPipeline {
             stride,
             size: miss_size,
         };
-        let hit_region = vk::StridedDeviceAddressRegionKHR {
-            device_address: at + raygen_size + miss_size,
-            stride,
-            size: hit_size,
+        // No hit group at all (an empty scene): a null region, never used.
+        let hit_region = if hits == 0 {
+            vk::StridedDeviceAddressRegionKHR::default()
+        } else {
+            vk::StridedDeviceAddressRegionKHR {
+                device_address: at + raygen_size + miss_size,
+                stride,
+                size: hit_size,
+            }
         };
         Ok(RtPipeline {
             module,

@@ -1,0 +1,59 @@
+//! The light table's selection probabilities and alias table (what `kernel::light::choose_light`
+//! reads), for uniform or power-proportional light selection.
+
+use kernel::scene::{light_selection, SphereLight};
+
+/// Emitted power of a sphere light up to a constant: luminance of its radiance times its
+/// area (power = pi x area x radiance for a uniform Lambertian emitter).
+pub fn light_power(l: &SphereLight) -> f64 {
+    let [r, g, b] = l.radiance.map(f64::from);
+    let luminance = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+    luminance.max(0.0) * 4.0 * std::f64::consts::PI * (l.radius as f64).powi(2)
+}
+
+/// Fills `select_pmf`, `alias_threshold` and `alias` of every light for `mode` (one of
+/// `kernel::scene::light_selection`). Power selection falls back to uniform when every light
+/// has zero power.
+pub fn assign_light_selection(lights: &mut [SphereLight], mode: u32) {
+    let weights: Vec<f64> = match mode {
+        light_selection::POWER => lights.iter().map(light_power).collect(),
+        _ => vec![1.0; lights.len()],
+    };
+    let weights = if weights.iter().sum::<f64>() > 0.0 {
+        weights
+    } else {
+        vec![1.0; lights.len()]
+    };
+    let table = alias_table(&weights);
+    let total: f64 = weights.iter().sum();
+    for (l, (w, (threshold, alias))) in lights.iter_mut().zip(weights.iter().zip(table)) {
+        l.select_pmf = (w / total) as f32;
+        l.alias_threshold = threshold;
+        l.alias = alias;
+    }
+}
+
+/// Walker's alias table by Vose's construction (Vose 1991, "A linear algorithm for generating
+/// random numbers with a given distribution"; pbrt-v4 `AliasTable`): for n weights, slot i keeps
+/// item i with probability `threshold[i]`, else gives `alias[i]`, so that item i's total
+/// probability is w_i / sum(w). Computed in f64; every slot with no alias has threshold 1.
+pub fn alias_table(weights: &[f64]) -> Vec<(f32, u32)> {
+    let n = weights.len();
+    let total: f64 = weights.iter().sum();
+    // Each slot holds 1/n of the probability; scaled so a slot's capacity is 1.
+    let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
+    let mut table: Vec<(f32, u32)> = (0..n as u32).map(|i| (1.0, i)).collect();
+    let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+    while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
+        small.pop();
+        // Slot s keeps item s with probability scaled[s] and gives item l the rest.
+        table[s] = (scaled[s] as f32, l as u32);
+        scaled[l] -= 1.0 - scaled[s];
+        if scaled[l] < 1.0 {
+            large.pop();
+            small.push(l);
+        }
+    }
+    // Whatever is left is full up to rounding: threshold 1 (already set).
+    table
+}

@@ -1,0 +1,116 @@
+//! What a scene needs, so paths skip what it doesn't: the host analyses the scene and its
+//! settings into feature bits; the GPU reads them as a Vulkan specialization constant (the
+//! driver folds the branches away), the CPU as a const generic (`Static<F>`, one monomorphised
+//! `trace_path` per combination). Without [`SPECIALIZED`] every question is answered from the
+//! run-time parameters instead: the generic path, kept for comparison (`--no-specialize`).
+//!
+//! Both paths compute the same values: a feature bit may only be cleared when the run-time
+//! answer is the same (`scene_features` derives both from the same parameters).
+
+use crate::scene::{light_sampling, mis, roulette, RenderParams};
+
+/// The bits are answers fixed before the render; without it, they are ignored.
+pub const SPECIALIZED: u32 = 1 << 0;
+/// The scene has lights: next-event estimation runs.
+pub const LIGHTS: u32 = 1 << 1;
+/// The background is not black: escaping paths add it.
+pub const BACKGROUND: u32 = 1 << 2;
+/// MIS uses the power heuristic (else the seed's 1/2 weights).
+pub const MIS_POWER: u32 = 1 << 3;
+/// Sphere lights are sampled by their cone (else by area).
+pub const LIGHT_CONE: u32 = 1 << 4;
+/// Russian roulette is driven by the throughput (else constant).
+pub const RR_THROUGHPUT: u32 = 1 << 5;
+/// The scene has exactly one light: no light choice.
+pub const SINGLE_LIGHT: u32 = 1 << 6;
+
+/// The feature bits of a render with these parameters.
+#[inline]
+pub fn scene_features(params: &RenderParams) -> u32 {
+    let mut f = SPECIALIZED;
+    if params.light_count > 0 {
+        f |= LIGHTS;
+    }
+    if params.light_count == 1 {
+        f |= SINGLE_LIGHT;
+    }
+    if params.background[0] != 0.0 || params.background[1] != 0.0 || params.background[2] != 0.0 {
+        f |= BACKGROUND;
+    }
+    if params.mis_mode == mis::POWER {
+        f |= MIS_POWER;
+    }
+    if params.light_sampling == light_sampling::CONE {
+        f |= LIGHT_CONE;
+    }
+    if params.rr_mode == roulette::THROUGHPUT {
+        f |= RR_THROUGHPUT;
+    }
+    f
+}
+
+/// A set of feature answers: fixed at compile time ([`Static`]) or read at run time
+/// ([`Dynamic`], the GPU's specialization constant, or the generic path).
+pub trait FeatureSet: Copy {
+    fn bits(self) -> u32;
+
+    #[inline]
+    fn specialized(self) -> bool {
+        self.bits() & SPECIALIZED != 0
+    }
+    #[inline]
+    fn answer(self, bit: u32, run_time: bool) -> bool {
+        if self.specialized() {
+            self.bits() & bit != 0
+        } else {
+            run_time
+        }
+    }
+    #[inline]
+    fn lights(self, p: &RenderParams) -> bool {
+        self.answer(LIGHTS, p.light_count > 0)
+    }
+    #[inline]
+    fn single_light(self, p: &RenderParams) -> bool {
+        self.answer(SINGLE_LIGHT, p.light_count == 1)
+    }
+    /// The generic path adds the background whatever it is (adding black changes nothing).
+    #[inline]
+    fn background(self) -> bool {
+        self.answer(BACKGROUND, true)
+    }
+    #[inline]
+    fn mis_power(self, p: &RenderParams) -> bool {
+        self.answer(MIS_POWER, p.mis_mode == mis::POWER)
+    }
+    #[inline]
+    fn light_cone(self, p: &RenderParams) -> bool {
+        self.answer(LIGHT_CONE, p.light_sampling == light_sampling::CONE)
+    }
+    #[inline]
+    fn rr_throughput(self, p: &RenderParams) -> bool {
+        self.answer(RR_THROUGHPUT, p.rr_mode == roulette::THROUGHPUT)
+    }
+}
+
+/// Feature bits known at compile time: each combination is its own monomorphised path.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Static<const F: u32>;
+
+impl<const F: u32> FeatureSet for Static<F> {
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        F
+    }
+}
+
+/// Feature bits known at run time (0: the generic path).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Dynamic(pub u32);
+
+impl FeatureSet for Dynamic {
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        self.0
+    }
+}

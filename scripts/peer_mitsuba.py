@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""Mitsuba 3 on the Cornell scene: time against error, in the CSV columns of `twinpath bench`.
+
+Builds the scene of ../shared/reference/cornell_spheres/scene.md with mi.load_dict (the same
+numbers as scenes/cornell.toml), renders it at 1, 2, 4, ... spp with the `path` integrator
+(max_depth -1, rr_depth 5, independent sampler), several seeds per point at low spp, and
+measures render seconds (mi.render plus the evaluation of the image) and relMSE / RMSE against
+the reference EXR with the definitions of `twinpath diff`:
+relMSE = mean over pixels and channels of (a - b)^2 / (b^2 + 0.01).
+
+Usage: peer_mitsuba.py REFERENCE.exr OUT.csv [--variant llvm_ad_rgb] [--max-spp 1024]
+       [--max-seconds 60]
+Install: pip install mitsuba numpy (scripts/peer_mitsuba.sh does it in a venv).
+"""
+
+import argparse
+import sys
+import time
+
+import mitsuba as mi
+import numpy as np
+
+
+def quad(p0, p1, p3, material):
+    """A parallelogram p0, p1, p2 = p1 + p3 - p0, p3 as a two-triangle mesh."""
+    p0, p1, p3 = (np.array(p, dtype=float) for p in (p0, p1, p3))
+    e1, e2 = p1 - p0, p3 - p0
+    n = np.cross(e1, e2)
+    n /= np.linalg.norm(n)
+    center = p0 + 0.5 * (e1 + e2)
+    # Mitsuba's rectangle spans [-1, 1]^2 in x, y with normal +z.
+    m = np.eye(4)
+    m[:3, 0] = 0.5 * e1
+    m[:3, 1] = 0.5 * e2
+    m[:3, 2] = n
+    m[:3, 3] = center
+    return {"type": "rectangle", "to_world": mi.ScalarTransform4f(m.tolist()),
+            "bsdf": {"type": "ref", "id": material}}
+
+
+def scene_dict(spp, seed):
+    white, red, green, blue = (0.73, 0.73, 0.73), (0.65, 0.05, 0.05), (0.12, 0.45, 0.15), \
+        (0.25, 0.35, 0.75)
+
+    def diffuse(rgb):
+        return {"type": "twosided",
+                "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": rgb}}}
+
+    return {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5, "hide_emitters": False},
+        "sensor": {
+            "type": "perspective",
+            "fov": 40.0,
+            "fov_axis": "y",
+            "to_world": mi.ScalarTransform4f().look_at(origin=[0, 1, 3.8], target=[0, 1, 0],
+                                                       up=[0, 1, 0]),
+            "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
+            "film": {"type": "hdrfilm", "width": 256, "height": 256, "pixel_format": "rgb",
+                     "rfilter": {"type": "box"}},
+        },
+        "white": diffuse(white), "red": diffuse(red), "green": diffuse(green),
+        "blue": diffuse(blue),
+        "floor": quad((-1, 0, 1), (1, 0, 1), (-1, 0, -1), "white"),
+        "ceiling": quad((-1, 2, -1), (1, 2, -1), (-1, 2, 1), "white"),
+        "back": quad((-1, 0, -1), (1, 0, -1), (-1, 2, -1), "white"),
+        "left": quad((-1, 0, 1), (-1, 0, -1), (-1, 2, 1), "red"),
+        "right": quad((1, 0, -1), (1, 0, 1), (1, 2, -1), "green"),
+        "sphere_left": {"type": "sphere", "center": [-0.45, 0.4, -0.3], "radius": 0.4,
+                        "bsdf": {"type": "ref", "id": "white"}},
+        "sphere_right": {"type": "sphere", "center": [0.5, 0.3, 0.35], "radius": 0.3,
+                         "bsdf": {"type": "ref", "id": "blue"}},
+        "light": {"type": "sphere", "center": [0, 1.6, 0], "radius": 0.3,
+                  "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": 0.0}},
+                  "emitter": {"type": "area", "radiance": {"type": "rgb", "value": 10.0}}},
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("reference")
+    ap.add_argument("out")
+    ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--max-spp", type=int, default=1024)
+    ap.add_argument("--max-seconds", type=float, default=60.0)
+    args = ap.parse_args()
+
+    mi.set_variant(args.variant)
+    ref = np.array(mi.Bitmap(args.reference).convert(
+        mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32), dtype=np.float64)
+    rows = []
+    spp = 1
+    while spp <= args.max_spp:
+        seeds = 4 if spp <= 4 else (2 if spp <= 32 else 1)
+        for k in range(seeds):
+            t0 = time.perf_counter()
+            scene = mi.load_dict(scene_dict(spp, 1 + k))
+            setup = time.perf_counter() - t0
+            # Warm-up render: the llvm variants compile a kernel for each new sample count (a
+            # set-up cost, cached afterwards); it is timed as set-up, not render.
+            if k == 0:
+                t0 = time.perf_counter()
+                np.array(mi.render(scene, spp=spp, seed=1000))
+                setup += time.perf_counter() - t0
+            t0 = time.perf_counter()
+            img = np.array(mi.render(scene, spp=spp, seed=1 + k), dtype=np.float64)
+            render_s = time.perf_counter() - t0
+            d = img - ref
+            relmse = float(np.mean(d * d / (ref * ref + 0.01)))
+            rmse = float(np.sqrt(np.mean(d * d)))
+            rows.append((spp, 1 + k, setup, render_s, relmse, rmse, 1.0 / (relmse * render_s)))
+            print(f"mitsuba {args.variant} spp {spp} seed {1 + k}: {render_s:.3f} s, "
+                  f"relMSE {relmse:.4e}", file=sys.stderr)
+        if render_s > args.max_seconds:
+            break
+        spp *= 2
+    with open(args.out, "w") as f:
+        f.write("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n")
+        for spp, seed, setup, render_s, relmse, rmse, eff in rows:
+            f.write(f"mitsuba-{args.variant},Cpu,{spp},{seed},{setup:.6f},{render_s:.6f},"
+                    f"{relmse:.6e},{rmse:.6e},{eff:.6e}\n")
+
+
+if __name__ == "__main__":
+    main()
