@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Mitsuba 3 (PyPI) on the Cornell scene, time against error: scripts/peer_mitsuba.py in a venv.
+# Usage: scripts/peer_mitsuba.sh OUT.csv [--max-spp N] [--max-seconds S] [--variant llvm_ad_rgb]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:?usage: scripts/peer_mitsuba.sh OUT.csv [options]}
+shift
+venv=target/peer-mitsuba-venv
+if [ ! -x "$venv/bin/python" ]; then
+    python3 -m venv "$venv"
+    "$venv/bin/pip" install -q mitsuba numpy
+fi
+# Dr.Jit's LLVM back end fails on Debian's libLLVM 14/15 ("Cannot select: fmaximum").
+llvm=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
+if [ ! -e "$llvm" ]; then
+    ${SUDO:-} apt-get install -y libllvm19
+fi
+DRJIT_LIBLLVM_PATH=$llvm "$venv/bin/python" scripts/peer_mitsuba.py \
+    ../shared/reference/cornell_spheres/mitsuba_ref.exr "$out" "$@"
