@@ -80,34 +80,29 @@ fn scene_analysis_finds_the_features_present() {
     assert_eq!(generic.features(), 0);
 }
 
-#[test]
-fn specialized_and_generic_paths_give_identical_images_on_the_cpu() {
+/// Every test scene rendered specialized and generic on `backend` at `spp`: identical films.
+fn assert_specialized_matches_generic(backend: Backend, spp: u32) {
     for (name, scene) in scenes() {
         let mut generic = scene.clone();
         generic.render.specialize = false;
-        let a = render_film(&scene, Backend::Cpu, 8);
-        let b = render_film(&generic, Backend::Cpu, 8);
+        let a = render_film(&scene, backend, spp);
+        let b = render_film(&generic, backend, spp);
         assert_identical(&a, &b, name);
         println!(
-            "cpu {name}: features {:#x}: identical to the generic path",
+            "{backend:?} {name}: features {:#x}: identical to the generic path",
             scene.features()
         );
     }
 }
 
 #[test]
+fn specialized_and_generic_paths_give_identical_images_on_the_cpu() {
+    assert_specialized_matches_generic(Backend::Cpu, 8);
+}
+
+#[test]
 fn specialized_and_generic_paths_give_identical_images_on_the_gpu() {
-    for (name, scene) in scenes() {
-        let mut generic = scene.clone();
-        generic.render.specialize = false;
-        let a = render_film(&scene, Backend::Gpu, 4);
-        let b = render_film(&generic, Backend::Gpu, 4);
-        assert_identical(&a, &b, name);
-        println!(
-            "gpu {name}: features {:#x}: identical to the generic path",
-            scene.features()
-        );
-    }
+    assert_specialized_matches_generic(Backend::Gpu, 4);
     assert_validation_clean();
 }
 
