@@ -1,6 +1,9 @@
 //! twinpath's host: scenes, the CPU backend, the film and image files, and the render driver.
 //! Everything here is "not a pixel's value"; the kernel crate decides those.
 
+// std::simd: the CPU traversal's four-lane box and triangle tests (cpu/simd.rs).
+#![feature(portable_simd)]
+
 #[cfg(feature = "gpu")]
 pub mod bench;
 pub mod cpu;

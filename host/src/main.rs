@@ -165,6 +165,28 @@ enum Command {
     },
     /// What this build contains: the SPIR-V module and the backends.
     Info,
+    /// Ray throughput of the CPU traversal on one thread (camera rays and diffuse bounce rays),
+    /// and the BVH's build time and memory.
+    Rays {
+        /// Scene file (TOML). Without it, the built-in Cornell scene.
+        scene: Option<PathBuf>,
+        /// Add a generated mesh of about N triangles (a rippled torus-knot tube) at the point
+        /// the camera looks at.
+        #[arg(long)]
+        mesh_triangles: Option<usize>,
+        /// Width of the camera-ray image (its height follows the scene's aspect ratio).
+        #[arg(long, default_value_t = 1024)]
+        width: u32,
+        /// Timed passes per measurement; the fastest is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: u32,
+        /// Write the rays and our hits here, for scripts/embree_rays.c.
+        #[arg(long)]
+        ray_file: Option<PathBuf>,
+        /// Append the results to this CSV file (header written when it is new).
+        #[arg(long)]
+        csv: Option<PathBuf>,
+    },
 }
 
 fn main() {
@@ -466,6 +488,69 @@ fn run() -> Result<()> {
             );
             Ok(())
         }
+        Command::Rays {
+            scene,
+            mesh_triangles,
+            width,
+            repeats,
+            ray_file,
+            csv,
+        } => {
+            let mut scene = load_scene(scene.as_deref())?;
+            if let Some(n) = mesh_triangles {
+                add_knot_mesh(&mut scene, n);
+            }
+            if width == 0 {
+                bail!("--width must be at least 1");
+            }
+            let height = ((width as u64 * scene.camera.height as u64) / scene.camera.width as u64)
+                .max(1) as u32;
+            let r =
+                twinpath::cpu::rays::measure(&scene, width, height, repeats, ray_file.as_deref())
+                    .context("writing the ray file")?;
+            let mib = |b: usize| b as f64 / (1024.0 * 1024.0);
+            println!(
+                "{}: {} triangles, {} spheres; BVH build {:.3} s, {} nodes, {:.1} MiB hierarchy + {:.1} MiB primitives",
+                scene.name, r.triangles, r.spheres, r.build_seconds, r.nodes,
+                mib(r.hierarchy_bytes), mib(r.primitive_bytes)
+            );
+            for s in &r.sets {
+                println!(
+                    "  {:<28} {:>9} rays ({:>9} hit): closest {:>7.3} Mrays/s, occluded {:>7.3} Mrays/s (one thread)",
+                    s.name, s.rays, s.hits, s.closest_per_second * 1e-6, s.occluded_per_second * 1e-6
+                );
+            }
+            if let Some(path) = csv {
+                use std::io::Write;
+                let new = !path.exists();
+                let mut f = std::fs::OpenOptions::new()
+                    .create(true)
+                    .append(true)
+                    .open(&path)
+                    .with_context(|| format!("opening {}", path.display()))?;
+                if new {
+                    writeln!(f, "tracer,scene,triangles,spheres,build_seconds,hierarchy_bytes,primitive_bytes,rays_name,rays,hits,closest_mrays_per_s,occluded_mrays_per_s")?;
+                }
+                for s in &r.sets {
+                    writeln!(
+                        f,
+                        "twinpath,{},{},{},{:.6},{},{},{},{},{},{:.4},{:.4}",
+                        scene_stem(&scene.name),
+                        r.triangles,
+                        r.spheres,
+                        r.build_seconds,
+                        r.hierarchy_bytes,
+                        r.primitive_bytes,
+                        s.name,
+                        s.rays,
+                        s.hits,
+                        s.closest_per_second * 1e-6,
+                        s.occluded_per_second * 1e-6
+                    )?;
+                }
+            }
+            Ok(())
+        }
         Command::Diff { a, b } => {
             let ia = RgbImage::read(&a)?;
             let ib = RgbImage::read(&b)?;
@@ -508,6 +593,30 @@ fn run() -> Result<()> {
 }
 
 /// The scene file, or the built-in Cornell scene.
+/// Adds `twinpath::cpu::rays::knot_mesh` with about `n` triangles, white (kd 0.73), centred on
+/// the camera's look-at point and a third of the camera's distance across.
+fn add_knot_mesh(scene: &mut Scene, n: usize) {
+    let size = 0.35 * (scene.camera.look_at - scene.camera.eye).length();
+    let vertices = twinpath::cpu::rays::knot_mesh(n, scene.camera.look_at, size);
+    let material = scene.materials.len() as u32;
+    scene.materials.push(kernel::scene::Material {
+        albedo: [0.73; 3],
+        _pad0: 0.0,
+        emission: [0.0; 3],
+        _pad1: 0.0,
+    });
+    scene.material_names.push("knot".into());
+    let start = scene.triangles.len();
+    scene
+        .triangles
+        .extend(twinpath::cpu::rays::to_triangles(&vertices, material));
+    scene.triangle_groups.push(twinpath::scene::TriangleGroup {
+        name: "knot".into(),
+        range: start..scene.triangles.len(),
+    });
+    scene.name = format!("{}+knot{}k", scene_stem(&scene.name), n / 1000);
+}
+
 fn load_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(match path {
         Some(p) => Scene::load(p)?,

@@ -3,6 +3,9 @@
 //! (seed, pixel, sample index) and each pixel sums its samples in index order.
 
 pub mod bvh;
+pub mod bvh_build;
+pub mod rays;
+pub mod simd;
 
 use crate::film::Film;
 use crate::scene::Scene;

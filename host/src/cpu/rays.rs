@@ -1,0 +1,312 @@
+//! Ray throughput of the CPU traversal, on two ray sets with opposite coherence: the camera's
+//! rays (one per pixel centre, neighbours nearly parallel) and diffuse bounce rays (one
+//! cosine-distributed direction from each camera ray's hit, as a path tracer's second
+//! vertex shoots them). Both sets can be written to a file so another ray tracer (Embree, in
+//! `scripts/embree_rays.c`) traces exactly the same rays.
+
+use super::bvh::Bvh;
+use crate::scene::Scene;
+use glam::Vec3;
+use kernel::camera::{camera_origin, camera_ray_direction};
+use kernel::geometry::offset_ray_origin;
+use kernel::rng::SampleRng;
+use kernel::sampling::sample_cosine_hemisphere;
+use kernel::scene::NONE;
+use std::io::Write;
+use std::time::Instant;
+
+/// Rays to trace, each from `origins[i]` along `dirs[i]` for t in (0, t_max[i]).
+#[derive(Clone, Debug, Default)]
+pub struct RaySet {
+    pub name: &'static str,
+    pub origins: Vec<Vec3>,
+    pub dirs: Vec<Vec3>,
+    pub t_max: Vec<f32>,
+}
+
+impl RaySet {
+    pub fn len(&self) -> usize {
+        self.origins.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.origins.is_empty()
+    }
+}
+
+/// The primary rays through the pixel centres of a `width` x `height` image of the scene.
+pub fn camera_rays(scene: &Scene, width: u32, height: u32) -> RaySet {
+    let mut desc = scene.camera;
+    desc.width = width;
+    desc.height = height;
+    let camera = desc.to_kernel();
+    let eye = camera_origin(&camera);
+    let mut rays = RaySet {
+        name: "camera (coherent)",
+        ..RaySet::default()
+    };
+    for py in 0..height {
+        for px in 0..width {
+            rays.origins.push(eye);
+            rays.dirs.push(camera_ray_direction(
+                &camera, width, height, px, py, 0.5, 0.5,
+            ));
+            rays.t_max.push(f32::INFINITY);
+        }
+    }
+    rays
+}
+
+/// One diffuse bounce from each hit of `primary`: cosine-distributed about the normal on the
+/// side the ray came from, starting at the kernel's offset origin (as `trace_path` spawns it).
+pub fn bounce_rays(bvh: &Bvh, primary: &RaySet, seed: u32) -> RaySet {
+    let mut rays = RaySet {
+        name: "diffuse bounce (incoherent)",
+        ..RaySet::default()
+    };
+    for i in 0..primary.len() {
+        let hit = bvh.closest_hit(primary.origins[i], primary.dirs[i], primary.t_max[i]);
+        if !hit.is_hit() {
+            continue;
+        }
+        let n = if hit.normal.dot(primary.dirs[i]) > 0.0 {
+            -hit.normal
+        } else {
+            hit.normal
+        };
+        let mut rng = SampleRng::new(seed, i as u32, 0);
+        let (u1, u2) = (rng.next_f32(), rng.next_f32());
+        rays.origins
+            .push(offset_ray_origin(hit.position, n, hit.error));
+        rays.dirs.push(sample_cosine_hemisphere(n, u1, u2));
+        rays.t_max.push(f32::INFINITY);
+    }
+    rays
+}
+
+/// What one pass over a ray set found: per ray the primitive hit (`NONE` for a miss) and t.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RayResults {
+    pub prim: Vec<u32>,
+    pub t: Vec<f32>,
+}
+
+/// Traces every ray of `rays` (closest hit) on this thread.
+pub fn trace_all(bvh: &Bvh, rays: &RaySet) -> RayResults {
+    let mut out = RayResults {
+        prim: Vec::with_capacity(rays.len()),
+        t: Vec::with_capacity(rays.len()),
+    };
+    for i in 0..rays.len() {
+        let (prim, t) = bvh.closest_prim(rays.origins[i], rays.dirs[i], rays.t_max[i]);
+        out.prim.push(prim);
+        out.t.push(t);
+    }
+    out
+}
+
+/// Whether each ray of `rays` is occluded (any hit), on this thread.
+pub fn occluded_all(bvh: &Bvh, rays: &RaySet) -> Vec<bool> {
+    (0..rays.len())
+        .map(|i| bvh.any_hit(rays.origins[i], rays.dirs[i], rays.t_max[i]))
+        .collect()
+}
+
+/// Rays per second of `pass` over `rays`: the best of `repeats` timed passes (the least
+/// disturbed by other work on the machine), each of which traces every ray once.
+pub fn rays_per_second(rays: &RaySet, repeats: u32, mut pass: impl FnMut()) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..repeats.max(1) {
+        let start = Instant::now();
+        pass();
+        best = best.min(start.elapsed().as_secs_f64());
+    }
+    rays.len() as f64 / best
+}
+
+/// A closed tube around a (2, 3) torus knot with a rippled radius: `about` triangles (to within
+/// a few percent), centred at `center`, about `size` across. A stand-in for a dense scanned
+/// mesh: long thin triangles at every orientation, many of them close to each other.
+pub fn knot_mesh(about: usize, center: Vec3, size: f32) -> Vec<[Vec3; 3]> {
+    // rings x sides quads, two triangles each; sides ~ sqrt(rings / 8) keeps the cells square-ish.
+    let quads = (about / 2).max(32);
+    let sides = ((quads as f64 / 16.0).sqrt().round() as usize).max(4);
+    let rings = (quads / sides).max(8);
+    let scale = size / 6.0;
+    let curve = |a: f32| -> Vec3 {
+        let r = 2.0 + (3.0 * a).cos();
+        Vec3::new(r * (2.0 * a).cos(), r * (2.0 * a).sin(), -(3.0 * a).sin())
+    };
+    let tau = std::f32::consts::TAU;
+    let mut vertices = Vec::with_capacity(rings * sides);
+    for i in 0..rings {
+        let a = tau * i as f32 / rings as f32;
+        let p = curve(a);
+        let tangent = (curve(a + 1e-3) - curve(a - 1e-3)).normalize();
+        let side = tangent.cross(Vec3::Z).normalize();
+        let normal = side.cross(tangent);
+        for j in 0..sides {
+            let b = tau * j as f32 / sides as f32;
+            let radius = 0.45 * (1.0 + 0.2 * (17.0 * a).sin() * (5.0 * b).sin());
+            let offset = radius * (b.cos() * side + b.sin() * normal);
+            vertices.push(center + scale * (p + offset));
+        }
+    }
+    let at = |i: usize, j: usize| vertices[(i % rings) * sides + j % sides];
+    let mut triangles = Vec::with_capacity(2 * rings * sides);
+    for i in 0..rings {
+        for j in 0..sides {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    triangles
+}
+
+/// Writes the scene's primitives, the ray sets and our closest hits as little-endian binary
+/// for `scripts/embree_rays.c` (its header documents the layout).
+pub fn write_ray_file(
+    path: &std::path::Path,
+    bvh: &Bvh,
+    sets: &[(&RaySet, &RayResults)],
+) -> std::io::Result<()> {
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let f32s = |out: &mut std::io::BufWriter<std::fs::File>, v: &[f32]| -> std::io::Result<()> {
+        for x in v {
+            out.write_all(&x.to_le_bytes())?;
+        }
+        Ok(())
+    };
+    out.write_all(b"TPRAYS1\0")?;
+    for n in [bvh.triangles.len(), bvh.spheres.len(), sets.len()] {
+        out.write_all(&(n as u32).to_le_bytes())?;
+    }
+    for t in &bvh.triangles {
+        let p0 = Vec3::from(t.p0);
+        let p1 = p0 + Vec3::from(t.edge1);
+        let p2 = p0 + Vec3::from(t.edge2);
+        f32s(
+            &mut out,
+            &[p0.x, p0.y, p0.z, p1.x, p1.y, p1.z, p2.x, p2.y, p2.z],
+        )?;
+    }
+    for s in &bvh.spheres {
+        f32s(&mut out, &[s.center[0], s.center[1], s.center[2], s.radius])?;
+    }
+    for (rays, results) in sets {
+        let mut name = [0u8; 32];
+        let n = rays.name.len().min(31);
+        name[..n].copy_from_slice(&rays.name.as_bytes()[..n]);
+        out.write_all(&name)?;
+        out.write_all(&(rays.len() as u32).to_le_bytes())?;
+        for i in 0..rays.len() {
+            let (o, d) = (rays.origins[i], rays.dirs[i]);
+            f32s(&mut out, &[o.x, o.y, o.z, d.x, d.y, d.z, rays.t_max[i]])?;
+        }
+        for i in 0..rays.len() {
+            out.write_all(&results.prim[i].to_le_bytes())?;
+            f32s(&mut out, &[results.t[i]])?;
+        }
+    }
+    out.flush()
+}
+
+/// Fraction of rays on which two passes found the same primitive (both missing counts).
+pub fn agreement(a: &RayResults, b: &RayResults) -> f64 {
+    let same = a.prim.iter().zip(&b.prim).filter(|(x, y)| x == y).count();
+    same as f64 / a.prim.len().max(1) as f64
+}
+
+/// Number of rays that hit something.
+pub fn hits(r: &RayResults) -> usize {
+    r.prim.iter().filter(|&&p| p != NONE).count()
+}
+
+/// Vertex triples as the kernel's triangles, all of material `material`.
+pub fn to_triangles(vertices: &[[Vec3; 3]], material: u32) -> Vec<kernel::scene::Triangle> {
+    vertices
+        .iter()
+        .map(|p| kernel::scene::Triangle {
+            p0: p[0].to_array(),
+            material,
+            edge1: (p[1] - p[0]).to_array(),
+            _pad0: 0,
+            edge2: (p[2] - p[0]).to_array(),
+            _pad1: 0,
+        })
+        .collect()
+}
+
+/// What `twinpath rays` measured on one scene.
+#[derive(Clone, Debug)]
+pub struct RayReport {
+    pub triangles: usize,
+    pub spheres: usize,
+    pub build_seconds: f64,
+    pub nodes: usize,
+    pub hierarchy_bytes: usize,
+    pub primitive_bytes: usize,
+    pub sets: Vec<RaySetReport>,
+}
+
+/// Throughput on one ray set.
+#[derive(Clone, Debug)]
+pub struct RaySetReport {
+    pub name: &'static str,
+    pub rays: usize,
+    pub hits: usize,
+    pub closest_per_second: f64,
+    pub occluded_per_second: f64,
+}
+
+/// Builds the BVH over `scene` (timed), makes the camera rays of a `width` x `height` image and
+/// their diffuse bounces, and times closest-hit and any-hit traversal of each set on one
+/// thread. With `ray_file`, also writes the rays and our hits for `scripts/embree_rays.c`.
+pub fn measure(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    repeats: u32,
+    ray_file: Option<&std::path::Path>,
+) -> std::io::Result<RayReport> {
+    let start = Instant::now();
+    let bvh = Bvh::build(scene.spheres.clone(), scene.triangles.clone());
+    let build_seconds = start.elapsed().as_secs_f64();
+    let camera = camera_rays(scene, width, height);
+    let bounce = bounce_rays(&bvh, &camera, scene.render.seed);
+    let mut sets = Vec::new();
+    let mut results = Vec::new();
+    for rays in [&camera, &bounce] {
+        let found = trace_all(&bvh, rays);
+        let closest = rays_per_second(rays, repeats, || {
+            std::hint::black_box(trace_all(&bvh, rays));
+        });
+        let occluded = rays_per_second(rays, repeats, || {
+            std::hint::black_box(occluded_all(&bvh, rays));
+        });
+        sets.push(RaySetReport {
+            name: rays.name,
+            rays: rays.len(),
+            hits: hits(&found),
+            closest_per_second: closest,
+            occluded_per_second: occluded,
+        });
+        results.push(found);
+    }
+    if let Some(path) = ray_file {
+        write_ray_file(
+            path,
+            &bvh,
+            &[(&camera, &results[0]), (&bounce, &results[1])],
+        )?;
+    }
+    Ok(RayReport {
+        triangles: bvh.triangles.len(),
+        spheres: bvh.spheres.len(),
+        build_seconds,
+        nodes: bvh.node_count(),
+        hierarchy_bytes: bvh.hierarchy_bytes(),
+        primitive_bytes: bvh.primitive_bytes(),
+        sets,
+    })
+}

@@ -1,0 +1,130 @@
+//! One ray against N boxes or four triangles at once (`std::simd`; the BVH uses 8 box lanes,
+//! one AVX2 instruction per step where the CPU has it, two SSE ones elsewhere). The triangle
+//! test performs, lane by lane, exactly the operations of the kernel's scalar
+//! `intersect_triangle` in the same order, so each lane's result is bit-identical to it (Rust
+//! never contracts a * b + c into a fused multiply-add); `tests/tests/properties.rs` checks
+//! this on random and degenerate triangles.
+
+use glam::Vec3;
+use std::simd::cmp::{SimdPartialEq, SimdPartialOrd};
+use std::simd::num::SimdFloat;
+use std::simd::{f32x4, Mask, Select, Simd};
+
+/// 1 + 2 gamma(3): widening of a slab test's far distance so rounding never culls a box the
+/// ray touches (pbrt-v4 6.8.2; gamma(n) = n u / (1 - n u), u = 2^-24).
+pub const SLAB_PAD: f32 = 1.0 + 2.0 * (3.0 * 5.960_464_5e-8) / (1.0 - 3.0 * 5.960_464_5e-8);
+
+/// N boxes, one per lane, as per-axis lower and upper bounds.
+#[derive(Clone, Copy, Debug)]
+pub struct Boxes<const N: usize> {
+    pub min: [Simd<f32, N>; 3],
+    pub max: [Simd<f32, N>; 3],
+}
+
+/// Four triangles, one per lane, as the kernel stores them: p0 and the two edges.
+#[derive(Clone, Copy, Debug)]
+pub struct Triangles4 {
+    pub p0: [f32x4; 3],
+    pub edge1: [f32x4; 3],
+    pub edge2: [f32x4; 3],
+}
+
+/// A ray with its components broadcast to every lane.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray4 {
+    pub origin: [f32x4; 3],
+    pub dir: [f32x4; 3],
+    /// Component-wise 1 / dir (infinite for zero components).
+    pub inv_dir: [f32; 3],
+    pub origin_xyz: [f32; 3],
+    /// Whether some 1 / dir component is infinite, so that the slab test can meet 0 x inf.
+    pub parallel: bool,
+}
+
+impl Ray4 {
+    pub fn new(origin: Vec3, dir: Vec3) -> Ray4 {
+        let inv = dir.recip();
+        let s = |v: Vec3| [f32x4::splat(v.x), f32x4::splat(v.y), f32x4::splat(v.z)];
+        Ray4 {
+            origin: s(origin),
+            dir: s(dir),
+            inv_dir: inv.to_array(),
+            origin_xyz: origin.to_array(),
+            parallel: !inv.is_finite(),
+        }
+    }
+
+    /// The slab test against four boxes: each lane's entry distance (clamped at 0) and whether
+    /// the ray enters that box within (0, t_max]; boxes are closed, and the far distance is
+    /// widened by [`SLAB_PAD`].
+    ///
+    /// A ray parallel to an axis (1/d infinite) meets 0 x inf = NaN when its origin lies on a
+    /// face's plane: it then runs inside that closed slab for every t, so that axis must not
+    /// narrow the interval. Such rays take a branch that says so (`tests/tests/bvh.rs` has
+    /// rays along triangle edges lying in box faces); for the others no NaN can arise, and
+    /// min/max are single instructions (minps/maxps).
+    #[inline(always)]
+    pub fn slab<const N: usize>(&self, b: &Boxes<N>, t_max: f32) -> (Simd<f32, N>, Mask<i32, N>) {
+        let mut near = Simd::splat(0.0);
+        let mut far = Simd::splat(t_max);
+        for axis in 0..3 {
+            let o = Simd::splat(self.origin_xyz[axis]);
+            let inv = Simd::splat(self.inv_dir[axis]);
+            let t0 = (b.min[axis] - o) * inv;
+            let t1 = (b.max[axis] - o) * inv;
+            let mut axis_near = min_or_second(t0, t1);
+            let mut axis_far = max_or_second(t0, t1);
+            if self.parallel {
+                let on_plane = t0.is_nan() | t1.is_nan();
+                axis_near = on_plane.select(Simd::splat(f32::NEG_INFINITY), axis_near);
+                axis_far = on_plane.select(Simd::splat(f32::INFINITY), axis_far);
+            }
+            near = max_or_second(axis_near, near);
+            far = min_or_second(axis_far, far);
+        }
+        let far = far * Simd::splat(SLAB_PAD);
+        (near, near.simd_le(far))
+    }
+
+    /// Moller-Trumbore against four triangles (the kernel's `intersect_triangle_uv`, lane by
+    /// lane): each lane's t where it hits within (t_min, t_max), else -1.
+    #[inline(always)]
+    pub fn triangles(&self, tri: &Triangles4, t_min: f32, t_max: f32) -> f32x4 {
+        let [dx, dy, dz] = self.dir;
+        let [e1x, e1y, e1z] = tri.edge1;
+        let [e2x, e2y, e2z] = tri.edge2;
+        // pvec = dir x edge2, in glam's order of operations.
+        let px = dy * e2z - e2y * dz;
+        let py = dz * e2x - e2z * dx;
+        let pz = dx * e2y - e2x * dy;
+        let det = e1x * px + e1y * py + e1z * pz;
+        let mut ok = det.simd_ne(f32x4::splat(0.0)) & det.is_finite();
+        let inv_det = f32x4::splat(1.0) / det;
+        let tx = self.origin[0] - tri.p0[0];
+        let ty = self.origin[1] - tri.p0[1];
+        let tz = self.origin[2] - tri.p0[2];
+        let u = (tx * px + ty * py + tz * pz) * inv_det;
+        ok &= u.simd_ge(f32x4::splat(0.0)) & u.simd_le(f32x4::splat(1.0));
+        // qvec = tvec x edge1.
+        let qx = ty * e1z - e1y * tz;
+        let qy = tz * e1x - e1z * tx;
+        let qz = tx * e1y - e1x * ty;
+        let v = (dx * qx + dy * qy + dz * qz) * inv_det;
+        ok &= v.simd_ge(f32x4::splat(0.0)) & (u + v).simd_le(f32x4::splat(1.0));
+        let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+        ok &= t.simd_gt(f32x4::splat(t_min)) & t.simd_lt(f32x4::splat(t_max)) & t.is_finite();
+        ok.select(t, f32x4::splat(-1.0))
+    }
+}
+
+/// Lane-wise a < b ? a : b: the second operand wherever either is NaN (x86 minps).
+#[inline(always)]
+pub fn min_or_second<const N: usize>(a: Simd<f32, N>, b: Simd<f32, N>) -> Simd<f32, N> {
+    a.simd_lt(b).select(a, b)
+}
+
+/// Lane-wise a > b ? a : b: the second operand wherever either is NaN (x86 maxps).
+#[inline(always)]
+pub fn max_or_second<const N: usize>(a: Simd<f32, N>, b: Simd<f32, N>) -> Simd<f32, N> {
+    a.simd_gt(b).select(a, b)
+}

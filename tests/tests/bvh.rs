@@ -1,0 +1,240 @@
+//! The CPU backend's 4-wide BVH against brute force: for every ray, the closest hit's t is
+//! bit-identical to the minimum over all primitives of the kernel's scalar intersection, the
+//! primitive returned really is hit at that t, and any-hit agrees with it. Scenes that stress
+//! the build and the traversal: random soups with spheres, a dense generated mesh, an
+//! axis-aligned grid (flat boxes, rays in their planes), thousands of identical triangles (the
+//! median-split fallback), and 0 to 5 primitives (a root that is a leaf). Memory is checked to
+//! grow linearly with the triangle count.
+
+use glam::Vec3;
+use kernel::rng::SampleRng;
+use kernel::scene::{Sphere, Triangle, NONE};
+use twinpath::cpu::bvh::Bvh;
+use twinpath::cpu::rays::{knot_mesh, to_triangles};
+
+/// Uniform numbers from the kernel's hash (a fixed stream per test).
+struct Uniform(SampleRng);
+
+impl Uniform {
+    fn new(stream: u32) -> Self {
+        Uniform(SampleRng::new(0x5eed, stream, 0))
+    }
+    fn f(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.0.next_f32()
+    }
+    fn point(&mut self, lo: f32, hi: f32) -> Vec3 {
+        Vec3::new(self.f(lo, hi), self.f(lo, hi), self.f(lo, hi))
+    }
+    /// Directions: a third exactly along an axis (zero components: infinite 1/d), the rest
+    /// uniform on the sphere.
+    fn dir(&mut self) -> Vec3 {
+        let k = self.0.next_u32() % 9;
+        if k < 6 {
+            let s = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
+            [Vec3::X, Vec3::Y, Vec3::Z][k as usize / 2] * s
+        } else {
+            let z = self.f(-1.0, 1.0);
+            let phi = self.f(0.0, std::f32::consts::TAU);
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Vec3::new(r * phi.cos(), r * phi.sin(), z)
+        }
+    }
+}
+
+fn sphere(center: Vec3, radius: f32) -> Sphere {
+    Sphere {
+        center: center.to_array(),
+        radius,
+        material: 0,
+        light: NONE,
+        _pad: [0; 2],
+    }
+}
+
+/// The closest hit by testing every primitive with the kernel's scalar functions.
+fn brute_force(bvh: &Bvh, o: Vec3, d: Vec3, t_max: f32) -> (u32, f32) {
+    let n = (bvh.spheres.len() + bvh.triangles.len()) as u32;
+    let (mut best, mut best_t) = (NONE, t_max);
+    for id in 0..n {
+        let t = bvh.intersect_prim(id, o, d, best_t);
+        if t >= 0.0 && t < best_t {
+            (best, best_t) = (id, t);
+        }
+    }
+    (best, best_t)
+}
+
+/// Casts `rays` rays (origins in [lo, hi]^3, some on the grid's planes, and finite and
+/// infinite t_max) and compares the BVH with brute force; returns how many hit.
+fn check_against_brute_force(
+    name: &str,
+    bvh: &Bvh,
+    stream: u32,
+    rays: u32,
+    lo: f32,
+    hi: f32,
+) -> u32 {
+    let mut rng = Uniform::new(stream);
+    let mut hits = 0;
+    for i in 0..rays {
+        let mut o = rng.point(lo, hi);
+        if i % 5 == 0 {
+            // On a lattice plane, where the grid scene's flat boxes lie.
+            o.y = o.y.round();
+        }
+        let d = rng.dir();
+        let t_max = if i % 3 == 0 {
+            rng.f(0.0, hi - lo)
+        } else {
+            f32::INFINITY
+        };
+        let (want, want_t) = brute_force(bvh, o, d, t_max);
+        let (got, got_t) = bvh.closest_prim(o, d, t_max);
+        assert_eq!(
+            got_t.to_bits(),
+            want_t.to_bits(),
+            "{name}: ray {i} from {o} along {d}: BVH t {got_t} (prim {got}), brute force {want_t} (prim {want})"
+        );
+        if got != want {
+            // A tie at exactly the same t: the returned primitive must be hit there too.
+            assert_ne!(got, NONE, "{name}: ray {i}: BVH missed prim {want}");
+            assert_eq!(
+                bvh.intersect_prim(got, o, d, f32::INFINITY).to_bits(),
+                got_t.to_bits(),
+                "{name}: ray {i}: prim {got} is not hit at {got_t}"
+            );
+        }
+        assert_eq!(
+            bvh.any_hit(o, d, t_max),
+            want != NONE,
+            "{name}: ray {i} from {o} along {d}, t_max {t_max}: any-hit disagrees"
+        );
+        hits += (want != NONE) as u32;
+    }
+    hits
+}
+
+fn random_soup(stream: u32, triangles: usize, spheres: usize) -> Bvh {
+    let mut rng = Uniform::new(stream);
+    let tris: Vec<[Vec3; 3]> = (0..triangles)
+        .map(|_| {
+            let c = rng.point(-10.0, 10.0);
+            let size = rng.f(0.05, 2.0);
+            [
+                c + size * rng.point(-1.0, 1.0),
+                c + size * rng.point(-1.0, 1.0),
+                c + size * rng.point(-1.0, 1.0),
+            ]
+        })
+        .collect();
+    let sph = (0..spheres)
+        .map(|_| sphere(rng.point(-10.0, 10.0), rng.f(0.01, 1.5)))
+        .collect();
+    Bvh::build(sph, to_triangles(&tris, 0))
+}
+
+#[test]
+fn random_soups_with_spheres_match_brute_force() {
+    for (k, (tris, spheres)) in [(3000, 40), (500, 0), (0, 300), (7, 2)]
+        .into_iter()
+        .enumerate()
+    {
+        let bvh = random_soup(k as u32, tris, spheres);
+        let hits = check_against_brute_force(
+            &format!("soup {tris}+{spheres}"),
+            &bvh,
+            100 + k as u32,
+            4000,
+            -12.0,
+            12.0,
+        );
+        if tris + spheres > 100 {
+            assert!(
+                hits > 400,
+                "soup {tris}+{spheres}: only {hits} of 4000 rays hit; the test would be weak"
+            );
+        }
+    }
+}
+
+#[test]
+fn dense_mesh_matches_brute_force() {
+    let tris = to_triangles(&knot_mesh(20_000, Vec3::ZERO, 4.0), 0);
+    let bvh = Bvh::build(vec![sphere(Vec3::ZERO, 0.3)], tris);
+    let hits = check_against_brute_force("knot 20k", &bvh, 7, 3000, -2.5, 2.5);
+    assert!(
+        hits > 300,
+        "knot: only {hits} of 3000 rays hit; the test would be weak"
+    );
+}
+
+#[test]
+fn axis_aligned_grid_with_rays_in_its_planes_matches_brute_force() {
+    // Unit squares in the planes y = 0, 1, 2: every triangle's box is flat in y, and a fifth of
+    // the rays start on those planes (some running inside them).
+    let mut tris = Vec::new();
+    for y in 0..3 {
+        for x in -4..4 {
+            for z in -4..4 {
+                let p = |dx: i32, dz: i32| Vec3::new((x + dx) as f32, y as f32, (z + dz) as f32);
+                tris.push([p(0, 0), p(1, 0), p(1, 1)]);
+                tris.push([p(0, 0), p(1, 1), p(0, 1)]);
+            }
+        }
+    }
+    let bvh = Bvh::build(Vec::new(), to_triangles(&tris, 0));
+    let hits = check_against_brute_force("grid", &bvh, 11, 6000, -5.0, 5.0);
+    assert!(
+        hits > 500,
+        "grid: only {hits} of 6000 rays hit; the test would be weak"
+    );
+}
+
+#[test]
+fn identical_triangles_and_tiny_scenes_match_brute_force() {
+    // 5000 copies of one triangle: no SAH split separates them (median splits do).
+    let one = [
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    let bvh = Bvh::build(Vec::new(), to_triangles(&vec![one; 5000], 0));
+    check_against_brute_force("5000 identical", &bvh, 21, 2000, -2.0, 2.0);
+    for n in 0..=5 {
+        let bvh = random_soup(50 + n, n as usize, (n % 2) as usize);
+        check_against_brute_force(&format!("{n} triangles"), &bvh, 60 + n, 2000, -12.0, 12.0);
+    }
+    let empty = Bvh::build(Vec::new(), Vec::new());
+    assert_eq!(
+        empty.closest_prim(Vec3::ZERO, Vec3::X, f32::INFINITY).0,
+        NONE
+    );
+    assert!(!empty.any_hit(Vec3::ZERO, Vec3::X, f32::INFINITY));
+}
+
+#[test]
+fn memory_grows_linearly_with_the_triangle_count() {
+    let bytes_per_triangle = |n: usize| {
+        let tris: Vec<Triangle> = to_triangles(&knot_mesh(n, Vec3::ZERO, 4.0), 0);
+        let count = tris.len();
+        let bvh = Bvh::build(Vec::new(), tris);
+        assert!(
+            bvh.node_count() <= count,
+            "{} nodes for {count} triangles",
+            bvh.node_count()
+        );
+        bvh.hierarchy_bytes() as f64 / count as f64
+    };
+    let small = bytes_per_triangle(10_000);
+    let large = bytes_per_triangle(200_000);
+    // Nodes and packed leaves are a bounded number of bytes per triangle, whatever n:
+    // one 160-byte block per 1 to 4 triangles, at most one 256-byte node per leaf.
+    assert!(
+        small < 300.0 && large < 300.0,
+        "bytes per triangle: {small:.1} at 10k, {large:.1} at 200k"
+    );
+    assert!(
+        (large / small - 1.0).abs() < 0.25,
+        "bytes per triangle: {small:.1} at 10k, {large:.1} at 200k"
+    );
+}
