@@ -22,7 +22,7 @@ use kernel::sampling::{
 };
 use proptest::prelude::*;
 use std::simd::f32x4;
-use twinpath::cpu::simd::{Ray4, Triangles4};
+use twinpath::cpu::simd::{Ray4, Spheres4, Triangles4};
 
 fn config() -> ProptestConfig {
     let cases = std::env::var("TWINPATH_PROP_CASES")
@@ -197,6 +197,34 @@ proptest! {
         let simd = Ray4::new(o, d).triangles(&four, 0.0, t_max).to_array();
         for i in 0..4 {
             let scalar = intersect_triangle(o, d, p0s[i], e1s[i], e2s[i], 0.0, t_max);
+            prop_assert_eq!(simd[i].to_bits(), scalar.to_bits(), "lane {}: {} vs {}", i, simd[i], scalar);
+        }
+    }
+
+    /// The same for the four-lane sphere test: each lane is the kernel's `intersect_sphere`
+    /// bit for bit. Half the rays aim at a point near the first sphere's centre.
+    #[test]
+    fn four_lane_sphere_test_is_bit_identical_to_the_kernel(
+        o in point(-30.0, 30.0),
+        d in unit(),
+        aim in any::<bool>(),
+        jitter in point(-30.0, 30.0),
+        spheres in prop::array::uniform4((point(-30.0, 30.0), scalar(-30.0, 30.0).prop_map(f32::abs))),
+        t_max in prop_oneof![Just(f32::INFINITY), scalar(-30.0, 30.0).prop_map(f32::abs)],
+    ) {
+        let d = if aim {
+            let (c, r) = spheres[0];
+            (c + r * jitter.clamp_length_max(1.0) - o).try_normalize().unwrap_or(d)
+        } else {
+            d
+        };
+        let four = Spheres4 {
+            center: [0, 1, 2].map(|k| f32x4::from_array(spheres.map(|s| s.0[k]))),
+            radius: f32x4::from_array(spheres.map(|s| s.1)),
+        };
+        let simd = Ray4::new(o, d).spheres(&four, 0.0, t_max).to_array();
+        for i in 0..4 {
+            let scalar = intersect_sphere(o, d, spheres[i].0, spheres[i].1, 0.0, t_max);
             prop_assert_eq!(simd[i].to_bits(), scalar.to_bits(), "lane {}: {} vs {}", i, simd[i], scalar);
         }
     }

@@ -11,7 +11,7 @@
 //! kernel's own intersection functions' answer (bit-identical t), whatever the traversal order.
 
 use super::bvh_build::{Aabb, BinaryBvh, SAH_MAX_DEPTH};
-use super::simd::{Boxes, Ray4, Triangles4, SLAB_PAD};
+use super::simd::{Boxes, Ray4, Spheres4, Triangles4, SLAB_PAD};
 use glam::Vec3;
 use kernel::geometry::{
     intersect_sphere, intersect_triangle, intersect_triangle_uv, reproject_to_sphere,
@@ -47,14 +47,14 @@ struct WideNode {
     used: u32,
 }
 
-/// A leaf: `triangle_blocks` blocks of four triangles from `first_block`, and `sphere_count`
-/// sphere ids from `first_sphere` of [`Bvh::leaf_spheres`].
+/// A leaf: `triangle_blocks` blocks of four triangles from `first_block`, and `sphere_blocks`
+/// blocks of four spheres from `first_sphere_block`.
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
     first_block: u32,
     triangle_blocks: u32,
-    first_sphere: u32,
-    sphere_count: u32,
+    first_sphere_block: u32,
+    sphere_blocks: u32,
 }
 
 /// Four triangles of a leaf and their primitive ids (`NONE` in unused lanes, whose edges are
@@ -66,12 +66,21 @@ struct TriangleBlock {
     id: [u32; 4],
 }
 
+/// Four spheres of a leaf and their primitive ids (`NONE` in unused lanes, whose centres are
+/// NaN so that they never hit).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+struct SphereBlock {
+    spheres: Spheres4,
+    id: [u32; 4],
+}
+
 /// Geometry plus its hierarchy.
 pub struct Bvh {
     nodes: Vec<WideNode>,
     leaves: Vec<Leaf>,
     blocks: Vec<TriangleBlock>,
-    leaf_spheres: Vec<u32>,
+    sphere_blocks: Vec<SphereBlock>,
     /// The root's reference; `None` for an empty scene.
     root: Option<u32>,
     pub spheres: Vec<Sphere>,
@@ -109,7 +118,7 @@ impl Bvh {
             nodes: Vec::with_capacity(binary.nodes.len() / 2 + 1),
             leaves: Vec::new(),
             blocks: Vec::with_capacity(triangles.len() / 4 + 1),
-            leaf_spheres: Vec::new(),
+            sphere_blocks: Vec::new(),
             root: None,
             spheres,
             triangles,
@@ -172,15 +181,26 @@ impl Bvh {
         let node = binary.nodes[b];
         let prims = &binary.prims[node.first as usize..(node.first + node.count) as usize];
         let n_spheres = self.spheres.len() as u32;
-        let first_sphere = self.leaf_spheres.len() as u32;
+        let first_sphere_block = self.sphere_blocks.len() as u32;
         let first_block = self.blocks.len() as u32;
-        let mut tris: Vec<u32> = Vec::new();
-        for &p in prims {
-            if p < n_spheres {
-                self.leaf_spheres.push(p);
-            } else {
-                tris.push(p);
+        let (spheres, tris): (Vec<u32>, Vec<u32>) = prims.iter().partition(|&&p| p < n_spheres);
+        for chunk in spheres.chunks(4) {
+            let mut block = SphereBlock {
+                spheres: Spheres4 {
+                    center: [f32x4::splat(f32::NAN); 3],
+                    radius: f32x4::splat(0.0),
+                },
+                id: [NONE; 4],
+            };
+            for (lane, &p) in chunk.iter().enumerate() {
+                let s = &self.spheres[p as usize];
+                for axis in 0..3 {
+                    block.spheres.center[axis][lane] = s.center[axis];
+                }
+                block.spheres.radius[lane] = s.radius;
+                block.id[lane] = p;
             }
+            self.sphere_blocks.push(block);
         }
         for chunk in tris.chunks(4) {
             let mut block = TriangleBlock {
@@ -203,16 +223,16 @@ impl Bvh {
             self.blocks.push(block);
         }
         let triangle_blocks = self.blocks.len() as u32 - first_block;
-        let sphere_count = self.leaf_spheres.len() as u32 - first_sphere;
-        if sphere_count == 0 && (1..=4).contains(&triangle_blocks) && first_block < 1 << BLOCK_BITS
+        let sphere_blocks = self.sphere_blocks.len() as u32 - first_sphere_block;
+        if sphere_blocks == 0 && (1..=4).contains(&triangle_blocks) && first_block < 1 << BLOCK_BITS
         {
             return LEAF | (triangle_blocks - 1) << BLOCK_BITS | first_block;
         }
         self.leaves.push(Leaf {
             first_block,
             triangle_blocks,
-            first_sphere,
-            sphere_count,
+            first_sphere_block,
+            sphere_blocks,
         });
         LEAF | SPHERES | (self.leaves.len() as u32 - 1)
     }
@@ -228,7 +248,7 @@ impl Bvh {
         std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.leaves.as_slice())
             + std::mem::size_of_val(self.blocks.as_slice())
-            + std::mem::size_of_val(self.leaf_spheres.as_slice())
+            + std::mem::size_of_val(self.sphere_blocks.as_slice())
     }
 
     /// Bytes of the primitives as the scene holds them (materials included).
@@ -323,11 +343,13 @@ impl Bvh {
                         }
                     }
                 }
-                for &id in &self.leaf_spheres[spheres] {
-                    let t = self.intersect_prim(id, origin, dir, best_t);
-                    if t >= 0.0 && t < best_t {
-                        best_t = t;
-                        best = id;
+                for block in &self.sphere_blocks[spheres] {
+                    let t = ray.spheres(&block.spheres, 0.0, best_t).to_array();
+                    for (&t, &id) in t.iter().zip(&block.id) {
+                        if t >= 0.0 && t < best_t {
+                            best_t = t;
+                            best = id;
+                        }
                     }
                 }
             }
@@ -393,8 +415,9 @@ impl Bvh {
                         return true;
                     }
                 }
-                for &id in &self.leaf_spheres[spheres] {
-                    if self.intersect_prim(id, origin, dir, t_max) >= 0.0 {
+                for block in &self.sphere_blocks[spheres] {
+                    let t = ray.spheres(&block.spheres, 0.0, t_max);
+                    if t.to_array().iter().any(|&t| t >= 0.0) {
                         return true;
                     }
                 }
@@ -408,7 +431,7 @@ impl Bvh {
         }
     }
 
-    /// The triangle blocks and the `leaf_spheres` range of leaf reference `r`.
+    /// The triangle blocks and the sphere blocks of leaf reference `r`.
     #[inline(always)]
     fn leaf_contents(&self, r: u32) -> (Range<usize>, Range<usize>) {
         if r & SPHERES == 0 {
@@ -418,10 +441,10 @@ impl Bvh {
         } else {
             let leaf = &self.leaves[(r & !(LEAF | SPHERES)) as usize];
             let first = leaf.first_block as usize;
-            let sphere = leaf.first_sphere as usize;
+            let sphere = leaf.first_sphere_block as usize;
             (
                 first..first + leaf.triangle_blocks as usize,
-                sphere..sphere + leaf.sphere_count as usize,
+                sphere..sphere + leaf.sphere_blocks as usize,
             )
         }
     }

@@ -8,6 +8,7 @@
 use glam::Vec3;
 use std::simd::cmp::{SimdPartialEq, SimdPartialOrd};
 use std::simd::num::SimdFloat;
+use std::simd::StdFloat;
 use std::simd::{f32x4, Mask, Select, Simd};
 
 /// 1 + 2 gamma(3): widening of a slab test's far distance so rounding never culls a box the
@@ -27,6 +28,13 @@ pub struct Triangles4 {
     pub p0: [f32x4; 3],
     pub edge1: [f32x4; 3],
     pub edge2: [f32x4; 3],
+}
+
+/// Four spheres, one per lane.
+#[derive(Clone, Copy, Debug)]
+pub struct Spheres4 {
+    pub center: [f32x4; 3],
+    pub radius: f32x4,
 }
 
 /// A ray with its components broadcast to every lane.
@@ -113,6 +121,39 @@ impl Ray4 {
         ok &= v.simd_ge(f32x4::splat(0.0)) & (u + v).simd_le(f32x4::splat(1.0));
         let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
         ok &= t.simd_gt(f32x4::splat(t_min)) & t.simd_lt(f32x4::splat(t_max)) & t.is_finite();
+        ok.select(t, f32x4::splat(-1.0))
+    }
+}
+
+impl Ray4 {
+    /// The kernel's `intersect_sphere`, lane by lane and operation for operation (Haines et
+    /// al.'s stable discriminant and quadratic): each lane's nearest root in (t_min, t_max),
+    /// else -1. A lane with a NaN centre never hits (the padding of a block).
+    #[inline(always)]
+    pub fn spheres(&self, s: &Spheres4, t_min: f32, t_max: f32) -> f32x4 {
+        let [dx, dy, dz] = self.dir;
+        let fx = self.origin[0] - s.center[0];
+        let fy = self.origin[1] - s.center[1];
+        let fz = self.origin[2] - s.center[2];
+        let a = dx * dx + dy * dy + dz * dz;
+        let b = fx * dx + fy * dy + fz * dz;
+        let k = b / a;
+        let (px, py, pz) = (fx - k * dx, fy - k * dy, fz - k * dz);
+        let r2 = s.radius * s.radius;
+        let disc = a * (r2 - (px * px + py * py + pz * pz));
+        let zero = f32x4::splat(0.0);
+        let ok = disc.simd_ge(zero) & a.simd_gt(zero);
+        let c = fx * fx + fy * fy + fz * fz - r2;
+        let sq = disc.sqrt();
+        let q = b.simd_ge(zero).select(-(b + sq), -(b - sq));
+        let t_a = q / a;
+        let t_b = q.simd_ne(zero).select(c / q, t_a);
+        let t_near = t_a.simd_min(t_b);
+        let t_far = t_a.simd_max(t_b);
+        let (lo, hi) = (f32x4::splat(t_min), f32x4::splat(t_max));
+        let near_ok = t_near.simd_gt(lo) & t_near.simd_lt(hi);
+        let far_ok = t_far.simd_gt(lo) & t_far.simd_lt(hi);
+        let t = near_ok.select(t_near, far_ok.select(t_far, f32x4::splat(-1.0)));
         ok.select(t, f32x4::splat(-1.0))
     }
 }
