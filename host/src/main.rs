@@ -498,7 +498,7 @@ fn run() -> Result<()> {
         } => {
             let mut scene = load_scene(scene.as_deref())?;
             if let Some(n) = mesh_triangles {
-                add_knot_mesh(&mut scene, n);
+                twinpath::cpu::rays::add_knot_mesh(&mut scene, n);
             }
             if width == 0 {
                 bail!("--width must be at least 1");
@@ -593,30 +593,6 @@ fn run() -> Result<()> {
 }
 
 /// The scene file, or the built-in Cornell scene.
-/// Adds `twinpath::cpu::rays::knot_mesh` with about `n` triangles, white (kd 0.73), centred on
-/// the camera's look-at point and a third of the camera's distance across.
-fn add_knot_mesh(scene: &mut Scene, n: usize) {
-    let size = 0.35 * (scene.camera.look_at - scene.camera.eye).length();
-    let vertices = twinpath::cpu::rays::knot_mesh(n, scene.camera.look_at, size);
-    let material = scene.materials.len() as u32;
-    scene.materials.push(kernel::scene::Material {
-        albedo: [0.73; 3],
-        _pad0: 0.0,
-        emission: [0.0; 3],
-        _pad1: 0.0,
-    });
-    scene.material_names.push("knot".into());
-    let start = scene.triangles.len();
-    scene
-        .triangles
-        .extend(twinpath::cpu::rays::to_triangles(&vertices, material));
-    scene.triangle_groups.push(twinpath::scene::TriangleGroup {
-        name: "knot".into(),
-        range: start..scene.triangles.len(),
-    });
-    scene.name = format!("{}+knot{}k", scene_stem(&scene.name), n / 1000);
-}
-
 fn load_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(match path {
         Some(p) => Scene::load(p)?,

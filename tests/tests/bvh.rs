@@ -238,3 +238,76 @@ fn memory_grows_linearly_with_the_triangle_count() {
         "bytes per triangle: {small:.1} at 10k, {large:.1} at 200k"
     );
 }
+
+/// `twinpath rays`' measurement on a small scene: the reported counts are those of the rays it
+/// made, and the ray file (what `scripts/embree_rays.c` reads) holds the scene's primitives,
+/// both ray sets, and for every ray exactly the hit the BVH finds.
+#[test]
+fn ray_measurement_and_ray_file_hold_what_was_traced() {
+    use twinpath::cpu::rays::{add_knot_mesh, measure};
+    let mut scene = twinpath::scene::Scene::builtin_default();
+    add_knot_mesh(&mut scene, 3000);
+    assert!(scene.name.ends_with("+knot3k"), "{}", scene.name);
+    let dir = std::env::temp_dir().join(format!("twinpath-rays-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("small.rays");
+    let report = measure(&scene, 48, 32, 1, Some(&path)).unwrap();
+    assert_eq!(report.triangles, scene.triangles.len());
+    assert_eq!(report.spheres, scene.spheres.len());
+    assert_eq!(report.sets.len(), 2);
+    assert_eq!(report.sets[0].rays, 48 * 32);
+    // One bounce ray per camera ray that hit.
+    assert_eq!(report.sets[1].rays, report.sets[0].hits);
+    assert!(report
+        .sets
+        .iter()
+        .all(|s| s.closest_per_second > 0.0 && s.occluded_per_second > 0.0));
+
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    let mut at = 0usize;
+    let mut take = |n: usize| {
+        let s = &bytes[at..at + n];
+        at += n;
+        s
+    };
+    let u32_at = |s: &[u8]| u32::from_le_bytes(s.try_into().unwrap());
+    let f32_at = |s: &[u8]| f32::from_le_bytes(s.try_into().unwrap());
+    assert_eq!(take(8), b"TPRAYS1\0");
+    let (ntri, nsph, nsets) = (u32_at(take(4)), u32_at(take(4)), u32_at(take(4)));
+    assert_eq!(
+        (ntri as usize, nsph as usize, nsets),
+        (scene.triangles.len(), scene.spheres.len(), 2)
+    );
+    for t in &scene.triangles {
+        let v: Vec<f32> = (0..9).map(|_| f32_at(take(4))).collect();
+        let p0 = Vec3::from(t.p0);
+        assert_eq!(&v[0..3], &p0.to_array());
+        assert_eq!(&v[3..6], &(p0 + Vec3::from(t.edge1)).to_array());
+        assert_eq!(&v[6..9], &(p0 + Vec3::from(t.edge2)).to_array());
+    }
+    for s in &scene.spheres {
+        let v: Vec<f32> = (0..4).map(|_| f32_at(take(4))).collect();
+        assert_eq!(v, [s.center[0], s.center[1], s.center[2], s.radius]);
+    }
+    let bvh = Bvh::build(scene.spheres.clone(), scene.triangles.clone());
+    for set in &report.sets {
+        let name = take(32);
+        assert!(name.starts_with(set.name.as_bytes()));
+        let n = u32_at(take(4)) as usize;
+        assert_eq!(n, set.rays);
+        let rays: Vec<[f32; 7]> = (0..n)
+            .map(|_| std::array::from_fn(|_| f32_at(take(4))))
+            .collect();
+        let mut hits = 0;
+        for r in &rays {
+            let (prim, t) = (u32_at(take(4)), f32_at(take(4)));
+            let (o, d) = (Vec3::new(r[0], r[1], r[2]), Vec3::new(r[3], r[4], r[5]));
+            let (want, want_t) = bvh.closest_prim(o, d, r[6]);
+            assert_eq!((prim, t.to_bits()), (want, want_t.to_bits()));
+            hits += (prim != NONE) as usize;
+        }
+        assert_eq!(hits, set.hits);
+    }
+    assert_eq!(at, bytes.len(), "trailing bytes in the ray file");
+}

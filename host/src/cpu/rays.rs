@@ -310,3 +310,30 @@ pub fn measure(
         sets,
     })
 }
+
+/// Adds [`knot_mesh`] with about `n` triangles to `scene`, white (kd 0.73), centred on the
+/// camera's look-at point and a third of the camera's distance across; renames the scene
+/// `<stem>+knot<n/1000>k`.
+pub fn add_knot_mesh(scene: &mut Scene, n: usize) {
+    let size = 0.35 * (scene.camera.look_at - scene.camera.eye).length();
+    let vertices = knot_mesh(n, scene.camera.look_at, size);
+    let material = scene.materials.len() as u32;
+    scene.materials.push(kernel::scene::Material {
+        albedo: [0.73; 3],
+        _pad0: 0.0,
+        emission: [0.0; 3],
+        _pad1: 0.0,
+    });
+    scene.material_names.push("knot".into());
+    let start = scene.triangles.len();
+    scene.triangles.extend(to_triangles(&vertices, material));
+    scene.triangle_groups.push(crate::scene::TriangleGroup {
+        name: "knot".into(),
+        range: start..scene.triangles.len(),
+    });
+    let stem = std::path::Path::new(&scene.name)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| scene.name.clone());
+    scene.name = format!("{stem}+knot{}k", n / 1000);
+}
