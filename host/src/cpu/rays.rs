@@ -226,14 +226,7 @@ pub fn hits(r: &RayResults) -> usize {
 pub fn to_triangles(vertices: &[[Vec3; 3]], material: u32) -> Vec<kernel::scene::Triangle> {
     vertices
         .iter()
-        .map(|p| kernel::scene::Triangle {
-            p0: p[0].to_array(),
-            material,
-            edge1: (p[1] - p[0]).to_array(),
-            _pad0: 0,
-            edge2: (p[2] - p[0]).to_array(),
-            _pad1: 0,
-        })
+        .map(|&p| crate::scene::triangle(p, material))
         .collect()
 }
 

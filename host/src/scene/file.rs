@@ -429,14 +429,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let mut triangles = Vec::new();
     let mut triangle_groups = Vec::new();
     let push_triangle = |triangles: &mut Vec<Triangle>, p: [Vec3; 3], material: u32| {
-        triangles.push(Triangle {
-            p0: p[0].to_array(),
-            material,
-            edge1: (p[1] - p[0]).to_array(),
-            _pad0: 0,
-            edge2: (p[2] - p[0]).to_array(),
-            _pad1: 0,
-        });
+        triangles.push(super::triangle(p, material));
     };
     let quads_start = triangles.len();
     for (i, q) in file.quad.iter().enumerate() {

@@ -96,6 +96,18 @@ impl Default for RenderSettings {
     }
 }
 
+/// The kernel's triangle with vertices `p` (p0 and the edges p1 - p0, p2 - p0) and `material`.
+pub fn triangle(p: [Vec3; 3], material: u32) -> Triangle {
+    Triangle {
+        p0: p[0].to_array(),
+        material,
+        edge1: (p[1] - p[0]).to_array(),
+        _pad0: 0,
+        edge2: (p[2] - p[0]).to_array(),
+        _pad1: 0,
+    }
+}
+
 /// A contiguous run of triangles from one source (a mesh, or the scene's quads).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TriangleGroup {
