@@ -277,8 +277,8 @@ impl Bvh {
         self.closest_prim_any_cpu(origin, dir, t_max)
     }
 
-    /// [`Bvh::closest_prim`] compiled for AVX2 (VEX three-operand encoding of the same
-    /// four-lane operations: identical results, fewer register copies).
+    /// [`Bvh::closest_prim`] compiled for AVX2: the eight box lanes in one register instead of
+    /// two, three-operand instructions; the same operations, so the same results (no FMA).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn closest_prim_avx2(&self, origin: Vec3, dir: Vec3, t_max: f32) -> (u32, f32) {
