@@ -361,3 +361,44 @@ fn not_utf8_scene_file() {
     let e = Scene::load(&dir.join("missing.toml")).unwrap_err();
     assert!(e.message.contains("cannot read"));
 }
+
+#[test]
+fn render_keywords_name_their_choices() {
+    for (key, a, b) in [
+        ("roulette", "constant", "throughput"),
+        ("mis", "power", "half"),
+        ("light_sampling", "cone", "area"),
+        ("light_selection", "power", "uniform"),
+    ] {
+        let text = format!("{GOOD}\n[render]\n{key} = \"bogus\"\n");
+        assert_error(
+            &text,
+            &format!("{key} = "),
+            &format!("render.{key}"),
+            &format!("'bogus' is not \"{a}\" or \"{b}\""),
+        );
+    }
+    // Throughput roulette starts at depth 5 unless the scene says otherwise.
+    let parse =
+        |extra: &str| parse_scene(&format!("{GOOD}\n[render]\n{extra}"), &scene_path()).unwrap();
+    let s = parse("roulette = \"throughput\"\n");
+    assert_eq!(
+        (s.render.rr_mode, s.render.rr_start_depth),
+        (kernel::scene::roulette::THROUGHPUT, 5)
+    );
+    let s = parse("roulette = \"throughput\"\nrr_start_depth = 2\n");
+    assert_eq!(s.render.rr_start_depth, 2);
+    let s = parse("mis = \"half\"\nlight_sampling = \"area\"\nlight_selection = \"uniform\"\n");
+    assert_eq!(
+        (
+            s.render.mis_mode,
+            s.render.light_sampling,
+            s.render.light_selection
+        ),
+        (
+            kernel::scene::mis::HALF,
+            kernel::scene::light_sampling::AREA,
+            kernel::scene::light_selection::UNIFORM
+        )
+    );
+}

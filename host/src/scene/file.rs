@@ -167,6 +167,24 @@ impl Checker<'_> {
         Ok(c)
     }
 
+    /// One of two keywords, as the kernel's constant the keyword names.
+    fn choice(
+        &self,
+        v: &Spanned<String>,
+        field: &str,
+        [(a, a_value), (b, b_value)]: [(&str, u32); 2],
+    ) -> Result<u32, SceneError> {
+        match v.get_ref().as_str() {
+            x if x == a => Ok(a_value),
+            x if x == b => Ok(b_value),
+            other => Err(self.err(
+                v.span(),
+                field,
+                format!("'{other}' is not \"{a}\" or \"{b}\""),
+            )),
+        }
+    }
+
     fn int(&self, v: &Spanned<i64>, field: &str, min: i64, max: i64) -> Result<u32, SceneError> {
         let x = *v.get_ref();
         if x < min || x > max {
@@ -236,20 +254,17 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             render.seed = ck.int(v, "render.seed", 0, u32::MAX as i64)?;
         }
         if let Some(v) = &r.roulette {
-            render.rr_mode = match v.get_ref().as_str() {
-                "constant" => roulette::CONSTANT,
-                "throughput" => {
-                    render.rr_start_depth = 5;
-                    roulette::THROUGHPUT
-                }
-                other => {
-                    return Err(ck.err(
-                        v.span(),
-                        "render.roulette",
-                        format!("'{other}' is not \"constant\" or \"throughput\""),
-                    ))
-                }
-            };
+            render.rr_mode = ck.choice(
+                v,
+                "render.roulette",
+                [
+                    ("constant", roulette::CONSTANT),
+                    ("throughput", roulette::THROUGHPUT),
+                ],
+            )?;
+            if render.rr_mode == roulette::THROUGHPUT {
+                render.rr_start_depth = 5;
+            }
         }
         if let Some(v) = &r.russian_roulette {
             let q = *v.get_ref();
@@ -266,46 +281,34 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             render.rr_start_depth = ck.int(v, "render.rr_start_depth", 0, u32::MAX as i64)?;
         }
         if let Some(v) = &r.mis {
-            render.mis_mode = match v.get_ref().as_str() {
-                "power" => mis::POWER,
-                "half" => mis::HALF,
-                other => {
-                    return Err(ck.err(
-                        v.span(),
-                        "render.mis",
-                        format!("'{other}' is not \"power\" or \"half\""),
-                    ))
-                }
-            };
+            render.mis_mode = ck.choice(
+                v,
+                "render.mis",
+                [("power", mis::POWER), ("half", mis::HALF)],
+            )?;
         }
         if let Some(v) = &r.light_sampling {
-            render.light_sampling = match v.get_ref().as_str() {
-                "cone" => light_sampling::CONE,
-                "area" => light_sampling::AREA,
-                other => {
-                    return Err(ck.err(
-                        v.span(),
-                        "render.light_sampling",
-                        format!("'{other}' is not \"cone\" or \"area\""),
-                    ))
-                }
-            };
+            render.light_sampling = ck.choice(
+                v,
+                "render.light_sampling",
+                [
+                    ("cone", light_sampling::CONE),
+                    ("area", light_sampling::AREA),
+                ],
+            )?;
         }
         if let Some(v) = &r.max_depth {
             render.max_depth = ck.int(v, "render.max_depth", 1, u32::MAX as i64)?;
         }
         if let Some(v) = &r.light_selection {
-            render.light_selection = match v.get_ref().as_str() {
-                "power" => light_selection::POWER,
-                "uniform" => light_selection::UNIFORM,
-                other => {
-                    return Err(ck.err(
-                        v.span(),
-                        "render.light_selection",
-                        format!("'{other}' is not \"power\" or \"uniform\""),
-                    ))
-                }
-            };
+            render.light_selection = ck.choice(
+                v,
+                "render.light_selection",
+                [
+                    ("power", light_selection::POWER),
+                    ("uniform", light_selection::UNIFORM),
+                ],
+            )?;
         }
         if let Some(v) = &r.adaptive_target {
             let t = *v.get_ref();
