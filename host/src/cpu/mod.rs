@@ -47,6 +47,22 @@ pub struct CpuRenderer {
     pub features: u32,
 }
 
+/// `match bits { combo => body with f = Static::<combo>, ..., other => body with Dynamic(other) }`.
+macro_rules! monomorphised {
+    ($bits:expr, $f:ident => $body:expr; $($combo:expr),+) => {
+        match $bits {
+            $(x if x == $combo => {
+                let $f = Static::<{ $combo }>;
+                $body
+            })+
+            other => {
+                let $f = Dynamic(other);
+                $body
+            }
+        }
+    };
+}
+
 /// The feature combinations with their own monomorphised `trace_path`: every combination of
 /// the scene features (lights: none, one, several; background; constant or throughput
 /// roulette) under the default MIS (power) and light sampling (cone). Others run the
@@ -58,60 +74,10 @@ macro_rules! with_features {
         const L1: u32 = features::LIGHTS | features::SINGLE_LIGHT;
         const B: u32 = features::BACKGROUND;
         const R: u32 = features::RR_THROUGHPUT;
-        match $bits {
-            x if x == BASE => {
-                let $f = Static::<BASE>;
-                $body
-            }
-            x if x == BASE | B => {
-                let $f = Static::<{ BASE | B }>;
-                $body
-            }
-            x if x == BASE | R => {
-                let $f = Static::<{ BASE | R }>;
-                $body
-            }
-            x if x == BASE | B | R => {
-                let $f = Static::<{ BASE | B | R }>;
-                $body
-            }
-            x if x == BASE | L => {
-                let $f = Static::<{ BASE | L }>;
-                $body
-            }
-            x if x == BASE | L | B => {
-                let $f = Static::<{ BASE | L | B }>;
-                $body
-            }
-            x if x == BASE | L | R => {
-                let $f = Static::<{ BASE | L | R }>;
-                $body
-            }
-            x if x == BASE | L | B | R => {
-                let $f = Static::<{ BASE | L | B | R }>;
-                $body
-            }
-            x if x == BASE | L1 => {
-                let $f = Static::<{ BASE | L1 }>;
-                $body
-            }
-            x if x == BASE | L1 | B => {
-                let $f = Static::<{ BASE | L1 | B }>;
-                $body
-            }
-            x if x == BASE | L1 | R => {
-                let $f = Static::<{ BASE | L1 | R }>;
-                $body
-            }
-            x if x == BASE | L1 | B | R => {
-                let $f = Static::<{ BASE | L1 | B | R }>;
-                $body
-            }
-            other => {
-                let $f = Dynamic(other);
-                $body
-            }
-        }
+        monomorphised!($bits, $f => $body;
+            BASE, BASE | B, BASE | R, BASE | B | R,
+            BASE | L, BASE | L | B, BASE | L | R, BASE | L | B | R,
+            BASE | L1, BASE | L1 | B, BASE | L1 | R, BASE | L1 | B | R)
     }};
 }
 
