@@ -7,7 +7,7 @@ use crate::film::{diff_images, RgbImage};
 use crate::render::{render, Backend, RenderOptions};
 use crate::scene::{RenderSettings, Scene};
 use anyhow::{anyhow, bail, Context, Result};
-use kernel::scene::{light_sampling, light_selection, mis, roulette};
+use kernel::scene::{light_sampling, light_selection, mis, roulette, sampler};
 use std::io::Write;
 use std::path::Path;
 
@@ -20,7 +20,7 @@ pub struct Variant {
 
 impl Variant {
     /// Parses `NAME` or `NAME:key=value,key=value` on top of `base`; keys: mis (power|half),
-    /// light_sampling (cone|area), light_selection (power|uniform), roulette
+    /// light_sampling (cone|area), light_selection (power|uniform), sampler (independent|sobol), roulette
     /// (constant|throughput), rr (probability), rr_start_depth (vertex), specialize (on|off),
     /// adaptive (target relative error, 0: off).
     pub fn parse(spec: &str, base: &RenderSettings) -> Result<Variant> {
@@ -40,6 +40,8 @@ impl Variant {
                 ("light_sampling", "area") => s.light_sampling = light_sampling::AREA,
                 ("light_selection", "power") => s.light_selection = light_selection::POWER,
                 ("light_selection", "uniform") => s.light_selection = light_selection::UNIFORM,
+                ("sampler", "independent") => s.sampler = sampler::INDEPENDENT,
+                ("sampler", "sobol") => s.sampler = sampler::SOBOL,
                 ("specialize", "on") => s.specialize = true,
                 ("specialize", "off") => s.specialize = false,
                 ("adaptive", t) => {
@@ -66,7 +68,7 @@ impl Variant {
                         .parse()
                         .with_context(|| format!("--variant {spec:?}: rr_start_depth"))?
                 }
-                _ => bail!("--variant {spec:?}: unknown setting {kv:?} (keys: mis, light_sampling, light_selection, roulette, rr, rr_start_depth, specialize, adaptive)"),
+                _ => bail!("--variant {spec:?}: unknown setting {kv:?} (keys: mis, light_sampling, light_selection, sampler, roulette, rr, rr_start_depth, specialize, adaptive)"),
             }
         }
         Ok(Variant {

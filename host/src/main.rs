@@ -52,6 +52,14 @@ enum LightSelection {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
+enum Sampler {
+    /// Independent uniform numbers per dimension.
+    Independent,
+    /// Owen-scrambled Sobol points, stratified within each pixel.
+    Sobol,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
 enum BenchBackends {
     Cpu,
     Gpu,
@@ -99,6 +107,9 @@ enum Command {
         /// How next-event estimation picks one of several lights.
         #[arg(long, value_enum)]
         light_selection: Option<LightSelection>,
+        /// Where each sample's random numbers come from.
+        #[arg(long, value_enum)]
+        sampler: Option<Sampler>,
         /// Run the generic kernel path instead of one specialized to the scene's features.
         #[arg(long)]
         no_specialize: bool,
@@ -126,7 +137,7 @@ enum Command {
         #[arg(long, value_enum, default_value_t = BenchBackends::Cpu)]
         backend: BenchBackends,
         /// NAME or NAME:key=value,... (mis=power|half, light_sampling=cone|area,
-        /// light_selection=power|uniform, roulette=constant|throughput, rr=P,
+        /// light_selection=power|uniform, sampler=independent|sobol, roulette=constant|throughput, rr=P,
         /// rr_start_depth=D, specialize=on|off, adaptive=TARGET), on top of the scene's
         /// settings; repeat to compare. Default: one variant, the scene's settings.
         #[arg(long = "variant")]
@@ -212,6 +223,7 @@ fn run() -> Result<()> {
             mis,
             light_sampling,
             light_selection,
+            sampler,
             no_specialize,
             target_error,
             spp_map,
@@ -269,6 +281,12 @@ fn run() -> Result<()> {
                 r.light_selection = match l {
                     LightSelection::Power => kernel::scene::light_selection::POWER,
                     LightSelection::Uniform => kernel::scene::light_selection::UNIFORM,
+                };
+            }
+            if let Some(s) = sampler {
+                r.sampler = match s {
+                    Sampler::Independent => kernel::scene::sampler::INDEPENDENT,
+                    Sampler::Sobol => kernel::scene::sampler::SOBOL,
                 };
             }
             if no_specialize {

@@ -19,6 +19,7 @@ pub mod sampling;
 pub mod scene;
 #[cfg(target_arch = "spirv")]
 pub mod shaders;
+pub mod sobol;
 
 pub use path::{trace_path, SurfaceHit, Tracer};
 pub use spirv_std::glam;

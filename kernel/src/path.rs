@@ -58,6 +58,8 @@ pub trait Tracer {
 }
 
 /// Random dimensions per path vertex: light choice (1) and point (2), roulette (1), BRDF (2).
+/// (Pairs start at offsets 1 and 4 of the block; the Sobol sampler scrambles each from its own
+/// starting dimension, so pairs need no alignment.)
 pub const DIMENSIONS_PER_VERTEX: u32 = 6;
 /// Random dimensions used by the camera before the first vertex (position inside the pixel).
 pub const CAMERA_DIMENSIONS: u32 = 2;
@@ -167,8 +169,7 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
 
         // 2(a): next-event estimation.
         let u_select = rng.next_f32();
-        let u_light1 = rng.next_f32();
-        let u_light2 = rng.next_f32();
+        let (u_light1, u_light2) = rng.next_2d();
         if features.lights(params) && albedo.max_element() > 0.0 {
             let ls = sample_light_from(
                 lights,
@@ -226,8 +227,7 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
         }
 
         // 3: extension by BRDF sampling.
-        let u_brdf1 = rng.next_f32();
-        let u_brdf2 = rng.next_f32();
+        let (u_brdf1, u_brdf2) = rng.next_2d();
         let wi = sample_brdf(n, u_brdf1, u_brdf2);
         let pdf_b = pdf_brdf(n, wi);
         if pdf_b < PDF_EPSILON {
@@ -291,9 +291,9 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
     py: u32,
     sample: u32,
 ) -> Vec3 {
-    let mut rng = SampleRng::new(params.seed, py * params.width + px, sample);
-    let u = rng.next_f32();
-    let v = rng.next_f32();
+    let mut rng =
+        SampleRng::with_sampler(params.seed, py * params.width + px, sample, params.sampler);
+    let (u, v) = rng.next_2d();
     let dir = camera_ray_direction(&params.camera, params.width, params.height, px, py, u, v);
     trace_path(
         tracer,

@@ -13,6 +13,7 @@ use crate::geometry::{
 use crate::rng::{pcg4d, u32_to_unit_f32};
 use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
 use crate::scene::Camera;
+use crate::sobol::{sobol_pair, sobol_single};
 use spirv_std::glam::{UVec4, Vec3, Vec4};
 
 /// Which function a probe record evaluates (input layout -> output layout).
@@ -42,7 +43,8 @@ pub mod function {
     /// n = in0.xyz, w = in1.xyz, albedo = in2.xyz, u = in3.xy -> out0.xyz eval_scattering,
     /// out0.w pdf_brdf(n, w), out1.xyz sample_brdf(n, u), out1.w its pdf
     pub const BRDF: u32 = 8;
-    /// in0 as four u32 -> out0 = pcg4d(in0), out1.x = u32_to_unit_f32(in0.x)
+    /// in0 as four u32 -> out0 = pcg4d(in0), out1.x = u32_to_unit_f32(in0.x);
+    /// (pixel, sample, dimension, seed) = in0 -> out1.yz = sobol_pair, out1.w = sobol_single
     pub const RNG: u32 = 9;
     /// forward = in0.xyz, right = in1.xyz, up = in2.xyz, (u, v) = in3.xy,
     /// (width, height, px, py) = (in0.w, in1.w, in2.w, in3.z) as u32 -> out0.xyz direction
@@ -132,10 +134,17 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
             s.extend(pdf_brdf(n, s)),
         )
     } else if function == function::RNG {
-        let h = pcg4d([input[0].x, input[0].y, input[0].z, input[0].w]);
+        let i = input[0];
+        let h = pcg4d([i.x, i.y, i.z, i.w]);
+        let (sx, sy) = sobol_pair(i.w, i.x, i.y, i.z);
         return [
             UVec4::new(h[0], h[1], h[2], h[3]),
-            UVec4::new(u32_to_unit_f32(input[0].x).to_bits(), 0, 0, 0),
+            UVec4::new(
+                u32_to_unit_f32(i.x).to_bits(),
+                sx,
+                sy,
+                sobol_single(i.w, i.x, i.y, i.z),
+            ),
         ];
     } else if function == function::CAMERA_RAY {
         let camera = Camera {

@@ -3,6 +3,11 @@
 //!
 //! The hash is `pcg4d` from Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 9(3),
 //! 2020: a 4D-to-4D permutation with good avalanche that costs a few integer multiply-adds.
+//! `scene::sampler::SOBOL` draws the same dimensions from Owen-scrambled Sobol points instead
+//! (`crate::sobol`).
+
+use crate::scene::sampler;
+use crate::sobol::{sobol_pair, sobol_single};
 
 /// Jarzynski and Olano's pcg4d: bijective mixing of four 32-bit words.
 #[inline]
@@ -34,24 +39,33 @@ pub fn u32_to_unit_f32(x: u32) -> f32 {
 }
 
 /// The random stream of one sample of one pixel; each call to [`SampleRng::next_f32`] consumes
-/// the next dimension.
+/// the next dimension, [`SampleRng::next_2d`] the next two.
 #[derive(Clone, Copy, Debug)]
 pub struct SampleRng {
     pub seed: u32,
     pub pixel: u32,
     pub sample: u32,
     pub dimension: u32,
+    /// One of `scene::sampler`.
+    pub sampler: u32,
 }
 
 impl SampleRng {
-    /// The stream of sample `sample` of pixel `pixel` (row-major index) under `seed`.
+    /// The independent stream of sample `sample` of pixel `pixel` (row-major index) under `seed`.
     #[inline]
     pub fn new(seed: u32, pixel: u32, sample: u32) -> Self {
+        Self::with_sampler(seed, pixel, sample, sampler::INDEPENDENT)
+    }
+
+    /// The stream of sample `sample` of pixel `pixel` drawn by `sampler` (`scene::sampler`).
+    #[inline]
+    pub fn with_sampler(seed: u32, pixel: u32, sample: u32, sampler: u32) -> Self {
         Self {
             seed,
             pixel,
             sample,
             dimension: 0,
+            sampler,
         }
     }
 
@@ -63,10 +77,32 @@ impl SampleRng {
         h[0]
     }
 
-    /// A float uniform in [0, 1), then advances the dimension.
+    /// A float uniform in [0, 1), then advances the dimension. With the Sobol sampler it is
+    /// the first coordinate of the dimension's pair (a stratified 1D sequence per pixel).
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        u32_to_unit_f32(self.next_u32())
+        if self.sampler == sampler::SOBOL {
+            let x = sobol_single(self.seed, self.pixel, self.sample, self.dimension);
+            self.dimension = self.dimension.wrapping_add(1);
+            u32_to_unit_f32(x)
+        } else {
+            u32_to_unit_f32(self.next_u32())
+        }
+    }
+
+    /// Two floats uniform in [0, 1) for one 2D decision (a point on a light, a direction),
+    /// then advances two dimensions. Independent: two calls of [`SampleRng::next_f32`], the
+    /// same numbers. Sobol: one point of the pair's scrambled (0,2)-sequence.
+    #[inline]
+    pub fn next_2d(&mut self) -> (f32, f32) {
+        if self.sampler == sampler::SOBOL {
+            let (x, y) = sobol_pair(self.seed, self.pixel, self.sample, self.dimension);
+            self.dimension = self.dimension.wrapping_add(2);
+            (u32_to_unit_f32(x), u32_to_unit_f32(y))
+        } else {
+            let u = self.next_f32();
+            (u, self.next_f32())
+        }
     }
 }
 

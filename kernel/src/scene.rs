@@ -112,6 +112,15 @@ pub mod light_selection {
     pub const POWER: u32 = 1;
 }
 
+/// Where a sample's random numbers come from.
+pub mod sampler {
+    /// Independent uniform numbers, a hash of (seed, pixel, sample, dimension) (`rng::pcg4d`).
+    pub const INDEPENDENT: u32 = 0;
+    /// Owen-scrambled Sobol points, two dimensions at a time (`sobol::sobol_pair`): stratified
+    /// within each pixel, independent across pixels.
+    pub const SOBOL: u32 = 1;
+}
+
 /// Everything a path needs besides the scene geometry and tables. 144 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
@@ -147,5 +156,6 @@ pub struct RenderParams {
     pub pilot_period: u32,
     /// Pilot samples a pixel needs before it may be declared converged.
     pub min_pilot_samples: u32,
-    pub _pad: u32,
+    /// One of [`sampler`].
+    pub sampler: u32,
 }

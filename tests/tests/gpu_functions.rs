@@ -232,7 +232,7 @@ struct Bound {
 }
 
 const BOUNDS: &[Bound] = &[
-    Bound { name: "rng (pcg4d, u32 -> float)", func: function::RNG, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, why: "integer arithmetic: bit-exact" },
+    Bound { name: "rng (pcg4d, u32 -> float, scrambled Sobol)", func: function::RNG, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, why: "integer arithmetic: bit-exact" },
     Bound { name: "offset_ray_origin / shadow_ray_end", func: function::OFFSET_RAY_ORIGIN, max_ulps: 1, abs: 0.0, flip_fraction: 0.0, why: "integer ULP steps are exact; p + s n may be fused into one FMA on the GPU: 1 ULP" },
     Bound { name: "orthonormal_basis", func: function::ORTHONORMAL_BASIS, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "a few multiply-adds (FMA contraction): 4 ULP, or 4 eps absolute near zero" },
     Bound { name: "sample_lobe", func: function::SAMPLE_LOBE, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos differ by 1 ULP (GLSL.std.450 vs libm) plus the frame: 8 eps absolute on unit vectors" },

@@ -105,7 +105,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     adaptive_target,
                     pilot_period,
                     min_pilot_samples,
-                    _pad
+                    sampler
                 ],
                 false
             ),

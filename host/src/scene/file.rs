@@ -6,7 +6,8 @@ use super::mesh::load_mesh;
 use super::{CameraDesc, RenderSettings, Scene, TriangleGroup};
 use glam::Vec3;
 use kernel::scene::{
-    light_sampling, light_selection, mis, roulette, Material, Sphere, SphereLight, Triangle, NONE,
+    light_sampling, light_selection, mis, roulette, sampler, Material, Sphere, SphereLight,
+    Triangle, NONE,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -75,6 +76,8 @@ struct RenderFile {
     light_sampling: Option<Spanned<String>>,
     /// "power" (default) or "uniform" (the seed's choice among several lights).
     light_selection: Option<Spanned<String>>,
+    /// "independent" (default) or "sobol" (Owen-scrambled Sobol points per pixel).
+    sampler: Option<Spanned<String>>,
     /// Adaptive sampling's target relative error per pixel (0 or absent: off).
     adaptive_target: Option<Spanned<f32>>,
 }
@@ -307,6 +310,16 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 [
                     ("power", light_selection::POWER),
                     ("uniform", light_selection::UNIFORM),
+                ],
+            )?;
+        }
+        if let Some(v) = &r.sampler {
+            render.sampler = ck.choice(
+                v,
+                "render.sampler",
+                [
+                    ("independent", sampler::INDEPENDENT),
+                    ("sobol", sampler::SOBOL),
                 ],
             )?;
         }

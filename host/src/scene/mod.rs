@@ -11,8 +11,8 @@ pub use file::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
 
 use glam::Vec3;
 use kernel::scene::{
-    light_sampling, light_selection, mis, roulette, Camera, Material, RenderParams, Sphere,
-    SphereLight, Triangle,
+    light_sampling, light_selection, mis, roulette, sampler, Camera, Material, RenderParams,
+    Sphere, SphereLight, Triangle,
 };
 use std::ops::Range;
 use std::path::Path;
@@ -65,6 +65,8 @@ pub struct RenderSettings {
     pub light_sampling: u32,
     /// One of `kernel::scene::light_selection`.
     pub light_selection: u32,
+    /// One of `kernel::scene::sampler`.
+    pub sampler: u32,
     /// Compile the kernel for what the scene needs (`kernel::features`); false: generic path.
     pub specialize: bool,
     /// Adaptive sampling's target relative error of a pixel (0: off; `kernel::adaptive`).
@@ -90,6 +92,7 @@ impl Default for RenderSettings {
             max_depth: u32::MAX,
             light_sampling: light_sampling::CONE,
             light_selection: light_selection::POWER,
+            sampler: sampler::INDEPENDENT,
             specialize: true,
             adaptive_target: 0.0,
         }
@@ -178,7 +181,7 @@ impl Scene {
                 0
             },
             min_pilot_samples: MIN_PILOT_SAMPLES,
-            _pad: 0,
+            sampler: r.sampler,
         }
     }
 
