@@ -9,7 +9,10 @@ the reference EXR with the definitions of `twinpath diff`:
 relMSE = mean over pixels and channels of (a - b)^2 / (b^2 + 0.01).
 
 Usage: peer_mitsuba.py REFERENCE.exr OUT.csv [--variant llvm_ad_rgb] [--max-spp 1024]
-       [--max-seconds 60]
+       [--max-seconds 60] [--sampler independent]
+--sampler picks Mitsuba's sampler (the reference's is `independent`; `ldsampler` is its
+low-discrepancy one, `multijitter` / `stratified` its stratified ones); names other than
+independent are added to the variant column.
 Install: pip install mitsuba numpy (scripts/peer_mitsuba.sh does it in a venv).
 """
 
@@ -38,7 +41,7 @@ def quad(p0, p1, p3, material):
             "bsdf": {"type": "ref", "id": material}}
 
 
-def scene_dict(spp, seed):
+def scene_dict(spp, seed, sampler="independent"):
     white, red, green, blue = (0.73, 0.73, 0.73), (0.65, 0.05, 0.05), (0.12, 0.45, 0.15), \
         (0.25, 0.35, 0.75)
 
@@ -55,7 +58,7 @@ def scene_dict(spp, seed):
             "fov_axis": "y",
             "to_world": mi.ScalarTransform4f().look_at(origin=[0, 1, 3.8], target=[0, 1, 0],
                                                        up=[0, 1, 0]),
-            "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
+            "sampler": {"type": sampler, "sample_count": spp, "seed": seed},
             "film": {"type": "hdrfilm", "width": 256, "height": 256, "pixel_format": "rgb",
                      "rfilter": {"type": "box"}},
         },
@@ -83,6 +86,7 @@ def main():
     ap.add_argument("--variant", default="llvm_ad_rgb")
     ap.add_argument("--max-spp", type=int, default=1024)
     ap.add_argument("--max-seconds", type=float, default=60.0)
+    ap.add_argument("--sampler", default="independent")
     args = ap.parse_args()
 
     mi.set_variant(args.variant)
@@ -94,7 +98,7 @@ def main():
         seeds = 4 if spp <= 4 else (2 if spp <= 32 else 1)
         for k in range(seeds):
             t0 = time.perf_counter()
-            scene = mi.load_dict(scene_dict(spp, 1 + k))
+            scene = mi.load_dict(scene_dict(spp, 1 + k, args.sampler))
             setup = time.perf_counter() - t0
             # Warm-up render: the llvm variants compile a kernel for each new sample count (a
             # set-up cost, cached afterwards); it is timed as set-up, not render.
@@ -109,15 +113,16 @@ def main():
             relmse = float(np.mean(d * d / (ref * ref + 0.01)))
             rmse = float(np.sqrt(np.mean(d * d)))
             rows.append((spp, 1 + k, setup, render_s, relmse, rmse, 1.0 / (relmse * render_s)))
-            print(f"mitsuba {args.variant} spp {spp} seed {1 + k}: {render_s:.3f} s, "
+            print(f"mitsuba {args.variant} {args.sampler} spp {spp} seed {1 + k}: {render_s:.3f} s, "
                   f"relMSE {relmse:.4e}", file=sys.stderr)
         if render_s > args.max_seconds:
             break
         spp *= 2
+    name = args.variant if args.sampler == "independent" else f"{args.variant}-{args.sampler}"
     with open(args.out, "w") as f:
         f.write("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n")
         for spp, seed, setup, render_s, relmse, rmse, eff in rows:
-            f.write(f"mitsuba-{args.variant},Cpu,{spp},{seed},{setup:.6f},{render_s:.6f},"
+            f.write(f"mitsuba-{name},Cpu,{spp},{seed},{setup:.6f},{render_s:.6f},"
                     f"{relmse:.6e},{rmse:.6e},{eff:.6e}\n")
 
 

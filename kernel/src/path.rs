@@ -165,12 +165,20 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
         let x = hit.position;
         let albedo = Vec3::from(material.albedo);
         let ray_origin = offset_ray_origin(x, n, hit.error);
-        rng.seek(CAMERA_DIMENSIONS + (depth - 1) * DIMENSIONS_PER_VERTEX);
+        // This vertex's block of dimensions; numbers nobody reads are not drawn (a counter-
+        // based stream gives the others the same values either way).
+        let dimensions = CAMERA_DIMENSIONS + (depth - 1) * DIMENSIONS_PER_VERTEX;
 
         // 2(a): next-event estimation.
-        let u_select = rng.next_f32();
-        let (u_light1, u_light2) = rng.next_2d();
         if features.lights(params) && albedo.max_element() > 0.0 {
+            rng.seek(dimensions);
+            let u_select = if light_count > 1 {
+                rng.next_f32()
+            } else {
+                rng.seek(dimensions + 1);
+                0.0
+            };
+            let (u_light1, u_light2) = rng.next_2d();
             let ls = sample_light_from(
                 lights,
                 light_count,
@@ -213,8 +221,9 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
             break;
         }
         // 4: Russian roulette on the extension.
-        let u_rr = rng.next_f32();
         if depth >= params.rr_start_depth {
+            rng.seek(dimensions + 3);
+            let u_rr = rng.next_f32();
             let q = if features.rr_throughput(params) {
                 throughput.max_element().min(1.0)
             } else {
@@ -227,6 +236,7 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
         }
 
         // 3: extension by BRDF sampling.
+        rng.seek(dimensions + 4);
         let (u_brdf1, u_brdf2) = rng.next_2d();
         let wi = sample_brdf(n, u_brdf1, u_brdf2);
         let pdf_b = pdf_brdf(n, wi);
