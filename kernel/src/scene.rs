@@ -117,7 +117,7 @@ pub mod sampler {
     /// Independent uniform numbers, a hash of (seed, pixel, sample, dimension) (`rng::pcg4d`).
     pub const INDEPENDENT: u32 = 0;
     /// Owen-scrambled Sobol points, two dimensions at a time (`sobol::sobol_pair`): stratified
-    /// within each pixel, independent across pixels.
+    /// within each pixel, independent across pixels. The host's default.
     pub const SOBOL: u32 = 1;
 }
 

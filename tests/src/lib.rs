@@ -59,6 +59,14 @@ pub fn scene_from_toml(text: &str) -> Scene {
     parse_scene(text, &path).unwrap_or_else(|e| panic!("test scene invalid: {e}"))
 }
 
+/// The scene with independent samples. Tests whose z-scores take a pixel's error from the
+/// spread of its own samples need them: Sobol points (the default) are stratified, so that
+/// spread overstates their error and such a test would lose power, not validity.
+pub fn with_independent_samples(mut scene: Scene) -> Scene {
+    scene.render.sampler = kernel::scene::sampler::INDEPENDENT;
+    scene
+}
+
 /// The repository root.
 pub fn repo_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -186,7 +194,8 @@ pub struct Lamp {
     pub radiance: f32,
 }
 
-/// The diffuse plane y = 0 of albedo `kd` (200 x 200 units) under several sphere lights.
+/// The diffuse plane y = 0 of albedo `kd` (200 x 200 units) under several sphere lights, with
+/// independent samples unless `render` names a sampler (the z-tests on it need them).
 pub fn plane_under_lamps(camera: &str, render: &str, kd: f32, lamps: &[Lamp]) -> Scene {
     let mut text = format!(
         r#"
@@ -210,7 +219,12 @@ pub fn plane_under_lamps(camera: &str, render: &str, kd: f32, lamps: &[Lamp]) ->
             l.radiance, c.x, c.y, c.z, l.radius
         ));
     }
-    scene_from_toml(&text)
+    let scene = scene_from_toml(&text);
+    if render.contains("sampler") {
+        scene
+    } else {
+        with_independent_samples(scene)
+    }
 }
 
 /// Exact pixel values of a plane scene: the sum over lamps of kd L (r/D)^2 cos(theta) at the

@@ -211,7 +211,8 @@ fn furnace_scene(roulette: &str, q: f32) -> Scene {
         .replace("width = 256", "width = 48")
         .replace("height = 256", "height = 48");
     text.push_str("\n[background]\nradiance = [0.7, 0.7, 0.7]\n");
-    let s = scene_from_toml(&text);
+    // Independent samples: the constant-roulette test takes its variance from the samples.
+    let s = twinpath_tests::with_independent_samples(scene_from_toml(&text));
     assert!(s.lights.is_empty());
     s
 }

@@ -7,7 +7,7 @@ use twinpath::scene::Scene;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
     assert_film_matches, image_mean_z, plane_exact, plane_under_lamps, render_film, repo_root,
-    scene_from_toml, z_critical, Lamp,
+    scene_from_toml, with_independent_samples, z_critical, Lamp,
 };
 
 /// Same scene, seed and spp on both backends: the same samples, so nearly every pixel must be
@@ -47,9 +47,12 @@ fn assert_backends_agree(path: &str, spp: u32) {
         100.0 * fraction_equal
     );
 
-    // Independent seeds: the two backends' image means agree within their noise.
-    let mut other = scene.clone();
+    // Independent seeds: the two backends' image means agree within their noise (independent
+    // samples, so each image's noise is known from its own samples).
+    let independent = with_independent_samples(scene.clone());
+    let mut other = independent.clone();
     other.render.seed = scene.render.seed.wrapping_add(1000);
+    let cpu = render_film(&independent, Backend::Cpu, spp);
     let gpu2 = render_film(&other, Backend::Gpu, spp);
     let z = image_mean_z(&cpu, &gpu2);
     println!(

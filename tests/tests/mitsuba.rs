@@ -7,7 +7,7 @@ use twinpath::cpu::CpuRenderer;
 use twinpath::film::{diff_images, Film, RgbImage};
 use twinpath::scene::Scene;
 use twinpath::stats::pixel_z_test;
-use twinpath_tests::{repo_root, z_critical};
+use twinpath_tests::{repo_root, with_independent_samples, z_critical};
 
 const SPP: u32 = 1024;
 
@@ -25,7 +25,8 @@ fn cornell_agrees_with_mitsuba_reference() {
         .map(|(a, b)| std::array::from_fn(|c| (a[c] - b[c]) * (a[c] - b[c]) / 4.0))
         .collect();
 
-    let scene = Scene::load(&repo_root().join("scenes/cornell.toml")).unwrap();
+    let scene =
+        with_independent_samples(Scene::load(&repo_root().join("scenes/cornell.toml")).unwrap());
     assert_eq!(
         (scene.camera.width, scene.camera.height),
         (reference.width, reference.height)

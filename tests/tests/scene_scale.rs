@@ -7,12 +7,14 @@ use glam::Vec3;
 use twinpath::film::Film;
 use twinpath::render::Backend;
 use twinpath::scene::Scene;
-use twinpath_tests::{image_mean_z, render_film, transform_scene, z_critical};
+use twinpath_tests::{
+    image_mean_z, render_film, transform_scene, with_independent_samples, z_critical,
+};
 
 const SPP: u32 = 32;
 
 fn small_cornell() -> Scene {
-    let mut s = Scene::builtin_default();
+    let mut s = with_independent_samples(Scene::builtin_default());
     s.camera.width = 96;
     s.camera.height = 96;
     s

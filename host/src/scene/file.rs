@@ -76,7 +76,7 @@ struct RenderFile {
     light_sampling: Option<Spanned<String>>,
     /// "power" (default) or "uniform" (the seed's choice among several lights).
     light_selection: Option<Spanned<String>>,
-    /// "independent" (default) or "sobol" (Owen-scrambled Sobol points per pixel).
+    /// "sobol" (default: Owen-scrambled Sobol points per pixel) or "independent".
     sampler: Option<Spanned<String>>,
     /// Adaptive sampling's target relative error per pixel (0 or absent: off).
     adaptive_target: Option<Spanned<f32>>,

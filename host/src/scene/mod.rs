@@ -92,7 +92,7 @@ impl Default for RenderSettings {
             max_depth: u32::MAX,
             light_sampling: light_sampling::CONE,
             light_selection: light_selection::POWER,
-            sampler: sampler::INDEPENDENT,
+            sampler: sampler::SOBOL,
             specialize: true,
             adaptive_target: 0.0,
         }
