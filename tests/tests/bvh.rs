@@ -311,3 +311,43 @@ fn ray_measurement_and_ray_file_hold_what_was_traced() {
     }
     assert_eq!(at, bytes.len(), "trailing bytes in the ray file");
 }
+
+#[test]
+fn parallel_build_gives_the_one_thread_tree() {
+    use twinpath::cpu::bvh_build::{Aabb, BinaryBvh};
+    // Large enough for several levels of parallel halves (PARALLEL_MIN = 4096).
+    let tris = to_triangles(&knot_mesh(60_000, Vec3::ZERO, 4.0), 0);
+    let bounds: Vec<Aabb> = tris
+        .iter()
+        .map(|t| {
+            let p0 = Vec3::from(t.p0);
+            [p0 + Vec3::from(t.edge1), p0 + Vec3::from(t.edge2)]
+                .into_iter()
+                .fold(Aabb::EMPTY.grow(p0), Aabb::grow)
+        })
+        .collect();
+    let parallel = BinaryBvh::build(&bounds);
+    let serial = BinaryBvh::build_one_thread(&bounds);
+    assert_eq!(parallel.prims, serial.prims, "different primitive order");
+    assert_eq!(parallel.nodes.len(), serial.nodes.len());
+    // The same tree node for node, walked from both roots (the node order differs).
+    let mut stack = vec![(0usize, 0usize)];
+    let mut visited = 0;
+    while let Some((a, b)) = stack.pop() {
+        let (na, nb) = (parallel.nodes[a], serial.nodes[b]);
+        assert_eq!(
+            (na.bounds, na.count),
+            (nb.bounds, nb.count),
+            "nodes {a} / {b}"
+        );
+        visited += 1;
+        if na.count > 0 {
+            assert_eq!(na.first, nb.first, "leaf {a} / {b}");
+        } else {
+            let (ca, cb) = (na.first as usize, nb.first as usize);
+            stack.push((ca, cb));
+            stack.push((ca + 1, cb + 1));
+        }
+    }
+    assert_eq!(visited, serial.nodes.len(), "some nodes are unreachable");
+}
