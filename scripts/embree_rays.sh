@@ -18,7 +18,8 @@ rm -f "$out"
 run() { # NAME WIDTH [twinpath rays options...]
     local name=$1 width=$2
     shift 2
-    "$twinpath" rays --width "$width" --repeats "$repeats" --ray-file "target/rays/$name.rays" --csv "$out" "$@"
+    # One thread for our BVH build too (Embree builds with threads=1).
+    RAYON_NUM_THREADS=1 "$twinpath" rays --width "$width" --repeats "$repeats" --ray-file "target/rays/$name.rays" --csv "$out" "$@"
     target/rays/embree_rays "target/rays/$name.rays" "$name" "$repeats" "$out"
 }
 run cornell 1024

@@ -528,8 +528,8 @@ fn run() -> Result<()> {
                     .context("writing the ray file")?;
             let mib = |b: usize| b as f64 / (1024.0 * 1024.0);
             println!(
-                "{}: {} triangles, {} spheres; BVH build {:.3} s, {} nodes, {:.1} MiB hierarchy + {:.1} MiB primitives",
-                scene.name, r.triangles, r.spheres, r.build_seconds, r.nodes,
+                "{}: {} triangles, {} spheres; BVH build {:.3} s ({} threads), {} nodes, {:.1} MiB hierarchy + {:.1} MiB primitives",
+                scene.name, r.triangles, r.spheres, r.build_seconds, rayon::current_num_threads(), r.nodes,
                 mib(r.hierarchy_bytes), mib(r.primitive_bytes)
             );
             for s in &r.sets {
