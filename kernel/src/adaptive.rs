@@ -6,19 +6,36 @@
 //! image is the mean of the other samples. Sampling proceeds in passes; before each pass a pixel
 //! whose estimated relative error is below the target gets no more samples. The number of image
 //! samples N is then a function of the pilot samples alone, which are independent of the image
-//! samples (each sample is a pure function of its own index), so E[mean | N = n] = mu for every
-//! n >= 1 and the image stays unbiased. Stopping on the image samples themselves would not be:
+//! samples (pilots always draw independent numbers, see [`sample_stream`]), so
+//! E[mean | N = n] = mu for every n >= 1 and the image stays unbiased. Stopping on the image samples themselves would not be:
 //! a pixel whose first samples happen to agree (say, all miss a small bright light) would stop
 //! early with a low estimate, which is the bias of most adaptive samplers. The price is the
 //! pilot share (1 / pilot_period) of the samples, which the bench reports.
 
-use crate::scene::RenderParams;
+use crate::scene::{sampler, RenderParams};
 use spirv_std::glam::Vec3;
 
 /// Whether sample index `sample` of a pixel is a pilot sample (see the module comment).
 #[inline]
 pub fn is_pilot_sample(params: &RenderParams, sample: u32) -> bool {
     params.pilot_period > 0 && sample.is_multiple_of(params.pilot_period)
+}
+
+/// The sampler (`scene::sampler`) and sequence index with which sample `sample` of a pixel
+/// draws its numbers. Pilots draw independent numbers: Sobol points of one pixel are stratified
+/// jointly, so pilots taken from the image's own sequence would depend on the image samples,
+/// and so would a decision to stop. With Sobol points the image samples take consecutive
+/// indices of the sequence (the pilots' slots left out), so its power-of-two prefixes stay nets.
+#[inline]
+pub fn sample_stream(params: &RenderParams, sample: u32) -> (u32, u32) {
+    let period = params.pilot_period;
+    if period == 0 || params.sampler != sampler::SOBOL {
+        (params.sampler, sample)
+    } else if sample.is_multiple_of(period) {
+        (sampler::INDEPENDENT, sample)
+    } else {
+        (sampler::SOBOL, sample - sample / period - 1)
+    }
 }
 
 /// Rec. 709 luminance of linear RGB.

@@ -1,6 +1,7 @@
 //! TracePath: the path-tracing estimator with next-event estimation and Russian roulette,
 //! generic over how rays meet the scene ([`Tracer`]).
 
+use crate::adaptive::sample_stream;
 use crate::brdf::{eval_scattering, pdf_brdf, sample_brdf, sampled_brdf_weight};
 use crate::camera::{camera_origin, camera_ray_direction};
 use crate::features::FeatureSet;
@@ -301,8 +302,8 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
     py: u32,
     sample: u32,
 ) -> Vec3 {
-    let mut rng =
-        SampleRng::with_sampler(params.seed, py * params.width + px, sample, params.sampler);
+    let (sampler, index) = sample_stream(params, sample);
+    let mut rng = SampleRng::with_sampler(params.seed, py * params.width + px, index, sampler);
     let (u, v) = rng.next_2d();
     let dir = camera_ray_direction(&params.camera, params.width, params.height, px, py, u, v);
     trace_path(

@@ -168,9 +168,14 @@ const KD: f32 = 0.6;
 const SEEDS: u32 = 8;
 
 fn plane_scene(sampler: &str, seed: u32) -> Scene {
+    plane_scene_with(sampler, seed, "")
+}
+
+/// The plane scene with extra `[render]` lines.
+fn plane_scene_with(sampler: &str, seed: u32, render: &str) -> Scene {
     plane_under_light(
         "eye = [0, 9, 9]\nlook_at = [0, 0, -1]\nup = [0, 1, 0]\nvfov = 70\nwidth = 48\nheight = 48",
-        &format!("seed = {seed}\nsampler = \"{sampler}\""),
+        &format!("seed = {seed}\nsampler = \"{sampler}\"\n{render}"),
         KD,
         2.0,
         0.5,
@@ -182,9 +187,16 @@ fn plane_scene(sampler: &str, seed: u32) -> Scene {
 /// the variance of that mean from the seeds' spread (valid whatever the sampler: different
 /// seeds scramble independently).
 fn seed_statistics(sampler: &str, backend: Backend, spp: u32) -> (Vec<f64>, Vec<f64>) {
-    let films: Vec<Vec<[f32; 3]>> = (0..SEEDS)
-        .map(|s| render_film(&plane_scene(sampler, 100 + s), backend, spp).mean())
-        .collect();
+    spread_over_seeds(
+        (0..SEEDS)
+            .map(|s| render_film(&plane_scene(sampler, 100 + s), backend, spp).mean())
+            .collect(),
+    )
+}
+
+/// Per pixel (red channel) of images of independent seeds: the mean, and its variance from
+/// the seeds' spread.
+fn spread_over_seeds(films: Vec<Vec<[f32; 3]>>) -> (Vec<f64>, Vec<f64>) {
     let pixels = films[0].len();
     let k = SEEDS as f64;
     (0..pixels)
@@ -245,6 +257,60 @@ fn sobol_images_are_unbiased_and_less_noisy_on_both_backends() {
         let ratio = spread[1] / spread[0];
         println!("{backend:?}: variance sobol / independent = {ratio:.3}");
         assert!(ratio < 0.5, "{backend:?}: Sobol variance ratio {ratio:.3}");
+    }
+    assert_validation_clean();
+}
+
+#[test]
+fn adaptive_sampling_with_sobol_points_stays_unbiased_on_both_backends() {
+    // The stopping rule reads the pilot samples; with Sobol points, samples of one pixel are
+    // stratified jointly, so pilots drawn from the image's own sequence would be dependent on
+    // the image samples and stopping on them could bias the image.
+    let lamp = twinpath_tests::Lamp {
+        center: Vec3::new(0.0, 2.0, 0.0),
+        radius: 0.5,
+        radiance: 5.0,
+    };
+    let exact = plane_exact(&plane_scene("sobol", 0), KD, &[lamp]);
+    let tested: Vec<usize> = (0..exact.len()).filter(|&i| exact[i].is_some()).collect();
+    let max_spp = 256;
+    for backend in [Backend::Cpu, Backend::Gpu] {
+        let mut stopped_early = 0;
+        let films = (0..SEEDS)
+            .map(|s| {
+                let scene = plane_scene_with("sobol", 300 + s, "adaptive_target = 0.003");
+                let film = render_film(&scene, backend, max_spp);
+                assert_eq!(film.discarded, 0);
+                stopped_early += film
+                    .samples_per_pixel()
+                    .iter()
+                    .filter(|&&n| n < max_spp)
+                    .count();
+                film.mean()
+            })
+            .collect();
+        let pixels = (SEEDS as usize * exact.len()) as f64;
+        println!(
+            "{backend:?}: {:.1}% of pixel renders stopped early",
+            100.0 * stopped_early as f64 / pixels
+        );
+        assert!(stopped_early as f64 > 0.25 * pixels && (stopped_early as f64) < pixels);
+        let (mean, var) = spread_over_seeds(films);
+        let (mut d, mut v, mut e_sum) = (0.0, 0.0, 0.0);
+        for &i in &tested {
+            d += mean[i] - exact[i].unwrap();
+            v += var[i];
+            e_sum += exact[i].unwrap();
+        }
+        let z = d / v.sqrt();
+        let z_biased = (d - 0.005 * e_sum) / v.sqrt();
+        println!("{backend:?}: adaptive Sobol image vs closed form z = {z:+.2} (0.5% bias: {z_biased:+.1})");
+        let z_max = z_critical(1e-3, 2);
+        assert!(z.abs() < z_max, "{backend:?}: biased, z = {z:.2}");
+        assert!(
+            z_biased.abs() > z_max,
+            "{backend:?}: cannot see a 0.5% bias"
+        );
     }
     assert_validation_clean();
 }
