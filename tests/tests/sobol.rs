@@ -212,6 +212,22 @@ fn spread_over_seeds(films: Vec<Vec<[f32; 3]>>) -> (Vec<f64>, Vec<f64>) {
         .unzip()
 }
 
+/// All pixels with a closed form together: z of the summed difference from it (a sum of many
+/// independent pixel errors is normal, and its variance, summed 7-dof estimates over > 1500
+/// pixels, is well known), the same z if the image were 0.5% low (the test's power), and the
+/// summed variance.
+fn image_z(mean: &[f64], var: &[f64], exact: &[Option<f64>]) -> (f64, f64, f64) {
+    let (mut d, mut v, mut e_sum) = (0.0, 0.0, 0.0);
+    for (i, e) in exact.iter().enumerate() {
+        if let Some(e) = e {
+            d += mean[i] - e;
+            v += var[i];
+            e_sum += e;
+        }
+    }
+    (d / v.sqrt(), (d - 0.005 * e_sum) / v.sqrt(), v)
+}
+
 #[test]
 fn sobol_images_are_unbiased_and_less_noisy_on_both_backends() {
     let scene = plane_scene("sobol", 0);
@@ -224,24 +240,13 @@ fn sobol_images_are_unbiased_and_less_noisy_on_both_backends() {
             radiance: 5.0,
         }],
     );
-    let tested: Vec<usize> = (0..exact.len()).filter(|&i| exact[i].is_some()).collect();
-    assert!(tested.len() > 1500);
+    assert!(exact.iter().filter(|e| e.is_some()).count() > 1500);
     let z_max = z_critical(1e-3, 4);
     for backend in [Backend::Cpu, Backend::Gpu] {
         let mut spread = Vec::new();
         for sampler in ["independent", "sobol"] {
             let (mean, var) = seed_statistics(sampler, backend, 64);
-            // All tested pixels together: the sum of many independent pixel errors is normal,
-            // and its variance (a sum of 7-dof estimates over > 1500 pixels) is well known.
-            let (mut d, mut v, mut e_sum) = (0.0, 0.0, 0.0);
-            for &i in &tested {
-                d += mean[i] - exact[i].unwrap();
-                v += var[i];
-                e_sum += exact[i].unwrap();
-            }
-            let z = d / v.sqrt();
-            // Power: a bias of 0.5% of the image must be visible to this test.
-            let z_biased = (d - 0.005 * e_sum) / v.sqrt();
+            let (z, z_biased, v) = image_z(&mean, &var, &exact);
             println!(
                 "{backend:?} {sampler}: image vs closed form z = {z:+.2}; with a 0.5% bias z = {z_biased:+.1}; summed variance of the mean {v:.3e}"
             );
@@ -272,7 +277,6 @@ fn adaptive_sampling_with_sobol_points_stays_unbiased_on_both_backends() {
         radiance: 5.0,
     };
     let exact = plane_exact(&plane_scene("sobol", 0), KD, &[lamp]);
-    let tested: Vec<usize> = (0..exact.len()).filter(|&i| exact[i].is_some()).collect();
     let max_spp = 256;
     for backend in [Backend::Cpu, Backend::Gpu] {
         let mut stopped_early = 0;
@@ -296,14 +300,7 @@ fn adaptive_sampling_with_sobol_points_stays_unbiased_on_both_backends() {
         );
         assert!(stopped_early as f64 > 0.25 * pixels && (stopped_early as f64) < pixels);
         let (mean, var) = spread_over_seeds(films);
-        let (mut d, mut v, mut e_sum) = (0.0, 0.0, 0.0);
-        for &i in &tested {
-            d += mean[i] - exact[i].unwrap();
-            v += var[i];
-            e_sum += exact[i].unwrap();
-        }
-        let z = d / v.sqrt();
-        let z_biased = (d - 0.005 * e_sum) / v.sqrt();
+        let (z, z_biased, _) = image_z(&mean, &var, &exact);
         println!("{backend:?}: adaptive Sobol image vs closed form z = {z:+.2} (0.5% bias: {z_biased:+.1})");
         let z_max = z_critical(1e-3, 2);
         assert!(z.abs() < z_max, "{backend:?}: biased, z = {z:.2}");
