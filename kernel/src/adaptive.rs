@@ -7,9 +7,10 @@
 //! whose estimated relative error is below the target gets no more samples. The number of image
 //! samples N is then a function of the pilot samples alone, which are independent of the image
 //! samples (pilots always draw independent numbers, see [`sample_stream`]), so
-//! E[mean | N = n] = mu for every n >= 1 and the image stays unbiased. Stopping on the image samples themselves would not be:
-//! a pixel whose first samples happen to agree (say, all miss a small bright light) would stop
-//! early with a low estimate, which is the bias of most adaptive samplers. The price is the
+//! E[mean | N = n] = mu for every n >= 1 and the image stays unbiased. Stopping on the image
+//! samples themselves would not be: a pixel whose first samples happen to agree (say, all miss
+//! a small bright light) would stop early with a low estimate, which is the bias of most
+//! adaptive samplers. The price is the
 //! pilot share (1 / pilot_period) of the samples, which the bench reports.
 
 use crate::scene::{sampler, RenderParams};
@@ -28,13 +29,12 @@ pub fn is_pilot_sample(params: &RenderParams, sample: u32) -> bool {
 /// indices of the sequence (the pilots' slots left out), so its power-of-two prefixes stay nets.
 #[inline]
 pub fn sample_stream(params: &RenderParams, sample: u32) -> (u32, u32) {
-    let period = params.pilot_period;
-    if period == 0 || params.sampler != sampler::SOBOL {
+    if params.sampler != sampler::SOBOL || params.pilot_period == 0 {
         (params.sampler, sample)
-    } else if sample.is_multiple_of(period) {
+    } else if is_pilot_sample(params, sample) {
         (sampler::INDEPENDENT, sample)
     } else {
-        (sampler::SOBOL, sample - sample / period - 1)
+        (sampler::SOBOL, sample - sample / params.pilot_period - 1)
     }
 }
 

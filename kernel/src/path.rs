@@ -172,13 +172,13 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
 
         // 2(a): next-event estimation.
         if features.lights(params) && albedo.max_element() > 0.0 {
-            rng.seek(dimensions);
             let u_select = if light_count > 1 {
+                rng.seek(dimensions);
                 rng.next_f32()
             } else {
-                rng.seek(dimensions + 1);
                 0.0
             };
+            rng.seek(dimensions + 1);
             let (u_light1, u_light2) = rng.next_2d();
             let ls = sample_light_from(
                 lights,

@@ -369,6 +369,7 @@ fn render_keywords_name_their_choices() {
         ("mis", "power", "half"),
         ("light_sampling", "cone", "area"),
         ("light_selection", "power", "uniform"),
+        ("sampler", "independent", "sobol"),
     ] {
         let text = format!("{GOOD}\n[render]\n{key} = \"bogus\"\n");
         assert_error(
@@ -401,4 +402,8 @@ fn render_keywords_name_their_choices() {
             kernel::scene::light_selection::UNIFORM
         )
     );
+    // Sobol points unless the scene asks for independent numbers.
+    assert_eq!(parse("").render.sampler, kernel::scene::sampler::SOBOL);
+    let s = parse("sampler = \"independent\"\n");
+    assert_eq!(s.render.sampler, kernel::scene::sampler::INDEPENDENT);
 }
