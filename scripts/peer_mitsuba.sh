@@ -5,11 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:?usage: scripts/peer_mitsuba.sh OUT.csv [options]}
 shift
-venv=target/peer-mitsuba-venv
-if [ ! -x "$venv/bin/python" ]; then
-    python3 -m venv "$venv"
-    "$venv/bin/pip" install -q mitsuba numpy
-fi
+source scripts/mitsuba_venv.sh
 # Dr.Jit's LLVM back end fails on Debian's libLLVM 14/15 ("Cannot select: fmaximum").
 llvm=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
 if [ ! -e "$llvm" ]; then

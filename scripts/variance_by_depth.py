@@ -47,6 +47,7 @@ def main():
             for depth in ["1", "2", "3", "4", "unlimited"]:
                 text = scene
                 if depth != "unlimited":
+                    assert "[render]\n" in text, "scenes/cornell.toml has no [render] table"
                     text = text.replace("[render]\n", f"[render]\nmax_depth = {depth}\n", 1)
                 path = os.path.join(tmp, f"d{depth}.toml")
                 open(path, "w").write(text)

@@ -4,11 +4,7 @@
 # Mitsuba's Bitmap). Usage: scripts/variance_by_depth.sh [SPP]   (default 16)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-venv=target/peer-mitsuba-venv
-if [ ! -x "$venv/bin/python" ]; then
-    python3 -m venv "$venv"
-    "$venv/bin/pip" install -q mitsuba numpy
-fi
+source scripts/mitsuba_venv.sh
 cargo build -q -p twinpath
 "$venv/bin/python" scripts/variance_by_depth.py target/debug/twinpath \
     ../shared/reference/cornell_spheres/mitsuba_ref.exr "${1:-16}"
