@@ -20,6 +20,7 @@ pub mod scene;
 #[cfg(target_arch = "spirv")]
 pub mod shaders;
 pub mod sobol;
+pub mod turns;
 
 pub use path::{trace_path, SurfaceHit, Tracer};
 pub use spirv_std::glam;

@@ -1,6 +1,7 @@
 //! Sampling routines: directions around an axis and points on spheres.
 
 use crate::frame::orthonormal_basis;
+use crate::turns::cos_sin_turns;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use core::f32::consts::PI;
@@ -13,17 +14,24 @@ use spirv_std::glam::Vec3;
 /// seed special-cases the poles.
 #[inline]
 pub fn sample_lobe(a: Vec3, c: f32, phi: f32) -> Vec3 {
+    lobe_direction(a, c, phi.cos(), phi.sin())
+}
+
+/// [`sample_lobe`] with the azimuth given by its cosine and sine.
+#[inline]
+fn lobe_direction(a: Vec3, c: f32, cos_phi: f32, sin_phi: f32) -> Vec3 {
     let c = c.clamp(-1.0, 1.0);
     let s = (1.0 - c * c).max(0.0).sqrt();
     let (t, b) = orthonormal_basis(a);
-    t * (s * phi.cos()) + b * (s * phi.sin()) + a * c
+    t * (s * cos_phi) + b * (s * sin_phi) + a * c
 }
 
 /// Cosine-weighted direction in the hemisphere around unit `n` from two uniform numbers
 /// (cos(theta) = sqrt(u1), phi = 2 pi u2); its solid-angle pdf is [`pdf_cosine_hemisphere`].
 #[inline]
 pub fn sample_cosine_hemisphere(n: Vec3, u1: f32, u2: f32) -> Vec3 {
-    sample_lobe(n, u1.sqrt(), 2.0 * PI * u2)
+    let (cos_phi, sin_phi) = cos_sin_turns(u2);
+    lobe_direction(n, u1.sqrt(), cos_phi, sin_phi)
 }
 
 /// Solid-angle density of [`sample_cosine_hemisphere`]: max(0, n . w) / pi.
@@ -46,8 +54,8 @@ pub struct SurfacePoint {
 pub fn sample_sphere(center: Vec3, radius: f32, u1: f32, u2: f32) -> SurfacePoint {
     let z = 2.0 * u1 - 1.0;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u2;
-    let normal = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+    let (cos_phi, sin_phi) = cos_sin_turns(u2);
+    let normal = Vec3::new(r * cos_phi, r * sin_phi, z);
     SurfacePoint {
         position: center + radius * normal,
         normal,
@@ -123,9 +131,9 @@ pub fn sample_sphere_cone(center: Vec3, radius: f32, p: Vec3, u1: f32, u2: f32) 
     let cos_alpha =
         (sin2 / sin_max + cos * (1.0 - sin2 / sin2_max).max(0.0).sqrt()).clamp(-1.0, 1.0);
     let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
-    let phi = 2.0 * PI * u2;
+    let (cos_phi, sin_phi) = cos_sin_turns(u2);
     let (t, b) = orthonormal_basis(axis);
-    let normal = t * (sin_alpha * phi.cos()) + b * (sin_alpha * phi.sin()) - axis * cos_alpha;
+    let normal = t * (sin_alpha * cos_phi) + b * (sin_alpha * sin_phi) - axis * cos_alpha;
     ConeSample {
         point: SurfacePoint {
             position: center + radius * normal,

@@ -236,12 +236,12 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "offset_ray_origin / shadow_ray_end", func: function::OFFSET_RAY_ORIGIN, max_ulps: 1, abs: 0.0, flip_fraction: 0.0, why: "integer ULP steps are exact; p + s n may be fused into one FMA on the GPU: 1 ULP" },
     Bound { name: "orthonormal_basis", func: function::ORTHONORMAL_BASIS, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "a few multiply-adds (FMA contraction): 4 ULP, or 4 eps absolute near zero" },
     Bound { name: "sample_lobe", func: function::SAMPLE_LOBE, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos differ by 1 ULP (GLSL.std.450 vs libm) plus the frame: 8 eps absolute on unit vectors" },
-    Bound { name: "sample_sphere", func: function::SAMPLE_SPHERE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos differ by 1 ULP: normals 4 eps, positions 4 eps x (|centre| + radius)" },
-    Bound { name: "sample_sphere_cone", func: function::SAMPLE_SPHERE_CONE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos 1 ULP, dot products under FMA: pdf 4 ULP, normals 4 eps, positions 4 eps x (|centre| + radius)" },
+    Bound { name: "sample_sphere", func: function::SAMPLE_SPHERE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "cos_sin_turns' polynomials under FMA contraction: normals 4 eps, positions 4 eps x (|centre| + radius)" },
+    Bound { name: "sample_sphere_cone", func: function::SAMPLE_SPHERE_CONE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, why: "cos_sin_turns and dot products under FMA contraction: pdf 4 ULP, normals 4 eps, positions 4 eps x (|centre| + radius)" },
     Bound { name: "geometry_factor", func: function::GEOMETRY_FACTOR, max_ulps: 8, abs: 0.0, flip_fraction: 0.0, why: "dot products (FMA contraction): 8 ULP" },
     Bound { name: "intersect_sphere (+ re-projection)", func: function::INTERSECT_SPHERE, max_ulps: 64, abs: 0.0, flip_fraction: 1e-3, why: "sqrt and FMA contraction; hit/miss may flip for rays within rounding of tangent or of the origin's surface" },
     Bound { name: "intersect_triangle (t, u, v, point, error bound)", func: function::INTERSECT_TRIANGLE, max_ulps: 64, abs: 4.0 * f32::EPSILON, flip_fraction: 1e-3, why: "cross/dot products under FMA contraction: 64 ULP, u and v 4 eps, points 4 eps x (|p0| + |e1| + |e2|); hit/miss may flip for rays within rounding of an edge" },
-    Bound { name: "eval_scattering / pdf_brdf / sample_brdf", func: function::BRDF, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "sin/cos and sqrt in sampling: 8 eps absolute on unit vectors and pdfs <= 1/pi" },
+    Bound { name: "eval_scattering / pdf_brdf / sample_brdf", func: function::BRDF, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "cos_sin_turns and sqrt in sampling (FMA contraction): 8 eps absolute on unit vectors and pdfs <= 1/pi" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
 

@@ -239,3 +239,46 @@ fn sample_sphere_cone_follows_its_pdf() {
         );
     }
 }
+
+/// `cos_sin_turns` over every value the samplers pass it (u = k / 2^24, all 2^24 of them) and
+/// around its reduction points against f64: both components within the error its doc derives
+/// (a few roundings of values <= 1 after an exact reduction: 2^-23 absolute), and every
+/// quadrant right (a swapped or negated quadrant is off by up to 2).
+#[test]
+fn cos_sin_turns_matches_f64_on_every_sampler_value() {
+    use kernel::turns::cos_sin_turns;
+    let mut worst = (0.0f64, 0.0f32);
+    let mut check = |u: f32| {
+        let (c, s) = cos_sin_turns(u);
+        let (s64, c64) = (2.0 * PI * u as f64).sin_cos();
+        let err = (c as f64 - c64).abs().max((s as f64 - s64).abs());
+        if err > worst.0 {
+            worst = (err, u);
+        }
+    };
+    for k in 0..1u32 << 24 {
+        check(k as f32 / 16_777_216.0);
+    }
+    // Reduction edges (q changes at u = (2j + 1) / 8) and whole turns, from both sides.
+    for j in -8..=16 {
+        let edge = j as f32 / 8.0;
+        let mut below = edge;
+        let mut above = edge;
+        for _ in 0..64 {
+            check(below);
+            check(above);
+            below = below.next_down();
+            above = above.next_up();
+        }
+    }
+    println!(
+        "cos_sin_turns: max error {:.3e} at u = {}",
+        worst.0, worst.1
+    );
+    assert!(
+        worst.0 <= 1.0 / 8_388_608.0,
+        "cos_sin_turns: error {:.3e} at u = {} exceeds 2^-23",
+        worst.0,
+        worst.1
+    );
+}
