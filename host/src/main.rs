@@ -356,7 +356,19 @@ fn run() -> Result<()> {
                     result.accel_build.as_secs_f64(),
                     result.pipeline.as_secs_f64()
                 ),
-                _ => format!("setup {:.3} s (BVH)", result.setup.as_secs_f64()),
+                // With --backend auto, set-up also holds the look for a Vulkan device (loading
+                // the driver: up to two seconds on a cold file cache).
+                _ if backend == Backend::Auto => format!(
+                    "setup {:.3} s (looking for a Vulkan device {:.3} s, BVH {:.3} s)",
+                    result.setup.as_secs_f64(),
+                    (result.setup - result.accel_build).as_secs_f64(),
+                    result.accel_build.as_secs_f64()
+                ),
+                _ => format!(
+                    "setup {:.3} s (BVH {:.3} s)",
+                    result.setup.as_secs_f64(),
+                    result.accel_build.as_secs_f64()
+                ),
             };
             eprintln!(
                 "twinpath: {:?} backend: {setup}, render {:.3} s, {:.3} M samples/s, {} non-finite samples discarded",

@@ -45,9 +45,11 @@ pub struct RenderOutput {
     pub film: Film,
     /// The backend that actually rendered (never `Auto`).
     pub backend: Backend,
-    /// Set-up before the first sample (BVH, or acceleration structures + pipeline).
+    /// Set-up before the first sample: on the CPU the BVH, and with `--backend auto` the look
+    /// for a Vulkan device before it; on the GPU instance, device, acceleration structures and
+    /// pipeline.
     pub setup: Duration,
-    /// Of `setup` on the GPU: acceleration-structure build and pipeline creation.
+    /// Of `setup`: the BVH build (CPU), or the acceleration-structure build (GPU).
     pub accel_build: Duration,
     pub pipeline: Duration,
     /// Time spent rendering samples.
@@ -157,7 +159,9 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
             }
         }
         None => {
+            let t_bvh = Instant::now();
             let renderer = CpuRenderer::new(scene);
+            let bvh = t_bvh.elapsed();
             let setup = t0.elapsed();
             let mut film = Film::new(scene.camera.width, scene.camera.height);
             let t1 = Instant::now();
@@ -177,7 +181,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
                 film,
                 backend: Backend::Cpu,
                 setup,
-                accel_build: setup,
+                accel_build: bvh,
                 pipeline: Duration::ZERO,
                 render: t1.elapsed(),
                 spp_done,
