@@ -361,7 +361,10 @@ fn run() -> Result<()> {
                 _ if backend == Backend::Auto => format!(
                     "setup {:.3} s (looking for a Vulkan device {:.3} s, BVH {:.3} s)",
                     result.setup.as_secs_f64(),
-                    (result.setup - result.accel_build).as_secs_f64(),
+                    result
+                        .setup
+                        .saturating_sub(result.accel_build)
+                        .as_secs_f64(),
                     result.accel_build.as_secs_f64()
                 ),
                 _ => format!(

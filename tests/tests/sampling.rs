@@ -259,7 +259,8 @@ fn cos_sin_turns_matches_f64_on_every_sampler_value() {
     for k in 0..1u32 << 24 {
         check(k as f32 / 16_777_216.0);
     }
-    // Reduction edges (q changes at u = (2j + 1) / 8) and whole turns, from both sides.
+    // From both sides of u = j / 8: the reduction's edges (q changes at odd j) and the quarter
+    // turns (even j), over two turns and one negative one.
     for j in -8..=16 {
         let edge = j as f32 / 8.0;
         let mut below = edge;
