@@ -195,11 +195,13 @@ fn max_abs(v: Vec3) -> f32 {
 /// angle theta) is itself only known to about eps |edge| / sin(theta), since its normal comes
 /// from the cross product of nearly parallel edges, so the edge terms carry 1 / sin(theta)
 /// (found by the re-intersection tests: slivers with sin(theta) = 0.002 self-intersected).
+/// 1 / sin(theta) is capped at f32::MAX: for a denormal sin(theta) it overflows to infinity,
+/// and a hit at u = v = 0 then computed 0 x inf = NaN (found by `properties.rs`).
 #[inline]
 pub fn triangle_point_error(p0: Vec3, edge1: Vec3, edge2: Vec3, u: f32, v: f32) -> f32 {
     let sin_theta = edge1.cross(edge2).length() / (edge1.length() * edge2.length());
     let condition = if sin_theta > 0.0 {
-        1.0 / sin_theta
+        (1.0 / sin_theta).min(f32::MAX)
     } else {
         1.0
     };

@@ -251,3 +251,25 @@ proptest! {
         }
     }
 }
+
+/// The case `ray_triangle_returns_barycentrics_inside` found (CI, 2026-11-22): a sliver whose
+/// sin(theta) is denormal (1/sin overflowed to infinity), hit at its corner u = v = 0, gave a
+/// NaN error bound (0 x inf). The bound must be a number, at least the corner's own rounding.
+#[test]
+fn triangle_point_error_of_a_denormal_sliver_is_not_nan() {
+    let o = Vec3::new(1.0059377e-20, 0.0, 0.0);
+    let d = Vec3::new(-0.0, -1.0, -0.0);
+    let p0 = Vec3::new(7.4105455e-21, -1.0, 0.0);
+    let e1 = Vec3::new(3.15264e18, 0.0, 0.0);
+    let e2 = Vec3::new(375248440000000.0, 3.578063e-29, 1e-45);
+    let h = intersect_triangle_uv(o, d, p0, e1, e2, 0.0, f32::INFINITY);
+    assert!(h.t > 0.0, "the ray hits the sliver (t = {})", h.t);
+    let err = triangle_point_error(p0, e1, e2, h.u, h.v);
+    let p = triangle_point(p0, e1, e2, h.u, h.v);
+    assert!(
+        err >= f32::EPSILON * 1.0 && !p.is_nan(),
+        "u = {}, v = {}, error bound {err}, point {p}",
+        h.u,
+        h.v
+    );
+}
