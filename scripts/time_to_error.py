@@ -17,7 +17,7 @@ from collections import defaultdict
 
 
 def load(paths):
-    """{variant: {spp: (mean render_s, mean relmse, seeds)}}, variants in file order."""
+    """{variant: {spp: (mean render_s, mean relmse)}} over the seeds, variants in file order."""
     sums = defaultdict(lambda: defaultdict(lambda: [0.0, 0.0, 0]))
     order = []
     for path in paths:
@@ -31,14 +31,14 @@ def load(paths):
                 point[1] += float(row["relmse"])
                 point[2] += 1
     return {
-        name: {spp: (t / n, e / n, n) for spp, (t, e, n) in sorted(sums[name].items())}
+        name: {spp: (t / n, e / n) for spp, (t, e, n) in sorted(sums[name].items())}
         for name in order
     }
 
 
 def time_to(points, target):
     """(seconds at the target, the spp, render_s and relmse of the point it came from)."""
-    spp, (t, e, _) = min(points.items(), key=lambda kv: abs(math.log(kv[1][1] / target)))
+    spp, (t, e) = min(points.items(), key=lambda kv: abs(math.log(kv[1][1] / target)))
     return t * e / target, spp, t, e
 
 

@@ -356,22 +356,21 @@ fn run() -> Result<()> {
                     result.accel_build.as_secs_f64(),
                     result.pipeline.as_secs_f64()
                 ),
-                // With --backend auto, set-up also holds the look for a Vulkan device (loading
-                // the driver: up to two seconds on a cold file cache).
-                _ if backend == Backend::Auto => format!(
-                    "setup {:.3} s (looking for a Vulkan device {:.3} s, BVH {:.3} s)",
-                    result.setup.as_secs_f64(),
-                    result
-                        .setup
-                        .saturating_sub(result.accel_build)
-                        .as_secs_f64(),
-                    result.accel_build.as_secs_f64()
-                ),
-                _ => format!(
-                    "setup {:.3} s (BVH {:.3} s)",
-                    result.setup.as_secs_f64(),
-                    result.accel_build.as_secs_f64()
-                ),
+                _ => {
+                    // With --backend auto, set-up also holds the look for a Vulkan device
+                    // (loading the driver: up to two seconds on a cold file cache).
+                    let probe = result.setup.saturating_sub(result.accel_build);
+                    let probe = if backend == Backend::Auto {
+                        format!("looking for a Vulkan device {:.3} s, ", probe.as_secs_f64())
+                    } else {
+                        String::new()
+                    };
+                    format!(
+                        "setup {:.3} s ({probe}BVH {:.3} s)",
+                        result.setup.as_secs_f64(),
+                        result.accel_build.as_secs_f64()
+                    )
+                }
             };
             eprintln!(
                 "twinpath: {:?} backend: {setup}, render {:.3} s, {:.3} M samples/s, {} non-finite samples discarded",
