@@ -115,6 +115,10 @@ pub const PDF_EPSILON: f32 = 1e-6;
 ///
 /// `features` answers which of these steps the scene needs (`crate::features`): a
 /// [`crate::features::Static`] set compiles the others away, a dynamic one asks `params`.
+///
+/// The loop is written as a state machine ([`PathState`]) that stops at each ray cast, so a
+/// backend can trace many paths' rays together (the CPU's packets); this function is its
+/// one-path driver, the GPU's.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn trace_path<T: Tracer, F: FeatureSet>(
@@ -127,36 +131,153 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
     dir: Vec3,
     rng: &mut SampleRng,
 ) -> Vec3 {
-    let background = Vec3::new(
-        params.background[0],
-        params.background[1],
-        params.background[2],
-    );
-    let mut hit = tracer.closest_hit(origin, dir);
-    if !hit.is_hit() {
-        return background;
+    let mut path = PathState::new(origin, dir, *rng);
+    loop {
+        let hit = if path.extend {
+            tracer.closest_hit(path.ray_origin, path.ray_dir)
+        } else {
+            SurfaceHit::miss()
+        };
+        let occluded = path.shadow && tracer.occluded(path.shadow_from, path.shadow_to);
+        path.advance(features, params, materials, lights, hit, occluded);
+        if path.finished() {
+            *rng = path.rng;
+            return path.radiance;
+        }
     }
-    let mut material = materials[hit.material as usize];
-    if hit.light != NONE {
-        return eval_radiance(Vec3::from(material.emission), hit.normal, -dir);
+}
+
+/// A path of [`trace_path`] between two rounds of ray casts: what it has gathered, and the rays
+/// it waits for. Each round traces up to two rays, both known before either is cast: the
+/// extension (or camera) ray `ray_origin + t ray_dir` when `extend`, and the shadow segment
+/// `shadow_from -> shadow_to` of the last vertex's light sample when `shadow`;
+/// [`PathState::advance`] takes their answers. The light sample's contribution is computed
+/// with the vertex and added once the segment is known to be clear, before the extension's
+/// hit is looked at, so the radiance sums its terms in the same order as a loop that casts the
+/// shadow ray first.
+#[derive(Clone, Copy, Debug)]
+pub struct PathState {
+    /// The estimate so far; the result once [`PathState::finished`].
+    pub radiance: Vec3,
+    /// The product of the BRDF weights (and roulette divisions) up to the current vertex.
+    pub throughput: Vec3,
+    pub ray_origin: Vec3,
+    /// The direction of the ray to trace (unit length); `-ray_dir` leaves the next vertex.
+    pub ray_dir: Vec3,
+    /// Whether `ray_origin + t ray_dir` waits to be traced (closest hit).
+    pub extend: bool,
+    pub shadow_from: Vec3,
+    pub shadow_to: Vec3,
+    /// Whether the segment `shadow_from -> shadow_to` waits to be tested (any hit).
+    pub shadow: bool,
+    /// What the light sample adds if the segment is clear.
+    pub shadow_radiance: Vec3,
+    /// The vertex the extension ray left and the BRDF density it was sampled with (for the MIS
+    /// weight of a light it finds).
+    pub previous_vertex: Vec3,
+    pub previous_pdf: f32,
+    /// Vertices so far: 0 while the camera ray is out.
+    pub depth: u32,
+    pub rng: SampleRng,
+}
+
+impl PathState {
+    /// A path whose camera ray `origin + t dir` is to be traced; `rng` is past the camera's
+    /// dimensions.
+    #[inline]
+    pub fn new(origin: Vec3, dir: Vec3, rng: SampleRng) -> Self {
+        Self {
+            radiance: Vec3::ZERO,
+            throughput: Vec3::ONE,
+            ray_origin: origin,
+            ray_dir: dir,
+            extend: true,
+            shadow_from: Vec3::ZERO,
+            shadow_to: Vec3::ZERO,
+            shadow: false,
+            shadow_radiance: Vec3::ZERO,
+            previous_vertex: origin,
+            previous_pdf: 0.0,
+            depth: 0,
+            rng,
+        }
     }
 
-    let mis_power = features.mis_power(params);
-    let sampling = if features.light_cone(params) {
-        light_sampling::CONE
-    } else {
-        light_sampling::AREA
-    };
-    let light_count = if features.single_light(params) {
-        1
-    } else {
-        params.light_count
-    };
-    let mut radiance = Vec3::ZERO;
-    let mut throughput = Vec3::ONE;
-    let mut w_out = -dir;
-    let mut depth: u32 = 1;
-    loop {
+    /// Whether the path is complete: no ray waits.
+    #[inline]
+    pub fn finished(&self) -> bool {
+        !self.extend && !self.shadow
+    }
+
+    /// Takes the answers to this round's rays: `hit`, the closest hit of the extension ray
+    /// (ignored unless `extend`), and whether the shadow segment is `occluded` (ignored unless
+    /// `shadow`); then runs the estimator up to its next ray casts (steps 1-5 above).
+    #[inline]
+    pub fn advance<F: FeatureSet>(
+        &mut self,
+        features: F,
+        params: &RenderParams,
+        materials: &[Material],
+        lights: &[SphereLight],
+        hit: SurfaceHit,
+        occluded: bool,
+    ) {
+        if self.shadow && !occluded {
+            self.radiance += self.shadow_radiance;
+        }
+        self.shadow = false;
+        if !self.extend {
+            return;
+        }
+        self.extend = false;
+        let dir = self.ray_dir;
+        if !hit.is_hit() {
+            // 1: the camera ray sees the background; an extension adds it with weight 1.
+            if self.depth == 0 {
+                self.radiance = background(params);
+            } else if features.background() {
+                self.radiance += self.throughput * background(params);
+            }
+            return;
+        }
+        let material = materials[hit.material as usize];
+        if hit.light != NONE {
+            let emitted = eval_radiance(Vec3::from(material.emission), hit.normal, -dir);
+            if self.depth == 0 {
+                // 1: a light seen directly (it reflects nothing, so the path ends).
+                self.radiance = emitted;
+            } else {
+                // 2(b): the extension found a light.
+                let weight = if features.mis_power(params) {
+                    let sampling = light_sampling_of(features, params);
+                    let x = self.previous_vertex;
+                    let pdf_l =
+                        pdf_light_from(lights, sampling, hit.light, x, hit.position, hit.normal);
+                    power_heuristic(self.previous_pdf, pdf_l)
+                } else {
+                    0.5
+                };
+                self.radiance += self.throughput * emitted * weight;
+            }
+            return;
+        }
+        self.depth += 1;
+        self.vertex(features, params, lights, hit, material, -dir);
+    }
+
+    /// Steps 2(a), 4 and 3 at vertex `hit` (reached at `self.depth`), left toward `w_out`:
+    /// prepares the light sample's shadow segment and, unless the path ends here, the extension.
+    #[inline]
+    fn vertex<F: FeatureSet>(
+        &mut self,
+        features: F,
+        params: &RenderParams,
+        lights: &[SphereLight],
+        hit: SurfaceHit,
+        material: Material,
+        w_out: Vec3,
+    ) {
+        let rng = &mut self.rng;
         // The normal on the side the light leaves toward (two-sided surfaces).
         let n = if hit.normal.dot(w_out) < 0.0 {
             -hit.normal
@@ -168,10 +289,15 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
         let ray_origin = offset_ray_origin(x, n, hit.error);
         // This vertex's block of dimensions; numbers nobody reads are not drawn (a counter-
         // based stream gives the others the same values either way).
-        let dimensions = CAMERA_DIMENSIONS + (depth - 1) * DIMENSIONS_PER_VERTEX;
+        let dimensions = CAMERA_DIMENSIONS + (self.depth - 1) * DIMENSIONS_PER_VERTEX;
 
         // 2(a): next-event estimation.
         if features.lights(params) && albedo.max_element() > 0.0 {
+            let light_count = if features.single_light(params) {
+                1
+            } else {
+                params.light_count
+            };
             let u_select = if light_count > 1 {
                 rng.seek(dimensions);
                 rng.next_f32()
@@ -183,7 +309,7 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
             let ls = sample_light_from(
                 lights,
                 light_count,
-                sampling,
+                light_sampling_of(features, params),
                 x,
                 u_select,
                 u_light1,
@@ -194,46 +320,42 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
             let cos_x = n.dot(wi);
             let cos_y = -ls.point.normal.dot(wi);
             let pdf_w = ls.pdf_solid_angle;
-            if cos_x > 0.0
-                && cos_y > 0.0
-                && pdf_w > 0.0
-                && !tracer.occluded(
-                    ray_origin,
-                    shadow_ray_end(
-                        ray_origin,
-                        y,
-                        ls.point.normal,
-                        light_point_error(lights, ls.light),
-                    ),
-                )
-            {
+            if cos_x > 0.0 && cos_y > 0.0 && pdf_w > 0.0 {
                 let emitted = Vec3::from(lights[ls.light as usize].radiance);
-                let weight = if mis_power {
+                let weight = if features.mis_power(params) {
                     power_heuristic(pdf_w, pdf_brdf(n, wi))
                 } else {
                     0.5
                 };
-                radiance +=
-                    throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
+                self.shadow = true;
+                self.shadow_from = ray_origin;
+                self.shadow_to = shadow_ray_end(
+                    ray_origin,
+                    y,
+                    ls.point.normal,
+                    light_point_error(lights, ls.light),
+                );
+                self.shadow_radiance =
+                    self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
             }
         }
 
-        if depth >= params.max_depth {
-            break;
+        if self.depth >= params.max_depth {
+            return;
         }
         // 4: Russian roulette on the extension.
-        if depth >= params.rr_start_depth {
+        if self.depth >= params.rr_start_depth {
             rng.seek(dimensions + 3);
             let u_rr = rng.next_f32();
             let q = if features.rr_throughput(params) {
-                throughput.max_element().min(1.0)
+                self.throughput.max_element().min(1.0)
             } else {
                 params.rr_probability
             };
             if !(u_rr < q) {
-                break;
+                return;
             }
-            throughput /= q;
+            self.throughput /= q;
         }
 
         // 3: extension by BRDF sampling.
@@ -242,42 +364,39 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
         let wi = sample_brdf(n, u_brdf1, u_brdf2);
         let pdf_b = pdf_brdf(n, wi);
         if pdf_b < PDF_EPSILON {
-            break;
+            return;
         }
         // = eval_scattering(n, wi, albedo) / pdf_b, exactly (see `sampled_brdf_weight`).
-        throughput *= sampled_brdf_weight(albedo);
-        if throughput.max_element() <= 0.0 {
-            break;
+        self.throughput *= sampled_brdf_weight(albedo);
+        if self.throughput.max_element() <= 0.0 {
+            return;
         }
-
-        let next = tracer.closest_hit(ray_origin, wi);
-        if !next.is_hit() {
-            if features.background() {
-                radiance += throughput * background;
-            }
-            break;
-        }
-        let next_material = materials[next.material as usize];
-        if next.light != NONE {
-            // 2(b): the extension found a light.
-            let emitted = eval_radiance(Vec3::from(next_material.emission), next.normal, -wi);
-            let weight = if mis_power {
-                let pdf_l =
-                    pdf_light_from(lights, sampling, next.light, x, next.position, next.normal);
-                power_heuristic(pdf_b, pdf_l)
-            } else {
-                0.5
-            };
-            radiance += throughput * emitted * weight;
-            break;
-        }
-
-        hit = next;
-        material = next_material;
-        w_out = -wi;
-        depth += 1;
+        self.extend = true;
+        self.ray_origin = ray_origin;
+        self.ray_dir = wi;
+        self.previous_vertex = x;
+        self.previous_pdf = pdf_b;
     }
-    radiance
+}
+
+/// The background radiance (seen by rays that leave the scene).
+#[inline]
+fn background(params: &RenderParams) -> Vec3 {
+    Vec3::new(
+        params.background[0],
+        params.background[1],
+        params.background[2],
+    )
+}
+
+/// How this render samples points on lights (`scene::light_sampling`).
+#[inline]
+fn light_sampling_of<F: FeatureSet>(features: F, params: &RenderParams) -> u32 {
+    if features.light_cone(params) {
+        light_sampling::CONE
+    } else {
+        light_sampling::AREA
+    }
 }
 
 /// Rounding-error bound of a point sampled on light `light` (c + r n).
@@ -289,7 +408,9 @@ fn light_point_error(lights: &[SphereLight], light: u32) -> f32 {
 
 /// One sample of pixel (px, py) (column from the left, row from the top): a uniformly random
 /// position inside the pixel (box filter), the camera ray through it, and [`trace_path`].
-/// Both backends call exactly this, so a sample is the same function of (seed, pixel, sample).
+/// Both backends compute exactly this, so a sample is the same function of (seed, pixel,
+/// sample): the GPU by this function, the CPU's packets by [`start_sample`] and
+/// [`PathState::advance`].
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn render_sample<T: Tracer, F: FeatureSet>(
@@ -302,18 +423,27 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
     py: u32,
     sample: u32,
 ) -> Vec3 {
-    let (sampler, index) = sample_stream(params, sample);
-    let mut rng = SampleRng::with_sampler(params.seed, py * params.width + px, index, sampler);
-    let (u, v) = rng.next_2d();
-    let dir = camera_ray_direction(&params.camera, params.width, params.height, px, py, u, v);
+    let path = start_sample(params, px, py, sample);
+    let mut rng = path.rng;
     trace_path(
         tracer,
         features,
         params,
         materials,
         lights,
-        camera_origin(&params.camera),
-        dir,
+        path.ray_origin,
+        path.ray_dir,
         &mut rng,
     )
+}
+
+/// The path of sample `sample` of pixel (px, py) with its camera ray waiting (see
+/// [`render_sample`]).
+#[inline]
+pub fn start_sample(params: &RenderParams, px: u32, py: u32, sample: u32) -> PathState {
+    let (sampler, index) = sample_stream(params, sample);
+    let mut rng = SampleRng::with_sampler(params.seed, py * params.width + px, index, sampler);
+    let (u, v) = rng.next_2d();
+    let dir = camera_ray_direction(&params.camera, params.width, params.height, px, py, u, v);
+    PathState::new(camera_origin(&params.camera), dir, rng)
 }
