@@ -22,7 +22,7 @@ impl Variant {
     /// Parses `NAME` or `NAME:key=value,key=value` on top of `base`; keys: mis (power|half),
     /// light_sampling (cone|area), light_selection (power|uniform), sampler (independent|sobol), roulette
     /// (constant|throughput), rr (probability), rr_start_depth (vertex), specialize (on|off),
-    /// adaptive (target relative error, 0: off).
+    /// packets (on|off), adaptive (target relative error, 0: off).
     pub fn parse(spec: &str, base: &RenderSettings) -> Result<Variant> {
         let (name, rest) = spec.split_once(':').unwrap_or((spec, ""));
         if name.is_empty() {
@@ -44,6 +44,8 @@ impl Variant {
                 ("sampler", "sobol") => s.sampler = sampler::SOBOL,
                 ("specialize", "on") => s.specialize = true,
                 ("specialize", "off") => s.specialize = false,
+                ("packets", "on") => s.packets = true,
+                ("packets", "off") => s.packets = false,
                 ("adaptive", t) => {
                     let t: f32 = t.parse().with_context(|| format!("--variant {spec:?}: adaptive"))?;
                     if !(t >= 0.0 && t.is_finite()) {
@@ -68,7 +70,7 @@ impl Variant {
                         .parse()
                         .with_context(|| format!("--variant {spec:?}: rr_start_depth"))?
                 }
-                _ => bail!("--variant {spec:?}: unknown setting {kv:?} (keys: mis, light_sampling, light_selection, sampler, roulette, rr, rr_start_depth, specialize, adaptive)"),
+                _ => bail!("--variant {spec:?}: unknown setting {kv:?} (keys: mis, light_sampling, light_selection, sampler, roulette, rr, rr_start_depth, specialize, packets, adaptive)"),
             }
         }
         Ok(Variant {

@@ -113,6 +113,10 @@ enum Command {
         /// Run the generic kernel path instead of one specialized to the scene's features.
         #[arg(long)]
         no_specialize: bool,
+        /// CPU: trace one path at a time over the BVH even in scenes small enough for
+        /// sixteen-path packets (README "Packets of paths").
+        #[arg(long)]
+        no_packets: bool,
         /// Adaptive sampling: stop each pixel once its estimated relative error is below this
         /// (--spp is then the most a pixel gets). Unbiased: see README "Adaptive sampling".
         #[arg(long)]
@@ -138,7 +142,7 @@ enum Command {
         backend: BenchBackends,
         /// NAME or NAME:key=value,... (mis=power|half, light_sampling=cone|area,
         /// light_selection=power|uniform, sampler=independent|sobol, roulette=constant|throughput, rr=P,
-        /// rr_start_depth=D, specialize=on|off, adaptive=TARGET), on top of the scene's
+        /// rr_start_depth=D, specialize=on|off, packets=on|off, adaptive=TARGET), on top of the scene's
         /// settings; repeat to compare. Default: one variant, the scene's settings.
         #[arg(long = "variant")]
         variants: Vec<String>,
@@ -225,6 +229,7 @@ fn run() -> Result<()> {
             light_selection,
             sampler,
             no_specialize,
+            no_packets,
             target_error,
             spp_map,
             threads,
@@ -291,6 +296,9 @@ fn run() -> Result<()> {
             }
             if no_specialize {
                 r.specialize = false;
+            }
+            if no_packets {
+                r.packets = false;
             }
             if let Some(t) = target_error {
                 if !(t >= 0.0 && t.is_finite()) {
@@ -551,6 +559,12 @@ fn run() -> Result<()> {
                     "  {:<28} {:>9} rays ({:>9} hit): closest {:>7.3} Mrays/s, occluded {:>7.3} Mrays/s (one thread)",
                     s.name, s.rays, s.hits, s.closest_per_second * 1e-6, s.occluded_per_second * 1e-6
                 );
+                if let Some((closest, occluded)) = s.packets {
+                    println!(
+                        "  {:<28} {:>9} rays in packets of 16:  closest {:>7.3} Mrays/s, occluded {:>7.3} Mrays/s (one thread)",
+                        "", s.rays, closest * 1e-6, occluded * 1e-6
+                    );
+                }
             }
             if let Some(path) = csv {
                 use std::io::Write;
@@ -579,6 +593,21 @@ fn run() -> Result<()> {
                         s.closest_per_second * 1e-6,
                         s.occluded_per_second * 1e-6
                     )?;
+                    if let Some((closest, occluded)) = s.packets {
+                        writeln!(
+                            f,
+                            "twinpath_packets,{},{},{},0,0,{},{},{},{},{:.4},{:.4}",
+                            scene_stem(&scene.name),
+                            r.triangles,
+                            r.spheres,
+                            r.primitive_bytes,
+                            s.name,
+                            s.rays,
+                            s.hits,
+                            closest * 1e-6,
+                            occluded * 1e-6
+                        )?;
+                    }
                 }
             }
             Ok(())

@@ -4,7 +4,10 @@
 //! the build and the traversal: random soups with spheres, a dense generated mesh, an
 //! axis-aligned grid (flat boxes, rays in their planes), thousands of identical triangles (the
 //! median-split fallback), and 0 to 5 primitives (a root that is a leaf). Memory is checked to
-//! grow linearly with the triangle count.
+//! grow linearly with the triangle count. The packets of sixteen rays that small scenes use
+//! instead are held to the same brute force.
+
+#![feature(portable_simd)]
 
 use glam::Vec3;
 use kernel::rng::SampleRng;
@@ -350,4 +353,70 @@ fn parallel_build_gives_the_one_thread_tree() {
         }
     }
     assert_eq!(visited, serial.nodes.len(), "some nodes are unreachable");
+}
+
+/// Sixteen rays at a time against every primitive (`cpu::packet`, what the renderer uses for
+/// scenes of at most `MAX_PRIMITIVES`): each lane's t bit-identical to brute force, the
+/// primitive hit there (the first in id order of a tie), and any-hit in agreement; lanes with
+/// finite and infinite t_max, axis-aligned directions, and 0 to 32 primitives.
+#[test]
+fn packets_of_sixteen_rays_match_brute_force() {
+    use std::simd::Simd;
+    use twinpath::cpu::packet::{RayPacket, SmallScene, LANES, MAX_PRIMITIVES};
+    let mut hits = 0;
+    let mut rays = 0;
+    for n in 0..=MAX_PRIMITIVES {
+        let bvh = random_soup(200 + n as u32, n - n / 4, n / 4);
+        let small = SmallScene::new(&bvh.spheres, &bvh.triangles);
+        let mut rng = Uniform::new(300 + n as u32);
+        for packet in 0..64 {
+            let mut o = [[0f32; LANES]; 3];
+            let mut d = [[0f32; LANES]; 3];
+            let mut t_max = [f32::INFINITY; LANES];
+            let mut lanes = Vec::new();
+            for lane in 0..LANES {
+                let origin = rng.point(-12.0, 12.0);
+                // Half the rays aim at a primitive's centre (random soups are mostly empty).
+                let dir = if lane % 2 == 0 && n > 0 {
+                    let k = (rng.0.next_u32() as usize) % n;
+                    let target = if k < bvh.spheres.len() {
+                        Vec3::from(bvh.spheres[k].center)
+                    } else {
+                        let t = &bvh.triangles[k - bvh.spheres.len()];
+                        Vec3::from(t.p0) + (Vec3::from(t.edge1) + Vec3::from(t.edge2)) / 3.0
+                    };
+                    (target - origin).normalize()
+                } else {
+                    rng.dir()
+                };
+                if (packet + lane) % 3 == 0 {
+                    t_max[lane] = rng.f(0.0, 24.0);
+                }
+                for a in 0..3 {
+                    o[a][lane] = origin[a];
+                    d[a][lane] = dir[a];
+                }
+                lanes.push((origin, dir));
+            }
+            let p = RayPacket {
+                origin: o.map(Simd::from_array),
+                dir: d.map(Simd::from_array),
+            };
+            let (prims, ts) = small.closest(&p, Simd::from_array(t_max));
+            let occluded = small.occluded(&p, Simd::from_array(t_max)).to_array();
+            for (lane, &(origin, dir)) in lanes.iter().enumerate() {
+                let (want, want_t) = brute_force(&bvh, origin, dir, t_max[lane]);
+                let label = format!("{n} primitives, packet {packet}, lane {lane}: ray from {origin} along {dir}, t_max {}", t_max[lane]);
+                assert_eq!(ts[lane].to_bits(), want_t.to_bits(), "{label}: t");
+                assert_eq!(prims[lane], want, "{label}: primitive");
+                assert_eq!(occluded[lane], want != NONE, "{label}: any-hit");
+                hits += (want != NONE) as u32;
+                rays += 1;
+            }
+        }
+    }
+    assert!(
+        hits > rays / 4,
+        "only {hits} of {rays} rays hit; the test would be weak"
+    );
 }

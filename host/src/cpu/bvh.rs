@@ -495,8 +495,9 @@ impl Bvh {
         }
     }
 
-    /// The hit record, computed as the GPU's closest-hit shaders do.
-    fn surface(&self, id: u32, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
+    /// The hit record of primitive `id` at `t` along the ray, computed as the GPU's closest-hit
+    /// shaders do.
+    pub fn surface(&self, id: u32, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
         let id = id as usize;
         if id < self.spheres.len() {
             let s = &self.spheres[id];

@@ -4,6 +4,8 @@
 
 pub mod bvh;
 pub mod bvh_build;
+pub mod packet;
+pub mod packet_paths;
 pub mod rays;
 pub mod simd;
 
@@ -17,6 +19,7 @@ use kernel::features::{self, Dynamic, FeatureSet, Static};
 use kernel::path::render_sample;
 use kernel::scene::{Material, RenderParams, SphereLight};
 use kernel::{SurfaceHit, Tracer};
+use packet::SmallScene;
 use rayon::prelude::*;
 
 /// Side of the square image tiles that threads take one at a time.
@@ -45,6 +48,9 @@ pub struct CpuRenderer {
     pub lights: Vec<SphereLight>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path).
     pub features: u32,
+    /// For scenes of at most `packet::MAX_PRIMITIVES` primitives (unless the scene's
+    /// `packets` setting is off): all of them, for tracing sixteen paths' rays at once.
+    pub small: Option<SmallScene>,
 }
 
 /// `match bits { combo => body with f = Static::<combo>, ..., other => body with Dynamic(other) }`.
@@ -82,13 +88,20 @@ macro_rules! with_features {
 }
 
 impl CpuRenderer {
-    /// Builds the BVH over the scene's spheres and triangles.
+    /// Builds the BVH over the scene's spheres and triangles (and, for a small scene, the
+    /// packets' copy of them).
     pub fn new(scene: &Scene) -> Self {
+        let bvh = Bvh::build(scene.spheres.clone(), scene.triangles.clone());
+        // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).
+        let small = (scene.render.packets
+            && bvh.spheres.len() + bvh.triangles.len() <= packet::MAX_PRIMITIVES)
+            .then(|| SmallScene::new(&bvh.spheres, &bvh.triangles));
         Self {
-            bvh: Bvh::build(scene.spheres.clone(), scene.triangles.clone()),
+            bvh,
             materials: scene.materials.clone(),
             lights: scene.light_table(),
             features: scene.features(),
+            small,
         }
     }
 
@@ -154,6 +167,21 @@ impl CpuRenderer {
         let results: Vec<((u32, u32), Vec<PixelSums>)> = tiles
             .par_iter()
             .map(|&(tx, ty)| {
+                if let Some(small) = &self.small {
+                    let pixels = (ty * TILE..((ty + 1) * TILE).min(h)).flat_map(|py| {
+                        (tx * TILE..((tx + 1) * TILE).min(w)).map(move |px| (px, py))
+                    });
+                    let sums = self
+                        .tile_by_packets(features, small, params, pixels, first, count, film_ref);
+                    if let Some(p) = progress {
+                        p.inc(
+                            sums.iter()
+                                .map(|s| (s.count + s.pilot_count + s.discarded) as u64)
+                                .sum(),
+                        );
+                    }
+                    return ((tx, ty), sums);
+                }
                 let mut out = Vec::with_capacity((TILE * TILE) as usize);
                 let mut done = 0u64;
                 for py in ty * TILE..((ty + 1) * TILE).min(h) {

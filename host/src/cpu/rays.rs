@@ -5,6 +5,7 @@
 //! `scripts/embree_rays.c`) traces exactly the same rays.
 
 use super::bvh::Bvh;
+use super::packet::{RayPacket, SmallScene, LANES, MAX_PRIMITIVES};
 use crate::scene::Scene;
 use glam::Vec3;
 use kernel::camera::{camera_origin, camera_ray_direction};
@@ -13,6 +14,7 @@ use kernel::rng::SampleRng;
 use kernel::sampling::sample_cosine_hemisphere;
 use kernel::scene::NONE;
 use std::io::Write;
+use std::simd::Simd;
 use std::time::Instant;
 
 /// Rays to trace, each from `origins[i]` along `dirs[i]` for t in (0, t_max[i]).
@@ -109,6 +111,54 @@ pub fn occluded_all(bvh: &Bvh, rays: &RaySet) -> Vec<bool> {
     (0..rays.len())
         .map(|i| bvh.any_hit(rays.origins[i], rays.dirs[i], rays.t_max[i]))
         .collect()
+}
+
+/// The rays `first..first + 16` of `rays` as a packet with their t_max (the tail repeats the
+/// last ray).
+fn packet_of(rays: &RaySet, first: usize) -> (RayPacket, [f32; LANES]) {
+    let mut o = [[0f32; LANES]; 3];
+    let mut d = [[0f32; LANES]; 3];
+    let mut t = [0f32; LANES];
+    for lane in 0..LANES {
+        let i = (first + lane).min(rays.len() - 1);
+        for a in 0..3 {
+            o[a][lane] = rays.origins[i][a];
+            d[a][lane] = rays.dirs[i][a];
+        }
+        t[lane] = rays.t_max[i];
+    }
+    let packet = RayPacket {
+        origin: o.map(Simd::from_array),
+        dir: d.map(Simd::from_array),
+    };
+    (packet, t)
+}
+
+/// Closest hits of every ray of `rays` by [`SmallScene`] packets of 16, on this thread.
+pub fn trace_all_packets(scene: &SmallScene, rays: &RaySet) -> RayResults {
+    let mut out = RayResults {
+        prim: Vec::with_capacity(rays.len()),
+        t: Vec::with_capacity(rays.len()),
+    };
+    for first in (0..rays.len()).step_by(LANES) {
+        let (packet, t_max) = packet_of(rays, first);
+        let (prim, t) = scene.closest(&packet, Simd::from_array(t_max));
+        let n = LANES.min(rays.len() - first);
+        out.prim.extend_from_slice(&prim.to_array()[..n]);
+        out.t.extend_from_slice(&t.to_array()[..n]);
+    }
+    out
+}
+
+/// Whether each ray of `rays` is occluded, by [`SmallScene`] packets of 16, on this thread.
+pub fn occluded_all_packets(scene: &SmallScene, rays: &RaySet) -> Vec<bool> {
+    let mut out = Vec::with_capacity(rays.len());
+    for first in (0..rays.len()).step_by(LANES) {
+        let (packet, t_max) = packet_of(rays, first);
+        let hit = scene.occluded(&packet, Simd::from_array(t_max)).to_array();
+        out.extend_from_slice(&hit[..LANES.min(rays.len() - first)]);
+    }
+    out
 }
 
 /// Rays per second of `pass` over `rays`: the best of `repeats` timed passes (the least
@@ -250,6 +300,9 @@ pub struct RaySetReport {
     pub hits: usize,
     pub closest_per_second: f64,
     pub occluded_per_second: f64,
+    /// Closest-hit and any-hit rays per second by packets of 16 (`cpu::packet`), for scenes
+    /// small enough for them.
+    pub packets: Option<(f64, f64)>,
 }
 
 /// Builds the BVH over `scene` (timed), makes the camera rays of a `width` x `height` image and
@@ -277,12 +330,24 @@ pub fn measure(
         let occluded = rays_per_second(rays, repeats, || {
             std::hint::black_box(occluded_all(&bvh, rays));
         });
+        // Scenes small enough for the renderer's packets: the same rays sixteen at a time.
+        let packets = (bvh.spheres.len() + bvh.triangles.len() <= MAX_PRIMITIVES).then(|| {
+            let small = SmallScene::new(&bvh.spheres, &bvh.triangles);
+            let closest = rays_per_second(rays, repeats, || {
+                std::hint::black_box(trace_all_packets(&small, rays));
+            });
+            let occluded = rays_per_second(rays, repeats, || {
+                std::hint::black_box(occluded_all_packets(&small, rays));
+            });
+            (closest, occluded)
+        });
         sets.push(RaySetReport {
             name: rays.name,
             rays: rays.len(),
             hits: hits(&found),
             closest_per_second: closest,
             occluded_per_second: occluded,
+            packets,
         });
         results.push(found);
     }

@@ -98,64 +98,108 @@ impl Ray4 {
     /// lane): each lane's t where it hits within (t_min, t_max), else -1.
     #[inline(always)]
     pub fn triangles(&self, tri: &Triangles4, t_min: f32, t_max: f32) -> f32x4 {
-        let [dx, dy, dz] = self.dir;
-        let [e1x, e1y, e1z] = tri.edge1;
-        let [e2x, e2y, e2z] = tri.edge2;
-        // pvec = dir x edge2, in glam's order of operations.
-        let px = dy * e2z - e2y * dz;
-        let py = dz * e2x - e2z * dx;
-        let pz = dx * e2y - e2x * dy;
-        let det = e1x * px + e1y * py + e1z * pz;
-        let mut ok = det.simd_ne(f32x4::splat(0.0)) & det.is_finite();
-        let inv_det = f32x4::splat(1.0) / det;
-        let tx = self.origin[0] - tri.p0[0];
-        let ty = self.origin[1] - tri.p0[1];
-        let tz = self.origin[2] - tri.p0[2];
-        let u = (tx * px + ty * py + tz * pz) * inv_det;
-        ok &= u.simd_ge(f32x4::splat(0.0)) & u.simd_le(f32x4::splat(1.0));
-        // qvec = tvec x edge1.
-        let qx = ty * e1z - e1y * tz;
-        let qy = tz * e1x - e1z * tx;
-        let qz = tx * e1y - e1x * ty;
-        let v = (dx * qx + dy * qy + dz * qz) * inv_det;
-        ok &= v.simd_ge(f32x4::splat(0.0)) & (u + v).simd_le(f32x4::splat(1.0));
-        let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
-        ok &= t.simd_gt(f32x4::splat(t_min)) & t.simd_lt(f32x4::splat(t_max)) & t.is_finite();
-        ok.select(t, f32x4::splat(-1.0))
+        triangle_lanes(
+            &self.origin,
+            &self.dir,
+            &tri.p0,
+            &tri.edge1,
+            &tri.edge2,
+            f32x4::splat(t_min),
+            f32x4::splat(t_max),
+        )
+    }
+
+    /// The kernel's `intersect_sphere` against four spheres, lane by lane: each lane's nearest
+    /// root in (t_min, t_max), else -1. A lane with a NaN centre never hits (a block's padding).
+    #[inline(always)]
+    pub fn spheres(&self, s: &Spheres4, t_min: f32, t_max: f32) -> f32x4 {
+        sphere_lanes(
+            &self.origin,
+            &self.dir,
+            &s.center,
+            s.radius,
+            f32x4::splat(t_min),
+            f32x4::splat(t_max),
+        )
     }
 }
 
-impl Ray4 {
-    /// The kernel's `intersect_sphere`, lane by lane and operation for operation (Haines et
-    /// al.'s stable discriminant and quadratic): each lane's nearest root in (t_min, t_max),
-    /// else -1. A lane with a NaN centre never hits (the padding of a block).
-    #[inline(always)]
-    pub fn spheres(&self, s: &Spheres4, t_min: f32, t_max: f32) -> f32x4 {
-        let [dx, dy, dz] = self.dir;
-        let fx = self.origin[0] - s.center[0];
-        let fy = self.origin[1] - s.center[1];
-        let fz = self.origin[2] - s.center[2];
-        let a = dx * dx + dy * dy + dz * dz;
-        let b = fx * dx + fy * dy + fz * dz;
-        let k = b / a;
-        let (px, py, pz) = (fx - k * dx, fy - k * dy, fz - k * dz);
-        let r2 = s.radius * s.radius;
-        let disc = a * (r2 - (px * px + py * py + pz * pz));
-        let zero = f32x4::splat(0.0);
-        let ok = disc.simd_ge(zero) & a.simd_gt(zero);
-        let c = fx * fx + fy * fy + fz * fz - r2;
-        let sq = disc.sqrt();
-        let q = b.simd_ge(zero).select(-(b + sq), -(b - sq));
-        let t_a = q / a;
-        let t_b = q.simd_ne(zero).select(c / q, t_a);
-        let t_near = t_a.simd_min(t_b);
-        let t_far = t_a.simd_max(t_b);
-        let (lo, hi) = (f32x4::splat(t_min), f32x4::splat(t_max));
-        let near_ok = t_near.simd_gt(lo) & t_near.simd_lt(hi);
-        let far_ok = t_far.simd_gt(lo) & t_far.simd_lt(hi);
-        let t = near_ok.select(t_near, far_ok.select(t_far, f32x4::splat(-1.0)));
-        ok.select(t, f32x4::splat(-1.0))
-    }
+/// Moller-Trumbore, lane by lane and operation for operation the kernel's
+/// `intersect_triangle_uv`: each lane's t where its ray hits its triangle within
+/// (t_min, t_max), else -1. Either side may be broadcast: one ray against N triangles
+/// ([`Ray4::triangles`]) or N rays against one triangle (`cpu::packet`).
+#[inline(always)]
+pub fn triangle_lanes<const N: usize>(
+    origin: &[Simd<f32, N>; 3],
+    dir: &[Simd<f32, N>; 3],
+    p0: &[Simd<f32, N>; 3],
+    edge1: &[Simd<f32, N>; 3],
+    edge2: &[Simd<f32, N>; 3],
+    t_min: Simd<f32, N>,
+    t_max: Simd<f32, N>,
+) -> Simd<f32, N> {
+    let [dx, dy, dz] = *dir;
+    let [e1x, e1y, e1z] = *edge1;
+    let [e2x, e2y, e2z] = *edge2;
+    let zero = Simd::splat(0.0);
+    let one = Simd::splat(1.0);
+    // pvec = dir x edge2, in glam's order of operations.
+    let px = dy * e2z - e2y * dz;
+    let py = dz * e2x - e2z * dx;
+    let pz = dx * e2y - e2x * dy;
+    let det = e1x * px + e1y * py + e1z * pz;
+    let mut ok = det.simd_ne(zero) & det.is_finite();
+    let inv_det = one / det;
+    let tx = origin[0] - p0[0];
+    let ty = origin[1] - p0[1];
+    let tz = origin[2] - p0[2];
+    let u = (tx * px + ty * py + tz * pz) * inv_det;
+    ok &= u.simd_ge(zero) & u.simd_le(one);
+    // qvec = tvec x edge1.
+    let qx = ty * e1z - e1y * tz;
+    let qy = tz * e1x - e1z * tx;
+    let qz = tx * e1y - e1x * ty;
+    let v = (dx * qx + dy * qy + dz * qz) * inv_det;
+    ok &= v.simd_ge(zero) & (u + v).simd_le(one);
+    let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+    ok &= t.simd_gt(t_min) & t.simd_lt(t_max) & t.is_finite();
+    ok.select(t, Simd::splat(-1.0))
+}
+
+/// The kernel's `intersect_sphere`, lane by lane and operation for operation (Haines et al.'s
+/// stable discriminant and quadratic): each lane's nearest root in (t_min, t_max), else -1.
+#[inline(always)]
+pub fn sphere_lanes<const N: usize>(
+    origin: &[Simd<f32, N>; 3],
+    dir: &[Simd<f32, N>; 3],
+    center: &[Simd<f32, N>; 3],
+    radius: Simd<f32, N>,
+    t_min: Simd<f32, N>,
+    t_max: Simd<f32, N>,
+) -> Simd<f32, N> {
+    let [dx, dy, dz] = *dir;
+    let fx = origin[0] - center[0];
+    let fy = origin[1] - center[1];
+    let fz = origin[2] - center[2];
+    let a = dx * dx + dy * dy + dz * dz;
+    let b = fx * dx + fy * dy + fz * dz;
+    let k = b / a;
+    let (px, py, pz) = (fx - k * dx, fy - k * dy, fz - k * dz);
+    let r2 = radius * radius;
+    let disc = a * (r2 - (px * px + py * py + pz * pz));
+    let zero = Simd::splat(0.0);
+    let ok = disc.simd_ge(zero) & a.simd_gt(zero);
+    let c = fx * fx + fy * fy + fz * fz - r2;
+    let sq = disc.sqrt();
+    let q = b.simd_ge(zero).select(-(b + sq), -(b - sq));
+    let t_a = q / a;
+    let t_b = q.simd_ne(zero).select(c / q, t_a);
+    let t_near = t_a.simd_min(t_b);
+    let t_far = t_a.simd_max(t_b);
+    let near_ok = t_near.simd_gt(t_min) & t_near.simd_lt(t_max);
+    let far_ok = t_far.simd_gt(t_min) & t_far.simd_lt(t_max);
+    let t = near_ok.select(t_near, far_ok.select(t_far, Simd::splat(-1.0)));
+    ok.select(t, Simd::splat(-1.0))
 }
 
 /// Lane-wise a < b ? a : b: the second operand wherever either is NaN (x86 minps).

@@ -69,6 +69,9 @@ pub struct RenderSettings {
     pub sampler: u32,
     /// Compile the kernel for what the scene needs (`kernel::features`); false: generic path.
     pub specialize: bool,
+    /// CPU: trace scenes of at most `cpu::packet::MAX_PRIMITIVES` primitives sixteen paths at
+    /// a time, SIMD over rays (`cpu::packet_paths`); false: one path at a time over the BVH.
+    pub packets: bool,
     /// Adaptive sampling's target relative error of a pixel (0: off; `kernel::adaptive`).
     pub adaptive_target: f32,
 }
@@ -94,6 +97,7 @@ impl Default for RenderSettings {
             light_selection: light_selection::POWER,
             sampler: sampler::SOBOL,
             specialize: true,
+            packets: true,
             adaptive_target: 0.0,
         }
     }

@@ -1,0 +1,157 @@
+//! Sixteen rays at once against every primitive of a small scene: SIMD over rays instead of
+//! over boxes. Each primitive is broadcast to the sixteen lanes and tested with the same
+//! lane-wise functions as the BVH's leaves (`simd::triangle_lanes`, `simd::sphere_lanes`), so
+//! each lane's t is bit-identical to the kernel's scalar intersection of that ray.
+
+use super::simd::{sphere_lanes, triangle_lanes};
+use kernel::scene::{Sphere, Triangle, NONE};
+use std::simd::cmp::SimdPartialOrd;
+use std::simd::{Mask, Select, Simd};
+
+/// Rays per packet: one AVX-512 register of f32 (two AVX2 ones).
+pub const LANES: usize = 16;
+
+type Lanes = Simd<f32, LANES>;
+type Ids = Simd<u32, LANES>;
+
+/// Sixteen rays, component by component.
+#[derive(Clone, Copy, Debug)]
+pub struct RayPacket {
+    pub origin: [Lanes; 3],
+    pub dir: [Lanes; 3],
+}
+
+/// Scenes with at most this many primitives are traced by packets without a hierarchy.
+pub const MAX_PRIMITIVES: usize = 32;
+
+/// Every primitive of a small scene, stored as the packet tests read them. Primitive ids are
+/// the BVH's: spheres first, then triangles.
+#[derive(Clone, Debug)]
+pub struct SmallScene {
+    spheres: Vec<[f32; 4]>,
+    triangles: Vec<[[f32; 3]; 3]>,
+}
+
+fn splat3(v: [f32; 3]) -> [Lanes; 3] {
+    [Lanes::splat(v[0]), Lanes::splat(v[1]), Lanes::splat(v[2])]
+}
+
+impl SmallScene {
+    pub fn new(spheres: &[Sphere], triangles: &[Triangle]) -> SmallScene {
+        SmallScene {
+            spheres: spheres
+                .iter()
+                .map(|s| [s.center[0], s.center[1], s.center[2], s.radius])
+                .collect(),
+            triangles: triangles.iter().map(|t| [t.p0, t.edge1, t.edge2]).collect(),
+        }
+    }
+
+    /// Each lane's closest primitive and its t in (0, t_max) (`NONE` and t_max for a miss).
+    /// Of primitives at exactly the same t the first in id order wins.
+    pub fn closest(&self, rays: &RayPacket, t_max: Lanes) -> (Ids, Lanes) {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F (checked just above).
+            return unsafe { self.closest_avx512(rays, t_max) };
+        }
+        self.closest_any_cpu(rays, t_max)
+    }
+
+    /// [`SmallScene::closest`] with the sixteen lanes in one register: the same operations,
+    /// so the same results (no FMA).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn closest_avx512(&self, rays: &RayPacket, t_max: Lanes) -> (Ids, Lanes) {
+        self.closest_any_cpu(rays, t_max)
+    }
+
+    #[inline(always)]
+    fn closest_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> (Ids, Lanes) {
+        let zero = Lanes::splat(0.0);
+        let mut best_t = t_max;
+        let mut best = Ids::splat(NONE);
+        let mut keep = |t: Lanes, id: u32, best_t: &mut Lanes| {
+            let closer = t.simd_ge(zero) & t.simd_lt(*best_t);
+            *best_t = closer.select(t, *best_t);
+            best = closer.select(Ids::splat(id), best);
+        };
+        for (i, s) in self.spheres.iter().enumerate() {
+            let center = splat3([s[0], s[1], s[2]]);
+            let t = sphere_lanes(
+                &rays.origin,
+                &rays.dir,
+                &center,
+                Lanes::splat(s[3]),
+                zero,
+                best_t,
+            );
+            keep(t, i as u32, &mut best_t);
+        }
+        let first = self.spheres.len() as u32;
+        for (i, tri) in self.triangles.iter().enumerate() {
+            let t = triangle_lanes(
+                &rays.origin,
+                &rays.dir,
+                &splat3(tri[0]),
+                &splat3(tri[1]),
+                &splat3(tri[2]),
+                zero,
+                best_t,
+            );
+            keep(t, first + i as u32, &mut best_t);
+        }
+        (best, best_t)
+    }
+
+    /// Whether each lane's ray meets anything within (0, t_max).
+    pub fn occluded(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F (checked just above).
+            return unsafe { self.occluded_avx512(rays, t_max) };
+        }
+        self.occluded_any_cpu(rays, t_max)
+    }
+
+    /// [`SmallScene::occluded`] with the sixteen lanes in one register.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn occluded_avx512(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES> {
+        self.occluded_any_cpu(rays, t_max)
+    }
+
+    #[inline(always)]
+    fn occluded_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES> {
+        let zero = Lanes::splat(0.0);
+        let mut hit = Mask::splat(false);
+        for s in &self.spheres {
+            let center = splat3([s[0], s[1], s[2]]);
+            let t = sphere_lanes(
+                &rays.origin,
+                &rays.dir,
+                &center,
+                Lanes::splat(s[3]),
+                zero,
+                t_max,
+            );
+            hit |= t.simd_ge(zero);
+        }
+        for tri in &self.triangles {
+            if hit.all() {
+                return hit;
+            }
+            let t = triangle_lanes(
+                &rays.origin,
+                &rays.dir,
+                &splat3(tri[0]),
+                &splat3(tri[1]),
+                &splat3(tri[2]),
+                zero,
+                t_max,
+            );
+            hit |= t.simd_ge(zero);
+        }
+        hit
+    }
+}

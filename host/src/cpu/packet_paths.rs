@@ -1,0 +1,151 @@
+//! Sixteen paths at a time: the kernel's path state machine (`kernel::path::PathState`) with
+//! each round's rays traced as packets by [`SmallScene`] (SIMD over rays). Every path runs
+//! the same kernel code as `render_sample`, and the packet tests return the same t as the
+//! BVH, so a pixel's samples are the ones the one-path loop computes (up to which of two
+//! primitives at exactly the same distance is reported, e.g. along a quad's diagonal).
+
+use super::packet::{RayPacket, SmallScene, LANES};
+use super::{CpuRenderer, PixelSums};
+use crate::film::Film;
+use glam::Vec3;
+use kernel::adaptive::is_pilot_sample;
+use kernel::features::FeatureSet;
+use kernel::path::{start_sample, PathState};
+use kernel::scene::{RenderParams, NONE};
+use kernel::SurfaceHit;
+use std::simd::Simd;
+
+/// The rays the paths in `slots` wait for, as two packets with their t_max: the extension rays
+/// (t_max infinite) and the shadow segments (from + t (to - from), t_max 1, as the BVH tracer
+/// tests them). Lanes without such a ray get t_max 0, which nothing is hit within.
+fn gather(slots: &[Option<(usize, PathState)>; LANES]) -> [(RayPacket, [f32; LANES]); 2] {
+    let mut rays = [[[0f32; LANES]; 6]; 2];
+    let mut t_max = [[0f32; LANES]; 2];
+    for (lane, slot) in slots.iter().enumerate() {
+        let Some((_, path)) = slot else { continue };
+        if path.extend {
+            for a in 0..3 {
+                rays[0][a][lane] = path.ray_origin[a];
+                rays[0][3 + a][lane] = path.ray_dir[a];
+            }
+            t_max[0][lane] = f32::INFINITY;
+        }
+        if path.shadow {
+            let to = path.shadow_to - path.shadow_from;
+            for a in 0..3 {
+                rays[1][a][lane] = path.shadow_from[a];
+                rays[1][3 + a][lane] = to[a];
+            }
+            t_max[1][lane] = 1.0;
+        }
+    }
+    [0, 1].map(|k| {
+        let r = &rays[k];
+        let packet = RayPacket {
+            origin: [r[0], r[1], r[2]].map(Simd::from_array),
+            dir: [r[3], r[4], r[5]].map(Simd::from_array),
+        };
+        (packet, t_max[k])
+    })
+}
+
+impl CpuRenderer {
+    /// Samples `first..first + count` of each of `pixels` (skipping those `film` says have
+    /// converged, under adaptive sampling), sixteen paths at a time; returns each pixel's sums,
+    /// added in sample order as the one-path loop adds them.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn tile_by_packets<F: FeatureSet>(
+        &self,
+        features: F,
+        small: &SmallScene,
+        params: &RenderParams,
+        pixels: impl Iterator<Item = (u32, u32)>,
+        first: u32,
+        count: u32,
+        film: &Film,
+    ) -> Vec<PixelSums> {
+        let adaptive = params.pilot_period > 0;
+        let pixels: Vec<(u32, u32, bool)> = pixels
+            .map(|(px, py)| (px, py, !(adaptive && film.converged(params, px, py))))
+            .collect();
+        let work: Vec<(u32, u32)> = pixels
+            .iter()
+            .filter(|p| p.2)
+            .map(|&(px, py, _)| (px, py))
+            .collect();
+        let n = work.len() * count as usize;
+        let start = |k: usize| {
+            let (px, py) = work[k / count as usize];
+            start_sample(params, px, py, first + (k % count as usize) as u32)
+        };
+        let mut radiance = vec![Vec3::ZERO; n];
+        let mut slots: [Option<(usize, PathState)>; LANES] = [None; LANES];
+        let mut next = 0;
+        loop {
+            let mut active = false;
+            for slot in slots.iter_mut() {
+                if slot.is_none() && next < n {
+                    *slot = Some((next, start(next)));
+                    next += 1;
+                }
+                active |= slot.is_some();
+            }
+            if !active {
+                break;
+            }
+            let [(extension, ext_t_max), (shadow, shadow_t_max)] = gather(&slots);
+            let (prims, ts) = if ext_t_max.iter().any(|&t| t > 0.0) {
+                let (p, t) = small.closest(&extension, Simd::from_array(ext_t_max));
+                (p.to_array(), t.to_array())
+            } else {
+                ([NONE; LANES], [0.0; LANES])
+            };
+            let occluded = if shadow_t_max.iter().any(|&t| t > 0.0) {
+                small
+                    .occluded(&shadow, Simd::from_array(shadow_t_max))
+                    .to_array()
+            } else {
+                [false; LANES]
+            };
+            for (lane, slot) in slots.iter_mut().enumerate() {
+                let Some((k, path)) = slot else { continue };
+                let hit = if path.extend && prims[lane] != NONE {
+                    self.bvh
+                        .surface(prims[lane], path.ray_origin, path.ray_dir, ts[lane])
+                } else {
+                    SurfaceHit::miss()
+                };
+                path.advance(
+                    features,
+                    params,
+                    &self.materials,
+                    &self.lights,
+                    hit,
+                    occluded[lane],
+                );
+                if path.finished() {
+                    radiance[*k] = path.radiance;
+                    *slot = None;
+                }
+            }
+        }
+        let mut samples = radiance.chunks(count.max(1) as usize);
+        pixels
+            .iter()
+            .map(|&(_, _, sampled)| {
+                let mut acc = PixelSums::default();
+                if sampled {
+                    let values = samples.next().unwrap_or(&[]);
+                    for (s, &l) in (first..).zip(values) {
+                        if adaptive && is_pilot_sample(params, s) {
+                            acc.add_pilot(l);
+                        } else {
+                            acc.add(l);
+                        }
+                    }
+                }
+                acc
+            })
+            .collect()
+    }
+}
