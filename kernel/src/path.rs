@@ -344,18 +344,22 @@ impl PathState {
             return;
         }
         // 4: Russian roulette on the extension.
+        // Survival at q = 1 is certain, so no number is drawn for it (the stream is counter-
+        // based: the other dimensions keep their values).
         if self.depth >= params.rr_start_depth {
-            rng.seek(dimensions + 3);
-            let u_rr = rng.next_f32();
             let q = if features.rr_throughput(params) {
                 self.throughput.max_element().min(1.0)
             } else {
                 params.rr_probability
             };
-            if !(u_rr < q) {
-                return;
+            if !(q >= 1.0) {
+                rng.seek(dimensions + 3);
+                let u_rr = rng.next_f32();
+                if !(u_rr < q) {
+                    return;
+                }
+                self.throughput /= q;
             }
-            self.throughput /= q;
         }
 
         // 3: extension by BRDF sampling.
