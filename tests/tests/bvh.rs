@@ -357,7 +357,8 @@ fn parallel_build_gives_the_one_thread_tree() {
 
 /// Sixteen rays at a time against every primitive (`cpu::packet`, what the renderer uses for
 /// scenes of at most `MAX_PRIMITIVES`): each lane's t bit-identical to brute force, the
-/// primitive hit there (the first in id order of a tie), and any-hit in agreement; lanes with
+/// primitive hit there (the first in id order of a tie), a triangle's barycentrics bit-identical
+/// to the kernel's, and any-hit in agreement; lanes with
 /// finite and infinite t_max, axis-aligned directions, and 0 to 32 primitives.
 #[test]
 fn packets_of_sixteen_rays_match_brute_force() {
@@ -402,7 +403,9 @@ fn packets_of_sixteen_rays_match_brute_force() {
                 origin: o.map(Simd::from_array),
                 dir: d.map(Simd::from_array),
             };
-            let (prims, ts) = small.closest(&p, Simd::from_array(t_max));
+            let found = small.closest(&p, Simd::from_array(t_max));
+            let (prims, ts) = (found.prim.to_array(), found.t.to_array());
+            let (us, vs) = (found.u.to_array(), found.v.to_array());
             let occluded = small.occluded(&p, Simd::from_array(t_max)).to_array();
             for (lane, &(origin, dir)) in lanes.iter().enumerate() {
                 let (want, want_t) = brute_force(&bvh, origin, dir, t_max[lane]);
@@ -410,6 +413,23 @@ fn packets_of_sixteen_rays_match_brute_force() {
                 assert_eq!(ts[lane].to_bits(), want_t.to_bits(), "{label}: t");
                 assert_eq!(prims[lane], want, "{label}: primitive");
                 assert_eq!(occluded[lane], want != NONE, "{label}: any-hit");
+                if want != NONE && want as usize >= bvh.spheres.len() {
+                    let tri = &bvh.triangles[want as usize - bvh.spheres.len()];
+                    let h = kernel::geometry::intersect_triangle_uv(
+                        origin,
+                        dir,
+                        Vec3::from(tri.p0),
+                        Vec3::from(tri.edge1),
+                        Vec3::from(tri.edge2),
+                        0.0,
+                        f32::INFINITY,
+                    );
+                    assert_eq!(
+                        (us[lane].to_bits(), vs[lane].to_bits()),
+                        (h.u.to_bits(), h.v.to_bits()),
+                        "{label}: barycentrics"
+                    );
+                }
                 hits += (want != NONE) as u32;
                 rays += 1;
             }

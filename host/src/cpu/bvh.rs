@@ -498,6 +498,35 @@ impl Bvh {
     /// The hit record of primitive `id` at `t` along the ray, computed as the GPU's closest-hit
     /// shaders do.
     pub fn surface(&self, id: u32, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
+        let uv = match self
+            .triangles
+            .get((id as usize).wrapping_sub(self.spheres.len()))
+        {
+            Some(tri) => {
+                // The winning triangle again, for its barycentrics (once per ray).
+                let (p0, e1, e2) = (
+                    Vec3::from(tri.p0),
+                    Vec3::from(tri.edge1),
+                    Vec3::from(tri.edge2),
+                );
+                let h = intersect_triangle_uv(origin, dir, p0, e1, e2, 0.0, f32::INFINITY);
+                (h.u, h.v)
+            }
+            None => (0.0, 0.0),
+        };
+        self.surface_with_uv(id, origin, dir, t, uv)
+    }
+
+    /// [`Bvh::surface`] with the barycentrics `uv` of a triangle's hit already known (as the
+    /// kernel's `intersect_triangle_uv` computes them; ignored for spheres).
+    pub fn surface_with_uv(
+        &self,
+        id: u32,
+        origin: Vec3,
+        dir: Vec3,
+        t: f32,
+        (u, v): (f32, f32),
+    ) -> SurfaceHit {
         let id = id as usize;
         if id < self.spheres.len() {
             let s = &self.spheres[id];
@@ -518,15 +547,13 @@ impl Bvh {
                 Vec3::from(tri.edge1),
                 Vec3::from(tri.edge2),
             );
-            // The winning triangle again, for its barycentrics (once per ray).
-            let h = intersect_triangle_uv(origin, dir, p0, e1, e2, 0.0, f32::INFINITY);
             SurfaceHit {
-                position: triangle_point(p0, e1, e2, h.u, h.v),
+                position: triangle_point(p0, e1, e2, u, v),
                 t,
                 normal: triangle_normal(e1, e2),
                 material: tri.material,
                 light: NONE,
-                error: triangle_point_error(p0, e1, e2, h.u, h.v),
+                error: triangle_point_error(p0, e1, e2, u, v),
             }
         }
     }

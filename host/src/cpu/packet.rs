@@ -3,7 +3,7 @@
 //! lane-wise functions as the BVH's leaves (`simd::triangle_lanes`, `simd::sphere_lanes`), so
 //! each lane's t is bit-identical to the kernel's scalar intersection of that ray.
 
-use super::simd::{sphere_lanes, triangle_lanes};
+use super::simd::{sphere_lanes, triangle_lanes, triangle_lanes_uv};
 use kernel::scene::{Sphere, Triangle, NONE};
 use std::simd::cmp::SimdPartialOrd;
 use std::simd::{Mask, Select, Simd};
@@ -19,6 +19,17 @@ type Ids = Simd<u32, LANES>;
 pub struct RayPacket {
     pub origin: [Lanes; 3],
     pub dir: [Lanes; 3],
+}
+
+/// What [`SmallScene::closest`] found, lane by lane: the primitive (`NONE` for a miss), its t,
+/// and for a triangle the barycentrics u, v of the hit (as the kernel's `intersect_triangle_uv`
+/// computes them; 0 for spheres and misses).
+#[derive(Clone, Copy, Debug)]
+pub struct PacketHits {
+    pub prim: Ids,
+    pub t: Lanes,
+    pub u: Lanes,
+    pub v: Lanes,
 }
 
 /// Scenes with at most this many primitives are traced by packets without a hierarchy.
@@ -47,9 +58,9 @@ impl SmallScene {
         }
     }
 
-    /// Each lane's closest primitive and its t in (0, t_max) (`NONE` and t_max for a miss).
-    /// Of primitives at exactly the same t the first in id order wins.
-    pub fn closest(&self, rays: &RayPacket, t_max: Lanes) -> (Ids, Lanes) {
+    /// Each lane's closest hit in (0, t_max) (`NONE` and t_max for a miss). Of primitives at
+    /// exactly the same t the first in id order wins.
+    pub fn closest(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx512f") {
             // SAFETY: the CPU has AVX-512F (checked just above).
@@ -62,19 +73,18 @@ impl SmallScene {
     /// so the same results (no FMA).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
-    unsafe fn closest_avx512(&self, rays: &RayPacket, t_max: Lanes) -> (Ids, Lanes) {
+    unsafe fn closest_avx512(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
         self.closest_any_cpu(rays, t_max)
     }
 
     #[inline(always)]
-    fn closest_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> (Ids, Lanes) {
+    fn closest_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
         let zero = Lanes::splat(0.0);
-        let mut best_t = t_max;
-        let mut best = Ids::splat(NONE);
-        let mut keep = |t: Lanes, id: u32, best_t: &mut Lanes| {
-            let closer = t.simd_ge(zero) & t.simd_lt(*best_t);
-            *best_t = closer.select(t, *best_t);
-            best = closer.select(Ids::splat(id), best);
+        let mut hits = PacketHits {
+            prim: Ids::splat(NONE),
+            t: t_max,
+            u: zero,
+            v: zero,
         };
         for (i, s) in self.spheres.iter().enumerate() {
             let center = splat3([s[0], s[1], s[2]]);
@@ -84,24 +94,30 @@ impl SmallScene {
                 &center,
                 Lanes::splat(s[3]),
                 zero,
-                best_t,
+                hits.t,
             );
-            keep(t, i as u32, &mut best_t);
+            let closer = t.simd_ge(zero) & t.simd_lt(hits.t);
+            hits.t = closer.select(t, hits.t);
+            hits.prim = closer.select(Ids::splat(i as u32), hits.prim);
         }
         let first = self.spheres.len() as u32;
         for (i, tri) in self.triangles.iter().enumerate() {
-            let t = triangle_lanes(
+            let (t, u, v) = triangle_lanes_uv(
                 &rays.origin,
                 &rays.dir,
                 &splat3(tri[0]),
                 &splat3(tri[1]),
                 &splat3(tri[2]),
                 zero,
-                best_t,
+                hits.t,
             );
-            keep(t, first + i as u32, &mut best_t);
+            let closer = t.simd_ge(zero) & t.simd_lt(hits.t);
+            hits.t = closer.select(t, hits.t);
+            hits.u = closer.select(u, hits.u);
+            hits.v = closer.select(v, hits.v);
+            hits.prim = closer.select(Ids::splat(first + i as u32), hits.prim);
         }
-        (best, best_t)
+        hits
     }
 
     /// Whether each lane's ray meets anything within (0, t_max).

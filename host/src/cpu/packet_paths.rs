@@ -94,11 +94,12 @@ impl CpuRenderer {
                 break;
             }
             let [(extension, ext_t_max), (shadow, shadow_t_max)] = gather(&slots);
-            let (prims, ts) = if ext_t_max.iter().any(|&t| t > 0.0) {
-                let (p, t) = small.closest(&extension, Simd::from_array(ext_t_max));
-                (p.to_array(), t.to_array())
+            let (prims, ts, us, vs) = if ext_t_max.iter().any(|&t| t > 0.0) {
+                let h = small.closest(&extension, Simd::from_array(ext_t_max));
+                let a = |x: Simd<f32, LANES>| x.to_array();
+                (h.prim.to_array(), a(h.t), a(h.u), a(h.v))
             } else {
-                ([NONE; LANES], [0.0; LANES])
+                ([NONE; LANES], [0.0; LANES], [0.0; LANES], [0.0; LANES])
             };
             let occluded = if shadow_t_max.iter().any(|&t| t > 0.0) {
                 small
@@ -110,8 +111,9 @@ impl CpuRenderer {
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((k, path)) = slot else { continue };
                 let hit = if path.extend && prims[lane] != NONE {
-                    self.bvh
-                        .surface(prims[lane], path.ray_origin, path.ray_dir, ts[lane])
+                    let (o, d) = (path.ray_origin, path.ray_dir);
+                    let uv = (us[lane], vs[lane]);
+                    self.bvh.surface_with_uv(prims[lane], o, d, ts[lane], uv)
                 } else {
                     SurfaceHit::miss()
                 };

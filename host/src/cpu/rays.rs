@@ -142,10 +142,10 @@ pub fn trace_all_packets(scene: &SmallScene, rays: &RaySet) -> RayResults {
     };
     for first in (0..rays.len()).step_by(LANES) {
         let (packet, t_max) = packet_of(rays, first);
-        let (prim, t) = scene.closest(&packet, Simd::from_array(t_max));
+        let hits = scene.closest(&packet, Simd::from_array(t_max));
         let n = LANES.min(rays.len() - first);
-        out.prim.extend_from_slice(&prim.to_array()[..n]);
-        out.t.extend_from_slice(&t.to_array()[..n]);
+        out.prim.extend_from_slice(&hits.prim.to_array()[..n]);
+        out.t.extend_from_slice(&hits.t.to_array()[..n]);
     }
     out
 }

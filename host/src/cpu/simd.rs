@@ -124,10 +124,7 @@ impl Ray4 {
     }
 }
 
-/// Moller-Trumbore, lane by lane and operation for operation the kernel's
-/// `intersect_triangle_uv`: each lane's t where its ray hits its triangle within
-/// (t_min, t_max), else -1. Either side may be broadcast: one ray against N triangles
-/// ([`Ray4::triangles`]) or N rays against one triangle (`cpu::packet`).
+/// [`triangle_lanes_uv`]'s t only.
 #[inline(always)]
 pub fn triangle_lanes<const N: usize>(
     origin: &[Simd<f32, N>; 3],
@@ -138,6 +135,24 @@ pub fn triangle_lanes<const N: usize>(
     t_min: Simd<f32, N>,
     t_max: Simd<f32, N>,
 ) -> Simd<f32, N> {
+    triangle_lanes_uv(origin, dir, p0, edge1, edge2, t_min, t_max).0
+}
+
+/// Moller-Trumbore, lane by lane and operation for operation the kernel's
+/// `intersect_triangle_uv`: each lane's t where its ray hits its triangle within
+/// (t_min, t_max), else -1, and the barycentrics u, v (meaningful where t >= 0). Either side
+/// may be broadcast: one ray against N triangles ([`Ray4::triangles`]) or N rays against one
+/// triangle (`cpu::packet`).
+#[inline(always)]
+pub fn triangle_lanes_uv<const N: usize>(
+    origin: &[Simd<f32, N>; 3],
+    dir: &[Simd<f32, N>; 3],
+    p0: &[Simd<f32, N>; 3],
+    edge1: &[Simd<f32, N>; 3],
+    edge2: &[Simd<f32, N>; 3],
+    t_min: Simd<f32, N>,
+    t_max: Simd<f32, N>,
+) -> (Simd<f32, N>, Simd<f32, N>, Simd<f32, N>) {
     let [dx, dy, dz] = *dir;
     let [e1x, e1y, e1z] = *edge1;
     let [e2x, e2y, e2z] = *edge2;
@@ -163,7 +178,7 @@ pub fn triangle_lanes<const N: usize>(
     ok &= v.simd_ge(zero) & (u + v).simd_le(one);
     let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
     ok &= t.simd_gt(t_min) & t.simd_lt(t_max) & t.is_finite();
-    ok.select(t, Simd::splat(-1.0))
+    (ok.select(t, Simd::splat(-1.0)), u, v)
 }
 
 /// The kernel's `intersect_sphere`, lane by lane and operation for operation (Haines et al.'s
