@@ -8,7 +8,7 @@ use kernel::scene::{Sphere, Triangle, NONE};
 use std::simd::cmp::SimdPartialOrd;
 use std::simd::{Mask, Select, Simd};
 
-/// Rays per packet: one AVX-512 register of f32 (two AVX2 ones).
+/// Rays per packet: one AVX-512 register of f32 (two AVX2 ones, four SSE ones).
 pub const LANES: usize = 16;
 
 type Lanes = Simd<f32, LANES>;
@@ -66,6 +66,18 @@ impl SmallScene {
             // SAFETY: the CPU has AVX-512F (checked just above).
             return unsafe { self.closest_avx512(rays, t_max) };
         }
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            return unsafe { self.closest_avx2(rays, t_max) };
+        }
+        self.closest_any_cpu(rays, t_max)
+    }
+
+    /// [`SmallScene::closest`] in two 8-lane registers (CPUs without AVX-512).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn closest_avx2(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
         self.closest_any_cpu(rays, t_max)
     }
 
@@ -127,6 +139,18 @@ impl SmallScene {
             // SAFETY: the CPU has AVX-512F (checked just above).
             return unsafe { self.occluded_avx512(rays, t_max) };
         }
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            return unsafe { self.occluded_avx2(rays, t_max) };
+        }
+        self.occluded_any_cpu(rays, t_max)
+    }
+
+    /// [`SmallScene::occluded`] in two 8-lane registers (CPUs without AVX-512).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn occluded_avx2(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES> {
         self.occluded_any_cpu(rays, t_max)
     }
 
