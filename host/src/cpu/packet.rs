@@ -3,7 +3,7 @@
 //! lane-wise functions as the BVH's leaves (`simd::triangle_lanes`, `simd::sphere_lanes`), so
 //! each lane's t is bit-identical to the kernel's scalar intersection of that ray.
 
-use super::simd::{sphere_lanes, triangle_lanes, triangle_lanes_uv};
+use super::simd::{sphere_lanes, triangle_lanes_uv};
 use kernel::scene::{Sphere, Triangle, NONE};
 use std::simd::cmp::SimdPartialOrd;
 use std::simd::{Mask, Select, Simd};
@@ -19,6 +19,39 @@ type Ids = Simd<u32, LANES>;
 pub struct RayPacket {
     pub origin: [Lanes; 3],
     pub dir: [Lanes; 3],
+}
+
+impl RayPacket {
+    /// Each lane's nearest root on the sphere (centre, radius) `s` in (0, t_max), else -1.
+    #[inline(always)]
+    fn sphere(&self, s: &[f32; 4], t_max: Lanes) -> Lanes {
+        let center = splat3([s[0], s[1], s[2]]);
+        let radius = Lanes::splat(s[3]);
+        sphere_lanes(
+            &self.origin,
+            &self.dir,
+            &center,
+            radius,
+            Lanes::splat(0.0),
+            t_max,
+        )
+    }
+
+    /// Each lane's t on the triangle (p0, edge1, edge2) `tri` in (0, t_max), else -1, and the
+    /// barycentrics u, v.
+    #[inline(always)]
+    fn triangle(&self, tri: &[[f32; 3]; 3], t_max: Lanes) -> (Lanes, Lanes, Lanes) {
+        let [p0, e1, e2] = tri.map(splat3);
+        triangle_lanes_uv(
+            &self.origin,
+            &self.dir,
+            &p0,
+            &e1,
+            &e2,
+            Lanes::splat(0.0),
+            t_max,
+        )
+    }
 }
 
 /// What [`SmallScene::closest`] found, lane by lane: the primitive (`NONE` for a miss), its t,
@@ -99,30 +132,14 @@ impl SmallScene {
             v: zero,
         };
         for (i, s) in self.spheres.iter().enumerate() {
-            let center = splat3([s[0], s[1], s[2]]);
-            let t = sphere_lanes(
-                &rays.origin,
-                &rays.dir,
-                &center,
-                Lanes::splat(s[3]),
-                zero,
-                hits.t,
-            );
+            let t = rays.sphere(s, hits.t);
             let closer = t.simd_ge(zero) & t.simd_lt(hits.t);
             hits.t = closer.select(t, hits.t);
             hits.prim = closer.select(Ids::splat(i as u32), hits.prim);
         }
         let first = self.spheres.len() as u32;
         for (i, tri) in self.triangles.iter().enumerate() {
-            let (t, u, v) = triangle_lanes_uv(
-                &rays.origin,
-                &rays.dir,
-                &splat3(tri[0]),
-                &splat3(tri[1]),
-                &splat3(tri[2]),
-                zero,
-                hits.t,
-            );
+            let (t, u, v) = rays.triangle(tri, hits.t);
             let closer = t.simd_ge(zero) & t.simd_lt(hits.t);
             hits.t = closer.select(t, hits.t);
             hits.u = closer.select(u, hits.u);
@@ -166,30 +183,13 @@ impl SmallScene {
         let zero = Lanes::splat(0.0);
         let mut hit = Mask::splat(false);
         for s in &self.spheres {
-            let center = splat3([s[0], s[1], s[2]]);
-            let t = sphere_lanes(
-                &rays.origin,
-                &rays.dir,
-                &center,
-                Lanes::splat(s[3]),
-                zero,
-                t_max,
-            );
-            hit |= t.simd_ge(zero);
+            hit |= rays.sphere(s, t_max).simd_ge(zero);
         }
         for tri in &self.triangles {
             if hit.all() {
                 return hit;
             }
-            let t = triangle_lanes(
-                &rays.origin,
-                &rays.dir,
-                &splat3(tri[0]),
-                &splat3(tri[1]),
-                &splat3(tri[2]),
-                zero,
-                t_max,
-            );
+            let (t, _, _) = rays.triangle(tri, t_max);
             hit |= t.simd_ge(zero);
         }
         hit
