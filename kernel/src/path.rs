@@ -117,8 +117,8 @@ pub const PDF_EPSILON: f32 = 1e-6;
 /// [`crate::features::Static`] set compiles the others away, a dynamic one asks `params`.
 ///
 /// The loop is written as a state machine ([`PathState`]) that stops at each ray cast, so a
-/// backend can trace many paths' rays together (the CPU's packets); this function is its
-/// one-path driver, the GPU's.
+/// backend can trace many paths' rays together (the CPU's packets); this function runs one
+/// path to its end ([`PathState::run`], the GPU's way).
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn trace_path<T: Tracer, F: FeatureSet>(
@@ -131,20 +131,9 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
     dir: Vec3,
     rng: &mut SampleRng,
 ) -> Vec3 {
-    let mut path = PathState::new(origin, dir, *rng);
-    loop {
-        let hit = if path.extend {
-            tracer.closest_hit(path.ray_origin, path.ray_dir)
-        } else {
-            SurfaceHit::miss()
-        };
-        let occluded = path.shadow && tracer.occluded(path.shadow_from, path.shadow_to);
-        path.advance(features, params, materials, lights, hit, occluded);
-        if path.finished() {
-            *rng = path.rng;
-            return path.radiance;
-        }
-    }
+    let path = PathState::new(origin, dir, *rng).run(tracer, features, params, materials, lights);
+    *rng = path.rng;
+    path.radiance
 }
 
 /// A path of [`trace_path`] between two rounds of ray casts: what it has gathered, and the rays
@@ -207,6 +196,31 @@ impl PathState {
     #[inline]
     pub fn finished(&self) -> bool {
         !self.extend && !self.shadow
+    }
+
+    /// Runs the path to its end, one ray cast at a time through `tracer`; the result is in
+    /// `radiance` of the returned (finished) state.
+    #[inline]
+    pub fn run<T: Tracer, F: FeatureSet>(
+        mut self,
+        tracer: &mut T,
+        features: F,
+        params: &RenderParams,
+        materials: &[Material],
+        lights: &[SphereLight],
+    ) -> Self {
+        loop {
+            let hit = if self.extend {
+                tracer.closest_hit(self.ray_origin, self.ray_dir)
+            } else {
+                SurfaceHit::miss()
+            };
+            let occluded = self.shadow && tracer.occluded(self.shadow_from, self.shadow_to);
+            self.advance(features, params, materials, lights, hit, occluded);
+            if self.finished() {
+                return self;
+            }
+        }
     }
 
     /// Takes the answers to this round's rays: `hit`, the closest hit of the extension ray
@@ -427,18 +441,9 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
     py: u32,
     sample: u32,
 ) -> Vec3 {
-    let path = start_sample(params, px, py, sample);
-    let mut rng = path.rng;
-    trace_path(
-        tracer,
-        features,
-        params,
-        materials,
-        lights,
-        path.ray_origin,
-        path.ray_dir,
-        &mut rng,
-    )
+    start_sample(params, px, py, sample)
+        .run(tracer, features, params, materials, lights)
+        .radiance
 }
 
 /// The path of sample `sample` of pixel (px, py) with its camera ray waiting (see
