@@ -371,11 +371,10 @@ fn packets_of_sixteen_rays_match_brute_force() {
         let small = SmallScene::new(&bvh.spheres, &bvh.triangles);
         let mut rng = Uniform::new(300 + n as u32);
         for packet in 0..64 {
-            let mut o = [[0f32; LANES]; 3];
-            let mut d = [[0f32; LANES]; 3];
+            let mut p = RayPacket::zero();
             let mut t_max = [f32::INFINITY; LANES];
             let mut lanes = Vec::new();
-            for lane in 0..LANES {
+            for (lane, lane_t_max) in t_max.iter_mut().enumerate() {
                 let origin = rng.point(-12.0, 12.0);
                 // Half the rays aim at a primitive's centre (random soups are mostly empty).
                 let dir = if lane % 2 == 0 && n > 0 {
@@ -391,18 +390,11 @@ fn packets_of_sixteen_rays_match_brute_force() {
                     rng.dir()
                 };
                 if (packet + lane) % 3 == 0 {
-                    t_max[lane] = rng.f(0.0, 24.0);
+                    *lane_t_max = rng.f(0.0, 24.0);
                 }
-                for a in 0..3 {
-                    o[a][lane] = origin[a];
-                    d[a][lane] = dir[a];
-                }
+                p.set(lane, origin, dir);
                 lanes.push((origin, dir));
             }
-            let p = RayPacket {
-                origin: o.map(Simd::from_array),
-                dir: d.map(Simd::from_array),
-            };
             let found = small.closest(&p, Simd::from_array(t_max));
             let (prims, ts) = (found.prim.to_array(), found.t.to_array());
             let (us, vs) = (found.u.to_array(), found.v.to_array());

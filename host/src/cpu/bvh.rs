@@ -498,21 +498,18 @@ impl Bvh {
     /// The hit record of primitive `id` at `t` along the ray, computed as the GPU's closest-hit
     /// shaders do.
     pub fn surface(&self, id: u32, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
-        let uv = match self
-            .triangles
-            .get((id as usize).wrapping_sub(self.spheres.len()))
-        {
-            Some(tri) => {
-                // The winning triangle again, for its barycentrics (once per ray).
-                let (p0, e1, e2) = (
-                    Vec3::from(tri.p0),
-                    Vec3::from(tri.edge1),
-                    Vec3::from(tri.edge2),
-                );
-                let h = intersect_triangle_uv(origin, dir, p0, e1, e2, 0.0, f32::INFINITY);
-                (h.u, h.v)
-            }
-            None => (0.0, 0.0),
+        let uv = if (id as usize) < self.spheres.len() {
+            (0.0, 0.0)
+        } else {
+            // The winning triangle again, for its barycentrics (once per ray).
+            let tri = &self.triangles[id as usize - self.spheres.len()];
+            let (p0, e1, e2) = (
+                Vec3::from(tri.p0),
+                Vec3::from(tri.edge1),
+                Vec3::from(tri.edge2),
+            );
+            let h = intersect_triangle_uv(origin, dir, p0, e1, e2, 0.0, f32::INFINITY);
+            (h.u, h.v)
         };
         self.surface_with_uv(id, origin, dir, t, uv)
     }

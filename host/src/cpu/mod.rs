@@ -93,9 +93,11 @@ impl CpuRenderer {
     pub fn new(scene: &Scene) -> Self {
         let bvh = Bvh::build(scene.spheres.clone(), scene.triangles.clone());
         // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).
-        let small = (scene.render.packets
-            && bvh.spheres.len() + bvh.triangles.len() <= packet::MAX_PRIMITIVES)
-            .then(|| SmallScene::new(&bvh.spheres, &bvh.triangles));
+        let small = scene
+            .render
+            .packets
+            .then(|| SmallScene::if_small(&bvh.spheres, &bvh.triangles))
+            .flatten();
         Self {
             bvh,
             materials: scene.materials.clone(),

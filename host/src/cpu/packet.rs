@@ -4,6 +4,7 @@
 //! each lane's t is bit-identical to the kernel's scalar intersection of that ray.
 
 use super::simd::{sphere_lanes, triangle_lanes_uv};
+use glam::Vec3;
 use kernel::scene::{Sphere, Triangle, NONE};
 use std::simd::cmp::SimdPartialOrd;
 use std::simd::{Mask, Select, Simd};
@@ -22,6 +23,23 @@ pub struct RayPacket {
 }
 
 impl RayPacket {
+    /// Sixteen zero rays (direction 0: nothing is hit), to be filled with [`RayPacket::set`].
+    pub fn zero() -> Self {
+        Self {
+            origin: [Lanes::splat(0.0); 3],
+            dir: [Lanes::splat(0.0); 3],
+        }
+    }
+
+    /// Makes lane `lane` the ray `origin + t dir`.
+    #[inline(always)]
+    pub fn set(&mut self, lane: usize, origin: Vec3, dir: Vec3) {
+        for a in 0..3 {
+            self.origin[a][lane] = origin[a];
+            self.dir[a][lane] = dir[a];
+        }
+    }
+
     /// Each lane's nearest root on the sphere (centre, radius) `s` in (0, t_max), else -1.
     #[inline(always)]
     fn sphere(&self, s: &[f32; 4], t_max: Lanes) -> Lanes {
@@ -81,6 +99,13 @@ fn splat3(v: [f32; 3]) -> [Lanes; 3] {
 }
 
 impl SmallScene {
+    /// The packets' copy of a scene of at most [`MAX_PRIMITIVES`] primitives; `None` for a
+    /// larger one (which keeps the BVH).
+    pub fn if_small(spheres: &[Sphere], triangles: &[Triangle]) -> Option<SmallScene> {
+        (spheres.len() + triangles.len() <= MAX_PRIMITIVES)
+            .then(|| SmallScene::new(spheres, triangles))
+    }
+
     pub fn new(spheres: &[Sphere], triangles: &[Triangle]) -> SmallScene {
         SmallScene {
             spheres: spheres

@@ -19,34 +19,21 @@ use std::simd::Simd;
 /// (t_max infinite) and the shadow segments (from + t (to - from), t_max 1, as the BVH tracer
 /// tests them). Lanes without such a ray get t_max 0, which nothing is hit within.
 fn gather(slots: &[Option<(usize, PathState)>; LANES]) -> [(RayPacket, [f32; LANES]); 2] {
-    let mut rays = [[[0f32; LANES]; 6]; 2];
+    let [mut extension, mut shadow] = [RayPacket::zero(); 2];
     let mut t_max = [[0f32; LANES]; 2];
     for (lane, slot) in slots.iter().enumerate() {
         let Some((_, path)) = slot else { continue };
         if path.extend {
-            for a in 0..3 {
-                rays[0][a][lane] = path.ray_origin[a];
-                rays[0][3 + a][lane] = path.ray_dir[a];
-            }
+            extension.set(lane, path.ray_origin, path.ray_dir);
             t_max[0][lane] = f32::INFINITY;
         }
         if path.shadow {
-            let to = path.shadow_to - path.shadow_from;
-            for a in 0..3 {
-                rays[1][a][lane] = path.shadow_from[a];
-                rays[1][3 + a][lane] = to[a];
-            }
+            let from = path.shadow_from;
+            shadow.set(lane, from, path.shadow_to - from);
             t_max[1][lane] = 1.0;
         }
     }
-    [0, 1].map(|k| {
-        let r = &rays[k];
-        let packet = RayPacket {
-            origin: [r[0], r[1], r[2]].map(Simd::from_array),
-            dir: [r[3], r[4], r[5]].map(Simd::from_array),
-        };
-        (packet, t_max[k])
-    })
+    [(extension, t_max[0]), (shadow, t_max[1])]
 }
 
 impl CpuRenderer {

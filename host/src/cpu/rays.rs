@@ -5,7 +5,7 @@
 //! `scripts/embree_rays.c`) traces exactly the same rays.
 
 use super::bvh::Bvh;
-use super::packet::{RayPacket, SmallScene, LANES, MAX_PRIMITIVES};
+use super::packet::{RayPacket, SmallScene, LANES};
 use crate::scene::Scene;
 use glam::Vec3;
 use kernel::camera::{camera_origin, camera_ray_direction};
@@ -116,21 +116,13 @@ pub fn occluded_all(bvh: &Bvh, rays: &RaySet) -> Vec<bool> {
 /// The rays `first..first + 16` of `rays` as a packet with their t_max (the tail repeats the
 /// last ray).
 fn packet_of(rays: &RaySet, first: usize) -> (RayPacket, [f32; LANES]) {
-    let mut o = [[0f32; LANES]; 3];
-    let mut d = [[0f32; LANES]; 3];
+    let mut packet = RayPacket::zero();
     let mut t = [0f32; LANES];
-    for lane in 0..LANES {
+    for (lane, t_max) in t.iter_mut().enumerate() {
         let i = (first + lane).min(rays.len() - 1);
-        for a in 0..3 {
-            o[a][lane] = rays.origins[i][a];
-            d[a][lane] = rays.dirs[i][a];
-        }
-        t[lane] = rays.t_max[i];
+        packet.set(lane, rays.origins[i], rays.dirs[i]);
+        *t_max = rays.t_max[i];
     }
-    let packet = RayPacket {
-        origin: o.map(Simd::from_array),
-        dir: d.map(Simd::from_array),
-    };
     (packet, t)
 }
 
@@ -331,8 +323,7 @@ pub fn measure(
             std::hint::black_box(occluded_all(&bvh, rays));
         });
         // Scenes small enough for the renderer's packets: the same rays sixteen at a time.
-        let packets = (bvh.spheres.len() + bvh.triangles.len() <= MAX_PRIMITIVES).then(|| {
-            let small = SmallScene::new(&bvh.spheres, &bvh.triangles);
+        let packets = SmallScene::if_small(&bvh.spheres, &bvh.triangles).map(|small| {
             let closest = rays_per_second(rays, repeats, || {
                 std::hint::black_box(trace_all_packets(&small, rays));
             });
