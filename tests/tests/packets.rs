@@ -6,10 +6,9 @@
 //! difference of a pixel or two.)
 
 use twinpath::cpu::CpuRenderer;
-use twinpath::film::Film;
 use twinpath::render::Backend;
 use twinpath::scene::Scene;
-use twinpath_tests::{render_film, repo_root};
+use twinpath_tests::{assert_films_identical, render_film, repo_root};
 
 fn small(name: &str) -> Scene {
     let mut s = Scene::load(&repo_root().join("scenes").join(name)).unwrap();
@@ -45,19 +44,6 @@ fn scenes() -> Vec<(&'static str, Scene)> {
     ]
 }
 
-fn assert_identical(a: &Film, b: &Film, label: &str) {
-    assert_eq!(a.count, b.count, "{label}: sample counts differ");
-    assert_eq!(a.pilot_count, b.pilot_count, "{label}: pilot counts differ");
-    let same = a.sum.iter().zip(&b.sum).filter(|(x, y)| x == y).count();
-    assert_eq!(
-        same,
-        a.sum.len(),
-        "{label}: {} of {} pixel sums differ",
-        a.sum.len() - same,
-        a.sum.len()
-    );
-}
-
 #[test]
 fn packets_of_paths_give_the_one_path_images() {
     for (name, scene) in scenes() {
@@ -75,7 +61,7 @@ fn packets_of_paths_give_the_one_path_images() {
         };
         let a = render_film(&scene, Backend::Cpu, spp);
         let b = render_film(&one_path, Backend::Cpu, spp);
-        assert_identical(&a, &b, name);
+        assert_films_identical(&a, &b, name);
         println!("{name}: packets and one path identical at {spp} spp");
     }
 }

@@ -4,13 +4,12 @@
 
 use glam::Vec3;
 use kernel::features;
-use twinpath::film::Film;
 use twinpath::render::Backend;
 use twinpath::scene::Scene;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches_with_variance, plane_exact, plane_under_lamps, render_film, repo_root,
-    variance_of_mean_from, z_critical, Lamp,
+    assert_film_matches_with_variance, assert_films_identical, plane_exact, plane_under_lamps,
+    render_film, repo_root, variance_of_mean_from, z_critical, Lamp,
 };
 
 fn small(mut s: Scene) -> Scene {
@@ -49,17 +48,6 @@ fn scenes() -> Vec<(&'static str, Scene)> {
     ]
 }
 
-fn assert_identical(a: &Film, b: &Film, label: &str) {
-    assert_eq!(a.count, b.count, "{label}: sample counts differ");
-    let same = a.sum.iter().zip(&b.sum).filter(|(x, y)| x == y).count();
-    assert_eq!(
-        same,
-        a.sum.len(),
-        "{label}: {} pixels differ",
-        a.sum.len() - same
-    );
-}
-
 #[test]
 fn scene_analysis_finds_the_features_present() {
     let f = cornell().features();
@@ -87,7 +75,7 @@ fn assert_specialized_matches_generic(backend: Backend, spp: u32) {
         generic.render.specialize = false;
         let a = render_film(&scene, backend, spp);
         let b = render_film(&generic, backend, spp);
-        assert_identical(&a, &b, name);
+        assert_films_identical(&a, &b, name);
         println!(
             "{backend:?} {name}: features {:#x}: identical to the generic path",
             scene.features()
