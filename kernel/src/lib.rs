@@ -4,6 +4,8 @@
 //! holds the entry points) and to native code for the CPU backend and the tests. The kernel
 //! reaches the scene only through [`path::Tracer`], so it knows neither backend.
 #![cfg_attr(target_arch = "spirv", no_std)]
+// Natively, the sampler's hashes also run on SIMD lanes (`word`, the CPU's packets of paths).
+#![cfg_attr(not(target_arch = "spirv"), feature(portable_simd))]
 
 pub mod adaptive;
 pub mod brdf;
@@ -21,6 +23,7 @@ pub mod scene;
 pub mod shaders;
 pub mod sobol;
 pub mod turns;
+pub mod word;
 
 pub use path::{trace_path, SurfaceHit, Tracer};
 pub use spirv_std::glam;

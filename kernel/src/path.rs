@@ -7,7 +7,7 @@ use crate::camera::{camera_origin, camera_ray_direction};
 use crate::features::FeatureSet;
 use crate::geometry::{offset_ray_origin, shadow_ray_end, sphere_point_error};
 use crate::light::{eval_radiance, pdf_light_from, sample_light_from};
-use crate::rng::SampleRng;
+use crate::rng::{SampleRng, SampleStream};
 use crate::sampling::power_heuristic;
 use crate::scene::{light_sampling, Material, RenderParams, SphereLight, NONE};
 use spirv_std::glam::Vec3;
@@ -62,6 +62,12 @@ pub trait Tracer {
 /// (Pairs start at offsets 1 and 4 of the block; the Sobol sampler scrambles each from its own
 /// starting dimension, so pairs need no alignment.)
 pub const DIMENSIONS_PER_VERTEX: u32 = 6;
+/// Offsets in a vertex's block of dimensions: the light choice (one number), the point on the
+/// light (a pair), the roulette decision (one), the BRDF direction (a pair).
+pub const LIGHT_CHOICE_DIMENSION: u32 = 0;
+pub const LIGHT_POINT_DIMENSION: u32 = 1;
+pub const ROULETTE_DIMENSION: u32 = 3;
+pub const BRDF_DIMENSION: u32 = 4;
 /// Random dimensions used by the camera before the first vertex (position inside the pixel).
 pub const CAMERA_DIMENSIONS: u32 = 2;
 /// Seed's epsilon: an extension whose pdf is below it ends the path (see [`trace_path`]).
@@ -145,7 +151,7 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
 /// hit is looked at, so the radiance sums its terms in the same order as a loop that casts the
 /// shadow ray first.
 #[derive(Clone, Copy, Debug)]
-pub struct PathState {
+pub struct PathState<R = SampleRng> {
     /// The estimate so far; the result once [`PathState::finished`].
     pub radiance: Vec3,
     /// The product of the BRDF weights (and roulette divisions) up to the current vertex.
@@ -167,14 +173,16 @@ pub struct PathState {
     pub previous_pdf: f32,
     /// Vertices so far: 0 while the camera ray is out.
     pub depth: u32,
-    pub rng: SampleRng,
+    /// The sample's random numbers ([`SampleRng`], or the CPU packets' numbers computed for
+    /// sixteen paths at once).
+    pub rng: R,
 }
 
-impl PathState {
+impl<R: SampleStream> PathState<R> {
     /// A path whose camera ray `origin + t dir` is to be traced; `rng` is past the camera's
     /// dimensions.
     #[inline]
-    pub fn new(origin: Vec3, dir: Vec3, rng: SampleRng) -> Self {
+    pub fn new(origin: Vec3, dir: Vec3, rng: R) -> Self {
         Self {
             radiance: Vec3::ZERO,
             throughput: Vec3::ONE,
@@ -313,12 +321,12 @@ impl PathState {
                 params.light_count
             };
             let u_select = if light_count > 1 {
-                rng.seek(dimensions);
+                rng.seek(dimensions + LIGHT_CHOICE_DIMENSION);
                 rng.next_f32()
             } else {
                 0.0
             };
-            rng.seek(dimensions + 1);
+            rng.seek(dimensions + LIGHT_POINT_DIMENSION);
             let (u_light1, u_light2) = rng.next_2d();
             let ls = sample_light_from(
                 lights,
@@ -367,7 +375,7 @@ impl PathState {
                 params.rr_probability
             };
             if !(q >= 1.0) {
-                rng.seek(dimensions + 3);
+                rng.seek(dimensions + ROULETTE_DIMENSION);
                 let u_rr = rng.next_f32();
                 if !(u_rr < q) {
                     return;
@@ -377,7 +385,7 @@ impl PathState {
         }
 
         // 3: extension by BRDF sampling.
-        rng.seek(dimensions + 4);
+        rng.seek(dimensions + BRDF_DIMENSION);
         let (u_brdf1, u_brdf2) = rng.next_2d();
         let wi = sample_brdf(n, u_brdf1, u_brdf2);
         let pdf_b = pdf_brdf(n, wi);
@@ -450,8 +458,27 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
 /// [`render_sample`]).
 #[inline]
 pub fn start_sample(params: &RenderParams, px: u32, py: u32, sample: u32) -> PathState {
+    start_path(params, px, py, sample_rng(params, px, py, sample))
+}
+
+/// The random numbers of sample `sample` of pixel (px, py) (its sampler and sequence index
+/// from [`sample_stream`]).
+#[inline]
+pub fn sample_rng(params: &RenderParams, px: u32, py: u32, sample: u32) -> SampleRng {
     let (sampler, index) = sample_stream(params, sample);
-    let mut rng = SampleRng::with_sampler(params.seed, py * params.width + px, index, sampler);
+    SampleRng::with_sampler(params.seed, py * params.width + px, index, sampler)
+}
+
+/// The path of pixel (px, py) that draws its numbers from `rng` (at dimension 0), with its
+/// camera ray waiting: a uniformly random position inside the pixel (the first pair of
+/// dimensions) and the camera ray through it.
+#[inline]
+pub fn start_path<R: SampleStream>(
+    params: &RenderParams,
+    px: u32,
+    py: u32,
+    mut rng: R,
+) -> PathState<R> {
     let (u, v) = rng.next_2d();
     let dir = camera_ray_direction(&params.camera, params.width, params.height, px, py, u, v);
     PathState::new(camera_origin(&params.camera), dir, rng)

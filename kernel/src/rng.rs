@@ -8,22 +8,25 @@
 
 use crate::scene::sampler;
 use crate::sobol::{sobol_pair, sobol_single};
+use crate::word::Word;
 
-/// Jarzynski and Olano's pcg4d: bijective mixing of four 32-bit words.
+/// Jarzynski and Olano's pcg4d: bijective mixing of four 32-bit words (each [`Word`] lane
+/// alone).
 #[inline]
-pub fn pcg4d(mut v: [u32; 4]) -> [u32; 4] {
-    v[0] = v[0].wrapping_mul(1664525).wrapping_add(1013904223);
-    v[1] = v[1].wrapping_mul(1664525).wrapping_add(1013904223);
-    v[2] = v[2].wrapping_mul(1664525).wrapping_add(1013904223);
-    v[3] = v[3].wrapping_mul(1664525).wrapping_add(1013904223);
+pub fn pcg4d<W: Word>(mut v: [W; 4]) -> [W; 4] {
+    let (a, c) = (W::splat(1664525), W::splat(1013904223));
+    v[0] = v[0].wrapping_mul(a).wrapping_add(c);
+    v[1] = v[1].wrapping_mul(a).wrapping_add(c);
+    v[2] = v[2].wrapping_mul(a).wrapping_add(c);
+    v[3] = v[3].wrapping_mul(a).wrapping_add(c);
     v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[3]));
     v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
     v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
     v[3] = v[3].wrapping_add(v[1].wrapping_mul(v[2]));
-    v[0] ^= v[0] >> 16;
-    v[1] ^= v[1] >> 16;
-    v[2] ^= v[2] >> 16;
-    v[3] ^= v[3] >> 16;
+    v[0] = v[0] ^ (v[0] >> 16);
+    v[1] = v[1] ^ (v[1] >> 16);
+    v[2] = v[2] ^ (v[2] >> 16);
+    v[3] = v[3] ^ (v[3] >> 16);
     v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[3]));
     v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
     v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
@@ -112,5 +115,36 @@ impl SampleRng {
     #[inline]
     pub fn seek(&mut self, dimension: u32) {
         self.dimension = dimension;
+    }
+}
+
+/// Where a path reads its random numbers: a stream of dimensions with [`SampleRng`]'s
+/// interface. [`SampleRng`] computes each number when asked; the CPU's packets of paths also
+/// hand over numbers they computed for sixteen paths at once, which must be exactly the ones
+/// [`SampleRng`] would compute.
+pub trait SampleStream {
+    /// Jumps to dimension `dimension`.
+    fn seek(&mut self, dimension: u32);
+    /// The number of the current dimension (see [`SampleRng::next_f32`]), then advances one.
+    fn next_f32(&mut self) -> f32;
+    /// The pair starting at the current dimension (see [`SampleRng::next_2d`]), then advances
+    /// two.
+    fn next_2d(&mut self) -> (f32, f32);
+}
+
+impl SampleStream for SampleRng {
+    #[inline]
+    fn seek(&mut self, dimension: u32) {
+        SampleRng::seek(self, dimension)
+    }
+
+    #[inline]
+    fn next_f32(&mut self) -> f32 {
+        SampleRng::next_f32(self)
+    }
+
+    #[inline]
+    fn next_2d(&mut self) -> (f32, f32) {
+        SampleRng::next_2d(self)
     }
 }

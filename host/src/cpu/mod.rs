@@ -5,6 +5,7 @@
 pub mod bvh;
 pub mod bvh_build;
 pub mod packet;
+pub mod packet_numbers;
 pub mod packet_paths;
 pub mod rays;
 pub mod simd;

@@ -5,12 +5,13 @@
 //! primitives at exactly the same distance is reported, e.g. along a quad's diagonal).
 
 use super::packet::{RayPacket, SmallScene, LANES};
+use super::packet_numbers::{camera_streams, prefetch_vertices, PrefetchedStream};
 use super::{CpuRenderer, PixelSums};
 use crate::film::Film;
 use glam::Vec3;
 use kernel::adaptive::is_pilot_sample;
 use kernel::features::FeatureSet;
-use kernel::path::{start_sample, PathState};
+use kernel::path::{sample_rng, start_path, PathState};
 use kernel::scene::{RenderParams, NONE};
 use kernel::SurfaceHit;
 use std::simd::Simd;
@@ -18,7 +19,7 @@ use std::simd::Simd;
 /// The rays the paths in `slots` wait for, as two packets with their t_max: the extension rays
 /// (t_max infinite) and the shadow segments (from + t (to - from), t_max 1, as the BVH tracer
 /// tests them). Lanes without such a ray get t_max 0, which nothing is hit within.
-fn gather(slots: &[Option<(usize, PathState)>; LANES]) -> [(RayPacket, [f32; LANES]); 2] {
+fn gather(slots: &[Option<(usize, Path)>; LANES]) -> [(RayPacket, [f32; LANES]); 2] {
     let [mut extension, mut shadow] = [RayPacket::zero(); 2];
     let mut t_max = [[0f32; LANES]; 2];
     for (lane, slot) in slots.iter().enumerate() {
@@ -35,6 +36,9 @@ fn gather(slots: &[Option<(usize, PathState)>; LANES]) -> [(RayPacket, [f32; LAN
     }
     [(extension, t_max[0]), (shadow, t_max[1])]
 }
+
+/// A path of the packets, with its numbers computed sixteen paths at a time.
+type Path = PathState<PrefetchedStream>;
 
 impl CpuRenderer {
     /// Samples `first..first + count` of each of `pixels` (skipping those `film` says have
@@ -61,23 +65,35 @@ impl CpuRenderer {
             .map(|&(px, py, _)| (px, py))
             .collect();
         let n = work.len() * count as usize;
-        let start = |k: usize| {
-            let (px, py) = work[k / count as usize];
-            start_sample(params, px, py, first + (k % count as usize) as u32)
-        };
+        let pixel_of = |k: usize| work[k / count as usize];
         let mut radiance = vec![Vec3::ZERO; n];
-        let mut slots: [Option<(usize, PathState)>; LANES] = [None; LANES];
+        let mut slots: [Option<(usize, Path)>; LANES] = [None; LANES];
         let mut next = 0;
+        let choose_light = params.light_count > 1;
+        // The streams of samples next..next + 16, with their camera numbers computed together.
+        let mut batch = [None; LANES];
         loop {
-            let mut active = false;
-            for slot in slots.iter_mut() {
-                if slot.is_none() && next < n {
-                    *slot = Some((next, start(next)));
-                    next += 1;
+            for slot in slots.iter_mut().filter(|s| s.is_none()) {
+                if next == n {
+                    break;
                 }
-                active |= slot.is_some();
+                if next % LANES == 0 {
+                    batch = camera_streams(&std::array::from_fn(|i| {
+                        let k = next + i;
+                        (k < n).then(|| {
+                            let (px, py) = pixel_of(k);
+                            sample_rng(params, px, py, first + (k % count as usize) as u32)
+                        })
+                    }));
+                }
+                let stream = batch[next % LANES]
+                    .take()
+                    .expect("the batch holds sample next");
+                let (px, py) = pixel_of(next);
+                *slot = Some((next, start_path(params, px, py, stream)));
+                next += 1;
             }
-            if !active {
+            if slots.iter().all(Option::is_none) {
                 break;
             }
             let [(extension, ext_t_max), (shadow, shadow_t_max)] = gather(&slots);
@@ -95,6 +111,7 @@ impl CpuRenderer {
             } else {
                 [false; LANES]
             };
+            prefetch_vertices(&mut slots, choose_light);
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((k, path)) = slot else { continue };
                 let hit = if path.extend && prims[lane] != NONE {
