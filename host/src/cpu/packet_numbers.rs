@@ -15,6 +15,8 @@ use kernel::sobol::{sobol_pair, sobol_single};
 use std::simd::{Mask, Select, Simd};
 
 type Words = Simd<u32, LANES>;
+/// Computed numbers by lane: two pairs (x, y) and two single numbers.
+type Numbers = ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]);
 
 /// No dimension: an empty entry.
 const EMPTY: u32 = u32::MAX;
@@ -129,7 +131,7 @@ impl Requests {
     }
 
     /// The requested numbers of every lane, computed together: pairs[p] = (x, y), singles[p].
-    fn compute(&self) -> ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]) {
+    fn compute(&self) -> Numbers {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx512f") {
             // SAFETY: the CPU has AVX-512F (checked just above).
@@ -146,19 +148,19 @@ impl Requests {
     /// [`Requests::compute`] with AVX2's lane-wise 32-bit multiply (baseline x86-64 has none).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn compute_avx2(&self) -> ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]) {
+    unsafe fn compute_avx2(&self) -> Numbers {
         self.compute_any_cpu()
     }
 
     /// [`Requests::compute`] with the sixteen lanes in one register.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
-    unsafe fn compute_avx512(&self) -> ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]) {
+    unsafe fn compute_avx512(&self) -> Numbers {
         self.compute_any_cpu()
     }
 
     #[inline(always)]
-    fn compute_any_cpu(&self) -> ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]) {
+    fn compute_any_cpu(&self) -> Numbers {
         let (seed, pixel, sample) = (
             Words::from_array(self.seed),
             Words::from_array(self.pixel),
@@ -207,7 +209,7 @@ impl Requests {
 /// Lane `lane`'s entries of computed numbers.
 fn entries(
     requests: &Requests,
-    (pairs, singles): &([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]),
+    (pairs, singles): &Numbers,
     lane: usize,
 ) -> ([Entry; 2], [Entry; 2]) {
     let pair = |p: usize| Entry {
