@@ -34,6 +34,13 @@ pub fn pcg4d<W: Word>(mut v: [W; 4]) -> [W; 4] {
     v
 }
 
+/// The independent sampler's 32 random bits of dimension `dimension` of sample `sample` of
+/// `pixel` under `seed`: the first word of [`pcg4d`] of the four.
+#[inline]
+pub fn independent_bits<W: Word>(seed: W, pixel: W, sample: W, dimension: W) -> W {
+    pcg4d([pixel, sample, dimension, seed])[0]
+}
+
 /// Maps 32 random bits to a float uniform in [0, 1): the top 24 bits times 2^-24, so every value
 /// is exactly representable and 1.0 is never returned.
 #[inline]
@@ -72,12 +79,13 @@ impl SampleRng {
         }
     }
 
-    /// 32 random bits for (seed, pixel, sample, dimension), then advances the dimension.
+    /// 32 random bits for (seed, pixel, sample, dimension) ([`independent_bits`]), then
+    /// advances the dimension.
     #[inline]
     pub fn next_u32(&mut self) -> u32 {
-        let h = pcg4d([self.pixel, self.sample, self.dimension, self.seed]);
+        let x = independent_bits(self.seed, self.pixel, self.sample, self.dimension);
         self.dimension = self.dimension.wrapping_add(1);
-        h[0]
+        x
     }
 
     /// A float uniform in [0, 1), then advances the dimension. With the Sobol sampler it is

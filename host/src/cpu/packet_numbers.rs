@@ -9,7 +9,7 @@ use kernel::path::{
     PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX, LIGHT_CHOICE_DIMENSION,
     LIGHT_POINT_DIMENSION, ROULETTE_DIMENSION,
 };
-use kernel::rng::{pcg4d, u32_to_unit_f32, SampleRng, SampleStream};
+use kernel::rng::{independent_bits, u32_to_unit_f32, SampleRng, SampleStream};
 use kernel::scene::sampler;
 use kernel::sobol::{sobol_pair, sobol_single};
 use std::simd::{Mask, Select, Simd};
@@ -181,8 +181,8 @@ impl Requests {
             }
             if any_independent {
                 // SampleRng::next_2d: two independent numbers, dimensions d and d + 1.
-                let ix = pcg4d([pixel, sample, d, seed])[0];
-                let iy = pcg4d([pixel, sample, d + Words::splat(1), seed])[0];
+                let ix = independent_bits(seed, pixel, sample, d);
+                let iy = independent_bits(seed, pixel, sample, d + Words::splat(1));
                 (x, y) = (sobol.select(x, ix), sobol.select(y, iy));
             }
             *out = [x.to_array(), y.to_array()];
@@ -198,7 +198,7 @@ impl Requests {
                 x = sobol_single(seed, pixel, sample, d);
             }
             if any_independent {
-                x = sobol.select(x, pcg4d([pixel, sample, d, seed])[0]);
+                x = sobol.select(x, independent_bits(seed, pixel, sample, d));
             }
             *out = x.to_array();
         }
