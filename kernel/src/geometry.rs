@@ -199,15 +199,37 @@ fn max_abs(v: Vec3) -> f32 {
 /// and a hit at u = v = 0 then computed 0 x inf = NaN (found by `properties.rs`).
 #[inline]
 pub fn triangle_point_error(p0: Vec3, edge1: Vec3, edge2: Vec3, u: f32, v: f32) -> f32 {
+    let condition = triangle_error_condition(edge1, edge2);
+    triangle_point_error_conditioned(p0, edge1, edge2, u, v, condition)
+}
+
+/// The factor of [`triangle_point_error`] that depends on the triangle's shape alone:
+/// max(1, min(f32::MAX, 1 / sin(theta))), or 1 for a degenerate triangle. A renderer may
+/// compute it once per triangle (the CPU backend does).
+#[inline]
+pub fn triangle_error_condition(edge1: Vec3, edge2: Vec3) -> f32 {
     let sin_theta = edge1.cross(edge2).length() / (edge1.length() * edge2.length());
     let condition = if sin_theta > 0.0 {
         (1.0 / sin_theta).min(f32::MAX)
     } else {
         1.0
     };
+    condition.max(1.0)
+}
+
+/// [`triangle_point_error`] with the triangle's [`triangle_error_condition`] given.
+#[inline]
+pub fn triangle_point_error_conditioned(
+    p0: Vec3,
+    edge1: Vec3,
+    edge2: Vec3,
+    u: f32,
+    v: f32,
+    condition: f32,
+) -> f32 {
     TRIANGLE_ERROR_EPS
         * f32::EPSILON
-        * (max_abs(p0) + (max_abs(u * edge1) + max_abs(v * edge2)) * condition.max(1.0))
+        * (max_abs(p0) + (max_abs(u * edge1) + max_abs(v * edge2)) * condition)
 }
 
 /// Absolute error bound of a point on a sphere (centre `center`, radius `radius`), re-projected

@@ -15,7 +15,8 @@ use super::simd::{Boxes, Ray4, Spheres4, Triangles4, SLAB_PAD};
 use glam::Vec3;
 use kernel::geometry::{
     intersect_sphere, intersect_triangle, intersect_triangle_uv, reproject_to_sphere,
-    sphere_point_error, triangle_normal, triangle_point, triangle_point_error,
+    sphere_point_error, triangle_error_condition, triangle_normal, triangle_point,
+    triangle_point_error_conditioned,
 };
 use kernel::scene::{Sphere, Triangle, NONE};
 use kernel::SurfaceHit;
@@ -85,6 +86,26 @@ pub struct Bvh {
     root: Option<u32>,
     pub spheres: Vec<Sphere>,
     pub triangles: Vec<Triangle>,
+    /// By triangle, what its hit records need that depends on its shape alone (computed once).
+    shapes: Vec<TriangleShape>,
+}
+
+/// A triangle's unit normal (`triangle_normal`) and its `triangle_error_condition`: a hit
+/// record would otherwise compute them again for every hit (four square roots, two divisions).
+#[derive(Clone, Copy, Debug)]
+struct TriangleShape {
+    normal: Vec3,
+    condition: f32,
+}
+
+impl TriangleShape {
+    fn of(t: &Triangle) -> Self {
+        let (e1, e2) = (Vec3::from(t.edge1), Vec3::from(t.edge2));
+        Self {
+            normal: triangle_normal(e1, e2),
+            condition: triangle_error_condition(e1, e2),
+        }
+    }
 }
 
 fn prim_bounds(spheres: &[Sphere], triangles: &[Triangle], id: u32) -> Aabb {
@@ -120,6 +141,7 @@ impl Bvh {
             blocks: Vec::with_capacity(triangles.len() / 4 + 1),
             sphere_blocks: Vec::new(),
             root: None,
+            shapes: triangles.iter().map(TriangleShape::of).collect(),
             spheres,
             triangles,
         };
@@ -242,10 +264,11 @@ impl Bvh {
         self.nodes.len()
     }
 
-    /// Bytes the hierarchy takes beyond the primitives themselves: nodes, leaves, and the
-    /// leaves' packed copies of their triangles.
+    /// Bytes the hierarchy takes beyond the primitives themselves: nodes, leaves, the
+    /// leaves' packed copies of their triangles, and the triangles' precomputed shapes.
     pub fn hierarchy_bytes(&self) -> usize {
         std::mem::size_of_val(self.nodes.as_slice())
+            + std::mem::size_of_val(self.shapes.as_slice())
             + std::mem::size_of_val(self.leaves.as_slice())
             + std::mem::size_of_val(self.blocks.as_slice())
             + std::mem::size_of_val(self.sphere_blocks.as_slice())
@@ -538,7 +561,8 @@ impl Bvh {
                 error: sphere_point_error(c, s.radius),
             }
         } else {
-            let tri = &self.triangles[id - self.spheres.len()];
+            let index = id - self.spheres.len();
+            let (tri, shape) = (&self.triangles[index], &self.shapes[index]);
             let (p0, e1, e2) = (
                 Vec3::from(tri.p0),
                 Vec3::from(tri.edge1),
@@ -547,10 +571,10 @@ impl Bvh {
             SurfaceHit {
                 position: triangle_point(p0, e1, e2, u, v),
                 t,
-                normal: triangle_normal(e1, e2),
+                normal: shape.normal,
                 material: tri.material,
                 light: NONE,
-                error: triangle_point_error(p0, e1, e2, u, v),
+                error: triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition),
             }
         }
     }
