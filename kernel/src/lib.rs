@@ -4,7 +4,8 @@
 //! holds the entry points) and to native code for the CPU backend and the tests. The kernel
 //! reaches the scene only through [`path::Tracer`], so it knows neither backend.
 #![cfg_attr(target_arch = "spirv", no_std)]
-// Natively, the sampler's hashes also run on SIMD lanes (`word`, the CPU's packets of paths).
+// Natively, the sampler's hashes and the sampling of points and directions also run on SIMD
+// lanes (`word`, `real`: the CPU's packets of paths).
 #![cfg_attr(not(target_arch = "spirv"), feature(portable_simd))]
 
 pub mod adaptive;
@@ -16,6 +17,7 @@ pub mod geometry;
 pub mod light;
 pub mod path;
 pub mod probe;
+pub mod real;
 pub mod rng;
 pub mod sampling;
 pub mod scene;
@@ -23,6 +25,7 @@ pub mod scene;
 pub mod shaders;
 pub mod sobol;
 pub mod turns;
+pub mod vertex_sampler;
 pub mod word;
 
 pub use path::{trace_path, SurfaceHit, Tracer};

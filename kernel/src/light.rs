@@ -2,7 +2,7 @@
 
 use crate::geometry::area_to_solid_angle_pdf;
 use crate::sampling::{
-    pdf_sphere_area, pdf_sphere_cone, sample_sphere, sample_sphere_cone, SurfacePoint,
+    pdf_sphere_area, pdf_sphere_cone, sample_sphere, sample_sphere_cone, ConeSample, SurfacePoint,
 };
 use crate::scene::{light_sampling, SphereLight};
 use spirv_std::glam::Vec3;
@@ -94,7 +94,7 @@ pub struct DirectionalLightSample {
 
 /// Whether `mode` samples light `l` by its cone from receiver `x` (x strictly outside).
 #[inline]
-fn uses_cone(mode: u32, l: &SphereLight, x: Vec3) -> bool {
+pub fn uses_cone(mode: u32, l: &SphereLight, x: Vec3) -> bool {
     let d = Vec3::from(l.center) - x;
     mode == light_sampling::CONE && d.dot(d) > l.radius * l.radius
 }
@@ -116,12 +116,7 @@ pub fn sample_light_from(
     let l = lights[light as usize];
     let center = Vec3::from(l.center);
     if uses_cone(mode, &l, x) {
-        let s = sample_sphere_cone(center, l.radius, x, u1, u2);
-        DirectionalLightSample {
-            point: s.point,
-            light,
-            pdf_solid_angle: l.select_pmf * s.pdf_solid_angle,
-        }
+        cone_light_sample(&l, light, sample_sphere_cone(center, l.radius, x, u1, u2))
     } else {
         let point = sample_sphere(center, l.radius, u1, u2);
         DirectionalLightSample {
@@ -134,6 +129,17 @@ pub fn sample_light_from(
                 point.normal,
             ),
         }
+    }
+}
+
+/// The light sample of [`sample_light_from`] that samples light `l` (index `light`) by its cone:
+/// the cone's sample `s`, its density times the light's selection probability.
+#[inline]
+pub fn cone_light_sample(l: &SphereLight, light: u32, s: ConeSample) -> DirectionalLightSample {
+    DirectionalLightSample {
+        point: s.point,
+        light,
+        pdf_solid_angle: l.select_pmf * s.pdf_solid_angle,
     }
 }
 

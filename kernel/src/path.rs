@@ -2,14 +2,15 @@
 //! generic over how rays meet the scene ([`Tracer`]).
 
 use crate::adaptive::sample_stream;
-use crate::brdf::{eval_scattering, pdf_brdf, sample_brdf, sampled_brdf_weight};
+use crate::brdf::{eval_scattering, pdf_brdf, sampled_brdf_weight};
 use crate::camera::{camera_origin, camera_ray_direction};
 use crate::features::FeatureSet;
 use crate::geometry::{offset_ray_origin, shadow_ray_end, sphere_point_error};
-use crate::light::{eval_radiance, pdf_light_from, sample_light_from};
-use crate::rng::{SampleRng, SampleStream};
+use crate::light::{eval_radiance, pdf_light_from};
+use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{light_sampling, Material, RenderParams, SphereLight, NONE};
+use crate::vertex_sampler::VertexSampler;
 use spirv_std::glam::Vec3;
 
 /// Where a ray meets the scene first. `t < 0` means it met nothing.
@@ -178,7 +179,7 @@ pub struct PathState<R = SampleRng> {
     pub rng: R,
 }
 
-impl<R: SampleStream> PathState<R> {
+impl<R: VertexSampler> PathState<R> {
     /// A path whose camera ray `origin + t dir` is to be traced; `rng` is past the camera's
     /// dimensions.
     #[inline]
@@ -300,12 +301,7 @@ impl<R: SampleStream> PathState<R> {
         w_out: Vec3,
     ) {
         let rng = &mut self.rng;
-        // The normal on the side the light leaves toward (two-sided surfaces).
-        let n = if hit.normal.dot(w_out) < 0.0 {
-            -hit.normal
-        } else {
-            hit.normal
-        };
+        let n = facing_normal(hit.normal, w_out);
         let x = hit.position;
         let albedo = Vec3::from(material.albedo);
         let ray_origin = offset_ray_origin(x, n, hit.error);
@@ -327,16 +323,8 @@ impl<R: SampleStream> PathState<R> {
                 0.0
             };
             rng.seek(dimensions + LIGHT_POINT_DIMENSION);
-            let (u_light1, u_light2) = rng.next_2d();
-            let ls = sample_light_from(
-                lights,
-                light_count,
-                light_sampling_of(features, params),
-                x,
-                u_select,
-                u_light1,
-                u_light2,
-            );
+            let mode = light_sampling_of(features, params);
+            let ls = rng.sample_light_from(lights, light_count, mode, x, u_select);
             let y = ls.point.position;
             let wi = (y - x).normalize();
             let cos_x = n.dot(wi);
@@ -386,8 +374,7 @@ impl<R: SampleStream> PathState<R> {
 
         // 3: extension by BRDF sampling.
         rng.seek(dimensions + BRDF_DIMENSION);
-        let (u_brdf1, u_brdf2) = rng.next_2d();
-        let wi = sample_brdf(n, u_brdf1, u_brdf2);
+        let wi = rng.sample_brdf(n);
         let pdf_b = pdf_brdf(n, wi);
         if pdf_b < PDF_EPSILON {
             return;
@@ -405,6 +392,17 @@ impl<R: SampleStream> PathState<R> {
     }
 }
 
+/// The normal on the side the light leaves toward, `w_out` (surfaces are two-sided): the `n` of
+/// a vertex's BRDF.
+#[inline]
+pub fn facing_normal(normal: Vec3, w_out: Vec3) -> Vec3 {
+    if normal.dot(w_out) < 0.0 {
+        -normal
+    } else {
+        normal
+    }
+}
+
 /// The background radiance (seen by rays that leave the scene).
 #[inline]
 fn background(params: &RenderParams) -> Vec3 {
@@ -417,7 +415,7 @@ fn background(params: &RenderParams) -> Vec3 {
 
 /// How this render samples points on lights (`scene::light_sampling`).
 #[inline]
-fn light_sampling_of<F: FeatureSet>(features: F, params: &RenderParams) -> u32 {
+pub fn light_sampling_of<F: FeatureSet>(features: F, params: &RenderParams) -> u32 {
     if features.light_cone(params) {
         light_sampling::CONE
     } else {
@@ -473,7 +471,7 @@ pub fn sample_rng(params: &RenderParams, px: u32, py: u32, sample: u32) -> Sampl
 /// camera ray waiting: a uniformly random position inside the pixel (the first pair of
 /// dimensions) and the camera ray through it.
 #[inline]
-pub fn start_path<R: SampleStream>(
+pub fn start_path<R: VertexSampler>(
     params: &RenderParams,
     px: u32,
     py: u32,

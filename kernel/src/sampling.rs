@@ -1,6 +1,8 @@
 //! Sampling routines: directions around an axis and points on spheres.
 
-use crate::frame::orthonormal_basis;
+use crate::frame::orthonormal_basis_v3;
+// `real::Real` by its path: imported, its f32 methods would clash with `Float`'s on the GPU.
+use crate::real::{self, V3};
 use crate::turns::cos_sin_turns;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -10,8 +12,8 @@ use spirv_std::glam::Vec3;
 /// Seed: `SampleLobe(A, c, phi)`. The unit direction whose cosine with the unit axis `a` is `c`
 /// (clamped to [-1, 1]) and whose azimuth around `a` is `phi`: `K = (s cos phi, s sin phi, c)`
 /// with `s = sqrt(1 - c^2)`, expressed in an orthonormal frame whose third axis is `a`.
-/// The frame is Duff et al.'s (see [`orthonormal_basis`]), which stays accurate near -Z where the
-/// seed special-cases the poles.
+/// The frame is Duff et al.'s (see [`crate::frame::orthonormal_basis`]), which stays accurate
+/// near -Z where the seed special-cases the poles.
 #[inline]
 pub fn sample_lobe(a: Vec3, c: f32, phi: f32) -> Vec3 {
     lobe_direction(a, c, phi.cos(), phi.sin())
@@ -20,9 +22,16 @@ pub fn sample_lobe(a: Vec3, c: f32, phi: f32) -> Vec3 {
 /// [`sample_lobe`] with the azimuth given by its cosine and sine.
 #[inline]
 fn lobe_direction(a: Vec3, c: f32, cos_phi: f32, sin_phi: f32) -> Vec3 {
-    let c = c.clamp(-1.0, 1.0);
-    let s = (1.0 - c * c).max(0.0).sqrt();
-    let (t, b) = orthonormal_basis(a);
+    lobe_direction_v3(V3::from(a), c, cos_phi, sin_phi).into()
+}
+
+/// [`lobe_direction`] for one axis or one per lane ([`real::Real`]).
+#[inline]
+fn lobe_direction_v3<R: real::Real>(a: V3<R>, c: R, cos_phi: R, sin_phi: R) -> V3<R> {
+    let one = R::splat(1.0);
+    let c = c.max(-one).min(one);
+    let s = (one - c * c).max(R::splat(0.0)).sqrt();
+    let (t, b) = orthonormal_basis_v3(a);
     t * (s * cos_phi) + b * (s * sin_phi) + a * c
 }
 
@@ -30,8 +39,14 @@ fn lobe_direction(a: Vec3, c: f32, cos_phi: f32, sin_phi: f32) -> Vec3 {
 /// (cos(theta) = sqrt(u1), phi = 2 pi u2); its solid-angle pdf is [`pdf_cosine_hemisphere`].
 #[inline]
 pub fn sample_cosine_hemisphere(n: Vec3, u1: f32, u2: f32) -> Vec3 {
+    sample_cosine_hemisphere_v3(V3::from(n), u1, u2).into()
+}
+
+/// [`sample_cosine_hemisphere`] for one normal or one per lane ([`real::Real`]).
+#[inline]
+pub fn sample_cosine_hemisphere_v3<R: real::Real>(n: V3<R>, u1: R, u2: R) -> V3<R> {
     let (cos_phi, sin_phi) = cos_sin_turns(u2);
-    lobe_direction(n, u1.sqrt(), cos_phi, sin_phi)
+    lobe_direction_v3(n, u1.sqrt(), cos_phi, sin_phi)
 }
 
 /// Solid-angle density of [`sample_cosine_hemisphere`]: max(0, n . w) / pi.
@@ -101,9 +116,10 @@ pub struct ConeSample {
 /// its cancellation, accurate for cones of any size (pbrt-v4 switches to a Taylor expansion
 /// below 1.5 degrees instead; this form needs no branch).
 #[inline]
-pub fn cone_one_minus_cos(radius: f32, dist2: f32) -> f32 {
-    let sin2_max = (radius * radius / dist2).min(1.0);
-    sin2_max / (1.0 + (1.0 - sin2_max).sqrt())
+pub fn cone_one_minus_cos<R: real::Real>(radius: R, dist2: R) -> R {
+    let one = R::splat(1.0);
+    let sin2_max = (radius * radius / dist2).min(one);
+    sin2_max / (one + (one - sin2_max).sqrt())
 }
 
 /// Samples the sphere (center, radius) as seen from outside point `p`: a direction uniform in
@@ -117,6 +133,26 @@ pub fn cone_one_minus_cos(radius: f32, dist2: f32) -> f32 {
 /// `p` must be outside the sphere (see [`pdf_sphere_cone`] for the caller's fallback).
 #[inline]
 pub fn sample_sphere_cone(center: Vec3, radius: f32, p: Vec3, u1: f32, u2: f32) -> ConeSample {
+    let s = sample_sphere_cone_v3(V3::from(center), radius, V3::from(p), u1, u2);
+    ConeSample {
+        point: SurfacePoint {
+            position: s.position.into(),
+            normal: s.normal.into(),
+        },
+        pdf_solid_angle: s.pdf_solid_angle,
+    }
+}
+
+/// [`sample_sphere_cone`] for one sphere and point, or one of each per lane ([`real::Real`]).
+#[inline]
+pub fn sample_sphere_cone_v3<R: real::Real>(
+    center: V3<R>,
+    radius: R,
+    p: V3<R>,
+    u1: R,
+    u2: R,
+) -> ConeSampleV3<R> {
+    let (zero, one, two) = (R::splat(0.0), R::splat(1.0), R::splat(2.0));
     let to_center = center - p;
     let dist2 = to_center.dot(to_center);
     let dist = dist2.sqrt();
@@ -126,21 +162,28 @@ pub fn sample_sphere_cone(center: Vec3, radius: f32, p: Vec3, u1: f32, u2: f32) 
     let one_minus_cos_max = cone_one_minus_cos(radius, dist2);
     // Uniform in 1 - cos(theta); sin^2 = (1 - cos)(1 + cos) keeps full precision in tiny cones.
     let one_minus_cos = u1 * one_minus_cos_max;
-    let cos = 1.0 - one_minus_cos;
-    let sin2 = one_minus_cos * (2.0 - one_minus_cos);
-    let cos_alpha =
-        (sin2 / sin_max + cos * (1.0 - sin2 / sin2_max).max(0.0).sqrt()).clamp(-1.0, 1.0);
-    let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+    let cos = one - one_minus_cos;
+    let sin2 = one_minus_cos * (two - one_minus_cos);
+    let cos_alpha = (sin2 / sin_max + cos * (one - sin2 / sin2_max).max(zero).sqrt())
+        .max(-one)
+        .min(one);
+    let sin_alpha = (one - cos_alpha * cos_alpha).max(zero).sqrt();
     let (cos_phi, sin_phi) = cos_sin_turns(u2);
-    let (t, b) = orthonormal_basis(axis);
+    let (t, b) = orthonormal_basis_v3(axis);
     let normal = t * (sin_alpha * cos_phi) + b * (sin_alpha * sin_phi) - axis * cos_alpha;
-    ConeSample {
-        point: SurfacePoint {
-            position: center + radius * normal,
-            normal,
-        },
-        pdf_solid_angle: 1.0 / (2.0 * PI * one_minus_cos_max),
+    ConeSampleV3 {
+        position: center + normal * radius,
+        normal,
+        pdf_solid_angle: one / (two * R::splat(PI) * one_minus_cos_max),
     }
+}
+
+/// [`ConeSample`] of one sphere or of one per lane.
+#[derive(Clone, Copy, Debug)]
+pub struct ConeSampleV3<R> {
+    pub position: V3<R>,
+    pub normal: V3<R>,
+    pub pdf_solid_angle: R,
 }
 
 /// Solid-angle density of [`sample_sphere_cone`] from outside point `p`, for any direction

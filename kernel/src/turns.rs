@@ -7,9 +7,11 @@
 //! driver's sin/cos they differed by up to 1.2e-7). Speed on the CPU is unchanged: the
 //! polynomials cost what libm's `sincosf` did (4.4% of a Cornell render).
 
+use crate::real::Real;
+use crate::word::Word;
 use core::f32::consts::FRAC_PI_2;
 
-/// (cos(2 pi u), sin(2 pi u)) for finite `u`.
+/// (cos(2 pi u), sin(2 pi u)) for finite `u` (one number, or one per lane: [`Real`]).
 ///
 /// Range reduction is exact: q = the nearest integer to 4u (quarter turns) and r = 4u - q,
 /// |r| <= 1/2, are computed without rounding (4u is exact, and r by Sterbenz's lemma or q = 0),
@@ -21,33 +23,39 @@ use core::f32::consts::FRAC_PI_2;
 /// sampler value in `tests/tests/sampling.rs`); |u| must stay below 2^22 for the reduction to
 /// see its fraction.
 #[inline]
-pub fn cos_sin_turns(u: f32) -> (f32, f32) {
-    let quarters = 4.0 * u;
-    // floor(quarters + 1/2) by conversions (truncation, less one below zero): `floor` is a
-    // libm call on baseline x86-64.
-    let half_up = quarters + 0.5;
-    let truncated = half_up as i32;
-    let nearest = truncated - ((truncated as f32 > half_up) as i32);
-    let q = nearest as f32;
-    let theta = (quarters - q) * FRAC_PI_2;
+pub fn cos_sin_turns<R: Real>(u: R) -> (R, R) {
+    let c = R::splat;
+    let quarters = c(4.0) * u;
+    // floor(quarters + 1/2) by conversions (truncation, less one below zero: the mask is -1
+    // there): `floor` is a libm call on baseline x86-64.
+    let half_up = quarters + c(0.5);
+    let truncated = half_up.to_i32_bits();
+    let nearest = truncated.wrapping_add(R::from_i32_bits(truncated).greater_than(half_up));
+    let q = R::from_i32_bits(nearest);
+    let theta = (quarters - q) * c(FRAC_PI_2);
     let z = theta * theta;
     let sin = theta
         + theta
             * z
-            * (-1.0 / 6.0 + z * (1.0 / 120.0 + z * (-1.0 / 5040.0 + z * (1.0 / 362_880.0))));
-    let cos = 1.0
-        + z * (-0.5
-            + z * (1.0 / 24.0
-                + z * (-1.0 / 720.0 + z * (1.0 / 40_320.0 + z * (-1.0 / 3_628_800.0)))));
+            * (c(-1.0 / 6.0)
+                + z * (c(1.0 / 120.0) + z * (c(-1.0 / 5040.0) + z * c(1.0 / 362_880.0))));
+    let cos = c(1.0)
+        + z * (c(-0.5)
+            + z * (c(1.0 / 24.0)
+                + z * (c(-1.0 / 720.0) + z * (c(1.0 / 40_320.0) + z * c(-1.0 / 3_628_800.0)))));
     // Rotate by q quarter turns, (c, s) -> (-s, c) per quarter: odd quadrants swap the two,
     // quadrants 1 and 2 negate the cosine, 2 and 3 the sine. Done on the bits, without a branch,
     // because the quadrant of a random azimuth is unpredictable.
-    let quadrant = (nearest as u32) & 3;
-    let swap = 0u32.wrapping_sub(quadrant & 1);
+    let bits = R::Bits::splat;
+    let quadrant = nearest & bits(3);
+    let swap = bits(0).wrapping_sub(quadrant & bits(1));
     let (cos_bits, sin_bits) = (cos.to_bits(), sin.to_bits());
-    let c = (cos_bits & !swap) | (sin_bits & swap);
-    let s = (sin_bits & !swap) | (cos_bits & swap);
-    let cos_sign = ((quadrant + 1) & 2) << 30;
-    let sin_sign = (quadrant & 2) << 30;
-    (f32::from_bits(c ^ cos_sign), f32::from_bits(s ^ sin_sign))
+    // Where `swap` is all ones the two exchange: x ^ ((x ^ y) & swap).
+    let exchanged = (cos_bits ^ sin_bits) & swap;
+    let cos_sign = (quadrant.wrapping_add(bits(1)) & bits(2)) << 30;
+    let sin_sign = (quadrant & bits(2)) << 30;
+    (
+        R::from_bits(cos_bits ^ exchanged ^ cos_sign),
+        R::from_bits(sin_bits ^ exchanged ^ sin_sign),
+    )
 }

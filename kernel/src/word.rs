@@ -1,7 +1,8 @@
 //! 32-bit words one at a time or many at once: the integer operations of the sampler's hashes
-//! (`rng::pcg4d`, `sobol`), so they are written once and run on a `u32` (the GPU, one path at a
-//! time) or on a SIMD vector of `u32` (the CPU's packets of paths, one lane per path). Every
-//! operation acts on each lane alone, so a lane's result is exactly the `u32` one.
+//! (`rng::pcg4d`, `sobol`) and of [`crate::real`]'s bit tricks, so they are written once and run
+//! on a `u32` (the GPU, one path at a time) or on a SIMD vector of `u32` (the CPU's packets of
+//! paths, one lane per path). Every operation acts on each lane alone, so a lane's result is
+//! exactly the `u32` one.
 
 use core::ops::{BitAnd, BitOr, BitXor, Shl, Shr};
 
@@ -19,6 +20,8 @@ pub trait Word:
     fn splat(x: u32) -> Self;
     /// Addition modulo 2^32.
     fn wrapping_add(self, rhs: Self) -> Self;
+    /// Subtraction modulo 2^32.
+    fn wrapping_sub(self, rhs: Self) -> Self;
     /// Multiplication modulo 2^32.
     fn wrapping_mul(self, rhs: Self) -> Self;
 }
@@ -32,6 +35,11 @@ impl Word for u32 {
     #[inline]
     fn wrapping_add(self, rhs: Self) -> Self {
         u32::wrapping_add(self, rhs)
+    }
+
+    #[inline]
+    fn wrapping_sub(self, rhs: Self) -> Self {
+        u32::wrapping_sub(self, rhs)
     }
 
     #[inline]
@@ -52,6 +60,11 @@ impl<const N: usize> Word for core::simd::Simd<u32, N> {
     #[inline]
     fn wrapping_add(self, rhs: Self) -> Self {
         self + rhs
+    }
+
+    #[inline]
+    fn wrapping_sub(self, rhs: Self) -> Self {
+        self - rhs
     }
 
     #[inline]

@@ -168,3 +168,183 @@ fn numbers_computed_for_sixteen_paths_are_sample_rng_numbers() {
         }
     }
 }
+
+/// The light samples and BRDF directions the packets compute for sixteen paths at once
+/// (`packet_vertices`, on SIMD lanes) are, bit for bit, what the kernel's samplers give the
+/// vertex one path at a time (`VertexSampler`'s provided methods on `SampleRng`), and are
+/// computed ahead exactly where a vertex will ask for them: at a surface that is not a light,
+/// the light sample only under cone sampling from outside the chosen light. Lanes mix misses,
+/// light hits, an empty lane, a lane without extension, receivers inside a light, one light
+/// and several (many_lights' alias table), cone and area sampling. A vertex that asks with
+/// other arguments (a moved receiver) gets them computed anew.
+#[test]
+fn vertex_samples_computed_for_sixteen_paths_are_the_kernel_samples() {
+    use glam::Vec3;
+    use kernel::light::uses_cone;
+    use kernel::path::{
+        facing_normal, PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX,
+        LIGHT_CHOICE_DIMENSION, LIGHT_POINT_DIMENSION,
+    };
+    use kernel::rng::{pcg4d, u32_to_unit_f32, SampleRng, SampleStream};
+    use kernel::scene::{light_sampling, sampler, NONE};
+    use kernel::vertex_sampler::{draw_brdf_direction, draw_light_sample, VertexSampler};
+    use kernel::SurfaceHit;
+    use twinpath::cpu::packet::LANES;
+    use twinpath::cpu::packet_numbers::{prefetch_vertices, PrefetchedStream};
+    use twinpath::cpu::packet_vertices::presample_vertices;
+
+    let many = small("many_lights.toml").lights;
+    let one = small("cornell.toml").lights;
+    assert!(many.len() > 1 && one.len() == 1);
+    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+    let mut computed = [0usize; 2];
+    for round in 0..256u32 {
+        let h = |lane: usize, k: u32| pcg4d([round, lane as u32, k, 0x7e58])[0];
+        let unit = |lane: usize, k: u32| u32_to_unit_f32(h(lane, k));
+        let lights = if round % 2 == 0 { &one } else { &many };
+        let light_count = lights.len() as u32;
+        let mode = if round % 8 == 7 {
+            light_sampling::AREA
+        } else {
+            light_sampling::CONE
+        };
+        let kind = |lane: usize| {
+            if h(lane, 0) % 3 == 0 {
+                sampler::INDEPENDENT
+            } else {
+                sampler::SOBOL
+            }
+        };
+        let rngs: [Option<SampleRng>; LANES] = std::array::from_fn(|lane| {
+            (lane != 3).then(|| {
+                SampleRng::with_sampler(h(lane, 1), h(lane, 2), h(lane, 3) % 4096, kind(lane))
+            })
+        });
+        let mut slots: [Option<((), PathState<PrefetchedStream>)>; LANES] =
+            std::array::from_fn(|lane| {
+                rngs[lane].map(|rng| {
+                    let dir = Vec3::new(unit(lane, 4) - 0.5, unit(lane, 5) - 0.5, -1.0);
+                    let mut path =
+                        PathState::new(Vec3::ZERO, dir.normalize(), PrefetchedStream::new(rng));
+                    path.depth = h(lane, 6) % 12;
+                    path.extend = lane != 5;
+                    ((), path)
+                })
+            });
+        let hits: [SurfaceHit; LANES] = std::array::from_fn(|lane| {
+            let kind = h(lane, 7) % 8;
+            if kind == 0 {
+                return SurfaceHit::miss();
+            }
+            let l = &lights[(h(lane, 8) % light_count) as usize];
+            let c = Vec3::from(l.center);
+            let position = match kind {
+                // Inside a light: no cone from there.
+                1 => c + 0.5 * l.radius * Vec3::new(unit(lane, 9), -unit(lane, 10), 0.1),
+                _ => Vec3::new(
+                    2.0 * unit(lane, 9) - 1.0,
+                    2.0 * unit(lane, 10),
+                    unit(lane, 11) - 1.0,
+                ),
+            };
+            let normal = Vec3::new(
+                unit(lane, 12) - 0.5,
+                unit(lane, 13) - 0.5,
+                unit(lane, 14) - 0.5,
+            )
+            .try_normalize()
+            .unwrap_or(Vec3::Y);
+            SurfaceHit {
+                position,
+                t: 1.0,
+                normal,
+                material: 0,
+                light: if kind == 2 { 0 } else { NONE },
+                error: 1e-6,
+            }
+        });
+        prefetch_vertices(&mut slots, light_count > 1);
+        presample_vertices(&mut slots, &hits, lights, light_count, mode);
+        for (lane, slot) in slots.iter_mut().enumerate() {
+            let Some((_, path)) = slot else { continue };
+            let hit = hits[lane];
+            let block = CAMERA_DIMENSIONS + path.depth * DIMENSIONS_PER_VERTEX;
+            let at_surface = path.extend && hit.is_hit() && hit.light == NONE;
+            let x = hit.position;
+            let mut expected = rngs[lane].unwrap();
+            // The vertex's light choice, as the kernel draws it.
+            let u_select = if light_count > 1 {
+                expected.seek(block + LIGHT_CHOICE_DIMENSION);
+                expected.next_f32()
+            } else {
+                0.0
+            };
+            let chosen = kernel::light::choose_light(lights, light_count, u_select);
+            let cone = mode == light_sampling::CONE && uses_cone(mode, &lights[chosen as usize], x);
+            let d = block + LIGHT_POINT_DIMENSION;
+            assert_eq!(
+                path.rng.holds_light_sample(d),
+                at_surface && cone,
+                "round {round} lane {lane}: light sample computed ahead?"
+            );
+            computed[0] += path.rng.holds_light_sample(d) as usize;
+            let mut twin = path.rng;
+            expected.seek(d);
+            path.rng.seek(d);
+            let want = draw_light_sample(&mut expected, lights, light_count, mode, x, u_select);
+            let got = path
+                .rng
+                .sample_light_from(lights, light_count, mode, x, u_select);
+            assert_eq!(
+                (
+                    bits(got.point.position),
+                    bits(got.point.normal),
+                    got.light,
+                    got.pdf_solid_angle.to_bits()
+                ),
+                (
+                    bits(want.point.position),
+                    bits(want.point.normal),
+                    want.light,
+                    want.pdf_solid_angle.to_bits()
+                ),
+                "round {round} lane {lane}: light sample"
+            );
+            assert_eq!(path.rng.rng.dimension, expected.dimension);
+            // Asked from elsewhere, the stream computes the sample for the receiver asked about.
+            let moved = x + Vec3::splat(0.25);
+            let mut again = rngs[lane].unwrap();
+            again.seek(d);
+            twin.seek(d);
+            let want = draw_light_sample(&mut again, lights, light_count, mode, moved, u_select);
+            let got = twin.sample_light_from(lights, light_count, mode, moved, u_select);
+            assert_eq!(
+                bits(got.point.position),
+                bits(want.point.position),
+                "moved receiver"
+            );
+
+            let d = block + BRDF_DIMENSION;
+            assert_eq!(
+                path.rng.holds_brdf_direction(d),
+                at_surface,
+                "round {round} lane {lane}: BRDF direction computed ahead?"
+            );
+            computed[1] += path.rng.holds_brdf_direction(d) as usize;
+            let n = facing_normal(hit.normal, -path.ray_dir);
+            expected.seek(d);
+            path.rng.seek(d);
+            assert_eq!(
+                bits(path.rng.sample_brdf(n)),
+                bits(draw_brdf_direction(&mut expected, n)),
+                "round {round} lane {lane}: BRDF direction"
+            );
+            assert_eq!(path.rng.rng.dimension, expected.dimension);
+        }
+    }
+    println!(
+        "computed ahead: {} light samples, {} BRDF directions",
+        computed[0], computed[1]
+    );
+    assert!(computed[0] > 500 && computed[1] > 1000, "{computed:?}");
+}

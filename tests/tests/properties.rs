@@ -227,6 +227,47 @@ proptest! {
         }
     }
 
+    /// The samplers written over `kernel::real::Real` give, in every SIMD lane, the `f32`
+    /// result bit for bit (the CPU's packets take their light samples and BRDF directions from
+    /// lanes; the images must not change): the cone sample's point, normal and pdf, the
+    /// cosine-weighted direction, and the azimuth's cosine and sine. Lane 0 is sampled as the
+    /// cone test above samples; the other lanes mix in other receivers, normals and numbers.
+    #[test]
+    fn lane_samplers_are_bit_identical_to_the_f32_ones(
+        c in point(-15.0, 15.0),
+        r in 1e-15f32..1e9,
+        ds in prop::array::uniform4(unit()),
+        ks in prop::array::uniform4(-5.0f32..6.0),
+        us in prop::array::uniform4((0.0f32..1.0, 0.0f32..1.0)),
+        ns in prop::array::uniform4(unit()),
+    ) {
+        use kernel::real::V3;
+        use kernel::sampling::{sample_cosine_hemisphere, sample_cosine_hemisphere_v3, sample_sphere_cone_v3};
+        use kernel::turns::cos_sin_turns;
+        let r = r.max(0.1 * c.abs().max_element());
+        let xs = [0, 1, 2, 3].map(|i| c + ds[i] * r * (1.0 + 10f32.powf(ks[i])).min(1e15 / r));
+        let lanes = |f: &dyn Fn(usize) -> f32| f32x4::from_array([0, 1, 2, 3].map(f));
+        let v3 = |v: [Vec3; 4]| V3::new(lanes(&|i| v[i].x), lanes(&|i| v[i].y), lanes(&|i| v[i].z));
+        let lane3 = |v: V3<f32x4>, i: usize| Vec3::new(v.x[i], v.y[i], v.z[i]);
+        let (u1, u2) = (lanes(&|i| us[i].0), lanes(&|i| us[i].1));
+        let cone = sample_sphere_cone_v3(v3([c; 4]), f32x4::splat(r), v3(xs), u1, u2);
+        let dirs = sample_cosine_hemisphere_v3(v3(ns), u1, u2);
+        let (cos, sin) = cos_sin_turns(u2);
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        for i in 0..4 {
+            let (a, b) = us[i];
+            // Receivers inside the sphere are the caller's to avoid; both forms must still agree.
+            let s = sample_sphere_cone(c, r, xs[i], a, b);
+            prop_assert_eq!(bits(lane3(cone.position, i)), bits(s.point.position), "lane {} position", i);
+            prop_assert_eq!(bits(lane3(cone.normal, i)), bits(s.point.normal), "lane {} normal", i);
+            prop_assert_eq!(cone.pdf_solid_angle[i].to_bits(), s.pdf_solid_angle.to_bits(), "lane {} pdf", i);
+            let w = sample_cosine_hemisphere(ns[i], a, b);
+            prop_assert_eq!(bits(lane3(dirs, i)), bits(w), "lane {} direction", i);
+            let (c1, s1) = cos_sin_turns(b);
+            prop_assert_eq!((cos[i].to_bits(), sin[i].to_bits()), (c1.to_bits(), s1.to_bits()), "lane {} azimuth", i);
+        }
+    }
+
     /// The same for the four-lane sphere test: each lane is the kernel's `intersect_sphere`
     /// bit for bit. Half the rays aim at a point near the first sphere's centre.
     #[test]

@@ -7,6 +7,7 @@ pub mod bvh_build;
 pub mod packet;
 pub mod packet_numbers;
 pub mod packet_paths;
+pub mod packet_vertices;
 pub mod rays;
 pub mod simd;
 

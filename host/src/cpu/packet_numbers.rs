@@ -5,6 +5,7 @@
 //! render). Each lane computes exactly what `SampleRng` computes, so images do not change.
 
 use super::packet::LANES;
+use super::packet_vertices::{PresampledBrdf, PresampledLight};
 use kernel::path::{
     PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX, LIGHT_CHOICE_DIMENSION,
     LIGHT_POINT_DIMENSION, ROULETTE_DIMENSION,
@@ -19,7 +20,7 @@ type Words = Simd<u32, LANES>;
 type Numbers = ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]);
 
 /// No dimension: an empty entry.
-const EMPTY: u32 = u32::MAX;
+pub const EMPTY: u32 = u32::MAX;
 
 /// Numbers computed ahead for one dimension (`bits[1]` unused for a single number).
 #[derive(Clone, Copy, Debug)]
@@ -44,6 +45,10 @@ pub struct PrefetchedStream {
     pub rng: SampleRng,
     pairs: [Entry; 2],
     singles: [Entry; 2],
+    /// The next vertex's light sample and BRDF direction computed ahead
+    /// (`super::packet_vertices`), or none (their dimension [`EMPTY`]).
+    pub(super) light: PresampledLight,
+    pub(super) brdf: PresampledBrdf,
 }
 
 impl PrefetchedStream {
@@ -53,6 +58,8 @@ impl PrefetchedStream {
             rng,
             pairs: [Entry::NONE; 2],
             singles: [Entry::NONE; 2],
+            light: PresampledLight::NONE,
+            brdf: PresampledBrdf::NONE,
         }
     }
 
@@ -60,6 +67,21 @@ impl PrefetchedStream {
     pub fn holds(&self, dimension: u32, pair: bool) -> bool {
         let entries = if pair { &self.pairs } else { &self.singles };
         entries.iter().any(|e| e.dimension == dimension)
+    }
+
+    /// Pair `p` computed ahead: its first dimension ([`EMPTY`] for none) and the numbers
+    /// `next_2d` returns there.
+    pub fn pair(&self, p: usize) -> (u32, (f32, f32)) {
+        let e = &self.pairs[p];
+        let numbers = (u32_to_unit_f32(e.bits[0]), u32_to_unit_f32(e.bits[1]));
+        (e.dimension, numbers)
+    }
+
+    /// Single number `p` computed ahead: its dimension ([`EMPTY`] for none) and the number
+    /// `next_f32` returns there.
+    pub fn single(&self, p: usize) -> (u32, f32) {
+        let e = &self.singles[p];
+        (e.dimension, u32_to_unit_f32(e.bits[0]))
     }
 }
 
@@ -237,17 +259,24 @@ pub fn camera_streams(rngs: &[Option<SampleRng>; LANES]) -> [Option<PrefetchedSt
         rngs[lane].map(|rng| {
             let (pairs, singles) = entries(&requests, &numbers, lane);
             PrefetchedStream {
-                rng,
                 pairs,
                 singles,
+                ..PrefetchedStream::new(rng)
             }
         })
     })
 }
 
+/// Where [`prefetch_vertices`] puts a vertex's numbers: the pairs of the light point and of the
+/// BRDF direction, the roulette number and the light choice.
+pub const LIGHT_POINT_PAIR: usize = 0;
+pub const BRDF_PAIR: usize = 1;
+pub const ROULETTE_SINGLE: usize = 0;
+pub const LIGHT_CHOICE_SINGLE: usize = 1;
+
 /// For each path of `slots` whose extension ray has been traced (it may reach its next vertex),
-/// computes that vertex's numbers: the light point, the BRDF direction, the roulette number
-/// and, if `choose_light` (several lights), the light choice.
+/// computes that vertex's numbers: pairs [`LIGHT_POINT_PAIR`] and [`BRDF_PAIR`], single numbers
+/// [`ROULETTE_SINGLE`] and, if `choose_light` (several lights), [`LIGHT_CHOICE_SINGLE`].
 pub fn prefetch_vertices<T>(
     slots: &mut [Option<(T, PathState<PrefetchedStream>)>; LANES],
     choose_light: bool,
@@ -267,6 +296,7 @@ pub fn prefetch_vertices<T>(
         requests.set(
             lane,
             &path.rng.rng,
+            // In the order of LIGHT_POINT_PAIR, BRDF_PAIR; ROULETTE_SINGLE, LIGHT_CHOICE_SINGLE.
             [block + LIGHT_POINT_DIMENSION, block + BRDF_DIMENSION],
             [block + ROULETTE_DIMENSION, choice],
         );

@@ -6,12 +6,13 @@
 
 use super::packet::{RayPacket, SmallScene, LANES};
 use super::packet_numbers::{camera_streams, prefetch_vertices, PrefetchedStream};
+use super::packet_vertices::presample_vertices;
 use super::{CpuRenderer, PixelSums};
 use crate::film::Film;
 use glam::Vec3;
 use kernel::adaptive::is_pilot_sample;
 use kernel::features::FeatureSet;
-use kernel::path::{sample_rng, start_path, PathState};
+use kernel::path::{light_sampling_of, sample_rng, start_path, PathState};
 use kernel::scene::{RenderParams, NONE};
 use kernel::SurfaceHit;
 use std::simd::Simd;
@@ -70,8 +71,10 @@ impl CpuRenderer {
         let mut slots: [Option<(usize, Path)>; LANES] = [None; LANES];
         let mut next = 0;
         let choose_light = params.light_count > 1;
+        let mode = light_sampling_of(features, params);
         // The streams of samples next..next + 16, with their camera numbers computed together.
         let mut batch = [None; LANES];
+        let mut hits = [SurfaceHit::miss(); LANES];
         loop {
             for slot in slots.iter_mut().filter(|s| s.is_none()) {
                 if next == n {
@@ -111,22 +114,26 @@ impl CpuRenderer {
             } else {
                 [false; LANES]
             };
-            prefetch_vertices(&mut slots, choose_light);
-            for (lane, slot) in slots.iter_mut().enumerate() {
-                let Some((k, path)) = slot else { continue };
-                let hit = if path.extend && prims[lane] != NONE {
+            // Filled in place (an array built by `from_fn` was copied each round).
+            hits.fill(SurfaceHit::miss());
+            for (lane, slot) in slots.iter().enumerate() {
+                let Some((_, path)) = slot else { continue };
+                if path.extend && prims[lane] != NONE {
                     let (o, d) = (path.ray_origin, path.ray_dir);
                     let uv = (us[lane], vs[lane]);
-                    self.bvh.surface_with_uv(prims[lane], o, d, ts[lane], uv)
-                } else {
-                    SurfaceHit::miss()
-                };
+                    hits[lane] = self.bvh.surface_with_uv(prims[lane], o, d, ts[lane], uv);
+                }
+            }
+            prefetch_vertices(&mut slots, choose_light);
+            presample_vertices(&mut slots, &hits, &self.lights, params.light_count, mode);
+            for (lane, slot) in slots.iter_mut().enumerate() {
+                let Some((k, path)) = slot else { continue };
                 path.advance(
                     features,
                     params,
                     &self.materials,
                     &self.lights,
-                    hit,
+                    hits[lane],
                     occluded[lane],
                 );
                 if path.finished() {

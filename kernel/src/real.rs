@@ -1,0 +1,257 @@
+//! 32-bit floats one at a time or many at once: the float arithmetic of the samplers that turn
+//! random numbers into points and directions (`sampling`, `frame`, `turns`), so they are written
+//! once and run on an `f32` (the GPU and the one-path loop) or on a SIMD vector of `f32` (the
+//! CPU's packets, one lane per path). Every operation is IEEE-754 arithmetic on each lane alone
+//! (no fused multiply-add, no approximate reciprocal), so a lane's result is exactly the `f32`
+//! one, bit for bit.
+
+use crate::word::Word;
+use core::ops::{Add, Div, Mul, Neg, Sub};
+use spirv_std::glam::Vec3;
+
+/// An `f32`, or several side by side, with its bits as a [`Word`] of the same width.
+pub trait Real:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// The bits of each lane (comparison masks, sign flips, integer conversions).
+    type Bits: Word;
+    /// `x` in every lane.
+    fn splat(x: f32) -> Self;
+    /// Correctly rounded square root.
+    fn sqrt(self) -> Self;
+    /// `f32::min` of each lane.
+    fn min(self, other: Self) -> Self;
+    /// `f32::max` of each lane.
+    fn max(self, other: Self) -> Self;
+    fn to_bits(self) -> Self::Bits;
+    fn from_bits(bits: Self::Bits) -> Self;
+    /// All ones where `self > other`, zero elsewhere.
+    fn greater_than(self, other: Self) -> Self::Bits;
+    /// All ones where `self >= other`, zero elsewhere.
+    fn at_least(self, other: Self) -> Self::Bits;
+    /// `self as i32` (toward zero, saturating), as the bits of the `i32`.
+    fn to_i32_bits(self) -> Self::Bits;
+    /// The `i32` whose bits are `bits`, `as f32` (rounded to nearest).
+    fn from_i32_bits(bits: Self::Bits) -> Self;
+}
+
+/// `yes` in the lanes where `mask` is all ones, `no` where it is zero.
+#[inline]
+pub fn select<R: Real>(mask: R::Bits, yes: R, no: R) -> R {
+    let (yes, no) = (yes.to_bits(), no.to_bits());
+    R::from_bits(no ^ ((yes ^ no) & mask))
+}
+
+impl Real for f32 {
+    type Bits = u32;
+
+    #[inline]
+    fn splat(x: f32) -> Self {
+        x
+    }
+
+    #[inline]
+    fn sqrt(self) -> Self {
+        #[cfg(target_arch = "spirv")]
+        {
+            <f32 as crate::Float>::sqrt(self)
+        }
+        #[cfg(not(target_arch = "spirv"))]
+        {
+            f32::sqrt(self)
+        }
+    }
+
+    #[inline]
+    fn min(self, other: Self) -> Self {
+        f32::min(self, other)
+    }
+
+    #[inline]
+    fn max(self, other: Self) -> Self {
+        f32::max(self, other)
+    }
+
+    #[inline]
+    fn to_bits(self) -> u32 {
+        f32::to_bits(self)
+    }
+
+    #[inline]
+    fn from_bits(bits: u32) -> Self {
+        f32::from_bits(bits)
+    }
+
+    #[inline]
+    fn greater_than(self, other: Self) -> u32 {
+        if self > other {
+            u32::MAX
+        } else {
+            0
+        }
+    }
+
+    #[inline]
+    fn at_least(self, other: Self) -> u32 {
+        if self >= other {
+            u32::MAX
+        } else {
+            0
+        }
+    }
+
+    #[inline]
+    fn to_i32_bits(self) -> u32 {
+        self as i32 as u32
+    }
+
+    #[inline]
+    fn from_i32_bits(bits: u32) -> Self {
+        bits as i32 as f32
+    }
+}
+
+/// SIMD lanes (native code only).
+#[cfg(not(target_arch = "spirv"))]
+impl<const N: usize> Real for core::simd::Simd<f32, N> {
+    type Bits = core::simd::Simd<u32, N>;
+
+    #[inline]
+    fn splat(x: f32) -> Self {
+        Self::splat(x)
+    }
+
+    #[inline]
+    fn sqrt(self) -> Self {
+        std::simd::StdFloat::sqrt(self)
+    }
+
+    #[inline]
+    fn min(self, other: Self) -> Self {
+        core::simd::num::SimdFloat::simd_min(self, other)
+    }
+
+    #[inline]
+    fn max(self, other: Self) -> Self {
+        core::simd::num::SimdFloat::simd_max(self, other)
+    }
+
+    #[inline]
+    fn to_bits(self) -> Self::Bits {
+        core::simd::num::SimdFloat::to_bits(self)
+    }
+
+    #[inline]
+    fn from_bits(bits: Self::Bits) -> Self {
+        core::simd::num::SimdFloat::from_bits(bits)
+    }
+
+    #[inline]
+    fn greater_than(self, other: Self) -> Self::Bits {
+        use core::simd::{cmp::SimdPartialOrd, Select};
+        self.simd_gt(other)
+            .select(Self::Bits::splat(u32::MAX), Self::Bits::splat(0))
+    }
+
+    #[inline]
+    fn at_least(self, other: Self) -> Self::Bits {
+        use core::simd::{cmp::SimdPartialOrd, Select};
+        self.simd_ge(other)
+            .select(Self::Bits::splat(u32::MAX), Self::Bits::splat(0))
+    }
+
+    #[inline]
+    fn to_i32_bits(self) -> Self::Bits {
+        use core::simd::num::{SimdFloat, SimdInt};
+        self.cast::<i32>().cast()
+    }
+
+    #[inline]
+    fn from_i32_bits(bits: Self::Bits) -> Self {
+        use core::simd::num::{SimdInt, SimdUint};
+        bits.cast::<i32>().cast()
+    }
+}
+
+/// A 3-vector of [`Real`]s: one vector, or one per lane. Its operations are glam's `Vec3` ones,
+/// component by component in the same order (`dot` = (x x' + y y') + z z'), so a `V3<f32>`
+/// gives exactly the `Vec3` result.
+#[derive(Clone, Copy, Debug)]
+pub struct V3<R> {
+    pub x: R,
+    pub y: R,
+    pub z: R,
+}
+
+impl<R: Real> V3<R> {
+    #[inline]
+    pub fn new(x: R, y: R, z: R) -> Self {
+        Self { x, y, z }
+    }
+
+    #[inline]
+    pub fn dot(self, rhs: Self) -> R {
+        (self.x * rhs.x) + (self.y * rhs.y) + (self.z * rhs.z)
+    }
+}
+
+impl<R: Real> Add for V3<R> {
+    type Output = Self;
+    #[inline]
+    fn add(self, rhs: Self) -> Self {
+        Self::new(self.x + rhs.x, self.y + rhs.y, self.z + rhs.z)
+    }
+}
+
+impl<R: Real> Sub for V3<R> {
+    type Output = Self;
+    #[inline]
+    fn sub(self, rhs: Self) -> Self {
+        Self::new(self.x - rhs.x, self.y - rhs.y, self.z - rhs.z)
+    }
+}
+
+impl<R: Real> Neg for V3<R> {
+    type Output = Self;
+    #[inline]
+    fn neg(self) -> Self {
+        Self::new(-self.x, -self.y, -self.z)
+    }
+}
+
+/// Each component times `rhs`.
+impl<R: Real> Mul<R> for V3<R> {
+    type Output = Self;
+    #[inline]
+    fn mul(self, rhs: R) -> Self {
+        Self::new(self.x * rhs, self.y * rhs, self.z * rhs)
+    }
+}
+
+/// Each component divided by `rhs`.
+impl<R: Real> Div<R> for V3<R> {
+    type Output = Self;
+    #[inline]
+    fn div(self, rhs: R) -> Self {
+        Self::new(self.x / rhs, self.y / rhs, self.z / rhs)
+    }
+}
+
+impl From<Vec3> for V3<f32> {
+    #[inline]
+    fn from(v: Vec3) -> Self {
+        Self::new(v.x, v.y, v.z)
+    }
+}
+
+impl From<V3<f32>> for Vec3 {
+    #[inline]
+    fn from(v: V3<f32>) -> Self {
+        Vec3::new(v.x, v.y, v.z)
+    }
+}
