@@ -97,7 +97,7 @@ impl PrefetchedStream {
     }
 }
 
-// Inlined into the kernel's vertex, so the arguments compared stay in registers.
+// Inlined into the kernel's vertex: a few comparisons, then the sample or the scalar fallback.
 impl VertexSampler for PrefetchedStream {
     #[inline(always)]
     fn sample_light_from(
@@ -133,8 +133,8 @@ impl VertexSampler for PrefetchedStream {
     }
 }
 
-/// The samplers' arguments by lane (zero in lanes that want nothing: their results, NaN or
-/// not, are not read).
+/// The samplers' arguments by lane (zero in empty lanes; lanes that want nothing compute too,
+/// and their results, NaN or not, are not read).
 #[derive(Default)]
 struct Arguments {
     center: [Column; 3],
