@@ -24,36 +24,17 @@ pub trait VertexSampler: SampleStream {
         x: Vec3,
         u_select: f32,
     ) -> DirectionalLightSample {
-        draw_light_sample(self, lights, light_count, mode, x, u_select)
+        let (u1, u2) = self.next_2d();
+        sample_light_from(lights, light_count, mode, x, u_select, u1, u2)
     }
 
     /// [`sample_brdf`] around the facing normal `n` with the pair of numbers at the current
     /// dimension (the stream advances two).
     #[inline]
     fn sample_brdf(&mut self, n: Vec3) -> Vec3 {
-        draw_brdf_direction(self, n)
+        let (u1, u2) = self.next_2d();
+        sample_brdf(n, u1, u2)
     }
 }
 
 impl VertexSampler for SampleRng {}
-
-/// What [`VertexSampler::sample_light_from`] returns: the light sample drawn from `stream`.
-#[inline]
-pub fn draw_light_sample<S: SampleStream + ?Sized>(
-    stream: &mut S,
-    lights: &[SphereLight],
-    light_count: u32,
-    mode: u32,
-    x: Vec3,
-    u_select: f32,
-) -> DirectionalLightSample {
-    let (u1, u2) = stream.next_2d();
-    sample_light_from(lights, light_count, mode, x, u_select, u1, u2)
-}
-
-/// What [`VertexSampler::sample_brdf`] returns: the BRDF direction drawn from `stream`.
-#[inline]
-pub fn draw_brdf_direction<S: SampleStream + ?Sized>(stream: &mut S, n: Vec3) -> Vec3 {
-    let (u1, u2) = stream.next_2d();
-    sample_brdf(n, u1, u2)
-}

@@ -187,7 +187,7 @@ fn vertex_samples_computed_for_sixteen_paths_are_the_kernel_samples() {
     };
     use kernel::rng::{pcg4d, u32_to_unit_f32, SampleRng, SampleStream};
     use kernel::scene::{light_sampling, sampler, NONE};
-    use kernel::vertex_sampler::{draw_brdf_direction, draw_light_sample, VertexSampler};
+    use kernel::vertex_sampler::VertexSampler;
     use kernel::SurfaceHit;
     use twinpath::cpu::packet::LANES;
     use twinpath::cpu::packet_numbers::{prefetch_vertices, PrefetchedStream};
@@ -291,7 +291,7 @@ fn vertex_samples_computed_for_sixteen_paths_are_the_kernel_samples() {
             let mut twin = path.rng;
             expected.seek(d);
             path.rng.seek(d);
-            let want = draw_light_sample(&mut expected, lights, light_count, mode, x, u_select);
+            let want = expected.sample_light_from(lights, light_count, mode, x, u_select);
             let got = path
                 .rng
                 .sample_light_from(lights, light_count, mode, x, u_select);
@@ -316,7 +316,7 @@ fn vertex_samples_computed_for_sixteen_paths_are_the_kernel_samples() {
             let mut again = rngs[lane].unwrap();
             again.seek(d);
             twin.seek(d);
-            let want = draw_light_sample(&mut again, lights, light_count, mode, moved, u_select);
+            let want = again.sample_light_from(lights, light_count, mode, moved, u_select);
             let got = twin.sample_light_from(lights, light_count, mode, moved, u_select);
             assert_eq!(
                 bits(got.point.position),
@@ -336,7 +336,7 @@ fn vertex_samples_computed_for_sixteen_paths_are_the_kernel_samples() {
             path.rng.seek(d);
             assert_eq!(
                 bits(path.rng.sample_brdf(n)),
-                bits(draw_brdf_direction(&mut expected, n)),
+                bits(expected.sample_brdf(n)),
                 "round {round} lane {lane}: BRDF direction"
             );
             assert_eq!(path.rng.rng.dimension, expected.dimension);

@@ -3,7 +3,7 @@
 //! lane-wise functions as the BVH's leaves (`simd::triangle_lanes`, `simd::sphere_lanes`), so
 //! each lane's t is bit-identical to the kernel's scalar intersection of that ray.
 
-use super::simd::{sphere_lanes, triangle_lanes_uv};
+use super::simd::{sphere_lanes, triangle_lanes_uv, widest_simd};
 use glam::Vec3;
 use kernel::scene::{Sphere, Triangle, NONE};
 use std::simd::cmp::SimdPartialOrd;
@@ -116,35 +116,11 @@ impl SmallScene {
         }
     }
 
-    /// Each lane's closest hit in (0, t_max) (`NONE` and t_max for a miss). Of primitives at
-    /// exactly the same t the first in id order wins.
-    pub fn closest(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { self.closest_avx512(rays, t_max) };
-        }
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { self.closest_avx2(rays, t_max) };
-        }
-        self.closest_any_cpu(rays, t_max)
-    }
-
-    /// [`SmallScene::closest`] in two 8-lane registers (CPUs without AVX-512).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn closest_avx2(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
-        self.closest_any_cpu(rays, t_max)
-    }
-
-    /// [`SmallScene::closest`] with the sixteen lanes in one register: the same operations,
-    /// so the same results (no FMA).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn closest_avx512(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
-        self.closest_any_cpu(rays, t_max)
+    widest_simd! {
+        /// Each lane's closest hit in (0, t_max) (`NONE` and t_max for a miss). Of primitives at
+        /// exactly the same t the first in id order wins.
+        pub fn closest(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits
+            = closest_any_cpu, closest_avx512, closest_avx2
     }
 
     #[inline(always)]
@@ -174,33 +150,10 @@ impl SmallScene {
         hits
     }
 
-    /// Whether each lane's ray meets anything within (0, t_max).
-    pub fn occluded(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES> {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { self.occluded_avx512(rays, t_max) };
-        }
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { self.occluded_avx2(rays, t_max) };
-        }
-        self.occluded_any_cpu(rays, t_max)
-    }
-
-    /// [`SmallScene::occluded`] in two 8-lane registers (CPUs without AVX-512).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn occluded_avx2(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES> {
-        self.occluded_any_cpu(rays, t_max)
-    }
-
-    /// [`SmallScene::occluded`] with the sixteen lanes in one register.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn occluded_avx512(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES> {
-        self.occluded_any_cpu(rays, t_max)
+    widest_simd! {
+        /// Whether each lane's ray meets anything within (0, t_max).
+        pub fn occluded(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES>
+            = occluded_any_cpu, occluded_avx512, occluded_avx2
     }
 
     #[inline(always)]

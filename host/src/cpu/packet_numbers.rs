@@ -6,6 +6,7 @@
 
 use super::packet::LANES;
 use super::packet_vertices::{PresampledBrdf, PresampledLight};
+use super::simd::widest_simd;
 use kernel::path::{
     PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX, LIGHT_CHOICE_DIMENSION,
     LIGHT_POINT_DIMENSION, ROULETTE_DIMENSION,
@@ -152,33 +153,10 @@ impl Requests {
         }
     }
 
-    /// The requested numbers of every lane, computed together: pairs[p] = (x, y), singles[p].
-    fn compute(&self) -> Numbers {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { self.compute_avx512() };
-        }
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { self.compute_avx2() };
-        }
-        self.compute_any_cpu()
-    }
-
-    /// [`Requests::compute`] with AVX2's lane-wise 32-bit multiply (baseline x86-64 has none).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn compute_avx2(&self) -> Numbers {
-        self.compute_any_cpu()
-    }
-
-    /// [`Requests::compute`] with the sixteen lanes in one register.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn compute_avx512(&self) -> Numbers {
-        self.compute_any_cpu()
+    widest_simd! {
+        /// The requested numbers of every lane, computed together: pairs[p] = (x, y), singles[p].
+        /// (Baseline x86-64 has no lane-wise 32-bit multiply; AVX2 and AVX-512F do.)
+        fn compute(&self) -> Numbers = compute_any_cpu, compute_avx512, compute_avx2
     }
 
     #[inline(always)]

@@ -11,6 +11,7 @@ use super::packet::LANES;
 use super::packet_numbers::{
     PrefetchedStream, BRDF_PAIR, EMPTY, LIGHT_CHOICE_SINGLE, LIGHT_POINT_PAIR,
 };
+use super::simd::widest_simd;
 use glam::Vec3;
 use kernel::light::{choose_light, cone_light_sample, uses_cone, DirectionalLightSample};
 use kernel::path::{
@@ -22,7 +23,7 @@ use kernel::sampling::{
     sample_cosine_hemisphere_v3, sample_sphere_cone_v3, ConeSample, SurfacePoint,
 };
 use kernel::scene::{light_sampling, SphereLight, NONE};
-use kernel::vertex_sampler::{draw_brdf_direction, draw_light_sample, VertexSampler};
+use kernel::vertex_sampler::VertexSampler;
 use kernel::SurfaceHit;
 use std::simd::Simd;
 
@@ -97,7 +98,9 @@ impl PrefetchedStream {
     }
 }
 
-// Inlined into the kernel's vertex: a few comparisons, then the sample or the scalar fallback.
+// Inlined into the kernel's vertex: a few comparisons, then the sample computed ahead or, for
+// anything else, `SampleRng`'s own (which computes the pair's numbers again: rare, and the same
+// numbers).
 impl VertexSampler for PrefetchedStream {
     #[inline(always)]
     fn sample_light_from(
@@ -119,7 +122,9 @@ impl VertexSampler for PrefetchedStream {
             self.rng.dimension += 2;
             return p.sample;
         }
-        draw_light_sample(self, lights, light_count, mode, x, u_select)
+        // Computed now, as the one-path loop does.
+        self.rng
+            .sample_light_from(lights, light_count, mode, x, u_select)
     }
 
     #[inline(always)]
@@ -129,7 +134,7 @@ impl VertexSampler for PrefetchedStream {
             self.rng.dimension += 2;
             return p.wi;
         }
-        draw_brdf_direction(self, n)
+        self.rng.sample_brdf(n)
     }
 }
 
@@ -179,33 +184,9 @@ fn set_lane3(v: &mut [Column; 3], lane: usize, x: Vec3) {
 }
 
 impl Arguments {
-    /// Both samplers on every lane.
-    fn compute(&self) -> Results {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { self.compute_avx512() };
-        }
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { self.compute_avx2() };
-        }
-        self.compute_any_cpu()
-    }
-
-    /// [`Arguments::compute`] with eight lanes per instruction.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn compute_avx2(&self) -> Results {
-        self.compute_any_cpu()
-    }
-
-    /// [`Arguments::compute`] with the sixteen lanes in one register.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn compute_avx512(&self) -> Results {
-        self.compute_any_cpu()
+    widest_simd! {
+        /// Both samplers on every lane.
+        fn compute(&self) -> Results = compute_any_cpu, compute_avx512, compute_avx2
     }
 
     #[inline(always)]

@@ -228,3 +228,46 @@ pub fn min_or_second<const N: usize>(a: Simd<f32, N>, b: Simd<f32, N>) -> Simd<f
 pub fn max_or_second<const N: usize>(a: Simd<f32, N>, b: Simd<f32, N>) -> Simd<f32, N> {
     a.simd_gt(b).select(a, b)
 }
+
+/// Defines method `$name` that runs `$any_cpu` (an `#[inline(always)]` method taking the same
+/// arguments, written with `std::simd`) compiled for the widest SIMD this CPU has, detected at
+/// run time: AVX-512F (method `$avx512`: sixteen `f32` lanes in one register), AVX2 (`$avx2`:
+/// two 8-lane registers), or the baseline. Every variant performs the same lane-wise IEEE
+/// operations (no FMA), so all give the same results.
+macro_rules! widest_simd {
+    (
+        $(#[$attr:meta])*
+        $vis:vis fn $name:ident(&self $(, $arg:ident: $ty:ty)*) -> $out:ty
+        = $any_cpu:ident, $avx512:ident, $avx2:ident
+    ) => {
+        $(#[$attr])*
+        $vis fn $name(&self $(, $arg: $ty)*) -> $out {
+            #[cfg(target_arch = "x86_64")]
+            if std::is_x86_feature_detected!("avx512f") {
+                // SAFETY: the CPU has AVX-512F (checked just above).
+                return unsafe { self.$avx512($($arg),*) };
+            }
+            #[cfg(target_arch = "x86_64")]
+            if std::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU has AVX2 (checked just above).
+                return unsafe { self.$avx2($($arg),*) };
+            }
+            self.$any_cpu($($arg),*)
+        }
+
+        #[doc = concat!("`", stringify!($name), "` for CPUs with AVX-512F.")]
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx512f")]
+        unsafe fn $avx512(&self $(, $arg: $ty)*) -> $out {
+            self.$any_cpu($($arg),*)
+        }
+
+        #[doc = concat!("`", stringify!($name), "` for CPUs with AVX2.")]
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        unsafe fn $avx2(&self $(, $arg: $ty)*) -> $out {
+            self.$any_cpu($($arg),*)
+        }
+    };
+}
+pub(crate) use widest_simd;
