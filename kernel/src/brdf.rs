@@ -1,7 +1,8 @@
 //! The two-sided Lambertian BRDF, f = Kd / pi. `n` is always the normal flipped to the side the
 //! light leaves toward (the side of the outgoing direction), so both sides reflect alike.
 
-use crate::sampling::{pdf_cosine_hemisphere, sample_cosine_hemisphere};
+use crate::real::{self, V3};
+use crate::sampling::{pdf_cosine_hemisphere, sample_cosine_hemisphere_v3};
 use core::f32::consts::PI;
 use spirv_std::glam::Vec3;
 
@@ -18,7 +19,13 @@ pub fn eval_scattering(n: Vec3, wi: Vec3, albedo: Vec3) -> Vec3 {
 /// importance sampling of the Lambertian `eval_scattering`.
 #[inline]
 pub fn sample_brdf(n: Vec3, u1: f32, u2: f32) -> Vec3 {
-    sample_cosine_hemisphere(n, u1, u2)
+    sample_brdf_v3(V3::from(n), u1, u2).into()
+}
+
+/// [`sample_brdf`] for one normal, or one per lane ([`real::Real`]: the CPU's packets).
+#[inline]
+pub fn sample_brdf_v3<R: real::Real>(n: V3<R>, u1: R, u2: R) -> V3<R> {
+    sample_cosine_hemisphere_v3(n, u1, u2)
 }
 
 /// Seed: `PdfBrdf(N, w_i)`. Solid-angle density of [`sample_brdf`]: max(0, n . w_i) / pi.

@@ -1,6 +1,6 @@
 //! The light samples and BRDF directions of sixteen paths' next vertices at once. After a
 //! round's rays, the kernel's samplers in their [`kernel::real::Real`] form
-//! (`sample_sphere_cone_v3`, `sample_cosine_hemisphere_v3`) run on SIMD lanes, one path per
+//! (`sample_sphere_cone_v3`, `brdf::sample_brdf_v3`) run on SIMD lanes, one path per
 //! lane, from the numbers `packet_numbers` computed; each path's vertex then takes its samples
 //! through [`VertexSampler`] instead of computing them one at a time (a chain of divisions and
 //! square roots: `sample_light_from` alone was 20% of a Cornell render). A lane computes exactly
@@ -13,15 +13,14 @@ use super::packet_numbers::{
 };
 use super::simd::widest_simd;
 use glam::Vec3;
+use kernel::brdf::sample_brdf_v3;
 use kernel::light::{choose_light, cone_light_sample, uses_cone, DirectionalLightSample};
 use kernel::path::{
     facing_normal, PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX,
     LIGHT_CHOICE_DIMENSION, LIGHT_POINT_DIMENSION,
 };
 use kernel::real::V3;
-use kernel::sampling::{
-    sample_cosine_hemisphere_v3, sample_sphere_cone_v3, ConeSample, SurfacePoint,
-};
+use kernel::sampling::{sample_sphere_cone_v3, ConeSample, SurfacePoint};
 use kernel::scene::{light_sampling, SphereLight, NONE};
 use kernel::vertex_sampler::VertexSampler;
 use kernel::SurfaceHit;
@@ -199,7 +198,7 @@ impl Arguments {
             lanes(self.u_light[0]),
             lanes(self.u_light[1]),
         );
-        let wi = sample_cosine_hemisphere_v3(
+        let wi = sample_brdf_v3(
             lanes3(&self.normal),
             lanes(self.u_brdf[0]),
             lanes(self.u_brdf[1]),
