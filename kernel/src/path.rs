@@ -5,8 +5,8 @@ use crate::adaptive::sample_stream;
 use crate::brdf::{eval_scattering, pdf_brdf, sampled_brdf_weight};
 use crate::camera::{camera_origin, camera_ray_direction};
 use crate::features::FeatureSet;
-use crate::geometry::{offset_ray_origin, shadow_ray_end, sphere_point_error};
-use crate::light::{eval_radiance, pdf_light_from};
+use crate::geometry::{offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error};
+use crate::light::pdf_light_from;
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{light_sampling, Material, RenderParams, SphereLight, NONE};
@@ -28,6 +28,12 @@ pub struct SurfaceHit {
     /// Absolute bound on the rounding error of `position` (per component), which sizes the
     /// offset of rays leaving it (`geometry::offset_ray_origin`).
     pub error: f32,
+    /// Whether the ray arrived from the side `normal` points away from (a sphere's inside, a
+    /// triangle's back). Decided where the record is made, and robustly for spheres: by which
+    /// side of the sphere the ray's origin lies on, not by the sign of `normal . dir`, which
+    /// rounding flips at grazing hits (a grazing ray would otherwise leave inward and be
+    /// trapped inside the sphere).
+    pub arrived_behind: bool,
 }
 
 impl SurfaceHit {
@@ -41,6 +47,51 @@ impl SurfaceHit {
             material: NONE,
             light: NONE,
             error: 0.0,
+            arrived_behind: false,
+        }
+    }
+
+    /// The record of ray `origin + t dir` meeting the sphere (`center`, `radius`) at `t`: the
+    /// point re-projected onto the surface, the outward normal, the point's error bound, and
+    /// the side the ray came from (the side its origin is on: exact geometry for a convex
+    /// surface, and a sign that holds at grazing hits). Both backends build sphere hits here.
+    #[inline]
+    pub fn sphere(
+        origin: Vec3,
+        dir: Vec3,
+        t: f32,
+        center: Vec3,
+        radius: f32,
+        material: u32,
+        light: u32,
+    ) -> Self {
+        let position = reproject_to_sphere(origin + t * dir, center, radius);
+        let from_center = origin - center;
+        Self {
+            position,
+            t,
+            normal: (position - center) / radius,
+            material,
+            light,
+            error: sphere_point_error(center, radius),
+            arrived_behind: from_center.dot(from_center) < radius * radius,
+        }
+    }
+
+    /// Whether a ray along `dir` meets a flat surface of unit normal `normal` from behind.
+    #[inline]
+    pub fn behind_plane(normal: Vec3, dir: Vec3) -> bool {
+        normal.dot(-dir) < 0.0
+    }
+
+    /// The normal on the side the ray arrived from, which light leaving toward the ray's
+    /// origin leaves from (surfaces are two-sided): the `n` of a vertex's BRDF.
+    #[inline]
+    pub fn facing_normal(&self) -> Vec3 {
+        if self.arrived_behind {
+            -self.normal
+        } else {
+            self.normal
         }
     }
 
@@ -71,8 +122,6 @@ pub const ROULETTE_DIMENSION: u32 = 3;
 pub const BRDF_DIMENSION: u32 = 4;
 /// Random dimensions used by the camera before the first vertex (position inside the pixel).
 pub const CAMERA_DIMENSIONS: u32 = 2;
-/// Seed's epsilon: an extension whose pdf is below it ends the path (see [`trace_path`]).
-pub const PDF_EPSILON: f32 = 1e-6;
 
 /// Seed: `TracePath(ray)`. One unbiased estimate of the radiance arriving at `origin` from
 /// direction `-dir` (`dir` unit length).
@@ -105,9 +154,12 @@ pub const PDF_EPSILON: f32 = 1e-6;
 ///    *The background is not light-sampled*, so a path that escapes gets weight 1.
 /// 3. **Reflected light: extension.** Choose w_i with the cosine-weighted density
 ///    p_brdf = cos(theta_x)/pi and multiply the path throughput by `f cos(theta_x) / p_brdf`,
-///    which is exactly Kd. Extensions with `p_brdf < 1e-6` (the seed's epsilon) end the path; the radiance so
-///    lost is that arriving within cos(theta) < pi * 1e-6 of the horizon, a relative
-///    contribution of about 1e-11, far below any test's resolution.
+///    which is exactly Kd. No direction ends the path. (The seed ends it where p_brdf < 1e-6,
+///    which looks harmless in the continuum, 1e-11 of the cosine-weighted measure; but the
+///    uniform numbers are discrete, u1 = 0 has probability 2^-24 and gave the tangent direction,
+///    pdf 0, so the cut-off lost 2^-24 of the paths at every bounce. The sampler now reads
+///    u1 = 0 as the midpoint of its interval, `sampling::U1_FLOOR`, so p_brdf >= 5.5e-5 and no
+///    extension is tangent; a tangent ray could graze into a sphere and be trapped inside.)
 /// 4. **Russian roulette** decides whether the extension of step 3 happens: with probability q
 ///    it does and the throughput is divided by q, else the path ends. Everything found after the
 ///    decision (the BRDF-sampled light hit, later vertices' light samples) is therefore divided
@@ -117,7 +169,8 @@ pub const PDF_EPSILON: f32 = 1e-6;
 ///    1/q^(k-1): direct light would come out 20% too dark at q = 0.8. Here the light sample of
 ///    a vertex always happens, and the roulette decision follows it.
 /// 5. A path also ends where its throughput is exactly zero (nothing after can add light) and,
-///    as a guard only, after `max_depth` vertices (`u32::MAX` by default: no bias). No shadow
+///    as a guard only, after `max_depth` vertices (`u32::MAX` by default: no bias). Every place
+///    a path ends without escaping is listed in `docs/correctness.md` ("Where a path ends"). No shadow
 ///    ray is traced from a black surface (its light sample would add exactly zero).
 ///
 /// `features` answers which of these steps the scene needs (`crate::features`): a
@@ -253,7 +306,6 @@ impl<R: VertexSampler> PathState<R> {
             return;
         }
         self.extend = false;
-        let dir = self.ray_dir;
         if !hit.is_hit() {
             // 1: the camera ray sees the background; an extension adds it with weight 1.
             if self.depth == 0 {
@@ -265,7 +317,13 @@ impl<R: VertexSampler> PathState<R> {
         }
         let material = materials[hit.material as usize];
         if hit.light != NONE {
-            let emitted = eval_radiance(Vec3::from(material.emission), hit.normal, -dir);
+            // Lights emit from their outer surface only (`light::eval_radiance`), decided by the
+            // side the ray arrived from.
+            let emitted = if hit.arrived_behind {
+                Vec3::ZERO
+            } else {
+                Vec3::from(material.emission)
+            };
             if self.depth == 0 {
                 // 1: a light seen directly (it reflects nothing, so the path ends).
                 self.radiance = emitted;
@@ -285,10 +343,10 @@ impl<R: VertexSampler> PathState<R> {
             return;
         }
         self.depth += 1;
-        self.vertex(features, params, lights, hit, material, -dir);
+        self.vertex(features, params, lights, hit, material);
     }
 
-    /// Steps 2(a), 4 and 3 at vertex `hit` (reached at `self.depth`), left toward `w_out`:
+    /// Steps 2(a), 4 and 3 at vertex `hit` (reached at `self.depth`), left toward the ray's origin:
     /// prepares the light sample's shadow segment and, unless the path ends here, the extension.
     #[inline]
     fn vertex<F: FeatureSet>(
@@ -298,10 +356,9 @@ impl<R: VertexSampler> PathState<R> {
         lights: &[SphereLight],
         hit: SurfaceHit,
         material: Material,
-        w_out: Vec3,
     ) {
         let rng = &mut self.rng;
-        let n = facing_normal(hit.normal, w_out);
+        let n = hit.facing_normal();
         let x = hit.position;
         let albedo = Vec3::from(material.albedo);
         let ray_origin = offset_ray_origin(x, n, hit.error);
@@ -372,13 +429,11 @@ impl<R: VertexSampler> PathState<R> {
             }
         }
 
-        // 3: extension by BRDF sampling.
+        // 3: extension by BRDF sampling. Every direction the sampler returns continues the
+        // path (none is tangent; step 3 of `trace_path`).
         rng.seek(dimensions + BRDF_DIMENSION);
         let wi = rng.sample_brdf(n);
         let pdf_b = pdf_brdf(n, wi);
-        if pdf_b < PDF_EPSILON {
-            return;
-        }
         // = eval_scattering(n, wi, albedo) / pdf_b, exactly (see `sampled_brdf_weight`).
         self.throughput *= sampled_brdf_weight(albedo);
         if self.throughput.max_element() <= 0.0 {
@@ -389,17 +444,6 @@ impl<R: VertexSampler> PathState<R> {
         self.ray_dir = wi;
         self.previous_vertex = x;
         self.previous_pdf = pdf_b;
-    }
-}
-
-/// The normal on the side the light leaves toward, `w_out` (surfaces are two-sided): the `n` of
-/// a vertex's BRDF.
-#[inline]
-pub fn facing_normal(normal: Vec3, w_out: Vec3) -> Vec3 {
-    if normal.dot(w_out) < 0.0 {
-        -normal
-    } else {
-        normal
     }
 }
 

@@ -12,10 +12,7 @@
 
 use crate::adaptive::{is_pilot_sample, luminance, pixel_converged};
 use crate::features::Dynamic;
-use crate::geometry::{
-    intersect_sphere, reproject_to_sphere, sphere_point_error, triangle_normal, triangle_point,
-    triangle_point_error,
-};
+use crate::geometry::{intersect_sphere, triangle_normal, triangle_point, triangle_point_error};
 use crate::path::{render_sample, SurfaceHit, Tracer};
 use crate::scene::{Material, RenderParams, Sphere, SphereLight, Triangle, NONE};
 use spirv_std::glam::{UVec2, UVec3, UVec4, Vec2, Vec3, Vec4};
@@ -35,7 +32,8 @@ pub struct HitPayload {
     pub light: u32,
     /// 1 if the ray hit something; the miss shader clears it.
     pub hit: u32,
-    pub _pad: u32,
+    /// 1 if the ray arrived from behind the normal (`SurfaceHit::arrived_behind`).
+    pub behind: u32,
 }
 
 /// [`Tracer`] over the top-level acceleration structure.
@@ -71,6 +69,7 @@ impl Tracer for RayTracer<'_> {
             material: self.payload.material,
             light: self.payload.light,
             error: self.payload.normal.w,
+            arrived_behind: self.payload.behind != 0,
         }
     }
 
@@ -209,6 +208,7 @@ pub fn closest_hit_triangle(
     #[spirv(hit_attribute)] barycentrics: &Vec2,
     #[spirv(primitive_id)] primitive: u32,
     #[spirv(instance_custom_index)] first: u32,
+    #[spirv(world_ray_direction)] dir: Vec3,
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
 ) {
@@ -220,11 +220,13 @@ pub fn closest_hit_triangle(
     );
     let (u, v) = (barycentrics.x, barycentrics.y);
     let p = triangle_point(p0, e1, e2, u, v);
+    let normal = triangle_normal(e1, e2);
     payload.position_t = p.extend(t);
-    payload.normal = triangle_normal(e1, e2).extend(triangle_point_error(p0, e1, e2, u, v));
+    payload.normal = normal.extend(triangle_point_error(p0, e1, e2, u, v));
     payload.material = tri.material;
     payload.light = NONE;
     payload.hit = 1;
+    payload.behind = SurfaceHit::behind_plane(normal, dir) as u32;
 }
 
 /// Intersection with a procedural sphere: the kernel's robust ray/sphere test, the same function
@@ -260,13 +262,21 @@ pub fn closest_hit_sphere(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] spheres: &[Sphere],
 ) {
     let s = spheres[(first + primitive) as usize];
-    let center = Vec3::from(s.center);
-    let p = reproject_to_sphere(origin + t * dir, center, s.radius);
-    payload.position_t = p.extend(t);
-    payload.normal = ((p - center) / s.radius).extend(sphere_point_error(center, s.radius));
-    payload.material = s.material;
-    payload.light = s.light;
+    let h = SurfaceHit::sphere(
+        origin,
+        dir,
+        t,
+        Vec3::from(s.center),
+        s.radius,
+        s.material,
+        s.light,
+    );
+    payload.position_t = h.position.extend(t);
+    payload.normal = h.normal.extend(h.error);
+    payload.material = h.material;
+    payload.light = h.light;
     payload.hit = 1;
+    payload.behind = h.arrived_behind as u32;
 }
 
 /// Push constants of [`probe`].

@@ -8,6 +8,7 @@
 use twinpath::cpu::CpuRenderer;
 use twinpath::render::Backend;
 use twinpath::scene::Scene;
+use twinpath::settings::{LightSampling, Mis, Roulette, Sampler};
 use twinpath_tests::{assert_films_identical, render_film, repo_root};
 
 fn small(name: &str) -> Scene {
@@ -19,22 +20,24 @@ fn small(name: &str) -> Scene {
 
 fn scenes() -> Vec<(&'static str, Scene)> {
     let mut half = small("cornell.toml");
-    half.render.mis_mode = kernel::scene::mis::HALF;
-    half.render.light_sampling = kernel::scene::light_sampling::AREA;
+    half.render.mis = Mis::Half;
+    half.render.light_sampling = LightSampling::Area;
+    let mut constant = small("cornell.toml");
+    constant.render.roulette = Roulette::Constant;
     let mut throughput = small("cornell.toml");
-    throughput.render.rr_mode = kernel::scene::roulette::THROUGHPUT;
-    throughput.render.rr_start_depth = 3;
+    throughput.render.rr_start_depth = Some(3);
     let mut generic = small("cornell.toml");
     generic.render.specialize = false;
     let mut independent = small("cornell.toml");
-    independent.render.sampler = kernel::scene::sampler::INDEPENDENT;
+    independent.render.sampler = Sampler::Independent;
     let mut adaptive = small("cornell.toml");
     adaptive.render.adaptive_target = 0.05;
     let mut sky = small("many_lights.toml");
     sky.background = glam::Vec3::new(0.2, 0.3, 0.5);
     vec![
         ("cornell", small("cornell.toml")),
-        ("cornell, throughput roulette", throughput),
+        ("cornell, constant roulette", constant),
+        ("cornell, throughput roulette from depth 3", throughput),
         ("cornell, half weights + area sampling", half),
         ("cornell, generic path", generic),
         ("cornell, independent sampler", independent),
@@ -182,7 +185,7 @@ fn vertex_samples_computed_for_sixteen_paths_are_the_kernel_samples() {
     use glam::Vec3;
     use kernel::light::uses_cone;
     use kernel::path::{
-        facing_normal, PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX,
+        PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX,
         LIGHT_CHOICE_DIMENSION, LIGHT_POINT_DIMENSION,
     };
     use kernel::rng::{pcg4d, u32_to_unit_f32, SampleRng, SampleStream};
@@ -261,6 +264,7 @@ fn vertex_samples_computed_for_sixteen_paths_are_the_kernel_samples() {
                 material: 0,
                 light: if kind == 2 { 0 } else { NONE },
                 error: 1e-6,
+                arrived_behind: unit(lane, 15) < 0.5,
             }
         });
         prefetch_vertices(&mut slots, light_count > 1);
@@ -331,7 +335,7 @@ fn vertex_samples_computed_for_sixteen_paths_are_the_kernel_samples() {
                 "round {round} lane {lane}: BRDF direction computed ahead?"
             );
             computed[1] += path.rng.holds_brdf_direction(d) as usize;
-            let n = facing_normal(hit.normal, -path.ray_dir);
+            let n = hit.facing_normal();
             expected.seek(d);
             path.rng.seek(d);
             assert_eq!(

@@ -114,6 +114,43 @@ fn sample_lobe_has_the_requested_cosine_and_uniform_azimuth() {
 }
 
 #[test]
+fn sample_brdf_is_never_tangent_and_moves_only_the_first_interval() {
+    // u1 = 0 (one value of 2^24) is read as its interval's midpoint 2^-25: cos(theta) = 2^-12.5
+    // and a pdf far above 0; every other u1 keeps cos(theta) = sqrt(u1) (at u1 = 2^-24 a shift
+    // of every u1 by 2^-25 would move it by 5e-5).
+    let normals = [
+        Vec3::Z,
+        -Vec3::Z,
+        Vec3::new(0.6, 0.0, 0.8),
+        Vec3::new(0.0, -0.6, 0.8),
+    ];
+    for n in normals {
+        for k in 0..64u32 {
+            let u2 = k as f32 / 64.0;
+            let w = sample_brdf(n, 0.0, u2);
+            let cos = n.dot(w);
+            assert!(
+                (cos - 2f32.powf(-12.5)).abs() < 1e-6,
+                "u1 = 0, n {n}: cos {cos}"
+            );
+            assert!(pdf_brdf(n, w) > 5e-5);
+            for u1 in [
+                1.0 / 16_777_216.0,
+                2.0 / 16_777_216.0,
+                0.25,
+                1.0 - 1.0 / 16_777_216.0,
+            ] {
+                let cos = n.dot(sample_brdf(n, u1, u2));
+                assert!(
+                    (cos - u1.sqrt()).abs() < 2e-6,
+                    "u1 {u1}, u2 {u2}, n {n}: cos {cos}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn sample_sphere_is_uniform_in_area() {
     let (center, radius) = (Vec3::new(1.0, -2.0, 0.5), 0.7f32);
     let mut observed = vec![0.0; THETA_BINS * PHI_BINS];

@@ -14,9 +14,8 @@ use super::bvh_build::{Aabb, BinaryBvh, SAH_MAX_DEPTH};
 use super::simd::{Boxes, Ray4, Spheres4, Triangles4, SLAB_PAD};
 use glam::Vec3;
 use kernel::geometry::{
-    intersect_sphere, intersect_triangle, intersect_triangle_uv, reproject_to_sphere,
-    sphere_point_error, triangle_error_condition, triangle_normal, triangle_point,
-    triangle_point_error_conditioned,
+    intersect_sphere, intersect_triangle, intersect_triangle_uv, triangle_error_condition,
+    triangle_normal, triangle_point, triangle_point_error_conditioned,
 };
 use kernel::scene::{Sphere, Triangle, NONE};
 use kernel::SurfaceHit;
@@ -550,16 +549,15 @@ impl Bvh {
         let id = id as usize;
         if id < self.spheres.len() {
             let s = &self.spheres[id];
-            let c = Vec3::from(s.center);
-            let p = reproject_to_sphere(origin + t * dir, c, s.radius);
-            SurfaceHit {
-                position: p,
+            SurfaceHit::sphere(
+                origin,
+                dir,
                 t,
-                normal: (p - c) / s.radius,
-                material: s.material,
-                light: s.light,
-                error: sphere_point_error(c, s.radius),
-            }
+                Vec3::from(s.center),
+                s.radius,
+                s.material,
+                s.light,
+            )
         } else {
             let index = id - self.spheres.len();
             let (tri, shape) = (&self.triangles[index], &self.shapes[index]);
@@ -575,6 +573,7 @@ impl Bvh {
                 material: tri.material,
                 light: NONE,
                 error: triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition),
+                arrived_behind: SurfaceHit::behind_plane(shape.normal, dir),
             }
         }
     }

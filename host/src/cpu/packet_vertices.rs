@@ -16,8 +16,8 @@ use glam::Vec3;
 use kernel::brdf::sample_brdf_v3;
 use kernel::light::{choose_light, cone_light_sample, uses_cone, DirectionalLightSample};
 use kernel::path::{
-    facing_normal, PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX,
-    LIGHT_CHOICE_DIMENSION, LIGHT_POINT_DIMENSION,
+    PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX, LIGHT_CHOICE_DIMENSION,
+    LIGHT_POINT_DIMENSION,
 };
 use kernel::real::V3;
 use kernel::sampling::{sample_sphere_cone_v3, ConeSample, SurfacePoint};
@@ -264,11 +264,7 @@ pub fn presample_vertices<T>(
         }
         let (dimension, (u1, u2)) = path.rng.pair(BRDF_PAIR);
         let wanted = at_surface & (dimension == block + BRDF_DIMENSION);
-        set_lane3(
-            &mut args.normal,
-            lane,
-            facing_normal(hit.normal, -path.ray_dir),
-        );
+        set_lane3(&mut args.normal, lane, hit.facing_normal());
         (args.u_brdf[0][lane], args.u_brdf[1][lane]) = (u1, u2);
         brdf_dimension[lane] = if wanted { dimension } else { EMPTY };
     }
