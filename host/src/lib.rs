@@ -11,7 +11,7 @@ pub mod film;
 #[cfg(feature = "gpu")]
 pub mod render;
 pub mod scene;
-pub mod stats;
+pub mod settings;
 #[cfg(feature = "gpu")]
 pub mod vulkan;
 

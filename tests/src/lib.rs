@@ -63,7 +63,7 @@ pub fn scene_from_toml(text: &str) -> Scene {
 /// spread of its own samples need them: Sobol points (the default) are stratified, so that
 /// spread overstates their error and such a test would lose power, not validity.
 pub fn with_independent_samples(mut scene: Scene) -> Scene {
-    scene.render.sampler = kernel::scene::sampler::INDEPENDENT;
+    scene.render.sampler = twinpath::settings::Sampler::Independent;
     scene
 }
 
@@ -73,6 +73,7 @@ pub fn repo_root() -> std::path::PathBuf {
 }
 pub mod gpu;
 pub mod spirv;
+pub mod stats;
 
 /// Renders `scene` at `spp` on `backend` (the GPU with validation layers on).
 pub fn render_film(

@@ -10,12 +10,12 @@
 use glam::Vec3;
 use kernel::path::trace_path;
 use kernel::rng::SampleRng;
-use kernel::scene::{mis, roulette};
 use rayon::prelude::*;
 use twinpath::cpu::{BvhTracer, CpuRenderer};
 use twinpath::film::Film;
 use twinpath::scene::Scene;
-use twinpath::stats::mean_and_variance_of_mean;
+use twinpath::settings::{Mis, Roulette};
+use twinpath_tests::stats::mean_and_variance_of_mean;
 use twinpath_tests::{scene_from_toml, z_critical};
 
 const KD: f32 = 0.6;
@@ -45,7 +45,7 @@ fn plane_scene(mis_mode: &str, roulette: &str, lamp: Lamp) -> Scene {
         l,
     );
     // Roulette from the first vertex on, so its division is exercised at every step.
-    s.render.rr_start_depth = 1;
+    s.render.rr_start_depth = Some(1);
     s
 }
 
@@ -126,15 +126,15 @@ fn plane_under_sphere_light_matches_closed_form() {
     for (k, &(name, m, rr, lamp)) in VARIANTS.iter().enumerate() {
         let scene = plane_scene(m, rr, lamp);
         assert_eq!(
-            scene.render.mis_mode,
-            if m == "half" { mis::HALF } else { mis::POWER }
+            scene.render.mis,
+            if m == "half" { Mis::Half } else { Mis::Power }
         );
         assert_eq!(
-            scene.render.rr_mode,
+            scene.render.roulette,
             if rr == "constant" {
-                roulette::CONSTANT
+                Roulette::Constant
             } else {
-                roulette::THROUGHPUT
+                Roulette::Throughput
             }
         );
         for (j, deg) in ANGLES_DEG.iter().enumerate() {
@@ -204,8 +204,8 @@ fn furnace_scene(roulette: &str, q: f32) -> Scene {
         "light = { kd = [1.0, 1.0, 1.0] }",
     );
     text = text.replace(
-        "russian_roulette = 0.8",
-        &format!("russian_roulette = {q}\nroulette = \"{roulette}\""),
+        "seed = 1",
+        &format!("seed = 1\nrussian_roulette = {q}\nroulette = \"{roulette}\""),
     );
     text = text
         .replace("width = 256", "width = 48")

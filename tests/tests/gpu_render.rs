@@ -133,7 +133,6 @@ fn white_furnace_exact_on_gpu() {
         ("kd = [0.12, 0.45, 0.15]", "kd = [1.0, 1.0, 1.0]"),
         ("kd = [0.25, 0.35, 0.75]", "kd = [1.0, 1.0, 1.0]"),
         ("emission = [10.0, 10.0, 10.0]", "kd = [1.0, 1.0, 1.0]"),
-        ("russian_roulette = 0.8", "roulette = \"throughput\""),
         ("width = 256", "width = 48"),
         ("height = 256", "height = 48"),
     ] {

@@ -6,7 +6,7 @@
 use twinpath::cpu::CpuRenderer;
 use twinpath::film::{diff_images, Film, RgbImage};
 use twinpath::scene::Scene;
-use twinpath::stats::pixel_z_test;
+use twinpath_tests::stats::pixel_z_test;
 use twinpath_tests::{repo_root, with_independent_samples, z_critical};
 
 const SPP: u32 = 1024;

@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 use twinpath::scene::{mesh::parse_ply, parse_scene, Scene, SceneError};
+use twinpath::settings::{LightSampling, LightSelection, Mis, Roulette, Sampler};
 
 const GOOD: &str = r#"
 [camera]
@@ -382,28 +383,29 @@ fn render_keywords_name_their_choices() {
     // Throughput roulette starts at depth 5 unless the scene says otherwise.
     let parse =
         |extra: &str| parse_scene(&format!("{GOOD}\n[render]\n{extra}"), &scene_path()).unwrap();
-    let s = parse("roulette = \"throughput\"\n");
+    let s = parse("");
     assert_eq!(
-        (s.render.rr_mode, s.render.rr_start_depth),
-        (kernel::scene::roulette::THROUGHPUT, 5)
+        (s.render.roulette, s.render.roulette_start_depth()),
+        (Roulette::Throughput, 5)
     );
-    let s = parse("roulette = \"throughput\"\nrr_start_depth = 2\n");
-    assert_eq!(s.render.rr_start_depth, 2);
+    let s = parse("roulette = \"constant\"\n");
+    assert_eq!(
+        (s.render.roulette, s.render.roulette_start_depth()),
+        (Roulette::Constant, 1)
+    );
+    let s = parse("rr_start_depth = 2\nroulette = \"constant\"\n");
+    assert_eq!(s.render.roulette_start_depth(), 2);
     let s = parse("mis = \"half\"\nlight_sampling = \"area\"\nlight_selection = \"uniform\"\n");
     assert_eq!(
         (
-            s.render.mis_mode,
+            s.render.mis,
             s.render.light_sampling,
             s.render.light_selection
         ),
-        (
-            kernel::scene::mis::HALF,
-            kernel::scene::light_sampling::AREA,
-            kernel::scene::light_selection::UNIFORM
-        )
+        (Mis::Half, LightSampling::Area, LightSelection::Uniform)
     );
     // Sobol points unless the scene asks for independent numbers.
-    assert_eq!(parse("").render.sampler, kernel::scene::sampler::SOBOL);
+    assert_eq!(parse("").render.sampler, Sampler::Sobol);
     let s = parse("sampler = \"independent\"\n");
-    assert_eq!(s.render.sampler, kernel::scene::sampler::INDEPENDENT);
+    assert_eq!(s.render.sampler, Sampler::Independent);
 }

@@ -13,8 +13,14 @@ use twinpath_tests::{
 
 const SPP: u32 = 32;
 
+/// The Cornell scene at 96 x 96, with the seed's constant roulette: the settings this test was
+/// calibrated with. The translation by 1e4 carries a real bias (docs/robustness.md: over 12
+/// seeds its image mean sits +1.1 standard errors above the original at 32 spp, with either
+/// roulette, while the scaled scenes sit at +0.1), which this test at 32 spp cannot resolve
+/// and does not claim to.
 fn small_cornell() -> Scene {
     let mut s = with_independent_samples(Scene::builtin_default());
+    s.render.roulette = twinpath::settings::Roulette::Constant;
     s.camera.width = 96;
     s.camera.height = 96;
     s

@@ -6,6 +6,7 @@ use glam::Vec3;
 use kernel::features;
 use twinpath::render::Backend;
 use twinpath::scene::Scene;
+use twinpath::settings::{LightSampling, Mis, Roulette};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
     assert_film_matches_with_variance, assert_films_identical, plane_exact, plane_under_lamps,
@@ -34,14 +35,13 @@ fn many_lights() -> Scene {
 
 fn scenes() -> Vec<(&'static str, Scene)> {
     let mut half = cornell();
-    half.render.mis_mode = kernel::scene::mis::HALF;
-    half.render.light_sampling = kernel::scene::light_sampling::AREA;
-    let mut throughput = cornell();
-    throughput.render.rr_mode = kernel::scene::roulette::THROUGHPUT;
-    throughput.render.rr_start_depth = 5;
+    half.render.mis = Mis::Half;
+    half.render.light_sampling = LightSampling::Area;
+    let mut constant = cornell();
+    constant.render.roulette = Roulette::Constant;
     vec![
         ("cornell", cornell()),
-        ("cornell, throughput roulette", throughput),
+        ("cornell, constant roulette", constant),
         ("cornell, half weights + area sampling", half),
         ("sky_meshes", sky_meshes()),
         ("many_lights", many_lights()),

@@ -3,11 +3,13 @@
 //! and RMSE against a reference (the definitions of `twinpath diff`) and efficiency
 //! 1 / (relMSE x render seconds); it writes a CSV and a log-log plot of error against time.
 
+pub mod rays;
+
 use crate::film::{diff_images, RgbImage};
 use crate::render::{render, Backend, RenderOptions};
-use crate::scene::{RenderSettings, Scene};
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use anyhow::{anyhow, bail, Context, Result};
-use kernel::scene::{light_sampling, light_selection, mis, roulette, sampler};
 use std::io::Write;
 use std::path::Path;
 
@@ -19,63 +21,25 @@ pub struct Variant {
 }
 
 impl Variant {
-    /// Parses `NAME` or `NAME:key=value,key=value` on top of `base`; keys: mis (power|half),
-    /// light_sampling (cone|area), light_selection (power|uniform), sampler (independent|sobol), roulette
-    /// (constant|throughput), rr (probability), rr_start_depth (vertex), specialize (on|off),
-    /// packets (on|off), adaptive (target relative error, 0: off).
+    /// Parses `NAME` or `NAME:key=value,key=value` on top of `base`; the keys and values are
+    /// the settings' vocabulary (`crate::settings::SETTINGS`).
     pub fn parse(spec: &str, base: &RenderSettings) -> Result<Variant> {
         let (name, rest) = spec.split_once(':').unwrap_or((spec, ""));
         if name.is_empty() {
             bail!("--variant {spec:?}: empty name");
         }
-        let mut s = *base;
+        let mut settings = *base;
         for kv in rest.split(',').filter(|kv| !kv.is_empty()) {
             let (k, v) = kv
                 .split_once('=')
                 .ok_or_else(|| anyhow!("--variant {spec:?}: {kv:?} is not key=value"))?;
-            match (k, v) {
-                ("mis", "power") => s.mis_mode = mis::POWER,
-                ("mis", "half") => s.mis_mode = mis::HALF,
-                ("light_sampling", "cone") => s.light_sampling = light_sampling::CONE,
-                ("light_sampling", "area") => s.light_sampling = light_sampling::AREA,
-                ("light_selection", "power") => s.light_selection = light_selection::POWER,
-                ("light_selection", "uniform") => s.light_selection = light_selection::UNIFORM,
-                ("sampler", "independent") => s.sampler = sampler::INDEPENDENT,
-                ("sampler", "sobol") => s.sampler = sampler::SOBOL,
-                ("specialize", "on") => s.specialize = true,
-                ("specialize", "off") => s.specialize = false,
-                ("packets", "on") => s.packets = true,
-                ("packets", "off") => s.packets = false,
-                ("adaptive", t) => {
-                    let t: f32 = t.parse().with_context(|| format!("--variant {spec:?}: adaptive"))?;
-                    if !(t >= 0.0 && t.is_finite()) {
-                        bail!("--variant {spec:?}: adaptive = {t} is not a relative error >= 0");
-                    }
-                    s.adaptive_target = t;
-                }
-                ("roulette", "constant") => s.rr_mode = roulette::CONSTANT,
-                ("roulette", "throughput") => {
-                    s.rr_mode = roulette::THROUGHPUT;
-                    s.rr_start_depth = 5;
-                }
-                ("rr", q) => {
-                    let q: f32 = q.parse().with_context(|| format!("--variant {spec:?}: rr"))?;
-                    if !(q > 0.0 && q <= 1.0) {
-                        bail!("--variant {spec:?}: rr = {q} is not in (0, 1]");
-                    }
-                    s.rr_probability = q;
-                }
-                ("rr_start_depth", d) => {
-                    s.rr_start_depth = d
-                        .parse()
-                        .with_context(|| format!("--variant {spec:?}: rr_start_depth"))?
-                }
-                _ => bail!("--variant {spec:?}: unknown setting {kv:?} (keys: mis, light_sampling, light_selection, sampler, roulette, rr, rr_start_depth, specialize, packets, adaptive)"),
-            }
+            settings
+                .set(k, v)
+                .map_err(|m| anyhow!("--variant {spec:?}: {k}: {m}"))?;
         }
         Ok(Variant {
             name: name.to_string(),
-            settings: s,
+            settings,
         })
     }
 }

@@ -3,12 +3,10 @@
 
 use super::error::{line_of, SceneError};
 use super::mesh::load_mesh;
-use super::{CameraDesc, RenderSettings, Scene, TriangleGroup};
+use super::{CameraDesc, Scene, TriangleGroup};
+use crate::settings::RenderSettings;
 use glam::Vec3;
-use kernel::scene::{
-    light_sampling, light_selection, mis, roulette, sampler, Material, Sphere, SphereLight,
-    Triangle, NONE,
-};
+use kernel::scene::{Material, Sphere, SphereLight, Triangle, NONE};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -34,8 +32,9 @@ type V3 = Spanned<[f32; 3]>;
 #[serde(deny_unknown_fields)]
 struct SceneFile {
     camera: Spanned<CameraFile>,
+    /// Settings by name (`crate::settings`), each value with its place in the file.
     #[serde(default)]
-    render: Option<RenderFile>,
+    render: BTreeMap<String, Spanned<toml::Value>>,
     #[serde(default)]
     materials: BTreeMap<String, Spanned<MaterialFile>>,
     #[serde(default)]
@@ -57,29 +56,6 @@ struct CameraFile {
     vfov: Spanned<f32>,
     width: Spanned<i64>,
     height: Spanned<i64>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RenderFile {
-    spp: Option<Spanned<i64>>,
-    seed: Option<Spanned<i64>>,
-    /// Constant survival probability (the seed's RussianRoulette).
-    russian_roulette: Option<Spanned<f32>>,
-    /// "constant" (default) or "throughput".
-    roulette: Option<Spanned<String>>,
-    rr_start_depth: Option<Spanned<i64>>,
-    /// "power" (default) or "half" (the seed's fixed weights).
-    mis: Option<Spanned<String>>,
-    max_depth: Option<Spanned<i64>>,
-    /// "cone" (default) or "area" (the seed's uniform point on the sphere).
-    light_sampling: Option<Spanned<String>>,
-    /// "power" (default) or "uniform" (the seed's choice among several lights).
-    light_selection: Option<Spanned<String>>,
-    /// "sobol" (default: Owen-scrambled Sobol points per pixel) or "independent".
-    sampler: Option<Spanned<String>>,
-    /// Adaptive sampling's target relative error per pixel (0 or absent: off).
-    adaptive_target: Option<Spanned<f32>>,
 }
 
 #[derive(Deserialize)]
@@ -170,24 +146,6 @@ impl Checker<'_> {
         Ok(c)
     }
 
-    /// One of two keywords, as the kernel's constant the keyword names.
-    fn choice(
-        &self,
-        v: &Spanned<String>,
-        field: &str,
-        [(a, a_value), (b, b_value)]: [(&str, u32); 2],
-    ) -> Result<u32, SceneError> {
-        match v.get_ref().as_str() {
-            x if x == a => Ok(a_value),
-            x if x == b => Ok(b_value),
-            other => Err(self.err(
-                v.span(),
-                field,
-                format!("'{other}' is not \"{a}\" or \"{b}\""),
-            )),
-        }
-    }
-
     fn int(&self, v: &Spanned<i64>, field: &str, min: i64, max: i64) -> Result<u32, SceneError> {
         let x = *v.get_ref();
         if x < min || x > max {
@@ -247,93 +205,27 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         height,
     };
 
-    // Render settings.
+    // Render settings: each through the one vocabulary, in the file's order.
     let mut render = RenderSettings::default();
-    if let Some(r) = &file.render {
-        if let Some(v) = &r.spp {
-            render.spp = ck.int(v, "render.spp", 1, u32::MAX as i64)?;
-        }
-        if let Some(v) = &r.seed {
-            render.seed = ck.int(v, "render.seed", 0, u32::MAX as i64)?;
-        }
-        if let Some(v) = &r.roulette {
-            render.rr_mode = ck.choice(
-                v,
-                "render.roulette",
-                [
-                    ("constant", roulette::CONSTANT),
-                    ("throughput", roulette::THROUGHPUT),
-                ],
-            )?;
-            if render.rr_mode == roulette::THROUGHPUT {
-                render.rr_start_depth = 5;
-            }
-        }
-        if let Some(v) = &r.russian_roulette {
-            let q = *v.get_ref();
-            if !(q > 0.0 && q <= 1.0) {
+    let mut settings: Vec<_> = file.render.iter().collect();
+    settings.sort_by_key(|(_, v)| v.span().start);
+    for (key, value) in settings {
+        let text = match value.get_ref() {
+            toml::Value::String(s) => s.clone(),
+            toml::Value::Integer(i) => i.to_string(),
+            toml::Value::Float(f) => f.to_string(),
+            toml::Value::Boolean(b) => b.to_string(),
+            other => {
                 return Err(ck.err(
-                    v.span(),
-                    "render.russian_roulette",
-                    format!("{q} is not a probability in (0, 1]"),
-                ));
+                    value.span(),
+                    &format!("render.{key}"),
+                    format!("a {} is not a setting's value", other.type_str()),
+                ))
             }
-            render.rr_probability = q;
-        }
-        if let Some(v) = &r.rr_start_depth {
-            render.rr_start_depth = ck.int(v, "render.rr_start_depth", 0, u32::MAX as i64)?;
-        }
-        if let Some(v) = &r.mis {
-            render.mis_mode = ck.choice(
-                v,
-                "render.mis",
-                [("power", mis::POWER), ("half", mis::HALF)],
-            )?;
-        }
-        if let Some(v) = &r.light_sampling {
-            render.light_sampling = ck.choice(
-                v,
-                "render.light_sampling",
-                [
-                    ("cone", light_sampling::CONE),
-                    ("area", light_sampling::AREA),
-                ],
-            )?;
-        }
-        if let Some(v) = &r.max_depth {
-            render.max_depth = ck.int(v, "render.max_depth", 1, u32::MAX as i64)?;
-        }
-        if let Some(v) = &r.light_selection {
-            render.light_selection = ck.choice(
-                v,
-                "render.light_selection",
-                [
-                    ("power", light_selection::POWER),
-                    ("uniform", light_selection::UNIFORM),
-                ],
-            )?;
-        }
-        if let Some(v) = &r.sampler {
-            render.sampler = ck.choice(
-                v,
-                "render.sampler",
-                [
-                    ("independent", sampler::INDEPENDENT),
-                    ("sobol", sampler::SOBOL),
-                ],
-            )?;
-        }
-        if let Some(v) = &r.adaptive_target {
-            let t = *v.get_ref();
-            if !(t >= 0.0 && t.is_finite()) {
-                return Err(ck.err(
-                    v.span(),
-                    "render.adaptive_target",
-                    format!("{t} is not a finite relative error >= 0"),
-                ));
-            }
-            render.adaptive_target = t;
-        }
+        };
+        render
+            .set(key, &text)
+            .map_err(|m| ck.err(value.span(), &format!("render.{key}"), m))?;
     }
 
     // Materials, in name order.
@@ -439,7 +331,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             _pad: [0; 2],
         });
     }
-    super::light_table::assign_light_selection(&mut lights, render.light_selection);
+    super::light_table::assign_light_selection(&mut lights, render.light_selection.code());
 
     // Quads (two triangles each) and meshes.
     let mut triangles = Vec::new();

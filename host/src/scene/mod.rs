@@ -9,11 +9,9 @@ pub mod mesh;
 pub use error::SceneError;
 pub use file::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
 
+use crate::settings::RenderSettings;
 use glam::Vec3;
-use kernel::scene::{
-    light_sampling, light_selection, mis, roulette, sampler, Camera, Material, RenderParams,
-    Sphere, SphereLight, Triangle,
-};
+use kernel::scene::{Camera, Material, RenderParams, Sphere, SphereLight, Triangle};
 use std::ops::Range;
 use std::path::Path;
 
@@ -47,61 +45,12 @@ impl CameraDesc {
     }
 }
 
-/// Integrator settings: from the scene's `[render]` table, overridable on the command line.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RenderSettings {
-    pub spp: u32,
-    pub seed: u32,
-    /// One of `kernel::scene::roulette`.
-    pub rr_mode: u32,
-    /// Survival probability of the constant roulette (the seed's 0.8 by default).
-    pub rr_probability: f32,
-    /// First path vertex (1 = the camera ray's hit) whose extension roulette decides.
-    pub rr_start_depth: u32,
-    /// One of `kernel::scene::mis`.
-    pub mis_mode: u32,
-    pub max_depth: u32,
-    /// One of `kernel::scene::light_sampling`.
-    pub light_sampling: u32,
-    /// One of `kernel::scene::light_selection`.
-    pub light_selection: u32,
-    /// One of `kernel::scene::sampler`.
-    pub sampler: u32,
-    /// Compile the kernel for what the scene needs (`kernel::features`); false: generic path.
-    pub specialize: bool,
-    /// CPU: trace scenes of at most `cpu::packet::MAX_PRIMITIVES` primitives sixteen paths at
-    /// a time, SIMD over rays (`cpu::packet_paths`); false: one path at a time over the BVH.
-    pub packets: bool,
-    /// Adaptive sampling's target relative error of a pixel (0: off; `kernel::adaptive`).
-    pub adaptive_target: f32,
-}
-
 /// With adaptive sampling, every PILOT_PERIOD-th sample is a pilot (`kernel::adaptive`).
 pub const PILOT_PERIOD: u32 = 4;
 /// Pilot samples before a pixel may stop (16 samples in all).
 pub const MIN_PILOT_SAMPLES: u32 = 4;
 /// Samples per pixel per adaptive pass: both backends decide at the same sample indices.
 pub const ADAPTIVE_PASS: u32 = 8;
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            spp: 64,
-            seed: 0,
-            rr_mode: roulette::CONSTANT,
-            rr_probability: 0.8,
-            rr_start_depth: 1,
-            mis_mode: mis::POWER,
-            max_depth: u32::MAX,
-            light_sampling: light_sampling::CONE,
-            light_selection: light_selection::POWER,
-            sampler: sampler::SOBOL,
-            specialize: true,
-            packets: true,
-            adaptive_target: 0.0,
-        }
-    }
-}
 
 /// The kernel's triangle with vertices `p` (p0 and the edges p1 - p0, p2 - p0) and `material`.
 pub fn triangle(p: [Vec3; 3], material: u32) -> Triangle {
@@ -172,12 +121,12 @@ impl Scene {
             sample_offset,
             samples_per_launch,
             light_count: self.lights.len() as u32,
-            rr_mode: r.rr_mode,
+            rr_mode: r.roulette.code(),
             rr_probability: r.rr_probability,
-            rr_start_depth: r.rr_start_depth,
-            mis_mode: r.mis_mode,
+            rr_start_depth: r.roulette_start_depth(),
+            mis_mode: r.mis.code(),
             max_depth: r.max_depth,
-            light_sampling: r.light_sampling,
+            light_sampling: r.light_sampling.code(),
             adaptive_target: r.adaptive_target,
             pilot_period: if r.adaptive_target > 0.0 {
                 PILOT_PERIOD
@@ -185,7 +134,7 @@ impl Scene {
                 0
             },
             min_pilot_samples: MIN_PILOT_SAMPLES,
-            sampler: r.sampler,
+            sampler: r.sampler.code(),
         }
     }
 
@@ -202,7 +151,7 @@ impl Scene {
     /// The light table with selection probabilities for `render.light_selection`.
     pub fn light_table(&self) -> Vec<SphereLight> {
         let mut lights = self.lights.clone();
-        light_table::assign_light_selection(&mut lights, self.render.light_selection);
+        light_table::assign_light_selection(&mut lights, self.render.light_selection.code());
         lights
     }
 

@@ -1,0 +1,35 @@
+//! `twinpath info`: what this build contains and which devices can run it.
+
+use anyhow::Result;
+
+/// What this build contains: the SPIR-V module and the backends.
+pub fn run() -> Result<()> {
+    println!("twinpath {}", env!("CARGO_PKG_VERSION"));
+    println!(
+        "kernel SPIR-V module: {} bytes (compiled by rust-gpu at build time)",
+        twinpath::KERNEL_SPV.len()
+    );
+    println!("cpu backend: {} threads", rayon::current_num_threads());
+    match twinpath::vulkan::device::list_devices() {
+        Ok(devices) if devices.is_empty() => println!("gpu backend: no Vulkan devices"),
+        Ok(devices) => {
+            println!("gpu backend: Vulkan devices (use --device N):");
+            for d in devices {
+                let (ma, mi, pa) = d.api_version;
+                let status = if d.usable() {
+                    "usable (ray-tracing pipelines)".to_string()
+                } else {
+                    format!("lacks {}", d.missing.join(", "))
+                };
+                let ray_query = if d.ray_query { "yes" } else { "no" };
+                let status = format!("{status}; ray queries: {ray_query} (not needed)");
+                println!(
+                    "  [{}] {} ({:?}, Vulkan {ma}.{mi}.{pa}): {status}",
+                    d.index, d.name, d.device_type
+                );
+            }
+        }
+        Err(e) => println!("gpu backend: unavailable: {e:#}"),
+    }
+    Ok(())
+}

@@ -1,0 +1,166 @@
+//! `twinpath render`: a scene to EXR and/or PNG, with progress, Ctrl-C and an honest log.
+
+use super::{extension, load_scene, scene_stem, SettingFlags};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+use twinpath::film::RgbImage;
+use twinpath::render::{install_interrupt_handler, render, Backend, RenderOptions, RenderOutput};
+use twinpath::scene::Scene;
+
+/// Render a scene (default: the built-in Cornell scene) to EXR and/or PNG.
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene file (TOML). Without it, the built-in Cornell scene.
+    scene: Option<PathBuf>,
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
+    backend: Backend,
+    /// Vulkan device index for the GPU backend (see `twinpath info`).
+    #[arg(long)]
+    device: Option<usize>,
+    /// Enable the Vulkan validation layers (Debian package vulkan-validationlayers).
+    #[arg(long)]
+    validation: bool,
+    /// Output file(s): .exr (linear float32) or .png (sRGB). Default: <scene stem>.exr and .png.
+    #[arg(long = "out", short = 'o')]
+    out: Vec<PathBuf>,
+    #[command(flatten)]
+    settings: SettingFlags,
+    /// Write the samples each pixel received as an image (EXR: the count in every channel).
+    #[arg(long)]
+    spp_map: Option<PathBuf>,
+    /// Worker threads for the CPU backend (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+pub fn run(a: RenderArgs) -> Result<()> {
+    if let Some(t) = a.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build_global()
+            .context("cannot set the thread count")?;
+    }
+    let mut scene = load_scene(a.scene.as_deref())?;
+    a.settings.apply(&mut scene.render)?;
+    if let Some(m) = &a.spp_map {
+        if extension(m).as_deref() != Some("exr") {
+            bail!("--spp-map {}: must be an .exr file", m.display());
+        }
+    }
+    let outputs = if a.out.is_empty() {
+        let stem = scene_stem(scene.name.as_str());
+        vec![
+            PathBuf::from(format!("{stem}.exr")),
+            PathBuf::from(format!("{stem}.png")),
+        ]
+    } else {
+        a.out
+    };
+    for o in &outputs {
+        match extension(o).as_deref() {
+            Some("exr") | Some("png") => {}
+            _ => bail!("--out {}: unknown format (use .exr or .png)", o.display()),
+        }
+    }
+    // From here on Ctrl-C stops the render and keeps the image (the line below says so).
+    install_interrupt_handler();
+    eprintln!(
+        "twinpath: {} ({}x{}, {} spheres, {} triangles, {} lights), {} spp, seed {}",
+        scene.name,
+        scene.camera.width,
+        scene.camera.height,
+        scene.spheres.len(),
+        scene.triangles.len(),
+        scene.lights.len(),
+        scene.render.spp,
+        scene.render.seed
+    );
+    let opts = RenderOptions {
+        backend: a.backend,
+        device: a.device,
+        validation: a.validation,
+        progress: !a.quiet,
+    };
+    let result = render(&scene, &opts)?;
+    log_costs(&result, a.backend);
+    if result.interrupted {
+        eprintln!(
+            "twinpath: interrupted: writing the image so far, {} of {} samples per pixel",
+            result.spp_done, scene.render.spp
+        );
+    }
+    let image = RgbImage::from_film(&result.film);
+    for o in &outputs {
+        image.write(o)?;
+        eprintln!("twinpath: wrote {}", o.display());
+    }
+    write_sample_counts(&scene, &result, a.spp_map.as_ref())
+}
+
+/// The log line of set-up and render time, throughput and discarded samples.
+fn log_costs(result: &RenderOutput, asked: Backend) {
+    let samples = result.film.total_samples();
+    let secs = result.render.as_secs_f64();
+    let setup = match result.backend {
+        Backend::Gpu => format!(
+            "setup {:.3} s (acceleration structures {:.3} s, pipeline {:.3} s)",
+            result.setup.as_secs_f64(),
+            result.accel_build.as_secs_f64(),
+            result.pipeline.as_secs_f64()
+        ),
+        _ => {
+            // With --backend auto, set-up also holds the look for a Vulkan device
+            // (loading the driver: up to two seconds on a cold file cache).
+            let probe = result.setup.saturating_sub(result.accel_build);
+            let probe = if asked == Backend::Auto {
+                format!("looking for a Vulkan device {:.3} s, ", probe.as_secs_f64())
+            } else {
+                String::new()
+            };
+            format!(
+                "setup {:.3} s ({probe}BVH {:.3} s)",
+                result.setup.as_secs_f64(),
+                result.accel_build.as_secs_f64()
+            )
+        }
+    };
+    eprintln!(
+        "twinpath: {:?} backend: {setup}, render {:.3} s, {:.3} M samples/s, {} non-finite samples discarded",
+        result.backend,
+        secs,
+        samples as f64 / secs.max(1e-9) / 1e6,
+        result.film.discarded
+    );
+}
+
+/// Adaptive sampling's summary, and the sample-count image if asked for.
+fn write_sample_counts(
+    scene: &Scene,
+    result: &RenderOutput,
+    spp_map: Option<&PathBuf>,
+) -> Result<()> {
+    let spp = result.film.samples_per_pixel();
+    if scene.render.adaptive_target > 0.0 {
+        let mean = spp.iter().map(|&c| c as f64).sum::<f64>() / spp.len().max(1) as f64;
+        eprintln!(
+            "twinpath: adaptive sampling (target {}): {mean:.1} samples per pixel on average, {} of {} pixels stopped early",
+            scene.render.adaptive_target,
+            spp.iter().filter(|&&c| c < result.spp_done).count(),
+            spp.len()
+        );
+    }
+    if let Some(m) = spp_map {
+        RgbImage {
+            width: result.film.width,
+            height: result.film.height,
+            pixels: spp.iter().map(|&c| [c as f32; 3]).collect(),
+        }
+        .write(m)?;
+        eprintln!("twinpath: wrote {} (samples per pixel)", m.display());
+    }
+    Ok(())
+}
