@@ -1,8 +1,9 @@
 //! The film: per-pixel sums of samples and of their squares (so every pixel knows its own
 //! variance), and image files: EXR (linear float32 RGB) and PNG (sRGB, clamped).
 
-use crate::cpu::PixelSums;
 use anyhow::{bail, Context, Result};
+use glam::Vec3;
+use kernel::adaptive::luminance;
 use std::path::Path;
 
 /// Accumulated samples of an image.
@@ -111,6 +112,48 @@ impl Film {
     /// Total samples over all pixels (image and pilot samples).
     pub fn total_samples(&self) -> u64 {
         self.samples_per_pixel().iter().map(|&c| c as u64).sum()
+    }
+}
+
+/// Per-pixel running sums of samples, their squares, and the counts; and of the adaptive
+/// sampler's pilot samples (luminance only).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PixelSums {
+    pub sum: [f64; 3],
+    pub sum_sq: [f64; 3],
+    pub count: u32,
+    pub discarded: u32,
+    /// Sum and sum of squares of the pilot samples' luminance, and their number.
+    pub pilot: [f64; 2],
+    pub pilot_count: u32,
+}
+
+impl PixelSums {
+    #[inline]
+    pub fn add(&mut self, v: Vec3) {
+        if !v.is_finite() {
+            self.discarded += 1;
+            return;
+        }
+        for c in 0..3 {
+            let x = v[c] as f64;
+            self.sum[c] += x;
+            self.sum_sq[c] += x * x;
+        }
+        self.count += 1;
+    }
+
+    /// Adds a pilot sample (`kernel::adaptive`).
+    #[inline]
+    pub fn add_pilot(&mut self, v: Vec3) {
+        if !v.is_finite() {
+            self.discarded += 1;
+            return;
+        }
+        let y = luminance(v) as f64;
+        self.pilot[0] += y;
+        self.pilot[1] += y * y;
+        self.pilot_count += 1;
     }
 }
 

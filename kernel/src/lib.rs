@@ -14,6 +14,7 @@ pub mod camera;
 pub mod features;
 pub mod frame;
 pub mod geometry;
+pub mod hash;
 pub mod light;
 pub mod path;
 pub mod probe;

@@ -1,38 +1,14 @@
 //! Counter-based random numbers: a value is a pure function of (seed, pixel, sample, dimension),
 //! so any backend, thread or dispatch order reproduces any sample exactly.
 //!
-//! The hash is `pcg4d` from Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 9(3),
-//! 2020: a 4D-to-4D permutation with good avalanche that costs a few integer multiply-adds.
+//! The hash is [`crate::hash::pcg4d`].
 //! `scene::sampler::SOBOL` draws the same dimensions from Owen-scrambled Sobol points instead
 //! (`crate::sobol`).
 
+pub use crate::hash::pcg4d;
 use crate::scene::sampler;
 use crate::sobol::{sobol_pair, sobol_single};
 use crate::word::Word;
-
-/// Jarzynski and Olano's pcg4d: bijective mixing of four 32-bit words (each [`Word`] lane
-/// alone).
-#[inline]
-pub fn pcg4d<W: Word>(mut v: [W; 4]) -> [W; 4] {
-    let (a, c) = (W::splat(1664525), W::splat(1013904223));
-    v[0] = v[0].wrapping_mul(a).wrapping_add(c);
-    v[1] = v[1].wrapping_mul(a).wrapping_add(c);
-    v[2] = v[2].wrapping_mul(a).wrapping_add(c);
-    v[3] = v[3].wrapping_mul(a).wrapping_add(c);
-    v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[3]));
-    v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
-    v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
-    v[3] = v[3].wrapping_add(v[1].wrapping_mul(v[2]));
-    v[0] = v[0] ^ (v[0] >> 16);
-    v[1] = v[1] ^ (v[1] >> 16);
-    v[2] = v[2] ^ (v[2] >> 16);
-    v[3] = v[3] ^ (v[3] >> 16);
-    v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[3]));
-    v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
-    v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
-    v[3] = v[3].wrapping_add(v[1].wrapping_mul(v[2]));
-    v
-}
 
 /// The independent sampler's 32 random bits of dimension `dimension` of sample `sample` of
 /// `pixel` under `seed`: the first word of [`pcg4d`] of the four.

@@ -114,7 +114,7 @@ pub mod light_selection {
 
 /// Where a sample's random numbers come from.
 pub mod sampler {
-    /// Independent uniform numbers, a hash of (seed, pixel, sample, dimension) (`rng::pcg4d`).
+    /// Independent uniform numbers, a hash of (seed, pixel, sample, dimension) (`hash::pcg4d`).
     pub const INDEPENDENT: u32 = 0;
     /// Owen-scrambled Sobol points, two dimensions at a time (`sobol::sobol_pair`): stratified
     /// within each pixel, independent across pixels. The host's default.

@@ -10,7 +10,7 @@
 //! variance; across pixels and pairs the scrambles are independent, and each point on its own
 //! is uniform in [0,1)^2, so every estimator stays unbiased.
 
-use crate::rng::pcg4d;
+use crate::hash::pcg4d;
 use crate::word::Word;
 
 /// Reverses the bit order of `x` (written out, so both backends and every lane run the same

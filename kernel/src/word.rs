@@ -1,5 +1,5 @@
 //! 32-bit words one at a time or many at once: the integer operations of the sampler's hashes
-//! (`rng::pcg4d`, `sobol`) and of [`crate::real`]'s bit tricks, so they are written once and run
+//! (`hash::pcg4d`, `sobol`) and of [`crate::real`]'s bit tricks, so they are written once and run
 //! on a `u32` (the GPU, one path at a time) or on a SIMD vector of `u32` (the CPU's packets of
 //! paths, one lane per path). Every operation acts on each lane alone, so a lane's result is
 //! exactly the `u32` one.

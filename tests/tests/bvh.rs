@@ -12,8 +12,8 @@
 use glam::Vec3;
 use kernel::rng::SampleRng;
 use kernel::scene::{Sphere, Triangle, NONE};
+use twinpath::bench::rays::{knot_mesh, to_triangles};
 use twinpath::cpu::bvh::Bvh;
-use twinpath::cpu::rays::{knot_mesh, to_triangles};
 
 /// Uniform numbers from the kernel's hash (a fixed stream per test).
 struct Uniform(SampleRng);
@@ -247,7 +247,7 @@ fn memory_grows_linearly_with_the_triangle_count() {
 /// both ray sets, and for every ray exactly the hit the BVH finds.
 #[test]
 fn ray_measurement_and_ray_file_hold_what_was_traced() {
-    use twinpath::cpu::rays::{add_knot_mesh, measure};
+    use twinpath::bench::rays::{add_knot_mesh, measure};
     let mut scene = twinpath::scene::Scene::builtin_default();
     add_knot_mesh(&mut scene, 3000);
     assert!(scene.name.ends_with("+knot3k"), "{}", scene.name);

@@ -4,8 +4,8 @@
 //! vertex shoots them). Both sets can be written to a file so another ray tracer (Embree, in
 //! `scripts/embree_rays.c`) traces exactly the same rays.
 
-use super::bvh::Bvh;
-use super::packet::{RayPacket, SmallScene, LANES};
+use crate::cpu::bvh::Bvh;
+use crate::cpu::packet::{RayPacket, SmallScene, LANES};
 use crate::scene::Scene;
 use glam::Vec3;
 use kernel::camera::{camera_origin, camera_ray_direction};

@@ -8,15 +8,14 @@ pub mod packet;
 pub mod packet_numbers;
 pub mod packet_paths;
 pub mod packet_vertices;
-pub mod rays;
 pub mod simd;
 
-use crate::film::Film;
+use crate::film::{Film, PixelSums};
 use crate::scene::Scene;
 use bvh::Bvh;
 use glam::Vec3;
 use indicatif::ProgressBar;
-use kernel::adaptive::{is_pilot_sample, luminance};
+use kernel::adaptive::is_pilot_sample;
 use kernel::features::{self, Dynamic, FeatureSet, Static};
 use kernel::path::render_sample;
 use kernel::scene::{Material, RenderParams, SphereLight};
@@ -220,47 +219,5 @@ impl CpuRenderer {
                 }
             }
         }
-    }
-}
-
-/// Per-pixel running sums of samples, their squares, and the counts; and of the adaptive
-/// sampler's pilot samples (luminance only).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct PixelSums {
-    pub sum: [f64; 3],
-    pub sum_sq: [f64; 3],
-    pub count: u32,
-    pub discarded: u32,
-    /// Sum and sum of squares of the pilot samples' luminance, and their number.
-    pub pilot: [f64; 2],
-    pub pilot_count: u32,
-}
-
-impl PixelSums {
-    #[inline]
-    pub fn add(&mut self, v: Vec3) {
-        if !v.is_finite() {
-            self.discarded += 1;
-            return;
-        }
-        for c in 0..3 {
-            let x = v[c] as f64;
-            self.sum[c] += x;
-            self.sum_sq[c] += x * x;
-        }
-        self.count += 1;
-    }
-
-    /// Adds a pilot sample (`kernel::adaptive`).
-    #[inline]
-    pub fn add_pilot(&mut self, v: Vec3) {
-        if !v.is_finite() {
-            self.discarded += 1;
-            return;
-        }
-        let y = luminance(v) as f64;
-        self.pilot[0] += y;
-        self.pilot[1] += y * y;
-        self.pilot_count += 1;
     }
 }

@@ -7,8 +7,9 @@
 use super::packet::{RayPacket, SmallScene, LANES};
 use super::packet_numbers::{camera_streams, prefetch_vertices, PrefetchedStream};
 use super::packet_vertices::presample_vertices;
-use super::{CpuRenderer, PixelSums};
+use super::CpuRenderer;
 use crate::film::Film;
+use crate::film::PixelSums;
 use glam::Vec3;
 use kernel::adaptive::is_pilot_sample;
 use kernel::features::FeatureSet;
