@@ -3,6 +3,8 @@
 
 use std::collections::{BTreeSet, HashMap};
 
+const OP_CAPABILITY: u32 = 17;
+const OP_EXTENSION: u32 = 10;
 const OP_ENTRY_POINT: u32 = 15;
 const OP_TYPE_ARRAY: u32 = 28;
 const OP_TYPE_RUNTIME_ARRAY: u32 = 29;
@@ -21,6 +23,10 @@ const DECORATION_SPEC_ID: u32 = 1;
 #[derive(Default, Debug)]
 pub struct Module {
     pub entry_points: BTreeSet<(u32, String)>,
+    /// The module's OpCapability operands (SPIR-V capability numbers).
+    pub capabilities: BTreeSet<u32>,
+    /// The module's OpExtension names.
+    pub extensions: BTreeSet<String>,
     /// SpecId decorations: the module's specialization-constant ids.
     pub spec_ids: BTreeSet<u32>,
     structs: HashMap<u32, Vec<u32>>,
@@ -67,6 +73,15 @@ impl Module {
                     let end = bytes.iter().position(|&b| b == 0).unwrap();
                     m.entry_points
                         .insert((w[1], String::from_utf8(bytes[..end].to_vec()).unwrap()));
+                }
+                OP_CAPABILITY => {
+                    m.capabilities.insert(w[1]);
+                }
+                OP_EXTENSION => {
+                    let bytes: Vec<u8> = w[1..].iter().flat_map(|x| x.to_le_bytes()).collect();
+                    let end = bytes.iter().position(|&b| b == 0).unwrap();
+                    m.extensions
+                        .insert(String::from_utf8(bytes[..end].to_vec()).unwrap());
                 }
                 OP_TYPE_STRUCT => {
                     m.structs.insert(w[1], w[2..].to_vec());

@@ -52,6 +52,29 @@ fn raygen_reads_the_feature_specialization_constant() {
 }
 
 #[test]
+fn module_needs_ray_tracing_pipelines_and_not_ray_queries() {
+    // Capability numbers from the SPIR-V specification, section 3.31.
+    const RAY_QUERY_KHR: u32 = 4472;
+    const RAY_TRACING_KHR: u32 = 4479;
+    let m = Module::parse(twinpath::KERNEL_SPV);
+    println!(
+        "capabilities: {:?}, extensions: {:?}",
+        m.capabilities, m.extensions
+    );
+    assert!(m.capabilities.contains(&RAY_TRACING_KHR));
+    assert!(
+        !m.capabilities.contains(&RAY_QUERY_KHR),
+        "the module declares RayQueryKHR: devices without VK_KHR_ray_query could not run it"
+    );
+    assert!(m.extensions.contains("SPV_KHR_ray_tracing"));
+    assert!(!m.extensions.contains("SPV_KHR_ray_query"));
+    // And the host does not ask for the extension either.
+    assert!(!twinpath::vulkan::device::REQUIRED_EXTENSIONS
+        .iter()
+        .any(|e| e.to_bytes() == b"VK_KHR_ray_query"));
+}
+
+#[test]
 fn module_passes_spirv_val() {
     let path = std::env::temp_dir().join(format!("twinpath-kernel-{}.spv", std::process::id()));
     std::fs::write(&path, twinpath::KERNEL_SPV).unwrap();

@@ -8,12 +8,12 @@ use std::mem::ManuallyDrop;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-/// Device extensions the backend needs (the kernel module declares RayQueryKHR, so ray query
-/// must be enabled too).
-pub const REQUIRED_EXTENSIONS: [&CStr; 4] = [
+/// Device extensions the backend needs: ray-tracing pipelines over acceleration structures.
+/// Not `VK_KHR_ray_query`: the kernel module declares no RayQueryKHR capability (a test checks),
+/// since some drivers (NVIDIA's data-centre ones) offer pipelines without ray queries.
+pub const REQUIRED_EXTENSIONS: [&CStr; 3] = [
     khr::acceleration_structure::NAME,
     khr::ray_tracing_pipeline::NAME,
-    khr::ray_query::NAME,
     khr::deferred_host_operations::NAME,
 ];
 
@@ -53,6 +53,8 @@ pub struct DeviceInfo {
     pub api_version: (u32, u32, u32),
     /// Required extensions it lacks (empty: usable).
     pub missing: Vec<String>,
+    /// Whether it offers `VK_KHR_ray_query` (not needed by twinpath; reported by `info`).
+    pub ray_query: bool,
 }
 
 impl DeviceInfo {
@@ -133,13 +135,13 @@ pub fn validation_layer_available(entry: &ash::Entry) -> bool {
 fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> DeviceInfo {
     let props = unsafe { instance.get_physical_device_properties(pd) };
     let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+    let offers = |want: &CStr| {
+        exts.iter()
+            .any(|e| e.extension_name_as_c_str().ok() == Some(want))
+    };
     let missing = REQUIRED_EXTENSIONS
         .iter()
-        .filter(|want| {
-            !exts
-                .iter()
-                .any(|e| e.extension_name_as_c_str().ok() == Some(**want))
-        })
+        .filter(|want| !offers(want))
         .map(|e| e.to_string_lossy().into_owned())
         .collect();
     DeviceInfo {
@@ -155,6 +157,7 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> D
             vk::api_version_patch(props.api_version),
         ),
         missing,
+        ray_query: offers(khr::ray_query::NAME),
     }
 }
 
@@ -262,14 +265,12 @@ impl Context {
             .acceleration_structure(true);
         let mut f_rt =
             vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default().ray_tracing_pipeline(true);
-        let mut f_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
         let info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_info)
             .enabled_extension_names(&ext_names)
             .push_next(&mut f12)
             .push_next(&mut f_as)
-            .push_next(&mut f_rt)
-            .push_next(&mut f_rq);
+            .push_next(&mut f_rt);
         let device =
             unsafe { instance.create_device(pd, &info, None) }.context("vkCreateDevice failed")?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
