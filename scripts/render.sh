@@ -4,7 +4,7 @@
 #
 # It builds the whole workspace, as scripts/test.sh does, and runs the binary directly: building
 # one package (`cargo run -p twinpath`) resolves the dependencies' features differently and
-# would rebuild rust-gpu's compiler backend and SPIRV-Tools (about 20 minutes) a second time.
+# would rebuild rust-gpu's compiler backend (several minutes) a second time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh

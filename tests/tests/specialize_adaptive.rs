@@ -58,6 +58,7 @@ fn scene_analysis_finds_the_features_present() {
             | features::SINGLE_LIGHT
             | features::MIS_POWER
             | features::LIGHT_CONE
+            | features::RR_THROUGHPUT
     );
     let f = sky_meshes().features();
     assert!(f & features::BACKGROUND != 0 && f & features::LIGHTS == 0);
