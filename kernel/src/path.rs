@@ -9,7 +9,7 @@ use crate::geometry::{offset_ray_origin, reproject_to_sphere, shadow_ray_end, sp
 use crate::light::pdf_light_from;
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
-use crate::scene::{light_sampling, Material, RenderParams, SphereLight, NONE};
+use crate::scene::{light_sampling, Material, RenderParams, Sphere, SphereLight, NONE};
 use crate::vertex_sampler::VertexSampler;
 use spirv_std::glam::Vec3;
 
@@ -51,28 +51,21 @@ impl SurfaceHit {
         }
     }
 
-    /// The record of ray `origin + t dir` meeting the sphere (`center`, `radius`) at `t`: the
+    /// The record of ray `origin + t dir` meeting `sphere` at `t`: the
     /// point re-projected onto the surface, the outward normal, the point's error bound, and
     /// the side the ray came from (the side its origin is on: exact geometry for a convex
     /// surface, and a sign that holds at grazing hits). Both backends build sphere hits here.
     #[inline]
-    pub fn sphere(
-        origin: Vec3,
-        dir: Vec3,
-        t: f32,
-        center: Vec3,
-        radius: f32,
-        material: u32,
-        light: u32,
-    ) -> Self {
+    pub fn sphere(origin: Vec3, dir: Vec3, t: f32, sphere: &Sphere) -> Self {
+        let (center, radius) = (Vec3::from(sphere.center), sphere.radius);
         let position = reproject_to_sphere(origin + t * dir, center, radius);
         let from_center = origin - center;
         Self {
             position,
             t,
             normal: (position - center) / radius,
-            material,
-            light,
+            material: sphere.material,
+            light: sphere.light,
             error: sphere_point_error(center, radius),
             arrived_behind: from_center.dot(from_center) < radius * radius,
         }

@@ -261,16 +261,7 @@ pub fn closest_hit_sphere(
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] spheres: &[Sphere],
 ) {
-    let s = spheres[(first + primitive) as usize];
-    let h = SurfaceHit::sphere(
-        origin,
-        dir,
-        t,
-        Vec3::from(s.center),
-        s.radius,
-        s.material,
-        s.light,
-    );
+    let h = SurfaceHit::sphere(origin, dir, t, &spheres[(first + primitive) as usize]);
     payload.position_t = h.position.extend(t);
     payload.normal = h.normal.extend(h.error);
     payload.material = h.material;

@@ -67,6 +67,24 @@ pub fn with_independent_samples(mut scene: Scene) -> Scene {
     scene
 }
 
+/// The text of `scenes/cornell.toml` with every albedo 1 and the light sphere made a white
+/// diffuse sphere: no light, five quads and three spheres; a white furnace once a background is
+/// added.
+pub fn white_cornell_toml() -> String {
+    let mut text = std::fs::read_to_string(repo_root().join("scenes/cornell.toml")).unwrap();
+    for from in [
+        "kd = [0.73, 0.73, 0.73]",
+        "kd = [0.65, 0.05, 0.05]",
+        "kd = [0.12, 0.45, 0.15]",
+        "kd = [0.25, 0.35, 0.75]",
+        "emission = [10.0, 10.0, 10.0]",
+    ] {
+        assert!(text.contains(from), "{from}");
+        text = text.replace(from, "kd = [1.0, 1.0, 1.0]");
+    }
+    text
+}
+
 /// The repository root.
 pub fn repo_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")

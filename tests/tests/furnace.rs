@@ -21,7 +21,7 @@ use twinpath::film::Film;
 use twinpath::render::Backend;
 use twinpath::scene::Scene;
 use twinpath_tests::gpu::assert_validation_clean;
-use twinpath_tests::{render_film, repo_root, scene_from_toml};
+use twinpath_tests::{render_film, scene_from_toml, white_cornell_toml};
 
 /// The background radiance: a power of two, so that sums and means of it are exact.
 const LB: f32 = 0.5;
@@ -35,13 +35,8 @@ const GPU_SPP: u32 = 4096;
 /// The Cornell room (five quads, two diffuse spheres) with every albedo 1 and the light sphere
 /// made a third white sphere; background Lb; throughput roulette.
 fn furnace(sampler: &str, seed: u32) -> Scene {
-    let mut text = std::fs::read_to_string(repo_root().join("scenes/cornell.toml")).unwrap();
+    let mut text = white_cornell_toml();
     for (from, to) in [
-        ("kd = [0.73, 0.73, 0.73]", "kd = [1.0, 1.0, 1.0]"),
-        ("kd = [0.65, 0.05, 0.05]", "kd = [1.0, 1.0, 1.0]"),
-        ("kd = [0.12, 0.45, 0.15]", "kd = [1.0, 1.0, 1.0]"),
-        ("kd = [0.25, 0.35, 0.75]", "kd = [1.0, 1.0, 1.0]"),
-        ("emission = [10.0, 10.0, 10.0]", "kd = [1.0, 1.0, 1.0]"),
         (
             "seed = 1",
             &format!("seed = {seed}\nroulette = \"throughput\"\nsampler = \"{sampler}\""),

@@ -548,16 +548,7 @@ impl Bvh {
     ) -> SurfaceHit {
         let id = id as usize;
         if id < self.spheres.len() {
-            let s = &self.spheres[id];
-            SurfaceHit::sphere(
-                origin,
-                dir,
-                t,
-                Vec3::from(s.center),
-                s.radius,
-                s.material,
-                s.light,
-            )
+            SurfaceHit::sphere(origin, dir, t, &self.spheres[id])
         } else {
             let index = id - self.spheres.len();
             let (tri, shape) = (&self.triangles[index], &self.shapes[index]);
