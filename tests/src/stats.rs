@@ -1,6 +1,6 @@
-//! Statistics used by tests and the CLI: z-tests of estimates against expectations.
+//! Statistics the tests use: z-tests of estimates against expectations.
 
-use crate::film::RgbImage;
+use twinpath::film::RgbImage;
 
 /// Per-pixel z-test of an image (with its per-pixel variance of the mean) against a reference
 /// (optionally with its own variance). A channel passes when |z| <= `z_max`; a pixel passes
