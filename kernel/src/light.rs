@@ -72,14 +72,16 @@ pub fn pdf_light(lights: &[SphereLight], light: u32) -> f32 {
     l.select_pmf * pdf_sphere_area(l.radius)
 }
 
-/// Seed: `EvalRadiance(L)`. Radiance leaving the light's outer surface toward `w_out` (unit,
-/// pointing away from the surface): the constant emission on the outside, zero on the inside.
+/// Seed: `EvalRadiance(L)`. Radiance a light sends back along a ray that met it: the constant
+/// emission on its outer surface, zero on the inside. `arrived_behind` is the hit record's
+/// side (`path::SurfaceHit::arrived_behind`), decided robustly where the record is made rather
+/// than from the sign of `normal . w_out`, which rounding flips at grazing hits.
 #[inline]
-pub fn eval_radiance(emission: Vec3, normal: Vec3, w_out: Vec3) -> Vec3 {
-    if normal.dot(w_out) > 0.0 {
-        emission
-    } else {
+pub fn eval_radiance(emission: Vec3, arrived_behind: bool) -> Vec3 {
+    if arrived_behind {
         Vec3::ZERO
+    } else {
+        emission
     }
 }
 

@@ -6,7 +6,7 @@ use crate::brdf::{eval_scattering, pdf_brdf, sampled_brdf_weight};
 use crate::camera::{camera_origin, camera_ray_direction};
 use crate::features::FeatureSet;
 use crate::geometry::{offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error};
-use crate::light::pdf_light_from;
+use crate::light::{eval_radiance, pdf_light_from};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{light_sampling, Material, RenderParams, Sphere, SphereLight, NONE};
@@ -310,13 +310,7 @@ impl<R: VertexSampler> PathState<R> {
         }
         let material = materials[hit.material as usize];
         if hit.light != NONE {
-            // Lights emit from their outer surface only (`light::eval_radiance`), decided by the
-            // side the ray arrived from.
-            let emitted = if hit.arrived_behind {
-                Vec3::ZERO
-            } else {
-                Vec3::from(material.emission)
-            };
+            let emitted = eval_radiance(Vec3::from(material.emission), hit.arrived_behind);
             if self.depth == 0 {
                 // 1: a light seen directly (it reflects nothing, so the path ends).
                 self.radiance = emitted;

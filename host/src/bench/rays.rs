@@ -70,11 +70,7 @@ pub fn bounce_rays(bvh: &Bvh, primary: &RaySet, seed: u32) -> RaySet {
         if !hit.is_hit() {
             continue;
         }
-        let n = if hit.normal.dot(primary.dirs[i]) > 0.0 {
-            -hit.normal
-        } else {
-            hit.normal
-        };
+        let n = hit.facing_normal();
         let mut rng = SampleRng::new(seed, i as u32, 0);
         let (u1, u2) = (rng.next_f32(), rng.next_f32());
         rays.origins
