@@ -4,6 +4,7 @@
 // std::simd: the CPU traversal's four-lane box and triangle tests (cpu/simd.rs).
 #![feature(portable_simd)]
 
+pub mod backend;
 #[cfg(feature = "gpu")]
 pub mod bench;
 pub mod cpu;

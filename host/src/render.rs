@@ -1,9 +1,10 @@
 //! The render driver: a scene, a backend, a sample count in, a film out, with progress and
 //! Ctrl-C (the samples finished so far are kept and written).
 
-use crate::cpu::CpuRenderer;
+use crate::backend::SampleBackend;
+use crate::cpu::CpuBackend;
 use crate::film::Film;
-use crate::scene::{Scene, ADAPTIVE_PASS};
+use crate::scene::Scene;
 use crate::vulkan::GpuRenderer;
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -58,9 +59,6 @@ pub struct RenderOutput {
     pub spp_done: u32,
     pub interrupted: bool,
 }
-
-/// Largest number of samples (pixels x spp) in one GPU launch.
-const MAX_SAMPLES_PER_LAUNCH: u32 = 1 << 22;
 
 /// Set by Ctrl-C (after `install_interrupt_handler`); renders stop between passes.
 pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
@@ -118,81 +116,43 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
             },
         },
     };
+    let (mut backend, kind): (Box<dyn SampleBackend>, Backend) = match gpu {
+        Some(g) => (Box::new(g), Backend::Gpu),
+        None => (Box::new(CpuBackend::new(scene)), Backend::Cpu),
+    };
+    let setup = t0.elapsed();
     let spp = scene.render.spp;
     let progress = opts
         .progress
         .then(|| progress_bar(scene.pixel_count() as u64 * spp as u64));
+    let t1 = Instant::now();
     let mut spp_done = 0;
-    let output = match gpu {
-        Some(mut g) => {
-            let setup = t0.elapsed();
-            let t1 = Instant::now();
-            // Dispatch sizes depend only on the image size and spp, never on timing, so a render
-            // is the same bit for bit every time (the running mean's rounding depends on how
-            // samples are split into launches): 1, 2, 4, ... samples per pixel, up to about 4M
-            // samples per launch (a display GPU must not hang). Adaptive sampling decides at
-            // fixed sample indices, the same as the CPU's.
-            let adaptive = scene.render.adaptive_target > 0.0;
-            let cap = (MAX_SAMPLES_PER_LAUNCH / scene.pixel_count().max(1) as u32).clamp(1, 64);
-            let mut launch = if adaptive { ADAPTIVE_PASS } else { 1u32 };
-            while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
-                let count = launch.min(spp - spp_done);
-                g.dispatch(&scene.params(spp_done, count))?;
-                spp_done += count;
-                if let Some(p) = &progress {
-                    p.inc(scene.pixel_count() as u64 * count as u64);
-                }
-                if !adaptive {
-                    launch = (launch * 2).min(cap);
-                }
-            }
-            let film = g.read_film()?;
-            RenderOutput {
-                film,
-                backend: Backend::Gpu,
-                setup,
-                accel_build: g.accel_build_time,
-                pipeline: g.pipeline_time,
-                render: t1.elapsed(),
-                spp_done,
-                interrupted: spp_done < spp,
-            }
-        }
-        None => {
-            let t_bvh = Instant::now();
-            let renderer = CpuRenderer::new(scene);
-            let bvh = t_bvh.elapsed();
-            let setup = t0.elapsed();
-            let mut film = Film::new(scene.camera.width, scene.camera.height);
-            let t1 = Instant::now();
-            // Passes of a few samples per pixel, so progress moves and Ctrl-C is prompt.
-            let pass = if scene.render.adaptive_target > 0.0 {
-                ADAPTIVE_PASS
-            } else {
-                spp.clamp(1, 8)
-            };
-            while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
-                let count = pass.min(spp - spp_done);
-                let params = scene.params(spp_done, count);
-                renderer.render_into(&params, spp_done, count, &mut film, progress.as_ref());
-                spp_done += count;
-            }
-            RenderOutput {
-                film,
-                backend: Backend::Cpu,
-                setup,
-                accel_build: bvh,
-                pipeline: Duration::ZERO,
-                render: t1.elapsed(),
-                spp_done,
-                interrupted: spp_done < spp,
-            }
-        }
-    };
+    while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
+        let count = backend.next_pass(spp_done, spp);
+        backend.add_samples(
+            &scene.params(spp_done, count),
+            spp_done,
+            count,
+            progress.as_ref(),
+        )?;
+        spp_done += count;
+    }
+    let film = backend.read_film()?;
+    let render = t1.elapsed();
     if let Some(p) = progress {
         p.finish_and_clear();
     }
-    Ok(output)
+    let (accel_build, pipeline) = backend.setup_times();
+    Ok(RenderOutput {
+        film,
+        backend: kind,
+        setup,
+        accel_build,
+        pipeline,
+        render,
+        spp_done,
+        interrupted: spp_done < spp,
+    })
 }
 
 /// A progress bar on stderr counting samples (drawn only when stderr is a terminal).

@@ -5,7 +5,7 @@
 //! along a quad's diagonal; none is in these renders, and one would show up here as a
 //! difference of a pixel or two.)
 
-use twinpath::cpu::CpuRenderer;
+use twinpath::cpu::{CpuRenderer, TileStrategy};
 use twinpath::render::Backend;
 use twinpath::scene::Scene;
 use twinpath::settings::{LightSampling, Mis, Roulette, Sampler};
@@ -51,12 +51,15 @@ fn scenes() -> Vec<(&'static str, Scene)> {
 fn packets_of_paths_give_the_one_path_images() {
     for (name, scene) in scenes() {
         assert!(
-            CpuRenderer::new(&scene).small.is_some(),
+            matches!(CpuRenderer::new(&scene).tiles, TileStrategy::Packets(_)),
             "{name}: small enough for packets, yet the renderer would not use them"
         );
         let mut one_path = scene.clone();
         one_path.render.packets = false;
-        assert!(CpuRenderer::new(&one_path).small.is_none());
+        assert!(matches!(
+            CpuRenderer::new(&one_path).tiles,
+            TileStrategy::OnePath
+        ));
         let spp = if scene.render.adaptive_target > 0.0 {
             32
         } else {
@@ -76,7 +79,10 @@ fn large_scenes_keep_the_bvh() {
         scene.spheres.len() + scene.triangles.len() > twinpath::cpu::packet::MAX_PRIMITIVES,
         "the test needs a scene above the packet limit"
     );
-    assert!(CpuRenderer::new(&scene).small.is_none());
+    assert!(matches!(
+        CpuRenderer::new(&scene).tiles,
+        TileStrategy::OnePath
+    ));
 }
 
 /// The numbers the packets compute for sixteen paths at once (`cpu::packet_numbers`, the

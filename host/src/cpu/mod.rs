@@ -10,8 +10,10 @@ pub mod packet_paths;
 pub mod packet_vertices;
 pub mod simd;
 
+use crate::backend::SampleBackend;
 use crate::film::{Film, PixelSums};
-use crate::scene::Scene;
+use crate::scene::{Scene, ADAPTIVE_PASS};
+use anyhow::Result;
 use bvh::Bvh;
 use glam::Vec3;
 use indicatif::ProgressBar;
@@ -22,6 +24,7 @@ use kernel::scene::{Material, RenderParams, SphereLight};
 use kernel::{SurfaceHit, Tracer};
 use packet::SmallScene;
 use rayon::prelude::*;
+use std::time::{Duration, Instant};
 
 /// Side of the square image tiles that threads take one at a time.
 pub const TILE: u32 = 16;
@@ -49,9 +52,19 @@ pub struct CpuRenderer {
     pub lights: Vec<SphereLight>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path).
     pub features: u32,
-    /// For scenes of at most `packet::MAX_PRIMITIVES` primitives (unless the scene's
-    /// `packets` setting is off): all of them, for tracing sixteen paths' rays at once.
-    pub small: Option<SmallScene>,
+    /// How a tile's samples are computed, chosen once when the renderer is built.
+    pub tiles: TileStrategy,
+}
+
+/// How the CPU renderer computes a tile's samples. Both give the same image bit for bit
+/// (`tests/tests/packets.rs`); packets are faster on small scenes.
+pub enum TileStrategy {
+    /// One path at a time through the BVH.
+    OnePath,
+    /// Sixteen paths at a time, their rays tested against every primitive by SIMD lanes
+    /// (`packet_paths.rs`): for scenes of at most `packet::MAX_PRIMITIVES` primitives unless
+    /// the scene's `packets` setting is off. Holds all the primitives.
+    Packets(SmallScene),
 }
 
 /// `match bits { combo => body with f = Static::<combo>, ..., other => body with Dynamic(other) }`.
@@ -104,7 +117,7 @@ impl CpuRenderer {
             materials: scene.materials.clone(),
             lights: scene.light_table(),
             features: scene.features(),
-            small,
+            tiles: small.map_or(TileStrategy::OnePath, TileStrategy::Packets),
         }
     }
 
@@ -159,65 +172,143 @@ impl CpuRenderer {
         film: &mut Film,
         progress: Option<&ProgressBar>,
     ) {
+        match &self.tiles {
+            TileStrategy::OnePath => {
+                self.render_tiles_by(params, film, progress, |pixels, film| {
+                    self.tile_by_paths(features, params, pixels, first, count, film)
+                })
+            }
+            TileStrategy::Packets(small) => {
+                self.render_tiles_by(params, film, progress, |pixels, film| {
+                    self.tile_by_packets(features, small, params, pixels, first, count, film)
+                })
+            }
+        }
+    }
+
+    /// Runs `tile` on every image tile in parallel (it returns each pixel's sums, in row
+    /// order, reading `film` only to skip converged pixels) and adds the sums to `film`.
+    fn render_tiles_by<T>(
+        &self,
+        params: &RenderParams,
+        film: &mut Film,
+        progress: Option<&ProgressBar>,
+        tile: T,
+    ) where
+        T: Fn(&mut dyn Iterator<Item = (u32, u32)>, &Film) -> Vec<PixelSums> + Sync,
+    {
         let (w, h) = (params.width, params.height);
-        let tiles_x = w.div_ceil(TILE);
-        let tiles_y = h.div_ceil(TILE);
-        let tiles: Vec<(u32, u32)> = (0..tiles_y)
-            .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
+        let tile_pixels = move |tx: u32, ty: u32| {
+            (ty * TILE..((ty + 1) * TILE).min(h))
+                .flat_map(move |py| (tx * TILE..((tx + 1) * TILE).min(w)).map(move |px| (px, py)))
+        };
+        let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
+            .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
             .collect();
-        let adaptive = params.pilot_period > 0;
         let film_ref = &*film;
         let results: Vec<((u32, u32), Vec<PixelSums>)> = tiles
             .par_iter()
             .map(|&(tx, ty)| {
-                if let Some(small) = &self.small {
-                    let pixels = (ty * TILE..((ty + 1) * TILE).min(h)).flat_map(|py| {
-                        (tx * TILE..((tx + 1) * TILE).min(w)).map(move |px| (px, py))
-                    });
-                    let sums = self
-                        .tile_by_packets(features, small, params, pixels, first, count, film_ref);
-                    if let Some(p) = progress {
-                        p.inc(
-                            sums.iter()
-                                .map(|s| (s.count + s.pilot_count + s.discarded) as u64)
-                                .sum(),
-                        );
-                    }
-                    return ((tx, ty), sums);
-                }
-                let mut out = Vec::with_capacity((TILE * TILE) as usize);
-                let mut done = 0u64;
-                for py in ty * TILE..((ty + 1) * TILE).min(h) {
-                    for px in tx * TILE..((tx + 1) * TILE).min(w) {
-                        let mut acc = PixelSums::default();
-                        if !(adaptive && film_ref.converged(params, px, py)) {
-                            for s in first..first + count {
-                                let l = self.sample_with(features, params, px, py, s);
-                                if adaptive && is_pilot_sample(params, s) {
-                                    acc.add_pilot(l);
-                                } else {
-                                    acc.add(l);
-                                }
-                            }
-                            done += count as u64;
-                        }
-                        out.push(acc);
-                    }
-                }
+                let sums = tile(&mut tile_pixels(tx, ty), film_ref);
                 if let Some(p) = progress {
-                    p.inc(done);
+                    p.inc(
+                        sums.iter()
+                            .map(|s| (s.count + s.pilot_count + s.discarded) as u64)
+                            .sum(),
+                    );
                 }
-                ((tx, ty), out)
+                ((tx, ty), sums)
             })
             .collect();
         for ((tx, ty), sums) in results {
-            let mut k = 0;
-            for py in ty * TILE..((ty + 1) * TILE).min(h) {
-                for px in tx * TILE..((tx + 1) * TILE).min(w) {
-                    film.add_sums(px, py, &sums[k]);
-                    k += 1;
-                }
+            for ((px, py), s) in tile_pixels(tx, ty).zip(&sums) {
+                film.add_sums(px, py, s);
             }
         }
+    }
+
+    /// Samples `first..first + count` of each of `pixels` (skipping those `film` says have
+    /// converged, under adaptive sampling), one path at a time, in sample order.
+    fn tile_by_paths<F: FeatureSet>(
+        &self,
+        features: F,
+        params: &RenderParams,
+        pixels: &mut dyn Iterator<Item = (u32, u32)>,
+        first: u32,
+        count: u32,
+        film: &Film,
+    ) -> Vec<PixelSums> {
+        let adaptive = params.pilot_period > 0;
+        pixels
+            .map(|(px, py)| {
+                let mut acc = PixelSums::default();
+                if !(adaptive && film.converged(params, px, py)) {
+                    for s in first..first + count {
+                        let l = self.sample_with(features, params, px, py, s);
+                        if adaptive && is_pilot_sample(params, s) {
+                            acc.add_pilot(l);
+                        } else {
+                            acc.add(l);
+                        }
+                    }
+                }
+                acc
+            })
+            .collect()
+    }
+}
+
+/// The CPU backend of the render loop: a [`CpuRenderer`] and the film it adds to.
+pub struct CpuBackend {
+    pub renderer: CpuRenderer,
+    pub film: Film,
+    /// Time [`CpuRenderer::new`] took (the BVH).
+    pub build_time: Duration,
+    adaptive: bool,
+}
+
+impl CpuBackend {
+    pub fn new(scene: &Scene) -> Self {
+        let t = Instant::now();
+        let renderer = CpuRenderer::new(scene);
+        Self {
+            renderer,
+            film: Film::new(scene.camera.width, scene.camera.height),
+            build_time: t.elapsed(),
+            adaptive: scene.render.adaptive_target > 0.0,
+        }
+    }
+}
+
+impl SampleBackend for CpuBackend {
+    /// Passes of a few samples per pixel, so progress moves and Ctrl-C is prompt; with
+    /// adaptive sampling, the passes at whose ends pixels may stop.
+    fn next_pass(&self, done: u32, spp: u32) -> u32 {
+        let pass = if self.adaptive {
+            ADAPTIVE_PASS
+        } else {
+            spp.clamp(1, 8)
+        };
+        pass.min(spp - done)
+    }
+
+    fn add_samples(
+        &mut self,
+        params: &RenderParams,
+        first: u32,
+        count: u32,
+        progress: Option<&ProgressBar>,
+    ) -> Result<()> {
+        self.renderer
+            .render_into(params, first, count, &mut self.film, progress);
+        Ok(())
+    }
+
+    fn read_film(&self) -> Result<Film> {
+        Ok(self.film.clone())
+    }
+
+    fn setup_times(&self) -> (Duration, Duration) {
+        (self.build_time, Duration::ZERO)
     }
 }

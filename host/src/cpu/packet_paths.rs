@@ -52,7 +52,7 @@ impl CpuRenderer {
         features: F,
         small: &SmallScene,
         params: &RenderParams,
-        pixels: impl Iterator<Item = (u32, u32)>,
+        pixels: &mut dyn Iterator<Item = (u32, u32)>,
         first: u32,
         count: u32,
         film: &Film,

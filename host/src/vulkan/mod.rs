@@ -7,13 +7,15 @@ pub mod device;
 pub mod memory;
 pub mod pipeline;
 
+use crate::backend::SampleBackend;
 use crate::film::Film;
-use crate::scene::Scene;
+use crate::scene::{Scene, ADAPTIVE_PASS};
 use accel::SceneAccel;
 use anyhow::{Context as _, Result};
 use ash::vk;
 use device::Context;
 use gpu_allocator::MemoryLocation;
+use indicatif::ProgressBar;
 use kernel::scene::RenderParams;
 use memory::{Buffer, Image};
 use pipeline::{binding, HitGroups, RtPipeline};
@@ -29,8 +31,14 @@ pub struct GpuRenderer {
     pub pipeline_time: Duration,
     pub width: u32,
     pub height: u32,
+    /// Adaptive sampling on: passes of `ADAPTIVE_PASS` samples.
+    adaptive: bool,
     pub ctx: Context,
 }
+
+/// Largest number of samples (pixels x spp) in one launch, so a display GPU is never stalled
+/// for long.
+const MAX_SAMPLES_PER_LAUNCH: u32 = 1 << 22;
 
 struct Resources {
     pipeline: RtPipeline,
@@ -183,6 +191,7 @@ impl GpuRenderer {
             pipeline_time,
             width: w,
             height: h,
+            adaptive: scene.render.adaptive_target > 0.0,
             ctx,
         })
     }
@@ -270,6 +279,46 @@ impl GpuRenderer {
             film.discarded += q[3] as u64;
         }
         Ok(film)
+    }
+}
+
+impl SampleBackend for GpuRenderer {
+    /// 1, 2, 4, ... samples per pixel, up to `MAX_SAMPLES_PER_LAUNCH` samples per launch (the
+    /// running mean's rounding depends on how samples are split into launches, so the split
+    /// depends only on the image size and `done`); with adaptive sampling, `ADAPTIVE_PASS`,
+    /// the same decision points as the CPU's.
+    fn next_pass(&self, done: u32, spp: u32) -> u32 {
+        let pass = if self.adaptive {
+            ADAPTIVE_PASS
+        } else {
+            let pixels = (self.width * self.height).max(1);
+            let cap = (MAX_SAMPLES_PER_LAUNCH / pixels).clamp(1, 64);
+            // The doubling from 1: after k passes `done` = 2^k - 1 below the cap.
+            (done + 1).min(cap)
+        };
+        pass.min(spp - done)
+    }
+
+    fn add_samples(
+        &mut self,
+        params: &RenderParams,
+        _first: u32,
+        count: u32,
+        progress: Option<&ProgressBar>,
+    ) -> Result<()> {
+        self.dispatch(params)?;
+        if let Some(p) = progress {
+            p.inc(self.width as u64 * self.height as u64 * count as u64);
+        }
+        Ok(())
+    }
+
+    fn read_film(&self) -> Result<Film> {
+        GpuRenderer::read_film(self)
+    }
+
+    fn setup_times(&self) -> (Duration, Duration) {
+        (self.accel_build_time, self.pipeline_time)
     }
 }
 

@@ -1,0 +1,33 @@
+//! What the render loop asks of a backend: add a pass of samples to its film, say how many
+//! samples per pixel the next pass holds, read the film back. `render::render` drives every
+//! backend through this one trait, so progress, Ctrl-C and timing are written once.
+
+use crate::film::Film;
+use anyhow::Result;
+use indicatif::ProgressBar;
+use kernel::scene::RenderParams;
+use std::time::Duration;
+
+/// A scene prepared on one backend, accumulating samples into a film it owns.
+///
+/// Invariant: after `add_samples` for passes `0..n0`, `n0..n1`, ... in order, `read_film`
+/// holds exactly those samples; the pass sizes come from `next_pass` alone (never from
+/// timing), so a render is the same bit for bit every time.
+pub trait SampleBackend {
+    /// Samples per pixel of the next pass, `done` of `spp` having been added (1..=spp - done).
+    fn next_pass(&self, done: u32, spp: u32) -> u32;
+    /// Adds samples `first..first + count` of every pixel; `params` is
+    /// `Scene::params(first, count)`. Counts the samples on `progress` as they finish.
+    fn add_samples(
+        &mut self,
+        params: &RenderParams,
+        first: u32,
+        count: u32,
+        progress: Option<&ProgressBar>,
+    ) -> Result<()>;
+    /// The film with every sample added so far.
+    fn read_film(&self) -> Result<Film>;
+    /// Of the set-up: building the acceleration structure (the CPU's BVH, the GPU's BLAS and
+    /// TLAS) and creating the pipeline (zero on the CPU).
+    fn setup_times(&self) -> (Duration, Duration);
+}
