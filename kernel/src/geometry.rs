@@ -1,5 +1,6 @@
 //! Ray/primitive intersection, the geometry factor, and where a new ray starts.
 
+use crate::intersect;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use spirv_std::glam::Vec3;
@@ -40,12 +41,8 @@ pub fn area_to_solid_angle_pdf(pdf_area: f32, p: Vec3, p_light: Vec3, n_light: V
     }
 }
 
-/// Closest root t in (t_min, t_max) of |o + t d - c|^2 = r^2, or a negative value for none.
-/// `d` need not be unit length. The discriminant is computed as
-/// a (r^2 - |f - (f.d / a) d|^2) with f = o - c, which avoids the b^2 - 4ac cancellation, and the
-/// roots by the stable quadratic formula q = -(b + sign(b) sqrt(disc)), t0 = q / a, t1 = c / q
-/// (Haines, Guenther, Akenine-Moller, "Precision Improvements for Ray/Sphere Intersection",
-/// Ray Tracing Gems, ch. 7, 2019).
+/// Closest root t in (t_min, t_max) of |o + t d - c|^2 = r^2, or a negative value for none:
+/// [`intersect::sphere`] on one ray.
 #[inline]
 pub fn intersect_sphere(
     origin: Vec3,
@@ -55,29 +52,14 @@ pub fn intersect_sphere(
     t_min: f32,
     t_max: f32,
 ) -> f32 {
-    let f = origin - center;
-    let a = dir.dot(dir);
-    let b = f.dot(dir); // half of the usual b
-    let perp = f - (b / a) * dir;
-    let r2 = radius * radius;
-    let disc = a * (r2 - perp.dot(perp));
-    if !(disc >= 0.0) || !(a > 0.0) {
-        return -1.0;
-    }
-    let c = f.dot(f) - r2;
-    let sq = disc.sqrt();
-    let q = if b >= 0.0 { -(b + sq) } else { -(b - sq) };
-    let t_a = q / a;
-    let t_b = if q != 0.0 { c / q } else { t_a };
-    let t_near = t_a.min(t_b);
-    let t_far = t_a.max(t_b);
-    if t_near > t_min && t_near < t_max {
-        t_near
-    } else if t_far > t_min && t_far < t_max {
-        t_far
-    } else {
-        -1.0
-    }
+    intersect::sphere(
+        origin.into(),
+        dir.into(),
+        center.into(),
+        radius,
+        t_min,
+        t_max,
+    )
 }
 
 /// Moves a point computed as o + t d onto the sphere's surface along the radius, removing most
@@ -102,8 +84,9 @@ pub struct TriangleHit {
     pub v: f32,
 }
 
-/// Ray/triangle intersection (Moller and Trumbore, "Fast, Minimum Storage Ray/Triangle
-/// Intersection", JGT 1997), two-sided, with the barycentric coordinates of the hit.
+/// Ray/triangle intersection, two-sided, with the barycentric coordinates of the hit:
+/// [`intersect::triangle`] on one ray (u = v = 0 for a miss). `t_min` must be at least 0
+/// (a miss is t = -1).
 #[inline]
 pub fn intersect_triangle_uv(
     origin: Vec3,
@@ -114,35 +97,23 @@ pub fn intersect_triangle_uv(
     t_min: f32,
     t_max: f32,
 ) -> TriangleHit {
-    let miss = TriangleHit {
-        t: -1.0,
-        u: 0.0,
-        v: 0.0,
-    };
-    let pvec = dir.cross(edge2);
-    let det = edge1.dot(pvec);
-    if det == 0.0 || !det.is_finite() {
-        return miss;
-    }
-    let inv_det = 1.0 / det;
-    let tvec = origin - p0;
-    // Negated tests so that NaN (from inf * 0 with extreme inputs) is a miss, not a hit.
-    let u = tvec.dot(pvec) * inv_det;
-    // Not `(0.0..=1.0).contains(&u)`: rust-gpu cannot compile the reference to a local range.
-    #[allow(clippy::manual_range_contains)]
-    if !(u >= 0.0 && u <= 1.0) {
-        return miss;
-    }
-    let qvec = tvec.cross(edge1);
-    let v = dir.dot(qvec) * inv_det;
-    if !(v >= 0.0 && u + v <= 1.0) {
-        return miss;
-    }
-    let t = edge2.dot(qvec) * inv_det;
-    if t > t_min && t < t_max && t.is_finite() {
+    let (t, u, v) = intersect::triangle(
+        origin.into(),
+        dir.into(),
+        p0.into(),
+        edge1.into(),
+        edge2.into(),
+        t_min,
+        t_max,
+    );
+    if t >= 0.0 {
         TriangleHit { t, u, v }
     } else {
-        miss
+        TriangleHit {
+            t: -1.0,
+            u: 0.0,
+            v: 0.0,
+        }
     }
 }
 
@@ -215,6 +186,25 @@ pub fn triangle_error_condition(edge1: Vec3, edge2: Vec3) -> f32 {
         1.0
     };
     condition.max(1.0)
+}
+
+/// What a triangle's hit records need that depends on its shape alone: its unit normal
+/// ([`triangle_normal`]) and its [`triangle_error_condition`] (four square roots and two
+/// divisions, which a renderer may compute once per triangle, as the CPU's BVH does).
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleShape {
+    pub normal: Vec3,
+    pub condition: f32,
+}
+
+impl TriangleShape {
+    #[inline]
+    pub fn of(edge1: Vec3, edge2: Vec3) -> Self {
+        Self {
+            normal: triangle_normal(edge1, edge2),
+            condition: triangle_error_condition(edge1, edge2),
+        }
+    }
 }
 
 /// [`triangle_point_error`] with the triangle's [`triangle_error_condition`] given.

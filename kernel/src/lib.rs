@@ -15,6 +15,7 @@ pub mod features;
 pub mod frame;
 pub mod geometry;
 pub mod hash;
+pub mod intersect;
 pub mod light;
 pub mod path;
 pub mod probe;

@@ -5,11 +5,14 @@ use crate::adaptive::sample_stream;
 use crate::brdf::{eval_scattering, pdf_brdf, sampled_brdf_weight};
 use crate::camera::{camera_origin, camera_ray_direction};
 use crate::features::FeatureSet;
-use crate::geometry::{offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error};
+use crate::geometry::{
+    offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error, triangle_point,
+    triangle_point_error_conditioned, TriangleShape,
+};
 use crate::light::{eval_radiance, pdf_light_from};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
-use crate::scene::{light_sampling, Material, RenderParams, Sphere, SphereLight, NONE};
+use crate::scene::{light_sampling, Material, RenderParams, Sphere, SphereLight, Triangle, NONE};
 use crate::vertex_sampler::VertexSampler;
 use spirv_std::glam::Vec3;
 
@@ -68,6 +71,36 @@ impl SurfaceHit {
             light: sphere.light,
             error: sphere_point_error(center, radius),
             arrived_behind: from_center.dot(from_center) < radius * radius,
+        }
+    }
+
+    /// The record of a ray along `dir` meeting triangle `tri` (of shape `shape`) at `t`, at
+    /// barycentric (u, v): the point from the barycentrics (`triangle_point`: on the plane up to
+    /// a few roundings, whatever t's error), the geometric normal edge1 x edge2, the point's
+    /// error bound, and the side by the sign of `normal . dir`. Both backends build triangle
+    /// hits here.
+    #[inline]
+    pub fn triangle(
+        tri: &Triangle,
+        shape: TriangleShape,
+        dir: Vec3,
+        t: f32,
+        u: f32,
+        v: f32,
+    ) -> Self {
+        let (p0, e1, e2) = (
+            Vec3::from(tri.p0),
+            Vec3::from(tri.edge1),
+            Vec3::from(tri.edge2),
+        );
+        Self {
+            position: triangle_point(p0, e1, e2, u, v),
+            t,
+            normal: shape.normal,
+            material: tri.material,
+            light: NONE,
+            error: triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition),
+            arrived_behind: Self::behind_plane(shape.normal, dir),
         }
     }
 

@@ -34,6 +34,14 @@ pub trait Real:
     fn greater_than(self, other: Self) -> Self::Bits;
     /// All ones where `self >= other`, zero elsewhere.
     fn at_least(self, other: Self) -> Self::Bits;
+    /// All ones where `self < other`, zero elsewhere.
+    fn less_than(self, other: Self) -> Self::Bits;
+    /// All ones where `self <= other`, zero elsewhere.
+    fn at_most(self, other: Self) -> Self::Bits;
+    /// All ones where `self != other` (so also where either is NaN), zero elsewhere.
+    fn not_equal(self, other: Self) -> Self::Bits;
+    /// All ones where the lane is neither infinite nor NaN, zero elsewhere.
+    fn finite(self) -> Self::Bits;
     /// `self as i32` (toward zero, saturating), as the bits of the `i32`.
     fn to_i32_bits(self) -> Self::Bits;
     /// The `i32` whose bits are `bits`, `as f32` (rounded to nearest).
@@ -106,6 +114,42 @@ impl Real for f32 {
     }
 
     #[inline]
+    fn less_than(self, other: Self) -> u32 {
+        if self < other {
+            u32::MAX
+        } else {
+            0
+        }
+    }
+
+    #[inline]
+    fn at_most(self, other: Self) -> u32 {
+        if self <= other {
+            u32::MAX
+        } else {
+            0
+        }
+    }
+
+    #[inline]
+    fn not_equal(self, other: Self) -> u32 {
+        if self != other {
+            u32::MAX
+        } else {
+            0
+        }
+    }
+
+    #[inline]
+    fn finite(self) -> u32 {
+        if self.is_finite() {
+            u32::MAX
+        } else {
+            0
+        }
+    }
+
+    #[inline]
     fn to_i32_bits(self) -> u32 {
         self as i32 as u32
     }
@@ -166,6 +210,34 @@ impl<const N: usize> Real for core::simd::Simd<f32, N> {
     }
 
     #[inline]
+    fn less_than(self, other: Self) -> Self::Bits {
+        use core::simd::{cmp::SimdPartialOrd, Select};
+        self.simd_lt(other)
+            .select(Self::Bits::splat(u32::MAX), Self::Bits::splat(0))
+    }
+
+    #[inline]
+    fn at_most(self, other: Self) -> Self::Bits {
+        use core::simd::{cmp::SimdPartialOrd, Select};
+        self.simd_le(other)
+            .select(Self::Bits::splat(u32::MAX), Self::Bits::splat(0))
+    }
+
+    #[inline]
+    fn not_equal(self, other: Self) -> Self::Bits {
+        use core::simd::{cmp::SimdPartialEq, Select};
+        self.simd_ne(other)
+            .select(Self::Bits::splat(u32::MAX), Self::Bits::splat(0))
+    }
+
+    #[inline]
+    fn finite(self) -> Self::Bits {
+        use core::simd::{num::SimdFloat, Select};
+        self.is_finite()
+            .select(Self::Bits::splat(u32::MAX), Self::Bits::splat(0))
+    }
+
+    #[inline]
     fn to_i32_bits(self) -> Self::Bits {
         use core::simd::num::{SimdFloat, SimdInt};
         self.cast::<i32>().cast()
@@ -197,6 +269,22 @@ impl<R: Real> V3<R> {
     #[inline]
     pub fn dot(self, rhs: Self) -> R {
         (self.x * rhs.x) + (self.y * rhs.y) + (self.z * rhs.z)
+    }
+
+    /// The cross product in glam's order of operations.
+    #[inline]
+    pub fn cross(self, rhs: Self) -> Self {
+        Self::new(
+            self.y * rhs.z - rhs.y * self.z,
+            self.z * rhs.x - rhs.z * self.x,
+            self.x * rhs.y - rhs.x * self.y,
+        )
+    }
+
+    /// `x` in every lane of every component.
+    #[inline]
+    pub fn splat(v: Vec3) -> Self {
+        Self::new(R::splat(v.x), R::splat(v.y), R::splat(v.z))
     }
 }
 

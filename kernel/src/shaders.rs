@@ -12,9 +12,9 @@
 
 use crate::adaptive::{is_pilot_sample, luminance, pixel_converged};
 use crate::features::Dynamic;
-use crate::geometry::{intersect_sphere, triangle_normal, triangle_point, triangle_point_error};
+use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::path::{render_sample, SurfaceHit, Tracer};
-use crate::scene::{Material, RenderParams, Sphere, SphereLight, Triangle, NONE};
+use crate::scene::{Material, RenderParams, Sphere, SphereLight, Triangle};
 use spirv_std::glam::{UVec2, UVec3, UVec4, Vec2, Vec3, Vec4};
 use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
@@ -34,6 +34,34 @@ pub struct HitPayload {
     pub hit: u32,
     /// 1 if the ray arrived from behind the normal (`SurfaceHit::arrived_behind`).
     pub behind: u32,
+}
+
+impl HitPayload {
+    /// Stores a closest-hit shader's record (and marks the ray as having hit).
+    fn store(&mut self, h: &SurfaceHit) {
+        self.position_t = h.position.extend(h.t);
+        self.normal = h.normal.extend(h.error);
+        self.material = h.material;
+        self.light = h.light;
+        self.hit = 1;
+        self.behind = h.arrived_behind as u32;
+    }
+
+    /// The record a closest-hit shader stored, or a miss.
+    fn surface(&self) -> SurfaceHit {
+        if self.hit == 0 {
+            return SurfaceHit::miss();
+        }
+        SurfaceHit {
+            position: self.position_t.truncate(),
+            t: self.position_t.w,
+            normal: self.normal.truncate(),
+            material: self.material,
+            light: self.light,
+            error: self.normal.w,
+            arrived_behind: self.behind != 0,
+        }
+    }
 }
 
 /// [`Tracer`] over the top-level acceleration structure.
@@ -59,18 +87,7 @@ impl Tracer for RayTracer<'_> {
                 self.payload,
             );
         }
-        if self.payload.hit == 0 {
-            return SurfaceHit::miss();
-        }
-        SurfaceHit {
-            position: self.payload.position_t.truncate(),
-            t: self.payload.position_t.w,
-            normal: self.payload.normal.truncate(),
-            material: self.payload.material,
-            light: self.payload.light,
-            error: self.payload.normal.w,
-            arrived_behind: self.payload.behind != 0,
-        }
+        self.payload.surface()
     }
 
     fn occluded(&mut self, from: Vec3, to: Vec3) -> bool {
@@ -199,9 +216,8 @@ pub fn miss(#[spirv(incoming_ray_payload)] payload: &mut HitPayload) {
     payload.hit = 0;
 }
 
-/// Closest hit on a triangle: position from the barycentrics (`geometry::triangle_point`, as on
-/// the CPU), normal and material from the triangle table (`instance_custom_index` is the
-/// instance's first triangle).
+/// Closest hit on a triangle: the record of `SurfaceHit::triangle`, as on the CPU, from the
+/// triangle table (`instance_custom_index` is the instance's first triangle).
 #[spirv(closest_hit)]
 pub fn closest_hit_triangle(
     #[spirv(incoming_ray_payload)] payload: &mut HitPayload,
@@ -212,21 +228,16 @@ pub fn closest_hit_triangle(
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
 ) {
-    let tri = triangles[(first + primitive) as usize];
-    let (p0, e1, e2) = (
-        Vec3::from(tri.p0),
-        Vec3::from(tri.edge1),
-        Vec3::from(tri.edge2),
-    );
-    let (u, v) = (barycentrics.x, barycentrics.y);
-    let p = triangle_point(p0, e1, e2, u, v);
-    let normal = triangle_normal(e1, e2);
-    payload.position_t = p.extend(t);
-    payload.normal = normal.extend(triangle_point_error(p0, e1, e2, u, v));
-    payload.material = tri.material;
-    payload.light = NONE;
-    payload.hit = 1;
-    payload.behind = SurfaceHit::behind_plane(normal, dir) as u32;
+    let tri = &triangles[(first + primitive) as usize];
+    let shape = TriangleShape::of(Vec3::from(tri.edge1), Vec3::from(tri.edge2));
+    payload.store(&SurfaceHit::triangle(
+        tri,
+        shape,
+        dir,
+        t,
+        barycentrics.x,
+        barycentrics.y,
+    ));
 }
 
 /// Intersection with a procedural sphere: the kernel's robust ray/sphere test, the same function
@@ -261,13 +272,12 @@ pub fn closest_hit_sphere(
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] spheres: &[Sphere],
 ) {
-    let h = SurfaceHit::sphere(origin, dir, t, &spheres[(first + primitive) as usize]);
-    payload.position_t = h.position.extend(t);
-    payload.normal = h.normal.extend(h.error);
-    payload.material = h.material;
-    payload.light = h.light;
-    payload.hit = 1;
-    payload.behind = h.arrived_behind as u32;
+    payload.store(&SurfaceHit::sphere(
+        origin,
+        dir,
+        t,
+        &spheres[(first + primitive) as usize],
+    ));
 }
 
 /// Push constants of [`probe`].

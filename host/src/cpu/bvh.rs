@@ -11,11 +11,10 @@
 //! kernel's own intersection functions' answer (bit-identical t), whatever the traversal order.
 
 use super::bvh_build::{Aabb, BinaryBvh, SAH_MAX_DEPTH};
-use super::simd::{Boxes, Ray4, Spheres4, Triangles4, SLAB_PAD};
+use super::simd::{widest_simd, Boxes, Ray4, Spheres4, Triangles4, SLAB_PAD};
 use glam::Vec3;
 use kernel::geometry::{
-    intersect_sphere, intersect_triangle, intersect_triangle_uv, triangle_error_condition,
-    triangle_normal, triangle_point, triangle_point_error_conditioned,
+    intersect_sphere, intersect_triangle, intersect_triangle_uv, TriangleShape,
 };
 use kernel::scene::{Sphere, Triangle, NONE};
 use kernel::SurfaceHit;
@@ -89,24 +88,6 @@ pub struct Bvh {
     shapes: Vec<TriangleShape>,
 }
 
-/// A triangle's unit normal (`triangle_normal`) and its `triangle_error_condition`: a hit
-/// record would otherwise compute them again for every hit (four square roots, two divisions).
-#[derive(Clone, Copy, Debug)]
-struct TriangleShape {
-    normal: Vec3,
-    condition: f32,
-}
-
-impl TriangleShape {
-    fn of(t: &Triangle) -> Self {
-        let (e1, e2) = (Vec3::from(t.edge1), Vec3::from(t.edge2));
-        Self {
-            normal: triangle_normal(e1, e2),
-            condition: triangle_error_condition(e1, e2),
-        }
-    }
-}
-
 fn prim_bounds(spheres: &[Sphere], triangles: &[Triangle], id: u32) -> Aabb {
     let id = id as usize;
     if id < spheres.len() {
@@ -140,7 +121,10 @@ impl Bvh {
             blocks: Vec::with_capacity(triangles.len() / 4 + 1),
             sphere_blocks: Vec::new(),
             root: None,
-            shapes: triangles.iter().map(TriangleShape::of).collect(),
+            shapes: triangles
+                .iter()
+                .map(|t| TriangleShape::of(Vec3::from(t.edge1), Vec3::from(t.edge2)))
+                .collect(),
             spheres,
             triangles,
         };
@@ -288,23 +272,11 @@ impl Bvh {
         self.surface(best, origin, dir, best_t)
     }
 
-    /// The primitive hit first along `origin + t dir`, t in (0, t_max), and its t; `NONE` for
-    /// a miss. Of primitives hit at exactly the same t, any one may be returned.
-    pub fn closest_prim(&self, origin: Vec3, dir: Vec3, t_max: f32) -> (u32, f32) {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { self.closest_prim_avx2(origin, dir, t_max) };
-        }
-        self.closest_prim_any_cpu(origin, dir, t_max)
-    }
-
-    /// [`Bvh::closest_prim`] compiled for AVX2: the eight box lanes in one register instead of
-    /// two, three-operand instructions; the same operations, so the same results (no FMA).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn closest_prim_avx2(&self, origin: Vec3, dir: Vec3, t_max: f32) -> (u32, f32) {
-        self.closest_prim_any_cpu(origin, dir, t_max)
+    widest_simd! {
+        /// The primitive hit first along `origin + t dir`, t in (0, t_max), and its t; `NONE`
+        /// for a miss. Of primitives hit at exactly the same t, any one may be returned.
+        pub fn closest_prim(&self, origin: Vec3, dir: Vec3, t_max: f32) -> (u32, f32)
+            = closest_prim_any_cpu, closest_prim_avx512, closest_prim_avx2
     }
 
     #[inline(always)]
@@ -393,21 +365,10 @@ impl Bvh {
         }
     }
 
-    /// Whether anything is hit along `origin + t dir`, t in (0, t_max).
-    pub fn any_hit(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { self.any_hit_avx2(origin, dir, t_max) };
-        }
-        self.any_hit_any_cpu(origin, dir, t_max)
-    }
-
-    /// [`Bvh::any_hit`] compiled for AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn any_hit_avx2(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        self.any_hit_any_cpu(origin, dir, t_max)
+    widest_simd! {
+        /// Whether anything is hit along `origin + t dir`, t in (0, t_max).
+        pub fn any_hit(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool
+            = any_hit_any_cpu, any_hit_avx512, any_hit_avx2
     }
 
     #[inline(always)]
@@ -551,21 +512,7 @@ impl Bvh {
             SurfaceHit::sphere(origin, dir, t, &self.spheres[id])
         } else {
             let index = id - self.spheres.len();
-            let (tri, shape) = (&self.triangles[index], &self.shapes[index]);
-            let (p0, e1, e2) = (
-                Vec3::from(tri.p0),
-                Vec3::from(tri.edge1),
-                Vec3::from(tri.edge2),
-            );
-            SurfaceHit {
-                position: triangle_point(p0, e1, e2, u, v),
-                t,
-                normal: shape.normal,
-                material: tri.material,
-                light: NONE,
-                error: triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition),
-                arrived_behind: SurfaceHit::behind_plane(shape.normal, dir),
-            }
+            SurfaceHit::triangle(&self.triangles[index], self.shapes[index], dir, t, u, v)
         }
     }
 }

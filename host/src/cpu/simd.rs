@@ -1,14 +1,15 @@
 //! One ray against N boxes or four triangles at once (`std::simd`; the BVH uses 8 box lanes,
 //! one AVX2 instruction per step where the CPU has it, two SSE ones elsewhere). The triangle
-//! test performs, lane by lane, exactly the operations of the kernel's scalar
-//! `intersect_triangle` in the same order, so each lane's result is bit-identical to it (Rust
-//! never contracts a * b + c into a fused multiply-add); `tests/tests/properties.rs` checks
-//! this on random and degenerate triangles.
+//! and sphere tests are the kernel's (`kernel::intersect`) instantiated on SIMD lanes, so each
+//! lane's result is bit-identical to the scalar one (Rust never contracts a * b + c into a
+//! fused multiply-add); `tests/tests/properties.rs` checks this on random and degenerate
+//! triangles.
 
 use glam::Vec3;
-use std::simd::cmp::{SimdPartialEq, SimdPartialOrd};
+use kernel::intersect;
+use kernel::real::V3;
+use std::simd::cmp::SimdPartialOrd;
 use std::simd::num::SimdFloat;
-use std::simd::StdFloat;
 use std::simd::{f32x4, Mask, Select, Simd};
 
 /// 1 + 2 gamma(3): widening of a slab test's far distance so rounding never culls a box the
@@ -138,11 +139,10 @@ pub fn triangle_lanes<const N: usize>(
     triangle_lanes_uv(origin, dir, p0, edge1, edge2, t_min, t_max).0
 }
 
-/// Moller-Trumbore, lane by lane and operation for operation the kernel's
-/// `intersect_triangle_uv`: each lane's t where its ray hits its triangle within
-/// (t_min, t_max), else -1, and the barycentrics u, v (meaningful where t >= 0). Either side
-/// may be broadcast: one ray against N triangles ([`Ray4::triangles`]) or N rays against one
-/// triangle (`cpu::packet`).
+/// The kernel's [`kernel::intersect::triangle`] on N lanes: each lane's t where its ray hits
+/// its triangle within (t_min, t_max), else -1, and the barycentrics u, v (meaningful where
+/// t >= 0). Either side may be broadcast: one ray against N triangles ([`Ray4::triangles`]) or
+/// N rays against one triangle (`cpu::packet`).
 #[inline(always)]
 pub fn triangle_lanes_uv<const N: usize>(
     origin: &[Simd<f32, N>; 3],
@@ -153,36 +153,19 @@ pub fn triangle_lanes_uv<const N: usize>(
     t_min: Simd<f32, N>,
     t_max: Simd<f32, N>,
 ) -> (Simd<f32, N>, Simd<f32, N>, Simd<f32, N>) {
-    let [dx, dy, dz] = *dir;
-    let [e1x, e1y, e1z] = *edge1;
-    let [e2x, e2y, e2z] = *edge2;
-    let zero = Simd::splat(0.0);
-    let one = Simd::splat(1.0);
-    // pvec = dir x edge2, in glam's order of operations.
-    let px = dy * e2z - e2y * dz;
-    let py = dz * e2x - e2z * dx;
-    let pz = dx * e2y - e2x * dy;
-    let det = e1x * px + e1y * py + e1z * pz;
-    let mut ok = det.simd_ne(zero) & det.is_finite();
-    let inv_det = one / det;
-    let tx = origin[0] - p0[0];
-    let ty = origin[1] - p0[1];
-    let tz = origin[2] - p0[2];
-    let u = (tx * px + ty * py + tz * pz) * inv_det;
-    ok &= u.simd_ge(zero) & u.simd_le(one);
-    // qvec = tvec x edge1.
-    let qx = ty * e1z - e1y * tz;
-    let qy = tz * e1x - e1z * tx;
-    let qz = tx * e1y - e1x * ty;
-    let v = (dx * qx + dy * qy + dz * qz) * inv_det;
-    ok &= v.simd_ge(zero) & (u + v).simd_le(one);
-    let t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
-    ok &= t.simd_gt(t_min) & t.simd_lt(t_max) & t.is_finite();
-    (ok.select(t, Simd::splat(-1.0)), u, v)
+    intersect::triangle(
+        v3(origin),
+        v3(dir),
+        v3(p0),
+        v3(edge1),
+        v3(edge2),
+        t_min,
+        t_max,
+    )
 }
 
-/// The kernel's `intersect_sphere`, lane by lane and operation for operation (Haines et al.'s
-/// stable discriminant and quadratic): each lane's nearest root in (t_min, t_max), else -1.
+/// The kernel's [`kernel::intersect::sphere`] on N lanes: each lane's nearest root in
+/// (t_min, t_max), else -1.
 #[inline(always)]
 pub fn sphere_lanes<const N: usize>(
     origin: &[Simd<f32, N>; 3],
@@ -192,29 +175,13 @@ pub fn sphere_lanes<const N: usize>(
     t_min: Simd<f32, N>,
     t_max: Simd<f32, N>,
 ) -> Simd<f32, N> {
-    let [dx, dy, dz] = *dir;
-    let fx = origin[0] - center[0];
-    let fy = origin[1] - center[1];
-    let fz = origin[2] - center[2];
-    let a = dx * dx + dy * dy + dz * dz;
-    let b = fx * dx + fy * dy + fz * dz;
-    let k = b / a;
-    let (px, py, pz) = (fx - k * dx, fy - k * dy, fz - k * dz);
-    let r2 = radius * radius;
-    let disc = a * (r2 - (px * px + py * py + pz * pz));
-    let zero = Simd::splat(0.0);
-    let ok = disc.simd_ge(zero) & a.simd_gt(zero);
-    let c = fx * fx + fy * fy + fz * fz - r2;
-    let sq = disc.sqrt();
-    let q = b.simd_ge(zero).select(-(b + sq), -(b - sq));
-    let t_a = q / a;
-    let t_b = q.simd_ne(zero).select(c / q, t_a);
-    let t_near = t_a.simd_min(t_b);
-    let t_far = t_a.simd_max(t_b);
-    let near_ok = t_near.simd_gt(t_min) & t_near.simd_lt(t_max);
-    let far_ok = t_far.simd_gt(t_min) & t_far.simd_lt(t_max);
-    let t = near_ok.select(t_near, far_ok.select(t_far, Simd::splat(-1.0)));
-    ok.select(t, Simd::splat(-1.0))
+    intersect::sphere(v3(origin), v3(dir), v3(center), radius, t_min, t_max)
+}
+
+/// Three lane vectors as the kernel's [`V3`].
+#[inline(always)]
+fn v3<const N: usize>(c: &[Simd<f32, N>; 3]) -> V3<Simd<f32, N>> {
+    V3::new(c[0], c[1], c[2])
 }
 
 /// Lane-wise a < b ? a : b: the second operand wherever either is NaN (x86 minps).
