@@ -27,7 +27,7 @@ pub mod scene;
 pub mod shaders;
 pub mod sobol;
 pub mod turns;
-pub mod vertex_sampler;
+pub mod vertex_samples;
 pub mod word;
 
 pub use path::{trace_path, SurfaceHit, Tracer};

@@ -13,7 +13,7 @@ use crate::light::{eval_radiance, pdf_light_from};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{light_sampling, Material, RenderParams, Sphere, SphereLight, Triangle, NONE};
-use crate::vertex_sampler::VertexSampler;
+use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION};
 use spirv_std::glam::Vec3;
 
 /// Where a ray meets the scene first. `t < 0` means it met nothing.
@@ -136,18 +136,10 @@ pub trait Tracer {
     fn occluded(&mut self, from: Vec3, to: Vec3) -> bool;
 }
 
-/// Random dimensions per path vertex: light choice (1) and point (2), roulette (1), BRDF (2).
-/// (Pairs start at offsets 1 and 4 of the block; the Sobol sampler scrambles each from its own
-/// starting dimension, so pairs need no alignment.)
-pub const DIMENSIONS_PER_VERTEX: u32 = 6;
-/// Offsets in a vertex's block of dimensions: the light choice (one number), the point on the
-/// light (a pair), the roulette decision (one), the BRDF direction (a pair).
-pub const LIGHT_CHOICE_DIMENSION: u32 = 0;
-pub const LIGHT_POINT_DIMENSION: u32 = 1;
-pub const ROULETTE_DIMENSION: u32 = 3;
-pub const BRDF_DIMENSION: u32 = 4;
-/// Random dimensions used by the camera before the first vertex (position inside the pixel).
-pub const CAMERA_DIMENSIONS: u32 = 2;
+pub use crate::vertex_samples::{
+    BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX, LIGHT_CHOICE_DIMENSION,
+    LIGHT_POINT_DIMENSION, ROULETTE_DIMENSION,
+};
 
 /// Seed: `TracePath(ray)`. One unbiased estimate of the radiance arriving at `origin` from
 /// direction `-dir` (`dir` unit length).
@@ -231,7 +223,7 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
 /// hit is looked at, so the radiance sums its terms in the same order as a loop that casts the
 /// shadow ray first.
 #[derive(Clone, Copy, Debug)]
-pub struct PathState<R = SampleRng> {
+pub struct PathState {
     /// The estimate so far; the result once [`PathState::finished`].
     pub radiance: Vec3,
     /// The product of the BRDF weights (and roulette divisions) up to the current vertex.
@@ -253,16 +245,16 @@ pub struct PathState<R = SampleRng> {
     pub previous_pdf: f32,
     /// Vertices so far: 0 while the camera ray is out.
     pub depth: u32,
-    /// The sample's random numbers ([`SampleRng`], or the CPU packets' numbers computed for
-    /// sixteen paths at once).
-    pub rng: R,
+    /// The sample's random numbers (the one-path loop draws a vertex's samples from them; the
+    /// CPU's packets compute them for sixteen paths at once).
+    pub rng: SampleRng,
 }
 
-impl<R: VertexSampler> PathState<R> {
+impl PathState {
     /// A path whose camera ray `origin + t dir` is to be traced; `rng` is past the camera's
     /// dimensions.
     #[inline]
-    pub fn new(origin: Vec3, dir: Vec3, rng: R) -> Self {
+    pub fn new(origin: Vec3, dir: Vec3, rng: SampleRng) -> Self {
         Self {
             radiance: Vec3::ZERO,
             throughput: Vec3::ONE,
@@ -304,7 +296,12 @@ impl<R: VertexSampler> PathState<R> {
                 SurfaceHit::miss()
             };
             let occluded = self.shadow && tracer.occluded(self.shadow_from, self.shadow_to);
-            self.advance(features, params, materials, lights, hit, occluded);
+            if self.advance(features, params, materials, lights, &hit, occluded) {
+                let material = materials[hit.material as usize];
+                let query = self.vertex_query(features, params, &hit, &material);
+                let samples = VertexSamples::draw(&query, &mut self.rng, lights);
+                self.vertex(features, params, lights, &hit, &material, &query, &samples);
+            }
             if self.finished() {
                 return self;
             }
@@ -313,7 +310,10 @@ impl<R: VertexSampler> PathState<R> {
 
     /// Takes the answers to this round's rays: `hit`, the closest hit of the extension ray
     /// (ignored unless `extend`), and whether the shadow segment is `occluded` (ignored unless
-    /// `shadow`); then runs the estimator up to its next ray casts (steps 1-5 above).
+    /// `shadow`); then runs the estimator up to its next ray casts (steps 1-5 above) or up to
+    /// the vertex at `hit`. Returns whether the path reached that vertex: then the caller
+    /// states its query ([`PathState::vertex_query`]), fills its samples and hands them to
+    /// [`PathState::vertex`], which prepares the next rays.
     #[inline]
     pub fn advance<F: FeatureSet>(
         &mut self,
@@ -321,15 +321,15 @@ impl<R: VertexSampler> PathState<R> {
         params: &RenderParams,
         materials: &[Material],
         lights: &[SphereLight],
-        hit: SurfaceHit,
+        hit: &SurfaceHit,
         occluded: bool,
-    ) {
+    ) -> bool {
         if self.shadow && !occluded {
             self.radiance += self.shadow_radiance;
         }
         self.shadow = false;
         if !self.extend {
-            return;
+            return false;
         }
         self.extend = false;
         if !hit.is_hit() {
@@ -339,7 +339,7 @@ impl<R: VertexSampler> PathState<R> {
             } else if features.background() {
                 self.radiance += self.throughput * background(params);
             }
-            return;
+            return false;
         }
         let material = materials[hit.material as usize];
         if hit.light != NONE {
@@ -360,48 +360,71 @@ impl<R: VertexSampler> PathState<R> {
                 };
                 self.radiance += self.throughput * emitted * weight;
             }
-            return;
+            return false;
         }
         self.depth += 1;
-        self.vertex(features, params, lights, hit, material);
+        true
     }
 
-    /// Steps 2(a), 4 and 3 at vertex `hit` (reached at `self.depth`), left toward the ray's origin:
-    /// prepares the light sample's shadow segment and, unless the path ends here, the extension.
+    /// What the vertex at `hit` (just reached, at `self.depth`) will draw: its receiver and
+    /// facing normal, its light choice (none on a black surface), whether it may extend and
+    /// roulette's survival probability.
     #[inline]
-    fn vertex<F: FeatureSet>(
+    pub fn vertex_query<F: FeatureSet>(
+        &self,
+        features: F,
+        params: &RenderParams,
+        hit: &SurfaceHit,
+        material: &Material,
+    ) -> VertexQuery {
+        let albedo = Vec3::from(material.albedo);
+        let light_count = if !(features.lights(params) && albedo.max_element() > 0.0) {
+            0
+        } else if features.single_light(params) {
+            1
+        } else {
+            params.light_count
+        };
+        let survival = if features.rr_throughput(params) {
+            self.throughput.max_element().min(1.0)
+        } else {
+            params.rr_probability
+        };
+        VertexQuery {
+            depth: self.depth,
+            x: hit.position,
+            n: hit.facing_normal(),
+            light_count,
+            mode: light_sampling_of(features, params),
+            extend: self.depth < params.max_depth,
+            roulette: self.depth >= params.rr_start_depth,
+            survival,
+        }
+    }
+
+    /// Steps 2(a), 4 and 3 at vertex `hit` (reached at `self.depth`), left toward the ray's
+    /// origin, with the samples `samples` filled for `query` (this vertex's
+    /// [`PathState::vertex_query`]): prepares the light sample's shadow segment and, unless the
+    /// path ends here, the extension.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub fn vertex<F: FeatureSet>(
         &mut self,
         features: F,
         params: &RenderParams,
         lights: &[SphereLight],
-        hit: SurfaceHit,
-        material: Material,
+        hit: &SurfaceHit,
+        material: &Material,
+        query: &VertexQuery,
+        samples: &VertexSamples,
     ) {
-        let rng = &mut self.rng;
-        let n = hit.facing_normal();
-        let x = hit.position;
+        let (x, n) = (query.x, query.n);
         let albedo = Vec3::from(material.albedo);
         let ray_origin = offset_ray_origin(x, n, hit.error);
-        // This vertex's block of dimensions; numbers nobody reads are not drawn (a counter-
-        // based stream gives the others the same values either way).
-        let dimensions = CAMERA_DIMENSIONS + (self.depth - 1) * DIMENSIONS_PER_VERTEX;
 
         // 2(a): next-event estimation.
-        if features.lights(params) && albedo.max_element() > 0.0 {
-            let light_count = if features.single_light(params) {
-                1
-            } else {
-                params.light_count
-            };
-            let u_select = if light_count > 1 {
-                rng.seek(dimensions + LIGHT_CHOICE_DIMENSION);
-                rng.next_f32()
-            } else {
-                0.0
-            };
-            rng.seek(dimensions + LIGHT_POINT_DIMENSION);
-            let mode = light_sampling_of(features, params);
-            let ls = rng.sample_light_from(lights, light_count, mode, x, u_select);
+        if query.samples_light() {
+            let ls = samples.light;
             let y = ls.point.position;
             let wi = (y - x).normalize();
             let cos_x = n.dot(wi);
@@ -427,32 +450,20 @@ impl<R: VertexSampler> PathState<R> {
             }
         }
 
-        if self.depth >= params.max_depth {
+        if !query.extend {
             return;
         }
-        // 4: Russian roulette on the extension.
-        // Survival at q = 1 is certain, so no number is drawn for it (the stream is counter-
-        // based: the other dimensions keep their values).
-        if self.depth >= params.rr_start_depth {
-            let q = if features.rr_throughput(params) {
-                self.throughput.max_element().min(1.0)
-            } else {
-                params.rr_probability
-            };
-            if !(q >= 1.0) {
-                rng.seek(dimensions + ROULETTE_DIMENSION);
-                let u_rr = rng.next_f32();
-                if !(u_rr < q) {
-                    return;
-                }
-                self.throughput /= q;
+        // 4: Russian roulette on the extension (no number is drawn where survival is certain).
+        if query.draws_roulette() {
+            if !query.survives(samples.u_roulette) {
+                return;
             }
+            self.throughput /= query.survival;
         }
 
         // 3: extension by BRDF sampling. Every direction the sampler returns continues the
         // path (none is tangent; step 3 of `trace_path`).
-        rng.seek(dimensions + BRDF_DIMENSION);
-        let wi = rng.sample_brdf(n);
+        let wi = samples.brdf_dir;
         let pdf_b = pdf_brdf(n, wi);
         // = eval_scattering(n, wi, albedo) / pdf_b, exactly (see `sampled_brdf_weight`).
         self.throughput *= sampled_brdf_weight(albedo);
@@ -531,17 +542,25 @@ pub fn sample_rng(params: &RenderParams, px: u32, py: u32, sample: u32) -> Sampl
     SampleRng::with_sampler(params.seed, py * params.width + px, index, sampler)
 }
 
-/// The path of pixel (px, py) that draws its numbers from `rng` (at dimension 0), with its
-/// camera ray waiting: a uniformly random position inside the pixel (the first pair of
-/// dimensions) and the camera ray through it.
+/// The path of pixel (px, py) that draws its numbers from `rng`, with its camera ray waiting:
+/// through a uniformly random position inside the pixel, the camera's pair of numbers.
 #[inline]
-pub fn start_path<R: VertexSampler>(
+pub fn start_path(params: &RenderParams, px: u32, py: u32, mut rng: SampleRng) -> PathState {
+    rng.seek(CAMERA_DIMENSION);
+    let (u, v) = rng.next_2d();
+    start_path_at(params, px, py, rng, (u, v))
+}
+
+/// [`start_path`] with the camera's pair `(u, v)` already drawn (the CPU's packets draw
+/// sixteen at once).
+#[inline]
+pub fn start_path_at(
     params: &RenderParams,
     px: u32,
     py: u32,
-    mut rng: R,
-) -> PathState<R> {
-    let (u, v) = rng.next_2d();
+    rng: SampleRng,
+    (u, v): (f32, f32),
+) -> PathState {
     let dir = camera_ray_direction(&params.camera, params.width, params.height, px, py, u, v);
     PathState::new(camera_origin(&params.camera), dir, rng)
 }

@@ -1,127 +1,33 @@
-//! The random numbers of sixteen paths at once: the kernel's sampler (`kernel::rng`,
-//! `kernel::sobol`, written over `kernel::word::Word`) run on SIMD lanes, one path per lane,
-//! for the dimensions each path reads next. A path then takes them from its
-//! [`PrefetchedStream`] instead of computing them one at a time (which cost 18% of a Cornell
-//! render). Each lane computes exactly what `SampleRng` computes, so images do not change.
+//! The random numbers of sixteen sample streams at once: the kernel's samplers (`kernel::rng`,
+//! `kernel::sobol`, written over `kernel::word::Word`) run on SIMD lanes, one stream per lane,
+//! at the dimensions each lane asks for. Each lane computes exactly what `SampleRng` gives at
+//! that dimension (computing them one at a time cost 18% of a Cornell render).
 
 use super::packet::LANES;
-use super::packet_vertices::{PresampledBrdf, PresampledLight};
 use super::simd::widest_simd;
-use kernel::path::{
-    PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX, LIGHT_CHOICE_DIMENSION,
-    LIGHT_POINT_DIMENSION, ROULETTE_DIMENSION,
-};
-use kernel::rng::{independent_bits, u32_to_unit_f32, SampleRng, SampleStream};
+use kernel::rng::{independent_bits, u32_to_unit_f32, SampleRng};
 use kernel::scene::sampler;
 use kernel::sobol::{sobol_pair, sobol_single};
+use kernel::vertex_samples::CAMERA_DIMENSION;
 use std::simd::{Mask, Select, Simd};
 
 type Words = Simd<u32, LANES>;
-/// Computed numbers by lane: two pairs (x, y) and two single numbers.
-type Numbers = ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]);
 
-/// No dimension: an empty entry.
+/// No dimension: a lane that asks for nothing there.
 pub const EMPTY: u32 = u32::MAX;
 
-/// Numbers computed ahead for one dimension (`bits[1]` unused for a single number).
-#[derive(Clone, Copy, Debug)]
-struct Entry {
-    dimension: u32,
-    bits: [u32; 2],
+/// The numbers by lane: two pairs (`pairs[p]` = the columns of x and y) and two single
+/// numbers, as `SampleRng::next_2d` and `next_f32` return them. Lanes that asked for nothing
+/// hold numbers nobody reads.
+pub struct Numbers {
+    pub pairs: [[[f32; LANES]; 2]; 2],
+    pub singles: [[f32; LANES]; 2],
 }
 
-impl Entry {
-    const NONE: Entry = Entry {
-        dimension: EMPTY,
-        bits: [0; 2],
-    };
-}
-
-/// A sample's [`SampleRng`] with the numbers of its next dimensions computed ahead: two pairs
-/// and two single numbers (a vertex's light point, BRDF direction, light choice and roulette
-/// number, or the camera's pair). A read of any other dimension computes it as [`SampleRng`]
-/// does.
-#[derive(Clone, Copy, Debug)]
-pub struct PrefetchedStream {
-    pub rng: SampleRng,
-    pairs: [Entry; 2],
-    singles: [Entry; 2],
-    /// The next vertex's light sample and BRDF direction computed ahead
-    /// (`super::packet_vertices`), or none (their dimension [`EMPTY`]).
-    pub(super) light: PresampledLight,
-    pub(super) brdf: PresampledBrdf,
-}
-
-impl PrefetchedStream {
-    /// `rng` with nothing computed ahead.
-    pub fn new(rng: SampleRng) -> Self {
-        Self {
-            rng,
-            pairs: [Entry::NONE; 2],
-            singles: [Entry::NONE; 2],
-            light: PresampledLight::NONE,
-            brdf: PresampledBrdf::NONE,
-        }
-    }
-
-    /// Whether the pair (`pair`) or single number starting at `dimension` is computed ahead.
-    pub fn holds(&self, dimension: u32, pair: bool) -> bool {
-        let entries = if pair { &self.pairs } else { &self.singles };
-        entries.iter().any(|e| e.dimension == dimension)
-    }
-
-    /// Pair `p` computed ahead: its first dimension ([`EMPTY`] for none) and the numbers
-    /// `next_2d` returns there.
-    pub fn pair(&self, p: usize) -> (u32, (f32, f32)) {
-        let e = &self.pairs[p];
-        let numbers = (u32_to_unit_f32(e.bits[0]), u32_to_unit_f32(e.bits[1]));
-        (e.dimension, numbers)
-    }
-
-    /// Single number `p` computed ahead: its dimension ([`EMPTY`] for none) and the number
-    /// `next_f32` returns there.
-    pub fn single(&self, p: usize) -> (u32, f32) {
-        let e = &self.singles[p];
-        (e.dimension, u32_to_unit_f32(e.bits[0]))
-    }
-}
-
-impl SampleStream for PrefetchedStream {
-    #[inline]
-    fn seek(&mut self, dimension: u32) {
-        self.rng.seek(dimension);
-    }
-
-    #[inline]
-    fn next_f32(&mut self) -> f32 {
-        for entry in &self.singles {
-            if entry.dimension == self.rng.dimension {
-                self.rng.dimension += 1;
-                return u32_to_unit_f32(entry.bits[0]);
-            }
-        }
-        self.rng.next_f32()
-    }
-
-    #[inline]
-    fn next_2d(&mut self) -> (f32, f32) {
-        for entry in &self.pairs {
-            if entry.dimension == self.rng.dimension {
-                self.rng.dimension += 2;
-                return (
-                    u32_to_unit_f32(entry.bits[0]),
-                    u32_to_unit_f32(entry.bits[1]),
-                );
-            }
-        }
-        self.rng.next_2d()
-    }
-}
-
-/// What the lanes compute ahead: each lane's stream (seed, pixel, sequence index, whether it is
+/// What the lanes ask for: each lane's stream (seed, pixel, sequence index, whether it is
 /// Sobol's), the first dimensions of two pairs and the dimensions of two single numbers
 /// ([`EMPTY`] where a lane wants none).
-struct Requests {
+pub struct NumberRequests {
     seed: [u32; LANES],
     pixel: [u32; LANES],
     sample: [u32; LANES],
@@ -130,8 +36,8 @@ struct Requests {
     singles: [[u32; LANES]; 2],
 }
 
-impl Requests {
-    fn new() -> Self {
+impl Default for NumberRequests {
+    fn default() -> Self {
         Self {
             seed: [0; LANES],
             pixel: [0; LANES],
@@ -141,8 +47,12 @@ impl Requests {
             singles: [[EMPTY; LANES]; 2],
         }
     }
+}
 
-    fn set(&mut self, lane: usize, rng: &SampleRng, pairs: [u32; 2], singles: [u32; 2]) {
+impl NumberRequests {
+    /// Lane `lane` asks stream `rng` for the pairs starting at `pairs` and the numbers at
+    /// `singles` (each [`EMPTY`] or a dimension).
+    pub fn set(&mut self, lane: usize, rng: &SampleRng, pairs: [u32; 2], singles: [u32; 2]) {
         self.seed[lane] = rng.seed;
         self.pixel[lane] = rng.pixel;
         self.sample[lane] = rng.sample;
@@ -153,14 +63,25 @@ impl Requests {
         }
     }
 
+    /// The numbers every lane asked for, computed together.
+    pub fn compute(&self) -> Numbers {
+        let (pairs, singles) = self.compute_bits();
+        let unit = |column: &[u32; LANES]| column.map(u32_to_unit_f32);
+        Numbers {
+            pairs: pairs.map(|[x, y]| [unit(&x), unit(&y)]),
+            singles: singles.map(|s| unit(&s)),
+        }
+    }
+
     widest_simd! {
-        /// The requested numbers of every lane, computed together: pairs[p] = (x, y), singles[p].
-        /// (Baseline x86-64 has no lane-wise 32-bit multiply; AVX2 and AVX-512F do.)
-        fn compute(&self) -> Numbers = compute_any_cpu, compute_avx512, compute_avx2
+        /// The requested numbers' bits: pairs[p] = (x, y), singles[p]. (Baseline x86-64 has no
+        /// lane-wise 32-bit multiply; AVX2 and AVX-512F do.)
+        fn compute_bits(&self) -> ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2])
+            = compute_any_cpu, compute_avx512, compute_avx2
     }
 
     #[inline(always)]
-    fn compute_any_cpu(&self) -> Numbers {
+    fn compute_any_cpu(&self) -> ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]) {
         let (seed, pixel, sample) = (
             Words::from_array(self.seed),
             Words::from_array(self.pixel),
@@ -206,84 +127,15 @@ impl Requests {
     }
 }
 
-/// Lane `lane`'s entries of computed numbers.
-fn entries(
-    requests: &Requests,
-    (pairs, singles): &Numbers,
-    lane: usize,
-) -> ([Entry; 2], [Entry; 2]) {
-    let pair = |p: usize| Entry {
-        dimension: requests.pairs[p][lane],
-        bits: [pairs[p][0][lane], pairs[p][1][lane]],
-    };
-    let single = |p: usize| Entry {
-        dimension: requests.singles[p][lane],
-        bits: [singles[p][lane], 0],
-    };
-    ([pair(0), pair(1)], [single(0), single(1)])
-}
-
-/// New samples' streams (`rngs`, by lane) with their camera pair (dimension 0) computed
-/// together.
-pub fn camera_streams(rngs: &[Option<SampleRng>; LANES]) -> [Option<PrefetchedStream>; LANES] {
-    let mut requests = Requests::new();
+/// The camera's pair of numbers (the position inside the pixel) of up to sixteen new samples'
+/// streams, by lane, computed together.
+pub fn camera_numbers(rngs: &[Option<SampleRng>; LANES]) -> [(f32, f32); LANES] {
+    let mut requests = NumberRequests::default();
     for (lane, rng) in rngs.iter().enumerate() {
         if let Some(rng) = rng {
-            requests.set(lane, rng, [0, EMPTY], [EMPTY; 2]);
+            requests.set(lane, rng, [CAMERA_DIMENSION, EMPTY], [EMPTY; 2]);
         }
     }
     let numbers = requests.compute();
-    std::array::from_fn(|lane| {
-        rngs[lane].map(|rng| {
-            let (pairs, singles) = entries(&requests, &numbers, lane);
-            PrefetchedStream {
-                pairs,
-                singles,
-                ..PrefetchedStream::new(rng)
-            }
-        })
-    })
-}
-
-/// Where [`prefetch_vertices`] puts a vertex's numbers: the pairs of the light point and of the
-/// BRDF direction, the roulette number and the light choice.
-pub const LIGHT_POINT_PAIR: usize = 0;
-pub const BRDF_PAIR: usize = 1;
-pub const ROULETTE_SINGLE: usize = 0;
-pub const LIGHT_CHOICE_SINGLE: usize = 1;
-
-/// For each path of `slots` whose extension ray has been traced (it may reach its next vertex),
-/// computes that vertex's numbers: pairs [`LIGHT_POINT_PAIR`] and [`BRDF_PAIR`], single numbers
-/// [`ROULETTE_SINGLE`] and, if `choose_light` (several lights), [`LIGHT_CHOICE_SINGLE`].
-pub fn prefetch_vertices<T>(
-    slots: &mut [Option<(T, PathState<PrefetchedStream>)>; LANES],
-    choose_light: bool,
-) {
-    let mut requests = Requests::new();
-    for (lane, slot) in slots.iter().enumerate() {
-        let Some((_, path)) = slot else { continue };
-        if !path.extend {
-            continue;
-        }
-        let block = CAMERA_DIMENSIONS + path.depth * DIMENSIONS_PER_VERTEX;
-        let choice = if choose_light {
-            block + LIGHT_CHOICE_DIMENSION
-        } else {
-            EMPTY
-        };
-        requests.set(
-            lane,
-            &path.rng.rng,
-            // In the order of LIGHT_POINT_PAIR, BRDF_PAIR; ROULETTE_SINGLE, LIGHT_CHOICE_SINGLE.
-            [block + LIGHT_POINT_DIMENSION, block + BRDF_DIMENSION],
-            [block + ROULETTE_DIMENSION, choice],
-        );
-    }
-    let numbers = requests.compute();
-    for (lane, slot) in slots.iter_mut().enumerate() {
-        let Some((_, path)) = slot else { continue };
-        if path.extend {
-            (path.rng.pairs, path.rng.singles) = entries(&requests, &numbers, lane);
-        }
-    }
+    std::array::from_fn(|lane| (numbers.pairs[0][0][lane], numbers.pairs[0][1][lane]))
 }

@@ -5,15 +5,15 @@
 //! primitives at exactly the same distance is reported, e.g. along a quad's diagonal).
 
 use super::packet::{RayPacket, SmallScene, LANES};
-use super::packet_numbers::{camera_streams, prefetch_vertices, PrefetchedStream};
-use super::packet_vertices::presample_vertices;
+use super::packet_numbers::camera_numbers;
+use super::packet_vertices::fill_vertex_samples;
 use super::CpuRenderer;
 use crate::film::Film;
 use crate::film::PixelSums;
 use glam::Vec3;
 use kernel::adaptive::is_pilot_sample;
 use kernel::features::FeatureSet;
-use kernel::path::{light_sampling_of, sample_rng, start_path, PathState};
+use kernel::path::{sample_rng, start_path_at, PathState};
 use kernel::scene::{RenderParams, NONE};
 use kernel::SurfaceHit;
 use std::simd::Simd;
@@ -39,8 +39,8 @@ fn gather(slots: &[Option<(usize, Path)>; LANES]) -> [(RayPacket, [f32; LANES]);
     [(extension, t_max[0]), (shadow, t_max[1])]
 }
 
-/// A path of the packets, with its numbers computed sixteen paths at a time.
-type Path = PathState<PrefetchedStream>;
+/// A path of the packets.
+type Path = PathState;
 
 impl CpuRenderer {
     /// Samples `first..first + count` of each of `pixels` (skipping those `film` says have
@@ -71,10 +71,9 @@ impl CpuRenderer {
         let mut radiance = vec![Vec3::ZERO; n];
         let mut slots: [Option<(usize, Path)>; LANES] = [None; LANES];
         let mut next = 0;
-        let choose_light = params.light_count > 1;
-        let mode = light_sampling_of(features, params);
-        // The streams of samples next..next + 16, with their camera numbers computed together.
+        // The streams of samples next..next + 16, and their camera numbers computed together.
         let mut batch = [None; LANES];
+        let mut batch_camera = [(0.0, 0.0); LANES];
         let mut hits = [SurfaceHit::miss(); LANES];
         loop {
             for slot in slots.iter_mut().filter(|s| s.is_none()) {
@@ -82,19 +81,21 @@ impl CpuRenderer {
                     break;
                 }
                 if next % LANES == 0 {
-                    batch = camera_streams(&std::array::from_fn(|i| {
+                    batch = std::array::from_fn(|i| {
                         let k = next + i;
                         (k < n).then(|| {
                             let (px, py) = pixel_of(k);
                             sample_rng(params, px, py, first + (k % count as usize) as u32)
                         })
-                    }));
+                    });
+                    batch_camera = camera_numbers(&batch);
                 }
-                let stream = batch[next % LANES]
+                let rng = batch[next % LANES]
                     .take()
                     .expect("the batch holds sample next");
                 let (px, py) = pixel_of(next);
-                *slot = Some((next, start_path(params, px, py, stream)));
+                let uv = batch_camera[next % LANES];
+                *slot = Some((next, start_path_at(params, px, py, rng, uv)));
                 next += 1;
             }
             if slots.iter().all(Option::is_none) {
@@ -125,18 +126,41 @@ impl CpuRenderer {
                     hits[lane] = self.bvh.surface_with_uv(prims[lane], o, d, ts[lane], uv);
                 }
             }
-            prefetch_vertices(&mut slots, choose_light);
-            presample_vertices(&mut slots, &hits, &self.lights, params.light_count, mode);
+            // Each path takes its round's answers; those that reach a vertex state what it will
+            // draw, and the sixteen vertices' samples are filled together.
+            let mut queries = [None; LANES];
             for (lane, slot) in slots.iter_mut().enumerate() {
-                let Some((k, path)) = slot else { continue };
-                path.advance(
+                let Some((_, path)) = slot else { continue };
+                let hit = &hits[lane];
+                if path.advance(
                     features,
                     params,
                     &self.materials,
                     &self.lights,
-                    hits[lane],
+                    hit,
                     occluded[lane],
-                );
+                ) {
+                    let material = &self.materials[hit.material as usize];
+                    let query = path.vertex_query(features, params, hit, material);
+                    queries[lane] = Some((path.rng, query));
+                }
+            }
+            let samples = fill_vertex_samples(&queries, &self.lights);
+            for (lane, slot) in slots.iter_mut().enumerate() {
+                let Some((k, path)) = slot else { continue };
+                if let Some((_, query)) = &queries[lane] {
+                    let hit = &hits[lane];
+                    let material = &self.materials[hit.material as usize];
+                    path.vertex(
+                        features,
+                        params,
+                        &self.lights,
+                        hit,
+                        material,
+                        query,
+                        &samples[lane],
+                    );
+                }
                 if path.finished() {
                     radiance[*k] = path.radiance;
                     *slot = None;

@@ -1,144 +1,39 @@
-//! The light samples and BRDF directions of sixteen paths' next vertices at once. After a
-//! round's rays, the kernel's samplers in their [`kernel::real::Real`] form
-//! (`sample_sphere_cone_v3`, `brdf::sample_brdf_v3`) run on SIMD lanes, one path per
-//! lane, from the numbers `packet_numbers` computed; each path's vertex then takes its samples
-//! through [`VertexSampler`] instead of computing them one at a time (a chain of divisions and
-//! square roots: `sample_light_from` alone was 20% of a Cornell render). A lane computes exactly
-//! what the scalar sampler computes, and a path takes a sample only if the arguments it asks
-//! with are, bit for bit, the ones the sample was computed for, so images do not change.
+//! The samples of sixteen path vertices at once, filled from their sixteen
+//! [`VertexQuery`]s: the numbers on SIMD lanes (`packet_numbers`), the cone light samples and
+//! the BRDF directions by the kernel's samplers in their [`kernel::real::Real`] form
+//! (`sample_sphere_cone_v3`, `brdf::sample_brdf_v3`) on lanes, and any other light sample (area
+//! sampling, a receiver inside its light) by the kernel's scalar sampler. Each lane gets, for
+//! every sample its query asks for, exactly what `VertexSamples::draw` gives (computing them
+//! one at a time, a chain of divisions and square roots, cost 20% of a Cornell render).
 
 use super::packet::LANES;
-use super::packet_numbers::{
-    PrefetchedStream, BRDF_PAIR, EMPTY, LIGHT_CHOICE_SINGLE, LIGHT_POINT_PAIR,
-};
+use super::packet_numbers::{NumberRequests, EMPTY};
 use super::simd::widest_simd;
 use glam::Vec3;
 use kernel::brdf::sample_brdf_v3;
-use kernel::light::{choose_light, cone_light_sample, uses_cone, DirectionalLightSample};
-use kernel::path::{
-    PathState, BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX, LIGHT_CHOICE_DIMENSION,
-    LIGHT_POINT_DIMENSION,
-};
+use kernel::light::{choose_light, cone_light_sample, sample_light_from, uses_cone};
 use kernel::real::V3;
+use kernel::rng::SampleRng;
 use kernel::sampling::{sample_sphere_cone_v3, ConeSample, SurfacePoint};
-use kernel::scene::{light_sampling, SphereLight, NONE};
-use kernel::vertex_sampler::VertexSampler;
-use kernel::SurfaceHit;
+use kernel::scene::SphereLight;
+use kernel::vertex_samples::{
+    VertexQuery, VertexSamples, BRDF_DIMENSION, LIGHT_CHOICE_DIMENSION, LIGHT_POINT_DIMENSION,
+    ROULETTE_DIMENSION,
+};
 use std::simd::Simd;
 
 type Lanes = Simd<f32, LANES>;
 /// Sixteen values of one argument, by lane.
 type Column = [f32; LANES];
 
-/// A light sample computed ahead, with the arguments it was computed for: the stream position
-/// of its pair of numbers ([`EMPTY`]: no sample) and the arguments of
-/// `VertexSampler::sample_light_from`.
-#[derive(Clone, Copy, Debug)]
-pub struct PresampledLight {
-    dimension: u32,
-    x: Vec3,
-    u_select: f32,
-    light_count: u32,
-    mode: u32,
-    sample: DirectionalLightSample,
-}
+/// Where [`fill_vertex_samples`] asks for a vertex's numbers.
+const LIGHT_POINT_PAIR: usize = 0;
+const BRDF_PAIR: usize = 1;
+const ROULETTE_SINGLE: usize = 0;
+const LIGHT_CHOICE_SINGLE: usize = 1;
 
-impl PresampledLight {
-    pub const NONE: Self = Self {
-        dimension: EMPTY,
-        x: Vec3::ZERO,
-        u_select: 0.0,
-        light_count: 0,
-        mode: 0,
-        sample: DirectionalLightSample {
-            point: SurfacePoint {
-                position: Vec3::ZERO,
-                normal: Vec3::ZERO,
-            },
-            light: NONE,
-            pdf_solid_angle: 0.0,
-        },
-    };
-}
-
-/// A BRDF direction computed ahead, with the stream position of its pair ([`EMPTY`]: none)
-/// and the facing normal.
-#[derive(Clone, Copy, Debug)]
-pub struct PresampledBrdf {
-    dimension: u32,
-    n: Vec3,
-    wi: Vec3,
-}
-
-impl PresampledBrdf {
-    pub const NONE: Self = Self {
-        dimension: EMPTY,
-        n: Vec3::ZERO,
-        wi: Vec3::ZERO,
-    };
-}
-
-/// Whether `a` and `b` have the same bits (so any function gives both the same result).
-#[inline(always)]
-fn same_bits(a: Vec3, b: Vec3) -> bool {
-    let same = |p: f32, q: f32| p.to_bits() == q.to_bits();
-    same(a.x, b.x) & same(a.y, b.y) & same(a.z, b.z)
-}
-
-impl PrefetchedStream {
-    /// Whether a light sample whose pair starts at `dimension` is computed ahead.
-    pub fn holds_light_sample(&self, dimension: u32) -> bool {
-        self.light.dimension == dimension
-    }
-
-    /// Whether a BRDF direction whose pair starts at `dimension` is computed ahead.
-    pub fn holds_brdf_direction(&self, dimension: u32) -> bool {
-        self.brdf.dimension == dimension
-    }
-}
-
-// Inlined into the kernel's vertex: a few comparisons, then the sample computed ahead or, for
-// anything else, `SampleRng`'s own (which computes the pair's numbers again: rare, and the same
-// numbers).
-impl VertexSampler for PrefetchedStream {
-    #[inline(always)]
-    fn sample_light_from(
-        &mut self,
-        lights: &[SphereLight],
-        light_count: u32,
-        mode: u32,
-        x: Vec3,
-        u_select: f32,
-    ) -> DirectionalLightSample {
-        let p = &self.light;
-        // (A dimension the stream is at is never EMPTY.)
-        if p.dimension == self.rng.dimension
-            && same_bits(p.x, x)
-            && p.u_select.to_bits() == u_select.to_bits()
-            && p.light_count == light_count
-            && p.mode == mode
-        {
-            self.rng.dimension += 2;
-            return p.sample;
-        }
-        // Computed now, as the one-path loop does.
-        self.rng
-            .sample_light_from(lights, light_count, mode, x, u_select)
-    }
-
-    #[inline(always)]
-    fn sample_brdf(&mut self, n: Vec3) -> Vec3 {
-        let p = &self.brdf;
-        if p.dimension == self.rng.dimension && same_bits(p.n, n) {
-            self.rng.dimension += 2;
-            return p.wi;
-        }
-        self.rng.sample_brdf(n)
-    }
-}
-
-/// The samplers' arguments by lane (zero in empty lanes; lanes that want nothing compute too,
-/// and their results, NaN or not, are not read).
+/// The samplers' arguments by lane (zero in lanes that want nothing; those compute too, and
+/// their results, NaN or not, are not read).
 #[derive(Default)]
 struct Arguments {
     center: [Column; 3],
@@ -212,75 +107,74 @@ impl Arguments {
     }
 }
 
-/// For each path of `slots` whose extension ray found a surface that is not a light
-/// (`hits`, by lane), computes the light sample and BRDF direction of the vertex there from its
-/// computed numbers (`packet_numbers::prefetch_vertices`, called before): the light sample if
-/// `mode` is cone sampling and the receiver is outside the chosen light (what the kernel's
-/// `sample_light_from` then samples by the cone), with `light_count` lights.
-pub fn presample_vertices<T>(
-    slots: &mut [Option<(T, PathState<PrefetchedStream>)>; LANES],
-    hits: &[SurfaceHit; LANES],
+/// The samples of up to sixteen vertices, by lane: for each `(stream, query)`, what
+/// `VertexSamples::draw(query, stream, lights)` gives for every sample the query asks for
+/// (`VertexSamples::NONE` in empty lanes).
+pub fn fill_vertex_samples(
+    queries: &[Option<(SampleRng, VertexQuery)>; LANES],
     lights: &[SphereLight],
-    light_count: u32,
-    mode: u32,
-) {
-    // Written without branches on the lanes' data (hit or miss, which light), which a CPU
-    // cannot predict: every lane computes, and the ones that want nothing get EMPTY dimensions.
-    let mut args = Arguments::default();
-    // By lane: the dimensions of the light sample's and the BRDF's pairs (EMPTY: none), the
-    // light whose cone is sampled and the light choice's number.
-    let mut light_dimension = [EMPTY; LANES];
-    let mut brdf_dimension = [EMPTY; LANES];
-    let mut chosen = [0u32; LANES];
-    let mut u_selects = [0f32; LANES];
-    let cones = light_count > 0 && mode == light_sampling::CONE;
-    for (lane, slot) in slots.iter().enumerate() {
-        let Some((_, path)) = slot else { continue };
-        let hit = &hits[lane];
-        let at_surface = path.extend & hit.is_hit() & (hit.light == NONE);
-        // The block of the vertex the hit becomes (its depth is one more than the path's).
-        let block = CAMERA_DIMENSIONS + path.depth * DIMENSIONS_PER_VERTEX;
-        let x = hit.position;
-        if cones {
-            let (choice_dimension, u_select) = if light_count > 1 {
-                path.rng.single(LIGHT_CHOICE_SINGLE)
-            } else {
-                (block + LIGHT_CHOICE_DIMENSION, 0.0)
-            };
-            let (dimension, (u1, u2)) = path.rng.pair(LIGHT_POINT_PAIR);
-            let light = choose_light(lights, light_count, u_select);
-            let l = &lights[light as usize];
-            let wanted = at_surface
-                & (choice_dimension == block + LIGHT_CHOICE_DIMENSION)
-                & (dimension == block + LIGHT_POINT_DIMENSION)
-                & uses_cone(mode, l, x);
-            set_lane3(&mut args.center, lane, Vec3::from(l.center));
-            args.radius[lane] = l.radius;
-            set_lane3(&mut args.receiver, lane, x);
-            (args.u_light[0][lane], args.u_light[1][lane]) = (u1, u2);
-            light_dimension[lane] = if wanted { dimension } else { EMPTY };
-            chosen[lane] = light;
-            u_selects[lane] = u_select;
-        }
-        let (dimension, (u1, u2)) = path.rng.pair(BRDF_PAIR);
-        let wanted = at_surface & (dimension == block + BRDF_DIMENSION);
-        set_lane3(&mut args.normal, lane, hit.facing_normal());
-        (args.u_brdf[0][lane], args.u_brdf[1][lane]) = (u1, u2);
-        brdf_dimension[lane] = if wanted { dimension } else { EMPTY };
+) -> [VertexSamples; LANES] {
+    let mut requests = NumberRequests::default();
+    for (lane, entry) in queries.iter().enumerate() {
+        let Some((rng, q)) = entry else { continue };
+        let block = q.block();
+        let at = |wanted: bool, offset: u32| if wanted { block + offset } else { EMPTY };
+        requests.set(
+            lane,
+            rng,
+            // In the order of LIGHT_POINT_PAIR, BRDF_PAIR; ROULETTE_SINGLE, LIGHT_CHOICE_SINGLE.
+            [
+                at(q.samples_light(), LIGHT_POINT_DIMENSION),
+                at(q.extend, BRDF_DIMENSION),
+            ],
+            [
+                at(q.draws_roulette(), ROULETTE_DIMENSION),
+                at(q.chooses_light(), LIGHT_CHOICE_DIMENSION),
+            ],
+        );
     }
-    let wanted = |dimensions: &[u32; LANES]| dimensions.iter().any(|&d| d != EMPTY);
-    if !wanted(&light_dimension) && !wanted(&brdf_dimension) {
-        for (_, path) in slots.iter_mut().flatten() {
-            path.rng.light = PresampledLight::NONE;
-            path.rng.brdf = PresampledBrdf::NONE;
+    let numbers = requests.compute();
+    let pair = |p: usize, lane: usize| (numbers.pairs[p][0][lane], numbers.pairs[p][1][lane]);
+
+    // Every lane's arguments (written without branches on the lanes' data where a CPU could
+    // not predict them); the cone's lanes and the others' light samples.
+    let mut samples = [VertexSamples::NONE; LANES];
+    let mut args = Arguments::default();
+    let mut cone_light = [None; LANES];
+    let mut brdf_wanted = false;
+    for (lane, entry) in queries.iter().enumerate() {
+        let Some((_, q)) = entry else { continue };
+        if q.samples_light() {
+            let u_select = if q.chooses_light() {
+                numbers.singles[LIGHT_CHOICE_SINGLE][lane]
+            } else {
+                0.0
+            };
+            let (u1, u2) = pair(LIGHT_POINT_PAIR, lane);
+            let light = choose_light(lights, q.light_count, u_select);
+            let l = &lights[light as usize];
+            if uses_cone(q.mode, l, q.x) {
+                set_lane3(&mut args.center, lane, Vec3::from(l.center));
+                args.radius[lane] = l.radius;
+                set_lane3(&mut args.receiver, lane, q.x);
+                (args.u_light[0][lane], args.u_light[1][lane]) = (u1, u2);
+                cone_light[lane] = Some(light);
+            } else {
+                samples[lane].light =
+                    sample_light_from(lights, q.light_count, q.mode, q.x, u_select, u1, u2);
+            }
         }
-        return;
+        samples[lane].u_roulette = numbers.singles[ROULETTE_SINGLE][lane];
+        set_lane3(&mut args.normal, lane, q.n);
+        (args.u_brdf[0][lane], args.u_brdf[1][lane]) = pair(BRDF_PAIR, lane);
+        brdf_wanted |= q.extend;
+    }
+    if !brdf_wanted && cone_light.iter().all(Option::is_none) {
+        return samples;
     }
     let results = args.compute();
-    for (lane, slot) in slots.iter_mut().enumerate() {
-        let Some((_, path)) = slot else { continue };
-        path.rng.light = if cones {
-            let light = chosen[lane];
+    for (lane, s) in samples.iter_mut().enumerate() {
+        if let Some(light) = cone_light[lane] {
             let cone = ConeSample {
                 point: SurfacePoint {
                     position: lane3(&results.position, lane),
@@ -288,21 +182,9 @@ pub fn presample_vertices<T>(
                 },
                 pdf_solid_angle: results.pdf[lane],
             };
-            PresampledLight {
-                dimension: light_dimension[lane],
-                x: lane3(&args.receiver, lane),
-                u_select: u_selects[lane],
-                light_count,
-                mode,
-                sample: cone_light_sample(&lights[light as usize], light, cone),
-            }
-        } else {
-            PresampledLight::NONE
-        };
-        path.rng.brdf = PresampledBrdf {
-            dimension: brdf_dimension[lane],
-            n: lane3(&args.normal, lane),
-            wi: lane3(&results.wi, lane),
-        };
+            s.light = cone_light_sample(&lights[light as usize], light, cone);
+        }
+        s.brdf_dir = lane3(&results.wi, lane);
     }
+    samples
 }
