@@ -299,7 +299,7 @@ impl PathState {
             if self.advance(features, params, materials, lights, &hit, occluded) {
                 let material = materials[hit.material as usize];
                 let query = self.vertex_query(features, params, &hit, &material);
-                let samples = VertexSamples::draw(&query, &mut self.rng, lights);
+                let samples = VertexSamples::draw(&query, &mut self.rng);
                 self.vertex(features, params, lights, &hit, &material, &query, &samples);
             }
             if self.finished() {
@@ -424,7 +424,7 @@ impl PathState {
 
         // 2(a): next-event estimation.
         if query.samples_light() {
-            let ls = samples.light;
+            let ls = samples.light_sample(query, lights);
             let y = ls.point.position;
             let wi = (y - x).normalize();
             let cos_x = n.dot(wi);
@@ -463,7 +463,7 @@ impl PathState {
 
         // 3: extension by BRDF sampling. Every direction the sampler returns continues the
         // path (none is tangent; step 3 of `trace_path`).
-        let wi = samples.brdf_dir;
+        let wi = samples.brdf_direction(query);
         let pdf_b = pdf_brdf(n, wi);
         // = eval_scattering(n, wi, albedo) / pdf_b, exactly (see `sampled_brdf_weight`).
         self.throughput *= sampled_brdf_weight(albedo);

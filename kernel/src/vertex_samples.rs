@@ -1,11 +1,13 @@
 //! A path vertex's random samples as a value (pbrt-v4's wavefront `RaySamples`,
 //! `src/pbrt/gpu/workitems.h`, filled by `src/pbrt/gpu/samples.cpp`): the vertex first states
 //! what it will draw ([`VertexQuery`]: its block of dimensions, its receiver and normal, its
-//! light choice, whether roulette draws), then consumes a [`VertexSamples`]. One path fills it
-//! with [`VertexSamples::draw`] (the GPU, the one-path loop); the CPU's packets fill sixteen at
-//! once from sixteen queries with the samplers' `Real`/`Word` forms on SIMD lanes. A filler
-//! must give, for every sample the query asks for, exactly what `draw` gives. This module alone
-//! owns the layout of a vertex's dimensions.
+//! light choice, whether roulette draws), then consumes a [`VertexSamples`]: the uniform
+//! numbers it reads, and any sample a filler computed from them ahead. One path fills it with
+//! [`VertexSamples::draw`] (the GPU, the one-path loop: numbers only); the CPU's packets fill
+//! sixteen at once from sixteen queries with the samplers' `Real`/`Word` forms on SIMD lanes. A
+//! filler must give, for every number the query asks for, exactly what `draw` gives, and for a
+//! sample it gives, exactly what the vertex would compute. This module alone owns the layout of
+//! a vertex's dimensions.
 
 use crate::brdf::sample_brdf;
 use crate::light::{sample_light_from, DirectionalLightSample};
@@ -81,19 +83,35 @@ impl VertexQuery {
     }
 }
 
-/// A vertex's samples: its light sample (where [`VertexQuery::samples_light`]), its roulette
-/// number (where [`VertexQuery::draws_roulette`]) and its BRDF direction (where the vertex
-/// extends and survives roulette). Fields the query does not ask for are not read.
+/// A vertex's samples: the uniform numbers it reads (the light choice's where
+/// [`VertexQuery::chooses_light`], the light point's pair where [`VertexQuery::samples_light`],
+/// the roulette's where [`VertexQuery::draws_roulette`], the BRDF's pair where the vertex
+/// extends and survives roulette), and optionally the light sample and the BRDF direction a
+/// filler computed from them ahead (`has_light`, `has_brdf_dir`; the CPU's packets, on SIMD
+/// lanes). The vertex computes any sample not given with the kernel's scalar sampler, so a
+/// filler that knows nothing of a new lobe or light stays correct. Fields the query does not
+/// ask for are not read.
 #[derive(Clone, Copy, Debug)]
 pub struct VertexSamples {
-    pub light: DirectionalLightSample,
+    pub u_select: f32,
+    pub u_light: (f32, f32),
     pub u_roulette: f32,
+    pub u_brdf: (f32, f32),
+    /// `sample_light_from(lights, light_count, mode, x, u_select, u_light)`, if `has_light`.
+    pub light: DirectionalLightSample,
+    pub has_light: bool,
+    /// `sample_brdf(n, u_brdf)`, if `has_brdf_dir`.
     pub brdf_dir: Vec3,
+    pub has_brdf_dir: bool,
 }
 
 impl VertexSamples {
-    /// No samples (the fields a filler has not set).
+    /// No numbers, no samples (the fields a filler has not set).
     pub const NONE: Self = Self {
+        u_select: 0.0,
+        u_light: (0.0, 0.0),
+        u_roulette: 0.0,
+        u_brdf: (0.0, 0.0),
         light: DirectionalLightSample {
             point: SurfacePoint {
                 position: Vec3::ZERO,
@@ -102,34 +120,24 @@ impl VertexSamples {
             light: NONE,
             pdf_solid_angle: 0.0,
         },
-        u_roulette: 0.0,
+        has_light: false,
         brdf_dir: Vec3::ZERO,
+        has_brdf_dir: false,
     };
 
-    /// One vertex's samples from its stream, drawing only the numbers it will read (the stream
-    /// is counter-based: the others keep their values either way).
+    /// One vertex's numbers from its stream, drawing only those it will read (the stream is
+    /// counter-based: the others keep their values either way).
     #[inline]
-    pub fn draw(query: &VertexQuery, rng: &mut SampleRng, lights: &[SphereLight]) -> Self {
+    pub fn draw(query: &VertexQuery, rng: &mut SampleRng) -> Self {
         let mut s = Self::NONE;
         let block = query.block();
+        if query.chooses_light() {
+            rng.seek(block + LIGHT_CHOICE_DIMENSION);
+            s.u_select = rng.next_f32();
+        }
         if query.samples_light() {
-            let u_select = if query.chooses_light() {
-                rng.seek(block + LIGHT_CHOICE_DIMENSION);
-                rng.next_f32()
-            } else {
-                0.0
-            };
             rng.seek(block + LIGHT_POINT_DIMENSION);
-            let (u1, u2) = rng.next_2d();
-            s.light = sample_light_from(
-                lights,
-                query.light_count,
-                query.mode,
-                query.x,
-                u_select,
-                u1,
-                u2,
-            );
+            s.u_light = rng.next_2d();
         }
         if !query.extend {
             return s;
@@ -142,8 +150,39 @@ impl VertexSamples {
             }
         }
         rng.seek(block + BRDF_DIMENSION);
-        let (u1, u2) = rng.next_2d();
-        s.brdf_dir = sample_brdf(query.n, u1, u2);
+        s.u_brdf = rng.next_2d();
         s
+    }
+
+    /// The light sample for `query`: the one given, or computed now.
+    #[inline]
+    pub fn light_sample(
+        &self,
+        query: &VertexQuery,
+        lights: &[SphereLight],
+    ) -> DirectionalLightSample {
+        if self.has_light {
+            return self.light;
+        }
+        let (u1, u2) = self.u_light;
+        sample_light_from(
+            lights,
+            query.light_count,
+            query.mode,
+            query.x,
+            self.u_select,
+            u1,
+            u2,
+        )
+    }
+
+    /// The BRDF direction for `query`: the one given, or computed now.
+    #[inline]
+    pub fn brdf_direction(&self, query: &VertexQuery) -> Vec3 {
+        if self.has_brdf_dir {
+            return self.brdf_dir;
+        }
+        let (u1, u2) = self.u_brdf;
+        sample_brdf(query.n, u1, u2)
     }
 }

@@ -158,9 +158,9 @@ fn numbers_computed_for_sixteen_streams_are_sample_rng_numbers() {
 }
 
 /// The samples the packets fill for sixteen vertices at once from their queries
-/// (`cpu::packet_vertices`: numbers, cone light samples and BRDF directions on SIMD lanes, the
-/// other light samples by the scalar sampler) are, bit for bit, what `VertexSamples::draw`
-/// gives one vertex at a time, for every sample the query asks for. Lanes mix: no light
+/// (`cpu::packet_vertices`: numbers, cone light samples and BRDF directions on SIMD lanes; other
+/// light samples left to the vertex) are, bit for bit, what one vertex at a time uses
+/// (`VertexSamples::draw`, then the scalar samplers), for every sample the query asks for. Lanes mix: no light
 /// sample, one light and several (many_lights' alias table), cone and area sampling, receivers
 /// inside a light, vertices that may not extend, roulette with survival below 1, at 1 and
 /// NaN, an empty lane; both samplers.
@@ -178,6 +178,8 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
     assert!(many.len() > 1 && one.len() == 1);
     let bits = |v: Vec3| v.to_array().map(f32::to_bits);
     let mut checked = [0usize; 4];
+    // Of those, the light samples and BRDF directions computed on lanes.
+    let mut given = [0usize; 2];
     for round in 0..256u32 {
         let h = |lane: usize, k: u32| pcg4d([round, lane as u32, k, 0x7e58])[0];
         let unit = |lane: usize, k: u32| u32_to_unit_f32(h(lane, k));
@@ -239,42 +241,59 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
         let filled = fill_vertex_samples(&queries, lights);
         for (lane, entry) in queries.iter().enumerate() {
             let Some((rng, q)) = entry else { continue };
-            let want = VertexSamples::draw(q, &mut rng.clone(), lights);
+            let want = VertexSamples::draw(q, &mut { *rng });
             let got = filled[lane];
+            let pair_bits = |(a, b): (f32, f32)| (a.to_bits(), b.to_bits());
+            if q.chooses_light() {
+                assert_eq!(got.u_select.to_bits(), want.u_select.to_bits());
+            }
             if q.samples_light() {
+                assert_eq!(pair_bits(got.u_light), pair_bits(want.u_light));
+                // What the vertex uses: the sample given, or the one it computes itself.
+                let (g, w) = (got.light_sample(q, lights), want.light_sample(q, lights));
                 assert_eq!(
                     (
-                        bits(got.light.point.position),
-                        bits(got.light.point.normal),
-                        got.light.light,
-                        got.light.pdf_solid_angle.to_bits()
+                        bits(g.point.position),
+                        bits(g.point.normal),
+                        g.light,
+                        g.pdf_solid_angle.to_bits()
                     ),
                     (
-                        bits(want.light.point.position),
-                        bits(want.light.point.normal),
-                        want.light.light,
-                        want.light.pdf_solid_angle.to_bits()
+                        bits(w.point.position),
+                        bits(w.point.normal),
+                        w.light,
+                        w.pdf_solid_angle.to_bits()
                     ),
                     "round {round} lane {lane}: light sample"
                 );
                 checked[0] += 1;
+                given[0] += got.has_light as usize;
             }
             if q.draws_roulette() {
                 assert_eq!(got.u_roulette.to_bits(), want.u_roulette.to_bits());
                 checked[1] += 1;
             }
             if q.extend && q.survives(want.u_roulette) {
+                assert_eq!(pair_bits(got.u_brdf), pair_bits(want.u_brdf));
                 assert_eq!(
-                    bits(got.brdf_dir),
-                    bits(want.brdf_dir),
+                    bits(got.brdf_direction(q)),
+                    bits(want.brdf_direction(q)),
                     "round {round} lane {lane}: BRDF direction"
                 );
                 checked[2] += 1;
+                given[1] += got.has_brdf_dir as usize;
             }
             checked[3] += 1;
         }
     }
-    println!("checked {checked:?} (light samples, roulette numbers, BRDF directions, vertices)");
-    // Every kind of sample was compared many times.
+    println!(
+        "checked {checked:?} (light samples, roulette numbers, BRDF directions, vertices); \
+         computed on lanes {given:?} (light samples, BRDF directions)"
+    );
+    // Every kind of sample was compared many times, and the lanes really computed most.
     assert!(checked[..3].iter().all(|&c| c > 500), "{checked:?}");
+    assert!(
+        given[0] > checked[0] / 2 && given[1] == checked[2],
+        "{given:?}"
+    );
 }

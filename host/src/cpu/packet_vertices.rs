@@ -1,17 +1,18 @@
 //! The samples of sixteen path vertices at once, filled from their sixteen
-//! [`VertexQuery`]s: the numbers on SIMD lanes (`packet_numbers`), the cone light samples and
-//! the BRDF directions by the kernel's samplers in their [`kernel::real::Real`] form
-//! (`sample_sphere_cone_v3`, `brdf::sample_brdf_v3`) on lanes, and any other light sample (area
-//! sampling, a receiver inside its light) by the kernel's scalar sampler. Each lane gets, for
-//! every sample its query asks for, exactly what `VertexSamples::draw` gives (computing them
-//! one at a time, a chain of divisions and square roots, cost 20% of a Cornell render).
+//! [`VertexQuery`]s: the numbers on SIMD lanes (`packet_numbers`), and from them the cone light
+//! samples and the Lambertian BRDF directions by the kernel's samplers in their
+//! [`kernel::real::Real`] form (`sample_sphere_cone_v3`, `brdf::sample_brdf_v3`) on lanes. Any
+//! other sample (area sampling, a receiver inside its light) is left to the vertex, which
+//! computes it from the numbers with the scalar sampler. Each lane's numbers are exactly what
+//! `VertexSamples::draw` gives, and each sample given exactly what the vertex would compute
+//! (one at a time, a chain of divisions and square roots, they cost 20% of a Cornell render).
 
 use super::packet::LANES;
 use super::packet_numbers::{NumberRequests, EMPTY};
 use super::simd::widest_simd;
 use glam::Vec3;
 use kernel::brdf::sample_brdf_v3;
-use kernel::light::{choose_light, cone_light_sample, sample_light_from, uses_cone};
+use kernel::light::{choose_light, cone_light_sample, uses_cone};
 use kernel::real::V3;
 use kernel::rng::SampleRng;
 use kernel::sampling::{sample_sphere_cone_v3, ConeSample, SurfacePoint};
@@ -107,9 +108,10 @@ impl Arguments {
     }
 }
 
-/// The samples of up to sixteen vertices, by lane: for each `(stream, query)`, what
-/// `VertexSamples::draw(query, stream, lights)` gives for every sample the query asks for
-/// (`VertexSamples::NONE` in empty lanes).
+/// The samples of up to sixteen vertices, by lane: for each `(stream, query)`, the numbers
+/// `VertexSamples::draw(query, stream)` gives and, where computed on lanes, the light sample
+/// and BRDF direction the vertex would compute from them (`VertexSamples::NONE` in empty
+/// lanes).
 pub fn fill_vertex_samples(
     queries: &[Option<(SampleRng, VertexQuery)>; LANES],
     lights: &[SphereLight],
@@ -136,37 +138,33 @@ pub fn fill_vertex_samples(
     let numbers = requests.compute();
     let pair = |p: usize, lane: usize| (numbers.pairs[p][0][lane], numbers.pairs[p][1][lane]);
 
-    // Every lane's arguments (written without branches on the lanes' data where a CPU could
-    // not predict them); the cone's lanes and the others' light samples.
+    // Every lane's numbers and the samplers' arguments (written without branches on the lanes'
+    // data where a CPU could not predict them).
     let mut samples = [VertexSamples::NONE; LANES];
     let mut args = Arguments::default();
     let mut cone_light = [None; LANES];
     let mut brdf_wanted = false;
     for (lane, entry) in queries.iter().enumerate() {
         let Some((_, q)) = entry else { continue };
+        let s = &mut samples[lane];
+        s.u_select = numbers.singles[LIGHT_CHOICE_SINGLE][lane];
+        s.u_light = pair(LIGHT_POINT_PAIR, lane);
+        s.u_roulette = numbers.singles[ROULETTE_SINGLE][lane];
+        s.u_brdf = pair(BRDF_PAIR, lane);
         if q.samples_light() {
-            let u_select = if q.chooses_light() {
-                numbers.singles[LIGHT_CHOICE_SINGLE][lane]
-            } else {
-                0.0
-            };
-            let (u1, u2) = pair(LIGHT_POINT_PAIR, lane);
+            let u_select = if q.chooses_light() { s.u_select } else { 0.0 };
             let light = choose_light(lights, q.light_count, u_select);
             let l = &lights[light as usize];
             if uses_cone(q.mode, l, q.x) {
                 set_lane3(&mut args.center, lane, Vec3::from(l.center));
                 args.radius[lane] = l.radius;
                 set_lane3(&mut args.receiver, lane, q.x);
-                (args.u_light[0][lane], args.u_light[1][lane]) = (u1, u2);
+                (args.u_light[0][lane], args.u_light[1][lane]) = s.u_light;
                 cone_light[lane] = Some(light);
-            } else {
-                samples[lane].light =
-                    sample_light_from(lights, q.light_count, q.mode, q.x, u_select, u1, u2);
             }
         }
-        samples[lane].u_roulette = numbers.singles[ROULETTE_SINGLE][lane];
         set_lane3(&mut args.normal, lane, q.n);
-        (args.u_brdf[0][lane], args.u_brdf[1][lane]) = pair(BRDF_PAIR, lane);
+        (args.u_brdf[0][lane], args.u_brdf[1][lane]) = s.u_brdf;
         brdf_wanted |= q.extend;
     }
     if !brdf_wanted && cone_light.iter().all(Option::is_none) {
@@ -174,6 +172,9 @@ pub fn fill_vertex_samples(
     }
     let results = args.compute();
     for (lane, s) in samples.iter_mut().enumerate() {
+        let Some((_, q)) = &queries[lane] else {
+            continue;
+        };
         if let Some(light) = cone_light[lane] {
             let cone = ConeSample {
                 point: SurfacePoint {
@@ -183,8 +184,11 @@ pub fn fill_vertex_samples(
                 pdf_solid_angle: results.pdf[lane],
             };
             s.light = cone_light_sample(&lights[light as usize], light, cone);
+            s.has_light = true;
         }
+        // The only lobe: Lambertian (`brdf::sample_brdf`).
         s.brdf_dir = lane3(&results.wi, lane);
+        s.has_brdf_dir = q.extend;
     }
     samples
 }
