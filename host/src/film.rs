@@ -3,7 +3,8 @@
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
-use kernel::adaptive::luminance;
+use kernel::adaptive::{is_pilot_sample, luminance};
+use kernel::scene::RenderParams;
 use std::path::Path;
 
 /// Accumulated samples of an image.
@@ -40,7 +41,7 @@ impl Film {
 
     /// Whether adaptive sampling stops pixel (px, py): `kernel::adaptive::pixel_converged` on
     /// the pilots' mean and sum of squared deviations.
-    pub fn converged(&self, params: &kernel::scene::RenderParams, px: u32, py: u32) -> bool {
+    pub fn converged(&self, params: &RenderParams, px: u32, py: u32) -> bool {
         let i = (py * self.width + px) as usize;
         let n = self.pilot_count[i] as f64;
         if n < 1.0 {
@@ -129,12 +130,23 @@ pub struct PixelSums {
 }
 
 impl PixelSums {
+    /// Adds sample number `sample` of the pixel, of value `v`: to the pilot sums if adaptive
+    /// sampling (`params.pilot_period > 0`) makes it a pilot sample, else to the image sums.
+    /// A non-finite value is counted as discarded instead.
     #[inline]
-    pub fn add(&mut self, v: Vec3) {
+    pub fn add_sample(&mut self, params: &RenderParams, sample: u32, v: Vec3) {
         if !v.is_finite() {
             self.discarded += 1;
-            return;
+        } else if params.pilot_period > 0 && is_pilot_sample(params, sample) {
+            self.add_pilot(v);
+        } else {
+            self.add(v);
         }
+    }
+
+    /// Adds an image sample (finite).
+    #[inline]
+    fn add(&mut self, v: Vec3) {
         for c in 0..3 {
             let x = v[c] as f64;
             self.sum[c] += x;
@@ -143,13 +155,9 @@ impl PixelSums {
         self.count += 1;
     }
 
-    /// Adds a pilot sample (`kernel::adaptive`).
+    /// Adds a pilot sample (`kernel::adaptive`; finite).
     #[inline]
-    pub fn add_pilot(&mut self, v: Vec3) {
-        if !v.is_finite() {
-            self.discarded += 1;
-            return;
-        }
+    fn add_pilot(&mut self, v: Vec3) {
         let y = luminance(v) as f64;
         self.pilot[0] += y;
         self.pilot[1] += y * y;

@@ -17,7 +17,6 @@ use anyhow::Result;
 use bvh::Bvh;
 use glam::Vec3;
 use indicatif::ProgressBar;
-use kernel::adaptive::is_pilot_sample;
 use kernel::features::{self, Dynamic, FeatureSet, Static};
 use kernel::path::render_sample;
 use kernel::scene::{Material, RenderParams, SphereLight};
@@ -244,12 +243,7 @@ impl CpuRenderer {
                 let mut acc = PixelSums::default();
                 if !(adaptive && film.converged(params, px, py)) {
                     for s in first..first + count {
-                        let l = self.sample_with(features, params, px, py, s);
-                        if adaptive && is_pilot_sample(params, s) {
-                            acc.add_pilot(l);
-                        } else {
-                            acc.add(l);
-                        }
+                        acc.add_sample(params, s, self.sample_with(features, params, px, py, s));
                     }
                 }
                 acc

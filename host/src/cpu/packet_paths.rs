@@ -11,7 +11,6 @@ use super::CpuRenderer;
 use crate::film::Film;
 use crate::film::PixelSums;
 use glam::Vec3;
-use kernel::adaptive::is_pilot_sample;
 use kernel::features::FeatureSet;
 use kernel::path::{sample_rng, start_path_at, PathState};
 use kernel::scene::{RenderParams, NONE};
@@ -175,11 +174,7 @@ impl CpuRenderer {
                 if sampled {
                     let values = samples.next().unwrap_or(&[]);
                     for (s, &l) in (first..).zip(values) {
-                        if adaptive && is_pilot_sample(params, s) {
-                            acc.add_pilot(l);
-                        } else {
-                            acc.add(l);
-                        }
+                        acc.add_sample(params, s, l);
                     }
                 }
                 acc
