@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Prepares a run of scripts/gpu_machine_check.sh on a borrowed Linux x86-64 machine with a GPU
+# and no network (docs/gpu.md, "An NVIDIA H200"): builds here, then puts into .gpu/ (ignored
+# by git) what that machine lacks: the Debian packages of the
+# Vulkan loader, libglvnd (NVIDIA's Vulkan driver is libGLX_nvidia.so.0, which needs it) and
+# the validation layers, the stripped twinpath binary and the GPU test binaries, and
+# scripts/torus_scenes.py's generator. Run there: `bash scripts/gpu_machine_check.sh`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --workspace --all-targets
+rm -rf .gpu && mkdir -p .gpu/bin .gpu/debs /tmp/twinpath-apt/partial
+apt_opts=(-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 -oDir::State::Lists=/tmp/twinpath-apt)
+apt-get "${apt_opts[@]}" update -qq
+(cd .gpu/debs && apt-get "${apt_opts[@]}" download libvulkan1 libglvnd0 libglx0 libegl1 libgl1 \
+  libopengl0 libgles2 vulkan-validationlayers)
+strip -o .gpu/bin/twinpath target/debug/twinpath
+for t in gpu_functions gpu_render spirv_module furnace scene_scale specialize_adaptive \
+  hard_lighting light_selection sobol; do
+  f=$(cargo test -p twinpath-tests --test "$t" --no-run 2>&1 | sed -n 's/.*Executable .*(\(.*\))/\1/p')
+  strip -o ".gpu/bin/$t" "$f"
+done
+du -sh .gpu
