@@ -29,6 +29,8 @@ pub const BRDF_DIMENSION: u32 = 4;
 /// The camera's pair (the position inside the pixel), before the first vertex's block.
 pub const CAMERA_DIMENSION: u32 = 0;
 pub const CAMERA_DIMENSIONS: u32 = 2;
+/// In [`VertexQuery::dimensions`]: a number the vertex does not read.
+pub const NO_DIMENSION: u32 = u32::MAX;
 
 /// What a vertex will draw, decided before any number is drawn.
 #[derive(Clone, Copy, Debug)]
@@ -74,6 +76,25 @@ impl VertexQuery {
     #[inline]
     pub fn draws_roulette(&self) -> bool {
         self.extend && self.roulette && !(self.survival >= 1.0)
+    }
+
+    /// The dimensions of the numbers the vertex may read ([`NO_DIMENSION`] where it reads
+    /// none): the single numbers `[light choice, roulette]` and the first dimensions of the
+    /// pairs `[light point, BRDF]`, the order of [`VertexSamples::from_numbers`].
+    #[inline]
+    pub fn dimensions(&self) -> ([u32; 2], [u32; 2]) {
+        let block = self.block();
+        let at = |read: bool, offset: u32| if read { block + offset } else { NO_DIMENSION };
+        (
+            [
+                at(self.chooses_light(), LIGHT_CHOICE_DIMENSION),
+                at(self.draws_roulette(), ROULETTE_DIMENSION),
+            ],
+            [
+                at(self.samples_light(), LIGHT_POINT_DIMENSION),
+                at(self.extend, BRDF_DIMENSION),
+            ],
+        )
     }
 
     /// Whether the path survives roulette number `u` (always, where no number is drawn).
@@ -125,32 +146,46 @@ impl VertexSamples {
         has_brdf_dir: false,
     };
 
-    /// One vertex's numbers from its stream, drawing only those it will read (the stream is
+    /// The samples holding the numbers at [`VertexQuery::dimensions`]: `singles` = [light
+    /// choice, roulette], `pairs` = [light point, BRDF] (a filler that computes numbers for
+    /// many vertices at once gives them here; no sample is given).
+    #[inline]
+    pub fn from_numbers(singles: [f32; 2], pairs: [(f32, f32); 2]) -> Self {
+        Self {
+            u_select: singles[0],
+            u_roulette: singles[1],
+            u_light: pairs[0],
+            u_brdf: pairs[1],
+            ..Self::NONE
+        }
+    }
+
+    /// One vertex's numbers from its stream, at [`VertexQuery::dimensions`], drawing only
+    /// those it will read: no BRDF pair after roulette ends the path (the stream is
     /// counter-based: the others keep their values either way).
     #[inline]
     pub fn draw(query: &VertexQuery, rng: &mut SampleRng) -> Self {
         let mut s = Self::NONE;
-        let block = query.block();
-        if query.chooses_light() {
-            rng.seek(block + LIGHT_CHOICE_DIMENSION);
+        let ([choice, roulette], [point, brdf]) = query.dimensions();
+        if choice != NO_DIMENSION {
+            rng.seek(choice);
             s.u_select = rng.next_f32();
         }
-        if query.samples_light() {
-            rng.seek(block + LIGHT_POINT_DIMENSION);
+        if point != NO_DIMENSION {
+            rng.seek(point);
             s.u_light = rng.next_2d();
         }
-        if !query.extend {
-            return s;
-        }
-        if query.draws_roulette() {
-            rng.seek(block + ROULETTE_DIMENSION);
+        if roulette != NO_DIMENSION {
+            rng.seek(roulette);
             s.u_roulette = rng.next_f32();
             if !query.survives(s.u_roulette) {
                 return s;
             }
         }
-        rng.seek(block + BRDF_DIMENSION);
-        s.u_brdf = rng.next_2d();
+        if brdf != NO_DIMENSION {
+            rng.seek(brdf);
+            s.u_brdf = rng.next_2d();
+        }
         s
     }
 

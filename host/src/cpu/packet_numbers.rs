@@ -14,7 +14,7 @@ use std::simd::{Mask, Select, Simd};
 type Words = Simd<u32, LANES>;
 
 /// No dimension: a lane that asks for nothing there.
-pub const EMPTY: u32 = u32::MAX;
+pub const EMPTY: u32 = kernel::vertex_samples::NO_DIMENSION;
 
 /// The numbers by lane: two pairs (`pairs[p]` = the columns of x and y) and two single
 /// numbers, as `SampleRng::next_2d` and `next_f32` return them. Lanes that asked for nothing

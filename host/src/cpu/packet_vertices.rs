@@ -8,7 +8,7 @@
 //! (one at a time, a chain of divisions and square roots, they cost 20% of a Cornell render).
 
 use super::packet::LANES;
-use super::packet_numbers::{NumberRequests, EMPTY};
+use super::packet_numbers::NumberRequests;
 use super::simd::widest_simd;
 use glam::Vec3;
 use kernel::brdf::sample_brdf_v3;
@@ -17,21 +17,12 @@ use kernel::real::V3;
 use kernel::rng::SampleRng;
 use kernel::sampling::{sample_sphere_cone_v3, ConeSample, SurfacePoint};
 use kernel::scene::SphereLight;
-use kernel::vertex_samples::{
-    VertexQuery, VertexSamples, BRDF_DIMENSION, LIGHT_CHOICE_DIMENSION, LIGHT_POINT_DIMENSION,
-    ROULETTE_DIMENSION,
-};
+use kernel::vertex_samples::{VertexQuery, VertexSamples};
 use std::simd::Simd;
 
 type Lanes = Simd<f32, LANES>;
 /// Sixteen values of one argument, by lane.
 type Column = [f32; LANES];
-
-/// Where [`fill_vertex_samples`] asks for a vertex's numbers.
-const LIGHT_POINT_PAIR: usize = 0;
-const BRDF_PAIR: usize = 1;
-const ROULETTE_SINGLE: usize = 0;
-const LIGHT_CHOICE_SINGLE: usize = 1;
 
 /// The samplers' arguments by lane (zero in lanes that want nothing; those compute too, and
 /// their results, NaN or not, are not read).
@@ -119,24 +110,10 @@ pub fn fill_vertex_samples(
     let mut requests = NumberRequests::default();
     for (lane, entry) in queries.iter().enumerate() {
         let Some((rng, q)) = entry else { continue };
-        let block = q.block();
-        let at = |wanted: bool, offset: u32| if wanted { block + offset } else { EMPTY };
-        requests.set(
-            lane,
-            rng,
-            // In the order of LIGHT_POINT_PAIR, BRDF_PAIR; ROULETTE_SINGLE, LIGHT_CHOICE_SINGLE.
-            [
-                at(q.samples_light(), LIGHT_POINT_DIMENSION),
-                at(q.extend, BRDF_DIMENSION),
-            ],
-            [
-                at(q.draws_roulette(), ROULETTE_DIMENSION),
-                at(q.chooses_light(), LIGHT_CHOICE_DIMENSION),
-            ],
-        );
+        let (singles, pairs) = q.dimensions();
+        requests.set(lane, rng, pairs, singles);
     }
     let numbers = requests.compute();
-    let pair = |p: usize, lane: usize| (numbers.pairs[p][0][lane], numbers.pairs[p][1][lane]);
 
     // Every lane's numbers and the samplers' arguments (written without branches on the lanes'
     // data where a CPU could not predict them).
@@ -146,11 +123,12 @@ pub fn fill_vertex_samples(
     let mut brdf_wanted = false;
     for (lane, entry) in queries.iter().enumerate() {
         let Some((_, q)) = entry else { continue };
+        let pair = |p: usize| (numbers.pairs[p][0][lane], numbers.pairs[p][1][lane]);
         let s = &mut samples[lane];
-        s.u_select = numbers.singles[LIGHT_CHOICE_SINGLE][lane];
-        s.u_light = pair(LIGHT_POINT_PAIR, lane);
-        s.u_roulette = numbers.singles[ROULETTE_SINGLE][lane];
-        s.u_brdf = pair(BRDF_PAIR, lane);
+        *s = VertexSamples::from_numbers(
+            [numbers.singles[0][lane], numbers.singles[1][lane]],
+            [pair(0), pair(1)],
+        );
         if q.samples_light() {
             let u_select = if q.chooses_light() { s.u_select } else { 0.0 };
             let light = choose_light(lights, q.light_count, u_select);
