@@ -136,11 +136,6 @@ pub trait Tracer {
     fn occluded(&mut self, from: Vec3, to: Vec3) -> bool;
 }
 
-pub use crate::vertex_samples::{
-    BRDF_DIMENSION, CAMERA_DIMENSIONS, DIMENSIONS_PER_VERTEX, LIGHT_CHOICE_DIMENSION,
-    LIGHT_POINT_DIMENSION, ROULETTE_DIMENSION,
-};
-
 /// Seed: `TracePath(ray)`. One unbiased estimate of the radiance arriving at `origin` from
 /// direction `-dir` (`dir` unit length).
 ///

@@ -146,16 +146,23 @@ impl VertexSamples {
         has_brdf_dir: false,
     };
 
-    /// The samples holding the numbers at [`VertexQuery::dimensions`]: `singles` = [light
-    /// choice, roulette], `pairs` = [light point, BRDF] (a filler that computes numbers for
-    /// many vertices at once gives them here; no sample is given).
+    /// The samples holding the numbers read at `dimensions` (a [`VertexQuery::dimensions`]):
+    /// `singles` = [light choice, roulette], `pairs` = [light point, BRDF], each kept where its
+    /// dimension is read and 0 elsewhere, as [`VertexSamples::draw`] leaves it (a filler that
+    /// computes numbers for many vertices at once gives them here; no sample is given).
     #[inline]
-    pub fn from_numbers(singles: [f32; 2], pairs: [(f32, f32); 2]) -> Self {
+    pub fn from_numbers(
+        ([choice, roulette], [point, brdf]): ([u32; 2], [u32; 2]),
+        singles: [f32; 2],
+        pairs: [(f32, f32); 2],
+    ) -> Self {
+        let single = |d: u32, u: f32| if d != NO_DIMENSION { u } else { 0.0 };
+        let pair = |d: u32, u: (f32, f32)| if d != NO_DIMENSION { u } else { (0.0, 0.0) };
         Self {
-            u_select: singles[0],
-            u_roulette: singles[1],
-            u_light: pairs[0],
-            u_brdf: pairs[1],
+            u_select: single(choice, singles[0]),
+            u_roulette: single(roulette, singles[1]),
+            u_light: pair(point, pairs[0]),
+            u_brdf: pair(brdf, pairs[1]),
             ..Self::NONE
         }
     }

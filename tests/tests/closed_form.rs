@@ -67,7 +67,7 @@ fn estimate_at(scene: &Scene, x: Vec3, view_dir: Vec3, stream: u32, batch: u32) 
         .map(|s| {
             let mut tracer = BvhTracer { bvh: &cpu.bvh };
             let mut rng = SampleRng::new(params.seed, stream, s);
-            rng.seek(kernel::path::CAMERA_DIMENSIONS);
+            rng.seek(kernel::vertex_samples::CAMERA_DIMENSIONS);
             let l = trace_path(
                 &mut tracer,
                 kernel::features::Dynamic(cpu.features),

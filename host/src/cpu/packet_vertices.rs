@@ -107,11 +107,13 @@ pub fn fill_vertex_samples(
     queries: &[Option<(SampleRng, VertexQuery)>; LANES],
     lights: &[SphereLight],
 ) -> [VertexSamples; LANES] {
+    let dimensions = queries.map(|entry| entry.map(|(_, q)| q.dimensions()));
     let mut requests = NumberRequests::default();
-    for (lane, entry) in queries.iter().enumerate() {
-        let Some((rng, q)) = entry else { continue };
-        let (singles, pairs) = q.dimensions();
-        requests.set(lane, rng, pairs, singles);
+    for (lane, (entry, dims)) in queries.iter().zip(&dimensions).enumerate() {
+        let (Some((rng, _)), Some((singles, pairs))) = (entry, dims) else {
+            continue;
+        };
+        requests.set(lane, rng, *pairs, *singles);
     }
     let numbers = requests.compute();
 
@@ -121,17 +123,19 @@ pub fn fill_vertex_samples(
     let mut args = Arguments::default();
     let mut cone_light = [None; LANES];
     let mut brdf_wanted = false;
-    for (lane, entry) in queries.iter().enumerate() {
-        let Some((_, q)) = entry else { continue };
+    for (lane, (entry, dims)) in queries.iter().zip(&dimensions).enumerate() {
+        let (Some((_, q)), Some(dims)) = (entry, dims) else {
+            continue;
+        };
         let pair = |p: usize| (numbers.pairs[p][0][lane], numbers.pairs[p][1][lane]);
         let s = &mut samples[lane];
         *s = VertexSamples::from_numbers(
+            *dims,
             [numbers.singles[0][lane], numbers.singles[1][lane]],
             [pair(0), pair(1)],
         );
         if q.samples_light() {
-            let u_select = if q.chooses_light() { s.u_select } else { 0.0 };
-            let light = choose_light(lights, q.light_count, u_select);
+            let light = choose_light(lights, q.light_count, s.u_select);
             let l = &lights[light as usize];
             if uses_cone(q.mode, l, q.x) {
                 set_lane3(&mut args.center, lane, Vec3::from(l.center));
