@@ -56,6 +56,11 @@ choice! {
         Power = "power" => mis::POWER,
         /// The seed's fixed 1/2 weights.
         Half = "half" => mis::HALF,
+        /// Light sampling alone (BSDF-sampled hits of lights add nothing unless a delta lobe
+        /// chose the direction): for comparing strategies, not for renders.
+        Light = "light" => mis::LIGHT_ONLY,
+        /// BSDF sampling alone (no light samples): for comparing strategies.
+        Bsdf = "bsdf" => mis::BSDF_ONLY,
     }
 }
 
@@ -149,7 +154,7 @@ pub const SETTINGS: &[(&str, &str)] = &[
         "rr_start_depth",
         "first vertex roulette may end (1 = camera hit); default 1 (constant), 5 (throughput)",
     ),
-    ("mis", "power | half"),
+    ("mis", "power | half | light | bsdf"),
     ("max_depth", "guard on the path length, an integer >= 1"),
     ("light_sampling", "cone | area"),
     ("light_selection", "power | uniform"),

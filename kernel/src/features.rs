@@ -7,7 +7,7 @@
 //! Both paths compute the same values: a feature bit may only be cleared when the run-time
 //! answer is the same (`scene_features` derives both from the same parameters).
 
-use crate::scene::{light_sampling, mis, roulette, RenderParams};
+use crate::scene::{light_sampling, material_kind, mis, roulette, Material, RenderParams};
 
 /// The bits are answers fixed before the render; without it, they are ignored.
 pub const SPECIALIZED: u32 = 1 << 0;
@@ -23,6 +23,31 @@ pub const LIGHT_CONE: u32 = 1 << 4;
 pub const RR_THROUGHPUT: u32 = 1 << 5;
 /// The scene has exactly one light: no light choice.
 pub const SINGLE_LIGHT: u32 = 1 << 6;
+/// The scene may have Kd + Ks (`material_kind::GLOSSY`) surfaces.
+pub const GLOSSY: u32 = 1 << 7;
+/// The scene may have conductors.
+pub const CONDUCTOR: u32 = 1 << 8;
+/// The scene may have dielectrics (refraction, and roulette's eta^2 bookkeeping).
+pub const DIELECTRIC: u32 = 1 << 9;
+/// Every material bit: a scene with none of them is Lambertian only and runs the diffuse path.
+pub const MATERIALS: u32 = GLOSSY | CONDUCTOR | DIELECTRIC;
+
+/// The material bits of a scene with these materials: one per kind present besides the
+/// Lambertian. (A bit may also be set for a kind that is absent: it only keeps that kind's
+/// code, which the material's own `kind` then skips.)
+#[inline]
+pub fn material_features(materials: &[Material]) -> u32 {
+    let mut f = 0;
+    for m in materials {
+        f |= match m.kind {
+            material_kind::GLOSSY => GLOSSY,
+            material_kind::CONDUCTOR => CONDUCTOR,
+            material_kind::DIELECTRIC => DIELECTRIC,
+            _ => 0,
+        };
+    }
+    f
+}
 
 /// The feature bits of a render with these parameters.
 #[inline]
@@ -82,6 +107,33 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn mis_power(self, p: &RenderParams) -> bool {
         self.answer(MIS_POWER, p.mis_mode == mis::POWER)
+    }
+    /// The MIS mode (`scene::mis`): the power heuristic when specialised to it, else the
+    /// run-time mode (the bit is cleared exactly when the mode is another).
+    #[inline]
+    fn mis_mode(self, p: &RenderParams) -> u32 {
+        if self.mis_power(p) {
+            mis::POWER
+        } else {
+            p.mis_mode
+        }
+    }
+    /// Whether any surface may be other than Lambertian (see [`MATERIALS`]).
+    #[inline]
+    fn materials(self) -> bool {
+        self.answer(MATERIALS, true)
+    }
+    #[inline]
+    fn glossy(self) -> bool {
+        self.answer(GLOSSY, true)
+    }
+    #[inline]
+    fn conductor(self) -> bool {
+        self.answer(CONDUCTOR, true)
+    }
+    #[inline]
+    fn dielectric(self) -> bool {
+        self.answer(DIELECTRIC, true)
     }
     #[inline]
     fn light_cone(self, p: &RenderParams) -> bool {

@@ -10,13 +10,16 @@
 
 pub mod adaptive;
 pub mod brdf;
+pub mod bsdf;
 pub mod camera;
 pub mod features;
 pub mod frame;
+pub mod fresnel;
 pub mod geometry;
 pub mod hash;
 pub mod intersect;
 pub mod light;
+pub mod microfacet;
 pub mod path;
 pub mod probe;
 pub mod real;

@@ -3,6 +3,7 @@
 
 use crate::adaptive::sample_stream;
 use crate::brdf::{eval_scattering, pdf_brdf, sampled_brdf_weight};
+use crate::bsdf::{self, DELTA_PDF};
 use crate::camera::{camera_origin, camera_ray_direction};
 use crate::features::FeatureSet;
 use crate::geometry::{
@@ -12,7 +13,9 @@ use crate::geometry::{
 use crate::light::{eval_radiance, pdf_light_from};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
-use crate::scene::{light_sampling, Material, RenderParams, Sphere, SphereLight, Triangle, NONE};
+use crate::scene::{
+    light_sampling, material_kind, mis, Material, RenderParams, Sphere, SphereLight, Triangle, NONE,
+};
 use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION};
 use spirv_std::glam::Vec3;
 
@@ -234,10 +237,14 @@ pub struct PathState {
     pub shadow: bool,
     /// What the light sample adds if the segment is clear.
     pub shadow_radiance: Vec3,
-    /// The vertex the extension ray left and the BRDF density it was sampled with (for the MIS
-    /// weight of a light it finds).
+    /// The vertex the extension ray left and the BSDF density it was sampled with (for the MIS
+    /// weight of a light it finds; `bsdf::DELTA_PDF` after a delta lobe).
     pub previous_vertex: Vec3,
     pub previous_pdf: f32,
+    /// The product of the eta^2 of the refractions so far (pbrt-v4's `etaScale`): the
+    /// throughput times it is what roulette reads, so radiance scaling at refractions alone
+    /// does not end paths inside glass nor keep them after they leave it.
+    pub eta_scale: f32,
     /// Vertices so far: 0 while the camera ray is out.
     pub depth: u32,
     /// The sample's random numbers (the one-path loop draws a vertex's samples from them; the
@@ -262,6 +269,7 @@ impl PathState {
             shadow_radiance: Vec3::ZERO,
             previous_vertex: origin,
             previous_pdf: 0.0,
+            eta_scale: 1.0,
             depth: 0,
             rng,
         }
@@ -343,15 +351,20 @@ impl PathState {
                 // 1: a light seen directly (it reflects nothing, so the path ends).
                 self.radiance = emitted;
             } else {
-                // 2(b): the extension found a light.
-                let weight = if features.mis_power(params) {
+                // 2(b): the extension found a light. After a delta lobe (pdf `DELTA_PDF`) light
+                // sampling could not have found it: the power heuristic's ratio pdf_l / inf is
+                // 0, weight 1; the other modes test for it.
+                let mode = features.mis_mode(params);
+                let weight = if mode == mis::POWER {
                     let sampling = light_sampling_of(features, params);
                     let x = self.previous_vertex;
                     let pdf_l =
                         pdf_light_from(lights, sampling, hit.light, x, hit.position, hit.normal);
                     power_heuristic(self.previous_pdf, pdf_l)
+                } else if features.materials() && self.previous_pdf == DELTA_PDF {
+                    1.0
                 } else {
-                    0.5
+                    bsdf_strategy_weight(mode)
                 };
                 self.radiance += self.throughput * emitted * weight;
             }
@@ -362,8 +375,9 @@ impl PathState {
     }
 
     /// What the vertex at `hit` (just reached, at `self.depth`) will draw: its receiver and
-    /// facing normal, its light choice (none on a black surface), whether it may extend and
-    /// roulette's survival probability.
+    /// facing normal, its light choice (none on a black or delta surface, or without light
+    /// sampling), whether it may extend, roulette's survival probability and whether it
+    /// chooses a lobe.
     #[inline]
     pub fn vertex_query<F: FeatureSet>(
         &self,
@@ -372,16 +386,27 @@ impl PathState {
         hit: &SurfaceHit,
         material: &Material,
     ) -> VertexQuery {
-        let albedo = Vec3::from(material.albedo);
-        let light_count = if !(features.lights(params) && albedo.max_element() > 0.0) {
+        let lambertian = !features.materials() || material.kind == material_kind::DIFFUSE;
+        let reflects = if lambertian {
+            Vec3::from(material.albedo).max_element() > 0.0
+        } else {
+            !bsdf::is_delta(material)
+        };
+        let light_count = if !(features.lights(params) && reflects)
+            || (!features.mis_power(params) && params.mis_mode == mis::BSDF_ONLY)
+        {
             0
         } else if features.single_light(params) {
             1
         } else {
             params.light_count
         };
+        let mut throughput = self.throughput;
+        if features.dielectric() {
+            throughput *= self.eta_scale;
+        }
         let survival = if features.rr_throughput(params) {
-            self.throughput.max_element().min(1.0)
+            throughput.max_element().min(1.0)
         } else {
             params.rr_probability
         };
@@ -394,16 +419,39 @@ impl PathState {
             extend: self.depth < params.max_depth,
             roulette: self.depth >= params.rr_start_depth,
             survival,
+            lambertian,
+            chooses_lobe: !lambertian && bsdf::chooses_lobe(material),
         }
     }
 
     /// Steps 2(a), 4 and 3 at vertex `hit` (reached at `self.depth`), left toward the ray's
     /// origin, with the samples `samples` filled for `query` (this vertex's
     /// [`PathState::vertex_query`]): prepares the light sample's shadow segment and, unless the
-    /// path ends here, the extension.
+    /// path ends here, the extension. A Lambertian vertex runs the diffuse renderer's exact
+    /// arithmetic; any other material, its BSDF (`crate::bsdf`).
     #[inline]
     #[allow(clippy::too_many_arguments)]
     pub fn vertex<F: FeatureSet>(
+        &mut self,
+        features: F,
+        params: &RenderParams,
+        lights: &[SphereLight],
+        hit: &SurfaceHit,
+        material: &Material,
+        query: &VertexQuery,
+        samples: &VertexSamples,
+    ) {
+        if query.lambertian {
+            self.lambertian_vertex(features, params, lights, hit, material, query, samples);
+        } else {
+            self.bsdf_vertex(features, params, lights, hit, material, query, samples);
+        }
+    }
+
+    /// [`PathState::vertex`] on a Lambertian surface.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn lambertian_vertex<F: FeatureSet>(
         &mut self,
         features: F,
         params: &RenderParams,
@@ -427,11 +475,7 @@ impl PathState {
             let pdf_w = ls.pdf_solid_angle;
             if cos_x > 0.0 && cos_y > 0.0 && pdf_w > 0.0 {
                 let emitted = Vec3::from(lights[ls.light as usize].radiance);
-                let weight = if features.mis_power(params) {
-                    power_heuristic(pdf_w, pdf_brdf(n, wi))
-                } else {
-                    0.5
-                };
+                let weight = light_strategy_weight(features, params, pdf_w, pdf_brdf(n, wi));
                 self.shadow = true;
                 self.shadow_from = ray_origin;
                 self.shadow_to = shadow_ray_end(
@@ -470,6 +514,127 @@ impl PathState {
         self.ray_dir = wi;
         self.previous_vertex = x;
         self.previous_pdf = pdf_b;
+    }
+
+    /// [`PathState::vertex`] on any other material: the light sample weighed by the BSDF's
+    /// value and density (skipped on delta surfaces, which `query` gives no light), the
+    /// extension drawn from the BSDF. Rays leave from the side of the direction they take
+    /// (through the surface after a refraction).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn bsdf_vertex<F: FeatureSet>(
+        &mut self,
+        features: F,
+        params: &RenderParams,
+        lights: &[SphereLight],
+        hit: &SurfaceHit,
+        material: &Material,
+        query: &VertexQuery,
+        samples: &VertexSamples,
+    ) {
+        let (x, n) = (query.x, query.n);
+        let wo = -self.ray_dir;
+        // The index beyond the surface over the index on wo's side (dielectrics only): the
+        // outside is the side the normal points to (`SurfaceHit::normal`).
+        let eta = if hit.arrived_behind {
+            1.0 / material.ior
+        } else {
+            material.ior
+        };
+
+        // 2(a): next-event estimation.
+        if query.samples_light() {
+            let ls = samples.light_sample(query, lights);
+            let y = ls.point.position;
+            let wi = (y - x).normalize();
+            let cos_y = -ls.point.normal.dot(wi);
+            let pdf_w = ls.pdf_solid_angle;
+            let (f_cos, pdf_b) = bsdf::eval(features, material, n, wo, wi, eta);
+            if cos_y > 0.0 && pdf_w > 0.0 && f_cos.max_element() > 0.0 {
+                let emitted = Vec3::from(lights[ls.light as usize].radiance);
+                let weight = light_strategy_weight(features, params, pdf_w, pdf_b);
+                let from = offset_ray_origin(x, side(n, n.dot(wi) > 0.0), hit.error);
+                self.shadow = true;
+                self.shadow_from = from;
+                self.shadow_to = shadow_ray_end(
+                    from,
+                    y,
+                    ls.point.normal,
+                    light_point_error(lights, ls.light),
+                );
+                self.shadow_radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
+            }
+        }
+
+        if !query.extend {
+            return;
+        }
+        // 4: Russian roulette, as on a Lambertian vertex.
+        if query.draws_roulette() {
+            if !query.survives(samples.u_roulette) {
+                return;
+            }
+            self.throughput /= query.survival;
+        }
+
+        // 3: extension by BSDF sampling.
+        let (u1, u2) = samples.u_brdf;
+        let s = bsdf::sample(features, material, n, wo, eta, samples.u_lobe, u1, u2);
+        self.throughput *= s.weight;
+        if features.dielectric() {
+            self.eta_scale *= s.eta2;
+        }
+        if !(self.throughput.max_element() > 0.0) {
+            return;
+        }
+        self.extend = true;
+        self.ray_origin = offset_ray_origin(x, side(n, !s.transmitted), hit.error);
+        self.ray_dir = s.wi;
+        self.previous_vertex = x;
+        self.previous_pdf = s.pdf;
+    }
+}
+
+/// `n` where `toward_n`, else `-n`: the normal of the side a ray leaves from.
+#[inline]
+fn side(n: Vec3, toward_n: bool) -> Vec3 {
+    if toward_n {
+        n
+    } else {
+        -n
+    }
+}
+
+/// The MIS weight of a light sample of density `pdf_light` whose direction the BSDF samples
+/// with density `pdf_bsdf`.
+#[inline]
+fn light_strategy_weight<F: FeatureSet>(
+    features: F,
+    params: &RenderParams,
+    pdf_light: f32,
+    pdf_bsdf: f32,
+) -> f32 {
+    let mode = features.mis_mode(params);
+    if mode == mis::POWER {
+        power_heuristic(pdf_light, pdf_bsdf)
+    } else if mode == mis::LIGHT_ONLY {
+        1.0
+    } else {
+        // HALF (BSDF_ONLY takes no light sample).
+        0.5
+    }
+}
+
+/// The MIS weight of a light found by BSDF sampling under a constant-weight `mode` (not the
+/// power heuristic, not after a delta lobe).
+#[inline]
+fn bsdf_strategy_weight(mode: u32) -> f32 {
+    if mode == mis::LIGHT_ONLY {
+        0.0
+    } else if mode == mis::BSDF_ONLY {
+        1.0
+    } else {
+        0.5
     }
 }
 

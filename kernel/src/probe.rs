@@ -4,15 +4,19 @@
 //! on either side can touch a value (denormals, NaN payloads) before the function sees it.
 
 use crate::brdf::{eval_scattering, pdf_brdf, sample_brdf};
+use crate::bsdf;
 use crate::camera::camera_ray_direction;
+use crate::features::Dynamic;
 use crate::frame::orthonormal_basis;
+use crate::fresnel::{conductor, dielectric, schlick};
 use crate::geometry::{
     geometry_factor, intersect_sphere, intersect_triangle_uv, offset_ray_origin,
     reproject_to_sphere, shadow_ray_end, triangle_point, triangle_point_error,
 };
+use crate::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal};
 use crate::rng::{pcg4d, u32_to_unit_f32};
 use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
-use crate::scene::Camera;
+use crate::scene::{Camera, Material};
 use crate::sobol::{sobol_pair, sobol_single};
 use spirv_std::glam::{UVec4, Vec3, Vec4};
 
@@ -49,7 +53,20 @@ pub mod function {
     /// forward = in0.xyz, right = in1.xyz, up = in2.xyz, (u, v) = in3.xy,
     /// (width, height, px, py) = (in0.w, in1.w, in2.w, in3.z) as u32 -> out0.xyz direction
     pub const CAMERA_RAY: u32 = 10;
-    pub const COUNT: u32 = 11;
+    /// cos = in0.x, eta = in0.y, k = in0.z, f0 = in1.xyz -> out0 = (fresnel::conductor,
+    /// fresnel::dielectric's F and cos_t, schlick.x), out1.xy = schlick.yz
+    pub const FRESNEL: u32 = 11;
+    /// n = in0.xyz, alpha = in0.w, wo = in1.xyz, cos = in1.w, u = in2.xy, sin^2 = in2.z ->
+    /// out0.xyz = sample_visible_normal(n, wo, alpha, u), out0.w = ggx_d(cos, sin^2, alpha),
+    /// out1.x = ggx_g1(cos, alpha), out1.y = pdf_reflected(n . wo, (cos, sin^2), alpha)
+    pub const MICROFACET: u32 = 12;
+    /// n = in0.xyz, alpha = in0.w, wo = in1.xyz, eta = in1.w, wi = in2.xyz, material kind and
+    /// complex flag = in3.xy as u32 ([`probe_material`]) -> out0 = (bsdf::eval's f cos, pdf)
+    pub const BSDF_EVAL: u32 = 13;
+    /// As [`BSDF_EVAL`] with (u_lobe, u1, u2) = in2.xyz -> bsdf::sample's out0 = (wi, pdf),
+    /// out1 = (weight, eta2)
+    pub const BSDF_SAMPLE: u32 = 14;
+    pub const COUNT: u32 = 15;
 }
 
 #[inline]
@@ -70,6 +87,26 @@ fn bits(v: Vec4) -> UVec4 {
 #[inline]
 fn v3(v: Vec3) -> Vec4 {
     v.extend(0.0)
+}
+
+/// The material of the BSDF probes: kind `kind` with roughness `alpha` and, for a dielectric,
+/// index `eta`; Kd (0.5, 0.4, 0.3) and Ks (0.2, 0.3, 0.4) for the Kd + Ks mixture; gold's RGB
+/// index (`complex` 1) or reflectance (0.9, 0.8, 0.7) for a conductor.
+#[inline]
+pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material {
+    let mut m = Material::diffuse([0.5, 0.4, 0.3]);
+    m.kind = kind;
+    m.alpha = alpha;
+    m.ior = eta;
+    m.complex = complex;
+    m.eta = [0.143036, 0.375307, 1.44205];
+    m.k = [3.983, 2.38556, 1.60336];
+    m.specular = if complex != 0 || kind != crate::scene::material_kind::CONDUCTOR {
+        [0.2, 0.3, 0.4]
+    } else {
+        [0.9, 0.8, 0.7]
+    };
+    m
 }
 
 /// Evaluates `function` on one input record; see [`function`] for the layouts.
@@ -157,6 +194,35 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
             &camera, input[0].w, input[1].w, input[2].w, input[3].z, i3.x, i3.y,
         );
         (v3(d), Vec4::ZERO)
+    } else if function == function::FRESNEL {
+        let (f, cos_t) = dielectric(i0.x, i0.y);
+        let s = schlick(i1.truncate(), i0.x);
+        (
+            Vec4::new(conductor(i0.x, i0.y, i0.z), f, cos_t, s.x),
+            Vec4::new(s.y, s.z, 0.0, 0.0),
+        )
+    } else if function == function::MICROFACET {
+        let (n, wo) = (i0.truncate(), i1.truncate());
+        let h = sample_visible_normal(n, wo, i0.w, i2.x, i2.y);
+        (
+            h.extend(ggx_d(i1.w, i2.z, i0.w)),
+            Vec4::new(
+                ggx_g1(i1.w, i0.w),
+                pdf_reflected(n.dot(wo), (i1.w, i2.z), i0.w),
+                0.0,
+                0.0,
+            ),
+        )
+    } else if function == function::BSDF_EVAL || function == function::BSDF_SAMPLE {
+        let m = probe_material(input[3].x, input[3].y, i0.w, i1.w);
+        let (n, wo) = (i0.truncate(), i1.truncate());
+        if function == function::BSDF_EVAL {
+            let (f, pdf) = bsdf::eval(Dynamic(0), &m, n, wo, i2.truncate(), i1.w);
+            (f.extend(pdf), Vec4::ZERO)
+        } else {
+            let s = bsdf::sample(Dynamic(0), &m, n, wo, i1.w, i2.x, i2.y, i2.z);
+            (s.wi.extend(s.pdf), s.weight.extend(s.eta2))
+        }
     } else {
         (Vec4::ZERO, Vec4::ZERO)
     };

@@ -33,17 +33,71 @@ pub struct Triangle {
     pub _pad1: u32,
 }
 
-/// A two-sided Lambertian surface, or a light (emission > 0 and no reflection). 32 bytes.
+/// The kinds of surface a [`Material`] describes (`Material::kind`); `crate::bsdf` derives each.
+pub mod material_kind {
+    /// Two-sided Lambertian, f = Kd / pi; also a light (emission > 0, albedo 0).
+    pub const DIFFUSE: u32 = 0;
+    /// The seed's BRDF: Kd / pi plus a GGX microfacet lobe with Schlick's Fresnel (F0 = Ks).
+    pub const GLOSSY: u32 = 1;
+    /// A metal: a GGX microfacet (or, at alpha 0, perfect) mirror with a conductor's Fresnel.
+    pub const CONDUCTOR: u32 = 2;
+    /// Glass: GGX (or smooth) reflection and refraction between the outside (index 1) and the
+    /// inside (index `ior`) of a closed surface.
+    pub const DIELECTRIC: u32 = 3;
+}
+
+/// A two-sided surface's scattering (one of [`material_kind`]), or a light (emission > 0 and
+/// no reflection). 80 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
 pub struct Material {
-    /// Diffuse reflectance Kd (albedo), linear RGB; the BRDF is Kd / pi.
+    /// Diffuse reflectance Kd (albedo), linear RGB: the Lambertian term Kd / pi.
     pub albedo: [f32; 3],
-    pub _pad0: f32,
+    /// One of [`material_kind`].
+    pub kind: u32,
     /// Emitted radiance, linear RGB (zero for non-emitters).
     pub emission: [f32; 3],
-    pub _pad1: f32,
+    /// GGX roughness (the distribution's alpha, no remapping); below `bsdf::DELTA_ALPHA` the
+    /// lobe is a perfect (delta) mirror or refraction.
+    pub alpha: f32,
+    /// GLOSSY: Ks, the Schlick Fresnel's reflectance at normal incidence. CONDUCTOR without
+    /// `complex`: the constant reflectance.
+    pub specular: [f32; 3],
+    /// DIELECTRIC: the inside's index of refraction relative to the outside.
+    pub ior: f32,
+    /// CONDUCTOR with `complex`: the real part eta of the complex index of refraction.
+    pub eta: [f32; 3],
+    /// CONDUCTOR: 1 for the exact Fresnel of `eta` + i `k`, 0 for the constant `specular`.
+    pub complex: u32,
+    /// CONDUCTOR with `complex`: the extinction coefficient k.
+    pub k: [f32; 3],
+    pub _pad: f32,
+}
+
+impl Material {
+    /// A Lambertian surface of albedo `kd`.
+    pub const fn diffuse(kd: [f32; 3]) -> Self {
+        Self {
+            albedo: kd,
+            kind: material_kind::DIFFUSE,
+            emission: [0.0; 3],
+            alpha: 0.0,
+            specular: [0.0; 3],
+            ior: 1.0,
+            eta: [0.0; 3],
+            complex: 0,
+            k: [0.0; 3],
+            _pad: 0.0,
+        }
+    }
+
+    /// A light's surface: emits `radiance`, reflects nothing.
+    pub const fn emitter(radiance: [f32; 3]) -> Self {
+        let mut m = Self::diffuse([0.0; 3]);
+        m.emission = radiance;
+        m
+    }
 }
 
 /// A spherical area light: the light table lists every emissive sphere. 48 bytes.
@@ -92,6 +146,11 @@ pub mod mis {
     pub const HALF: u32 = 0;
     /// Veach's power heuristic (beta = 2).
     pub const POWER: u32 = 1;
+    /// Light sampling alone: a light found by BSDF sampling adds nothing, unless the direction
+    /// was a delta lobe's, which light sampling cannot find (for comparisons, not renders).
+    pub const LIGHT_ONLY: u32 = 2;
+    /// BSDF sampling alone: no next-event estimation (for comparisons, not renders).
+    pub const BSDF_ONLY: u32 = 3;
 }
 
 /// How a point on a sphere light is chosen for next-event estimation.

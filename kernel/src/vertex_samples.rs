@@ -29,6 +29,11 @@ pub const BRDF_DIMENSION: u32 = 4;
 /// The camera's pair (the position inside the pixel), before the first vertex's block.
 pub const CAMERA_DIMENSION: u32 = 0;
 pub const CAMERA_DIMENSIONS: u32 = 2;
+/// The lobe choice of the vertex at depth d (a BSDF that mixes lobes, `bsdf::chooses_lobe`) is
+/// dimension `LOBE_DIMENSION + d`: outside every vertex's block, so scenes without such a
+/// material draw exactly the numbers they drew before it existed. (Both samplers hash the
+/// dimension into an independent stream: any dimension is as good as the next.)
+pub const LOBE_DIMENSION: u32 = 1 << 31;
 /// In [`VertexQuery::dimensions`]: a number the vertex does not read.
 pub const NO_DIMENSION: u32 = u32::MAX;
 
@@ -51,6 +56,11 @@ pub struct VertexQuery {
     /// `survival >= 1` (survival at 1 is certain).
     pub roulette: bool,
     pub survival: f32,
+    /// Whether the surface is Lambertian (the diffuse renderer's vertex; a filler may give
+    /// its direction, `VertexSamples::brdf_dir`).
+    pub lambertian: bool,
+    /// Whether the BSDF reads a lobe-choice number (`VertexSamples::u_lobe`) when it extends.
+    pub chooses_lobe: bool,
 }
 
 impl VertexQuery {
@@ -97,6 +107,16 @@ impl VertexQuery {
         )
     }
 
+    /// The dimension of the lobe-choice number, or [`NO_DIMENSION`] where none is read.
+    #[inline]
+    pub fn lobe_dimension(&self) -> u32 {
+        if self.extend && self.chooses_lobe {
+            LOBE_DIMENSION + self.depth
+        } else {
+            NO_DIMENSION
+        }
+    }
+
     /// Whether the path survives roulette number `u` (always, where no number is drawn).
     #[inline]
     pub fn survives(&self, u: f32) -> bool {
@@ -118,6 +138,9 @@ pub struct VertexSamples {
     pub u_light: (f32, f32),
     pub u_roulette: f32,
     pub u_brdf: (f32, f32),
+    /// The lobe choice, where [`VertexQuery::lobe_dimension`] names one and the path survives
+    /// roulette.
+    pub u_lobe: f32,
     /// `sample_light_from(lights, light_count, mode, x, u_select, u_light)`, if `has_light`.
     pub light: DirectionalLightSample,
     pub has_light: bool,
@@ -133,6 +156,7 @@ impl VertexSamples {
         u_light: (0.0, 0.0),
         u_roulette: 0.0,
         u_brdf: (0.0, 0.0),
+        u_lobe: 0.0,
         light: DirectionalLightSample {
             point: SurfacePoint {
                 position: Vec3::ZERO,
@@ -149,7 +173,8 @@ impl VertexSamples {
     /// The samples holding the numbers read at `dimensions` (a [`VertexQuery::dimensions`]):
     /// `singles` = [light choice, roulette], `pairs` = [light point, BRDF], each kept where its
     /// dimension is read and 0 elsewhere, as [`VertexSamples::draw`] leaves it (a filler that
-    /// computes numbers for many vertices at once gives them here; no sample is given).
+    /// computes numbers for many vertices at once gives them here; no sample is given; the
+    /// lobe choice, where drawn, is set apart: [`VertexQuery::lobe_dimension`]).
     #[inline]
     pub fn from_numbers(
         ([choice, roulette], [point, brdf]): ([u32; 2], [u32; 2]),
@@ -192,6 +217,11 @@ impl VertexSamples {
         if brdf != NO_DIMENSION {
             rng.seek(brdf);
             s.u_brdf = rng.next_2d();
+        }
+        let lobe = query.lobe_dimension();
+        if lobe != NO_DIMENSION {
+            rng.seek(lobe);
+            s.u_lobe = rng.next_f32();
         }
         s
     }

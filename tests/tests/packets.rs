@@ -169,7 +169,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
     use glam::Vec3;
     use kernel::rng::{pcg4d, u32_to_unit_f32, SampleRng};
     use kernel::scene::{light_sampling, sampler};
-    use kernel::vertex_samples::{VertexQuery, VertexSamples};
+    use kernel::vertex_samples::{VertexQuery, VertexSamples, NO_DIMENSION};
     use twinpath::cpu::packet::LANES;
     use twinpath::cpu::packet_vertices::fill_vertex_samples;
 
@@ -177,9 +177,10 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
     let one = small("cornell.toml").lights;
     assert!(many.len() > 1 && one.len() == 1);
     let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-    let mut checked = [0usize; 4];
+    let mut checked = [0usize; 5];
     // Of those, the light samples and BRDF directions computed on lanes.
     let mut given = [0usize; 2];
+    let mut lambertian_extensions = 0;
     for round in 0..256u32 {
         let h = |lane: usize, k: u32| pcg4d([round, lane as u32, k, 0x7e58])[0];
         let unit = |lane: usize, k: u32| u32_to_unit_f32(h(lane, k));
@@ -222,6 +223,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 1 => f32::NAN,
                 _ => unit(lane, 17),
             };
+            let lambertian = h(lane, 21) % 3 != 0;
             let query = VertexQuery {
                 depth: 1 + h(lane, 6) % 40,
                 x,
@@ -235,6 +237,8 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 extend: h(lane, 19) % 5 != 0,
                 roulette: h(lane, 20) % 3 != 0,
                 survival,
+                lambertian,
+                chooses_lobe: !lambertian && h(lane, 22) % 2 == 0,
             };
             Some((rng, query))
         });
@@ -282,18 +286,27 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 );
                 checked[2] += 1;
                 given[1] += got.has_brdf_dir as usize;
+                lambertian_extensions += q.lambertian as usize;
+                if q.lobe_dimension() != NO_DIMENSION {
+                    assert_eq!(got.u_lobe.to_bits(), want.u_lobe.to_bits());
+                    checked[4] += 1;
+                }
             }
             checked[3] += 1;
         }
     }
     println!(
-        "checked {checked:?} (light samples, roulette numbers, BRDF directions, vertices); \
-         computed on lanes {given:?} (light samples, BRDF directions)"
+        "checked {checked:?} (light samples, roulette numbers, BSDF pairs, vertices, lobe \
+         choices); computed on lanes {given:?} (light samples, Lambertian directions)"
     );
-    // Every kind of sample was compared many times, and the lanes really computed most.
-    assert!(checked[..3].iter().all(|&c| c > 500), "{checked:?}");
+    // Every kind of sample was compared many times, and the lanes really computed most: every
+    // Lambertian direction (other materials sample their own).
     assert!(
-        given[0] > checked[0] / 2 && given[1] == checked[2],
+        checked[..3].iter().chain(&checked[4..]).all(|&c| c > 500),
+        "{checked:?}"
+    );
+    assert!(
+        given[0] > checked[0] / 2 && given[1] == lambertian_extensions,
         "{given:?}"
     );
 }

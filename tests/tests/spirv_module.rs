@@ -136,7 +136,11 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
         (
             "Material",
             binding::MATERIALS,
-            host_layout!(Material, [albedo, _pad0, emission, _pad1], true),
+            host_layout!(
+                Material,
+                [albedo, kind, emission, alpha, specular, ior, eta, complex, k, _pad],
+                true
+            ),
         ),
         (
             "SphereLight",

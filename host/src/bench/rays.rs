@@ -363,12 +363,9 @@ pub fn add_knot_mesh(scene: &mut Scene, n: usize) {
     let size = 0.35 * (scene.camera.look_at - scene.camera.eye).length();
     let vertices = knot_mesh(n, scene.camera.look_at, size);
     let material = scene.materials.len() as u32;
-    scene.materials.push(kernel::scene::Material {
-        albedo: [0.73; 3],
-        _pad0: 0.0,
-        emission: [0.0; 3],
-        _pad1: 0.0,
-    });
+    scene
+        .materials
+        .push(kernel::scene::Material::diffuse([0.73; 3]));
     scene.material_names.push("knot".into());
     let start = scene.triangles.len();
     scene.triangles.extend(to_triangles(&vertices, material));

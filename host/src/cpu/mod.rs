@@ -84,8 +84,8 @@ macro_rules! monomorphised {
 
 /// The feature combinations with their own monomorphised `trace_path`: every combination of
 /// the scene features (lights: none, one, several; background; constant or throughput
-/// roulette) under the default MIS (power) and light sampling (cone). Others run the
-/// [`Dynamic`] path with the same bits.
+/// roulette; Lambertian only or any materials) under the default MIS (power) and light
+/// sampling (cone). Others run the [`Dynamic`] path with the same bits.
 macro_rules! with_features {
     ($bits:expr, $f:ident => $body:expr) => {{
         const BASE: u32 = features::SPECIALIZED | features::MIS_POWER | features::LIGHT_CONE;
@@ -93,11 +93,26 @@ macro_rules! with_features {
         const L1: u32 = features::LIGHTS | features::SINGLE_LIGHT;
         const B: u32 = features::BACKGROUND;
         const R: u32 = features::RR_THROUGHPUT;
+        const M: u32 = features::MATERIALS;
         monomorphised!($bits, $f => $body;
             BASE, BASE | B, BASE | R, BASE | B | R,
             BASE | L, BASE | L | B, BASE | L | R, BASE | L | B | R,
-            BASE | L1, BASE | L1 | B, BASE | L1 | R, BASE | L1 | B | R)
+            BASE | L1, BASE | L1 | B, BASE | L1 | R, BASE | L1 | B | R,
+            BASE | M, BASE | B | M, BASE | R | M, BASE | B | R | M,
+            BASE | L | M, BASE | L | B | M, BASE | L | R | M, BASE | L | B | R | M,
+            BASE | L1 | M, BASE | L1 | B | M, BASE | L1 | R | M, BASE | L1 | B | R | M)
     }};
+}
+
+/// `bits` with every material bit set if any is: the CPU compiles one path for scenes with
+/// other materials than the Lambertian (a material bit only keeps code, see
+/// `kernel::features::material_features`), not one per combination of them.
+fn with_all_materials(bits: u32) -> u32 {
+    if bits & features::MATERIALS != 0 {
+        bits | features::MATERIALS
+    } else {
+        bits
+    }
 }
 
 impl CpuRenderer {
@@ -115,7 +130,7 @@ impl CpuRenderer {
             bvh,
             materials: scene.materials.clone(),
             lights: scene.light_table(),
-            features: scene.features(),
+            features: with_all_materials(scene.features()),
             tiles: small.map_or(TileStrategy::OnePath, TileStrategy::Packets),
         }
     }

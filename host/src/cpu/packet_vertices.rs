@@ -1,6 +1,7 @@
 //! The samples of sixteen path vertices at once, filled from their sixteen
 //! [`VertexQuery`]s: the numbers on SIMD lanes (`packet_numbers`), and from them the cone light
-//! samples and the Lambertian BRDF directions by the kernel's samplers in their
+//! samples and the Lambertian BRDF directions (other materials' directions are the vertex's
+//! own, from the numbers; the lobe choice is drawn one lane at a time) by the kernel's samplers in their
 //! [`kernel::real::Real`] form (`sample_sphere_cone_v3`, `brdf::sample_brdf_v3`) on lanes. Any
 //! other sample (area sampling, a receiver inside its light) is left to the vertex, which
 //! computes it from the numbers with the scalar sampler. Each lane's numbers are exactly what
@@ -17,7 +18,7 @@ use kernel::real::V3;
 use kernel::rng::SampleRng;
 use kernel::sampling::{sample_sphere_cone_v3, ConeSample, SurfacePoint};
 use kernel::scene::SphereLight;
-use kernel::vertex_samples::{VertexQuery, VertexSamples};
+use kernel::vertex_samples::{VertexQuery, VertexSamples, NO_DIMENSION};
 use std::simd::Simd;
 
 type Lanes = Simd<f32, LANES>;
@@ -124,7 +125,7 @@ pub fn fill_vertex_samples(
     let mut cone_light = [None; LANES];
     let mut brdf_wanted = false;
     for (lane, (entry, dims)) in queries.iter().zip(&dimensions).enumerate() {
-        let (Some((_, q)), Some(dims)) = (entry, dims) else {
+        let (Some((rng, q)), Some(dims)) = (entry, dims) else {
             continue;
         };
         let pair = |p: usize| (numbers.pairs[p][0][lane], numbers.pairs[p][1][lane]);
@@ -147,7 +148,14 @@ pub fn fill_vertex_samples(
         }
         set_lane3(&mut args.normal, lane, q.n);
         (args.u_brdf[0][lane], args.u_brdf[1][lane]) = s.u_brdf;
-        brdf_wanted |= q.extend;
+        brdf_wanted |= q.extend && q.lambertian;
+        // The lobe choice, one number, drawn here for the few vertices that read it.
+        let lobe = q.lobe_dimension();
+        if lobe != NO_DIMENSION && q.survives(s.u_roulette) {
+            let mut rng = *rng;
+            rng.seek(lobe);
+            s.u_lobe = rng.next_f32();
+        }
     }
     if !brdf_wanted && cone_light.iter().all(Option::is_none) {
         return samples;
@@ -168,9 +176,9 @@ pub fn fill_vertex_samples(
             s.light = cone_light_sample(&lights[light as usize], light, cone);
             s.has_light = true;
         }
-        // The only lobe: Lambertian (`brdf::sample_brdf`).
+        // The Lambertian direction (`brdf::sample_brdf`); other materials sample their own.
         s.brdf_dir = lane3(&results.wi, lane);
-        s.has_brdf_dir = q.extend;
+        s.has_brdf_dir = q.extend && q.lambertian;
     }
     samples
 }

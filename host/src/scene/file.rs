@@ -1,12 +1,13 @@
 //! The TOML scene format (see README "Scene format"), parsed with serde and checked field by
 //! field; every error carries the file, the line of the offending value and the field's path.
 
+use super::closed_surface::check_closed_outward;
 use super::error::{line_of, SceneError};
 use super::mesh::load_mesh;
 use super::{CameraDesc, Scene, TriangleGroup};
 use crate::settings::RenderSettings;
 use glam::Vec3;
-use kernel::scene::{Material, Sphere, SphereLight, Triangle, NONE};
+use kernel::scene::{material_kind, Sphere, SphereLight, Triangle, NONE};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -26,7 +27,7 @@ pub const MIN_RADIUS: f32 = 1e-15;
 /// Largest image side accepted (a typo like 1e9 must not try to allocate the film).
 pub const MAX_IMAGE_SIDE: i64 = 1 << 15;
 
-type V3 = Spanned<[f32; 3]>;
+pub(super) type V3 = Spanned<[f32; 3]>;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -60,9 +61,19 @@ struct CameraFile {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct MaterialFile {
-    kd: Option<V3>,
-    emission: Option<V3>,
+pub(super) struct MaterialFile {
+    pub kd: Option<V3>,
+    pub ks: Option<V3>,
+    pub alpha: Option<Spanned<f32>>,
+    pub conductor: Option<Spanned<toml::Value>>,
+    pub dielectric: Option<Spanned<DielectricFile>>,
+    pub emission: Option<V3>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct DielectricFile {
+    pub ior: Spanned<f32>,
 }
 
 #[derive(Deserialize)]
@@ -100,17 +111,22 @@ struct BackgroundFile {
 }
 
 /// Checks values and reports errors at their line.
-struct Checker<'a> {
-    path: &'a Path,
-    text: &'a str,
+pub(super) struct Checker<'a> {
+    pub path: &'a Path,
+    pub text: &'a str,
 }
 
 impl Checker<'_> {
-    fn err(&self, span: std::ops::Range<usize>, field: &str, msg: impl Into<String>) -> SceneError {
+    pub fn err(
+        &self,
+        span: std::ops::Range<usize>,
+        field: &str,
+        msg: impl Into<String>,
+    ) -> SceneError {
         SceneError::new(self.path, Some(line_of(self.text, span.start)), field, msg)
     }
 
-    fn vec3(&self, v: &V3, field: &str) -> Result<Vec3, SceneError> {
+    pub fn vec3(&self, v: &V3, field: &str) -> Result<Vec3, SceneError> {
         let a = *v.get_ref();
         if !a.iter().all(|c| c.is_finite()) {
             Err(self.err(v.span(), field, format!("{a:?} is not finite")))
@@ -125,7 +141,7 @@ impl Checker<'_> {
         }
     }
 
-    fn color(&self, v: &V3, field: &str, max: Option<f32>) -> Result<Vec3, SceneError> {
+    pub fn color(&self, v: &V3, field: &str, max: Option<f32>) -> Result<Vec3, SceneError> {
         let c = self.vec3(v, field)?;
         if c.min_element() < 0.0 {
             return Err(self.err(
@@ -233,38 +249,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let mut material_names = Vec::new();
     for (name, m) in &file.materials {
         let field = format!("materials.{name}");
-        let mf = m.get_ref();
-        let material = match (&mf.kd, &mf.emission) {
-            (Some(kd), None) => Material {
-                albedo: ck.color(kd, &format!("{field}.kd"), Some(1.0))?.to_array(),
-                _pad0: 0.0,
-                emission: [0.0; 3],
-                _pad1: 0.0,
-            },
-            (None, Some(e)) => {
-                let e = ck.color(e, &format!("{field}.emission"), None)?;
-                Material {
-                    albedo: [0.0; 3],
-                    _pad0: 0.0,
-                    emission: e.to_array(),
-                    _pad1: 0.0,
-                }
-            }
-            (Some(_), Some(_)) => {
-                return Err(ck.err(
-                    m.span(),
-                    &field,
-                    "has both kd and emission: a light reflects nothing, give one of them",
-                ))
-            }
-            (None, None) => {
-                return Err(ck.err(
-                    m.span(),
-                    &field,
-                    "needs kd = [r, g, b] or emission = [r, g, b]",
-                ))
-            }
-        };
+        let material = super::materials::material(&ck, &field, m)?;
         materials.push(material);
         material_names.push(name.clone());
     }
@@ -286,6 +271,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             })
     };
     let is_emissive = |m: u32| materials[m as usize].emission.iter().any(|&c| c > 0.0);
+    let is_dielectric = |m: u32| materials[m as usize].kind == material_kind::DIELECTRIC;
 
     // Spheres; emissive ones become lights.
     let mut spheres = Vec::new();
@@ -365,6 +351,17 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 ),
             ));
         }
+        if is_dielectric(material) {
+            return Err(ck.err(
+                qf.material.span(),
+                &format!("{field}.material"),
+                format!(
+                    "'{}' is a dielectric: it needs a closed surface (a sphere or a closed mesh) \
+                     to have an inside, and a quad has none",
+                    qf.material.get_ref()
+                ),
+            ));
+        }
         push_triangle(
             &mut triangles,
             [corner, corner + e1, corner + e1 + e2],
@@ -424,6 +421,16 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             None => Vec3::ZERO,
         };
         let soup = load_mesh(&mesh_path)?;
+        if is_dielectric(material) {
+            check_closed_outward(&soup.triangles).map_err(|msg| {
+                SceneError::new(
+                    &mesh_path,
+                    None,
+                    format!("{field} (material '{}')", mf.material.get_ref()),
+                    msg,
+                )
+            })?;
+        }
         let start = triangles.len();
         for (k, t) in soup.triangles.iter().enumerate() {
             let p = t.map(|v| Vec3::from(v) * scale + translate);

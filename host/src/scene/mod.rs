@@ -1,9 +1,11 @@
 //! Scenes: TOML files (and the meshes they name) validated and flattened into the kernel's
 //! `#[repr(C)]` tables. Neither backend knows the file format.
 
+mod closed_surface;
 mod error;
 mod file;
 pub mod light_table;
+mod materials;
 pub mod mesh;
 
 pub use error::SceneError;
@@ -143,6 +145,7 @@ impl Scene {
     pub fn features(&self) -> u32 {
         if self.render.specialize {
             kernel::features::scene_features(&self.params(0, 1))
+                | kernel::features::material_features(&self.materials)
         } else {
             0
         }

@@ -1,0 +1,230 @@
+//! The `[materials]` table of a scene file: each entry checked field by field and made a
+//! kernel [`Material`] (README "Scene format"; the models in `docs/materials.md`).
+
+use super::error::SceneError;
+use super::file::{Checker, MaterialFile};
+use glam::Vec3;
+use kernel::scene::{material_kind, Material};
+use toml::Spanned;
+
+/// Named conductors: RGB (eta, k) as Mitsuba 3 reduces its measured spectra (the `eta` and `k`
+/// of `mi.traverse` of `{"type": "conductor", "material": ...}` in the `scalar_rgb` variant,
+/// Mitsuba 3.6), so both renderers use the same numbers.
+pub const METALS: [(&str, [f32; 3], [f32; 3]); 4] = [
+    (
+        "gold",
+        [0.143036, 0.375307, 1.44205],
+        [3.983, 2.38556, 1.60336],
+    ),
+    (
+        "silver",
+        [0.155276, 0.116728, 0.138388],
+        [4.82835, 3.12222, 2.1469],
+    ),
+    (
+        "copper",
+        [0.201005, 0.92375, 1.10222],
+        [3.91326, 2.45305, 2.14209],
+    ),
+    (
+        "aluminium",
+        [1.6575, 0.880405, 0.521244],
+        [9.22381, 6.2695, 4.837],
+    ),
+];
+
+/// Largest GGX roughness accepted: alpha 1 is already rougher than a Lambertian surface looks.
+pub const MAX_ALPHA: f32 = 1.0;
+/// Range of a dielectric's index of refraction (relative to the outside) accepted.
+pub const IOR_RANGE: (f32, f32) = (0.1, 10.0);
+
+/// The material `field` (`materials.NAME`) of entry `m`.
+pub(super) fn material(
+    ck: &Checker,
+    field: &str,
+    m: &Spanned<MaterialFile>,
+) -> Result<Material, SceneError> {
+    let mf = m.get_ref();
+    let whole = |msg: &str| ck.err(m.span(), field, msg);
+    let kinds = [
+        mf.ks.is_some(),
+        mf.conductor.is_some(),
+        mf.dielectric.is_some(),
+        mf.emission.is_some(),
+    ];
+    if kinds.iter().filter(|&&k| k).count() > 1 {
+        return Err(whole(
+            "gives more than one of ks, conductor, dielectric and emission: choose one kind",
+        ));
+    }
+    let alpha = match &mf.alpha {
+        Some(a) => {
+            let x = *a.get_ref();
+            if !(0.0..=MAX_ALPHA).contains(&x) {
+                return Err(ck.err(
+                    a.span(),
+                    &format!("{field}.alpha"),
+                    format!("{x} is outside 0..={MAX_ALPHA}"),
+                ));
+            }
+            Some(x)
+        }
+        None => None,
+    };
+    if let Some(e) = &mf.emission {
+        if mf.kd.is_some() || alpha.is_some() {
+            return Err(whole(
+                "has emission and reflection: a light reflects nothing, give emission alone",
+            ));
+        }
+        return Ok(Material::emitter(
+            ck.color(e, &format!("{field}.emission"), None)?.to_array(),
+        ));
+    }
+    if mf.conductor.is_some() || mf.dielectric.is_some() {
+        if mf.kd.is_some() {
+            return Err(whole(
+                "kd belongs to diffuse and kd + ks materials, not to metal or glass",
+            ));
+        }
+        let mut out = Material::diffuse([0.0; 3]);
+        out.alpha = alpha.unwrap_or(0.0);
+        if let Some(c) = &mf.conductor {
+            conductor(ck, &format!("{field}.conductor"), c, &mut out)?;
+        } else if let Some(d) = &mf.dielectric {
+            let ior = *d.get_ref().ior.get_ref();
+            let (lo, hi) = IOR_RANGE;
+            if !(lo..=hi).contains(&ior) {
+                return Err(ck.err(
+                    d.get_ref().ior.span(),
+                    &format!("{field}.dielectric.ior"),
+                    format!("{ior} is outside {lo}..={hi}"),
+                ));
+            }
+            out.kind = material_kind::DIELECTRIC;
+            out.ior = ior;
+        }
+        return Ok(out);
+    }
+    let kd = match &mf.kd {
+        Some(kd) => Some(ck.color(kd, &format!("{field}.kd"), Some(1.0))?),
+        None => None,
+    };
+    match (&mf.ks, kd, alpha) {
+        (None, Some(kd), None) => Ok(Material::diffuse(kd.to_array())),
+        (None, Some(_), Some(_)) => Err(whole(
+            "has alpha but no ks: a rough lobe needs ks (or conductor, or dielectric)",
+        )),
+        (None, None, _) => Err(whole(
+            "needs kd, kd + ks + alpha, conductor, dielectric or emission",
+        )),
+        (Some(ks), kd, alpha) => {
+            let ks_field = format!("{field}.ks");
+            let ks_value = ck.color(ks, &ks_field, Some(1.0))?;
+            let kd = kd.unwrap_or(Vec3::ZERO);
+            let Some(alpha) = alpha else {
+                return Err(whole(
+                    "has ks but no alpha: give the glossy lobe's roughness",
+                ));
+            };
+            let sum = kd + ks_value;
+            if sum.max_element() > 1.0 {
+                return Err(ck.err(
+                    ks.span(),
+                    &ks_field,
+                    format!(
+                        "kd + ks = {:?} exceeds 1 in a channel: the surface would reflect more \
+                         than it receives",
+                        sum.to_array()
+                    ),
+                ));
+            }
+            let mut out = Material::diffuse(kd.to_array());
+            out.kind = material_kind::GLOSSY;
+            out.specular = ks_value.to_array();
+            out.alpha = alpha;
+            Ok(out)
+        }
+    }
+}
+
+/// A conductor: a metal's name, `{ eta = [...], k = [...] }` or `{ reflectance = [...] }`.
+fn conductor(
+    ck: &Checker,
+    field: &str,
+    c: &Spanned<toml::Value>,
+    out: &mut Material,
+) -> Result<(), SceneError> {
+    out.kind = material_kind::CONDUCTOR;
+    let names: Vec<&str> = METALS.iter().map(|m| m.0).collect();
+    let bad = |msg: String| ck.err(c.span(), field, msg);
+    match c.get_ref() {
+        toml::Value::String(name) => {
+            let Some((_, eta, k)) = METALS.iter().find(|m| m.0 == name) else {
+                return Err(bad(format!(
+                    "unknown metal '{name}' (known: {})",
+                    names.join(", ")
+                )));
+            };
+            out.eta = *eta;
+            out.k = *k;
+            out.complex = 1;
+            Ok(())
+        }
+        toml::Value::Table(t) => {
+            let rgb = |key: &str| -> Result<Option<Vec3>, SceneError> {
+                let Some(v) = t.get(key) else { return Ok(None) };
+                let a = v
+                    .as_array()
+                    .filter(|a| a.len() == 3)
+                    .and_then(|a| {
+                        a.iter()
+                            .map(|x| x.as_float().or(x.as_integer().map(|i| i as f64)))
+                            .collect::<Option<Vec<f64>>>()
+                    })
+                    .ok_or_else(|| bad(format!("{key} must be [r, g, b] numbers")))?;
+                let v = Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
+                if !v.is_finite() || v.min_element() < 0.0 {
+                    return Err(bad(format!("{key} = {:?} must be finite and >= 0", v.to_array())));
+                }
+                Ok(Some(v))
+            };
+            if let Some(key) = t
+                .keys()
+                .find(|k| !["eta", "k", "reflectance"].contains(&k.as_str()))
+            {
+                return Err(bad(format!(
+                    "unknown field '{key}' (expected eta and k, or reflectance)"
+                )));
+            }
+            match (rgb("eta")?, rgb("k")?, rgb("reflectance")?) {
+                (Some(eta), Some(k), None) => {
+                    if !(eta.min_element() > 0.0) {
+                        return Err(bad("eta must be > 0 in every channel".into()));
+                    }
+                    out.eta = eta.to_array();
+                    out.k = k.to_array();
+                    out.complex = 1;
+                    Ok(())
+                }
+                (None, None, Some(r)) => {
+                    if r.max_element() > 1.0 {
+                        return Err(bad(format!(
+                            "reflectance {:?} has a component above 1",
+                            r.to_array()
+                        )));
+                    }
+                    out.specular = r.to_array();
+                    Ok(())
+                }
+                _ => Err(bad(
+                    "needs eta and k together, or reflectance alone".into(),
+                )),
+            }
+        }
+        _ => Err(bad(format!(
+            "must be a metal's name ({}), {{ eta = [...], k = [...] }} or {{ reflectance = [...] }}",
+            names.join(", ")
+        ))),
+    }
+}

@@ -1,0 +1,411 @@
+//! The scattering of every [`Material`] kind (`scene::material_kind`) at a path vertex:
+//! its value times the cosine, its density, and its importance sampling. The Lambertian
+//! surface keeps its own exact form in `brdf`; this module adds the seed's Kd + Ks BRDF, the
+//! conductor and the dielectric, rough (GGX, `microfacet`) or smooth (delta). Derivations and
+//! sources: `docs/materials.md`.
+//!
+//! Conventions: `wo` is the unit direction toward the previous vertex (the camera side), `wi`
+//! the unit direction toward the next one (the light side); `n` is the unit normal on `wo`'s
+//! side (`SurfaceHit::facing_normal`); `eta` is the index of refraction beyond the surface over
+//! the index on `wo`'s side (only a dielectric reads it). Values are for radiance transport
+//! (pbrt-v4's `TransportMode::Radiance`): refraction into a denser medium scales radiance by
+//! 1 / eta^2.
+
+use crate::brdf::sample_brdf;
+use crate::features::FeatureSet;
+use crate::fresnel::{conductor_rgb, dielectric, refract, schlick};
+use crate::microfacet::{ggx_d, ggx_g1, normal_angle, pdf_reflected, sample_visible_normal};
+use crate::scene::{material_kind, Material};
+use core::f32::consts::PI;
+use spirv_std::glam::Vec3;
+
+/// Roughness below which a lobe is a perfect mirror or refraction (a delta distribution),
+/// pbrt-v4's `EffectivelySmooth` threshold: GGX with alpha < 1e-3 has D up to 1/(pi 1e-6),
+/// beyond which f32 sampling and evaluation lose the lobe's shape.
+pub const DELTA_ALPHA: f32 = 1e-3;
+
+/// The density [`BsdfSample::pdf`] gives a delta lobe's direction: infinite relative to any
+/// solid-angle density, so the power heuristic gives a light found along it weight 1.
+pub const DELTA_PDF: f32 = f32::INFINITY;
+
+/// A direction drawn by [`sample`], with what the path multiplies its throughput by.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    /// f |n . wi| / pdf: what the throughput is multiplied by (zero: the path ends).
+    pub weight: Vec3,
+    /// The density of `wi` per unit solid angle (the whole mixture's), or [`DELTA_PDF`].
+    pub pdf: f32,
+    /// eta^2 of a refraction (index on `wi`'s side over `wo`'s, squared), 1 for a reflection:
+    /// the factor by which `weight` holds 1 / eta^2, which Russian roulette leaves out.
+    pub eta2: f32,
+    /// Whether `wi` crossed the surface (leaves on the side opposite `n`).
+    pub transmitted: bool,
+}
+
+impl BsdfSample {
+    /// The sample that ends the path.
+    const NONE: Self = Self {
+        wi: Vec3::Z,
+        weight: Vec3::ZERO,
+        pdf: 0.0,
+        eta2: 1.0,
+        transmitted: false,
+    };
+}
+
+/// Whether the material's scattering is a delta distribution only (a perfect mirror or
+/// refraction): no light sample can meet it, so its vertex takes none.
+#[inline]
+pub fn is_delta(m: &Material) -> bool {
+    m.kind != material_kind::DIFFUSE && m.kind != material_kind::GLOSSY && m.alpha < DELTA_ALPHA
+}
+
+/// Whether [`sample`] reads the lobe-choice number `u_lobe`: the Kd + Ks mixture chooses its
+/// lobe, the dielectric reflection or refraction.
+#[inline]
+pub fn chooses_lobe(m: &Material) -> bool {
+    m.kind == material_kind::GLOSSY || m.kind == material_kind::DIELECTRIC
+}
+
+/// The probability that the Kd + Ks mixture samples its glossy lobe from `wo` at cosine
+/// `cos_o`: each lobe in proportion to an estimate of its albedo, mean(Kd) for the diffuse
+/// and mean(F_Schlick(cos_o)) for the glossy (the masking left out); 0 when both are 0.
+#[inline]
+pub fn glossy_lobe_probability(m: &Material, cos_o: f32) -> f32 {
+    let fd = Vec3::from(m.albedo).dot(Vec3::ONE);
+    let fs = schlick(Vec3::from(m.specular), cos_o).dot(Vec3::ONE);
+    if fd + fs > 0.0 {
+        fs / (fd + fs)
+    } else {
+        0.0
+    }
+}
+
+/// A conductor's Fresnel reflectance at cosine `cos`: exact for its complex index, or its
+/// constant reflectance.
+#[inline]
+fn conductor_fresnel(m: &Material, cos: f32) -> Vec3 {
+    if m.complex != 0 {
+        conductor_rgb(cos, Vec3::from(m.eta), Vec3::from(m.k))
+    } else {
+        Vec3::from(m.specular)
+    }
+}
+
+/// The mirror direction of `wo` about unit `h`.
+#[inline]
+fn reflect(wo: Vec3, h: Vec3) -> Vec3 {
+    2.0 * wo.dot(h) * h - wo
+}
+
+/// The non-delta part of the scattering from `wi` toward `wo`: (f |n . wi|, the density with
+/// which [`sample`] draws `wi`, per unit solid angle). Delta lobes contribute to neither (no
+/// direction given in advance meets them). Zero where `wo` is not above `n` (rounding at
+/// grazing hits) for the microfacet lobes. `features` keeps only the kinds the scene may have.
+#[inline]
+pub fn eval<F: FeatureSet>(
+    features: F,
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+    eta: f32,
+) -> (Vec3, f32) {
+    let cos_o = n.dot(wo);
+    let cos_i = n.dot(wi);
+    if m.kind == material_kind::DIFFUSE {
+        return if cos_i > 0.0 {
+            let c = cos_i * (1.0 / PI);
+            (Vec3::from(m.albedo) * c, c)
+        } else {
+            (Vec3::ZERO, 0.0)
+        };
+    }
+    if !(cos_o > 0.0) {
+        return (Vec3::ZERO, 0.0);
+    }
+    if features.glossy() && m.kind == material_kind::GLOSSY {
+        eval_glossy(m, n, wo, wi, cos_o, cos_i)
+    } else if m.alpha < DELTA_ALPHA {
+        (Vec3::ZERO, 0.0)
+    } else if features.conductor() && m.kind == material_kind::CONDUCTOR {
+        eval_conductor(m, n, wo, wi, cos_o, cos_i)
+    } else if features.dielectric() && m.kind == material_kind::DIELECTRIC {
+        eval_dielectric(m, n, wo, wi, cos_o, cos_i, eta)
+    } else {
+        (Vec3::ZERO, 0.0)
+    }
+}
+
+/// [`eval`] of the Kd + Ks mixture: Kd/pi cos + D G F_Schlick(wi . h) / (4 cos_o), density the
+/// mixture of the cosine lobe and the visible-normal reflection.
+#[inline]
+fn eval_glossy(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32) -> (Vec3, f32) {
+    if !(cos_i > 0.0) {
+        return (Vec3::ZERO, 0.0);
+    }
+    let p_glossy = glossy_lobe_probability(m, cos_o);
+    let c = cos_i * (1.0 / PI);
+    let mut f = Vec3::from(m.albedo) * c;
+    let mut pdf = (1.0 - p_glossy) * c;
+    if !(m.alpha < DELTA_ALPHA) {
+        let h = (wo + wi).normalize();
+        let angle = normal_angle(n, h);
+        let d = ggx_d(angle.0, angle.1, m.alpha);
+        let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_i, m.alpha);
+        let fresnel = schlick(Vec3::from(m.specular), wi.dot(h));
+        f += fresnel * (d * g / (4.0 * cos_o));
+        pdf += p_glossy * pdf_reflected(cos_o, angle, m.alpha);
+    }
+    (f, pdf)
+}
+
+/// [`eval`] of a rough conductor: F(wo . h) D G / (4 cos_o).
+#[inline]
+fn eval_conductor(
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+    cos_o: f32,
+    cos_i: f32,
+) -> (Vec3, f32) {
+    if !(cos_i > 0.0) {
+        return (Vec3::ZERO, 0.0);
+    }
+    let h = (wo + wi).normalize();
+    let angle = normal_angle(n, h);
+    let d = ggx_d(angle.0, angle.1, m.alpha);
+    let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_i, m.alpha);
+    let f = conductor_fresnel(m, wo.dot(h)) * (d * g / (4.0 * cos_o));
+    (f, pdf_reflected(cos_o, angle, m.alpha))
+}
+
+/// [`eval`] of a rough dielectric: Walter et al. 2007, eqs. 20-21 (radiance transport).
+#[inline]
+fn eval_dielectric(
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+    cos_o: f32,
+    cos_i: f32,
+    eta: f32,
+) -> (Vec3, f32) {
+    if cos_i > 0.0 {
+        let h = (wo + wi).normalize();
+        let angle = normal_angle(n, h);
+        let (fresnel, _) = dielectric(wo.dot(h), eta);
+        let d = ggx_d(angle.0, angle.1, m.alpha);
+        let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_i, m.alpha);
+        let f = fresnel * d * g / (4.0 * cos_o);
+        return (
+            Vec3::splat(f),
+            fresnel * pdf_reflected(cos_o, angle, m.alpha),
+        );
+    }
+    if !(cos_i < 0.0) {
+        return (Vec3::ZERO, 0.0);
+    }
+    // The generalised half vector of a refraction (Walter et al. 2007, eq. 16), on n's side.
+    let mut h = (wo + eta * wi).normalize();
+    if n.dot(h) < 0.0 {
+        h = -h;
+    }
+    let (cos_oh, cos_ih) = (wo.dot(h), wi.dot(h));
+    // Only microfacets that face wo and that wi leaves from behind refract between them.
+    if !(cos_oh > 0.0 && cos_ih < 0.0) {
+        return (Vec3::ZERO, 0.0);
+    }
+    let (fresnel, _) = dielectric(cos_oh, eta);
+    let (cos_h, sin2_h) = normal_angle(n, h);
+    let d = ggx_d(cos_h, sin2_h, m.alpha);
+    let g1o = ggx_g1(cos_o, m.alpha);
+    let g = g1o * ggx_g1(cos_i, m.alpha);
+    let denom = eta * cos_ih + cos_oh;
+    let denom2 = denom * denom;
+    let transmitted = 1.0 - fresnel;
+    // f |cos_i| = D (1 - F) G |wi.h| |wo.h| / ((eta wi.h + wo.h)^2 |cos_o|), radiance mode.
+    let f = d * transmitted * g * (-cos_ih) * cos_oh / (denom2 * cos_o);
+    // (1 - F) D_wo(h) |dh/dwi|, |dh/dwi| = eta^2 |wi.h| / (eta wi.h + wo.h)^2.
+    let pdf = transmitted * g1o * cos_oh * d / cos_o * (eta * eta * (-cos_ih) / denom2);
+    (Vec3::splat(f), pdf)
+}
+
+/// Draws `wi` for `wo` from the material's lobes: `u_lobe` chooses a lobe (where
+/// [`chooses_lobe`]), `(u1, u2)` the direction within it. The weight is f |n . wi| / pdf in the
+/// forms that cancel analytically (a conductor's F G1(wi); a dielectric's G1(wi), over eta^2
+/// after a refraction; exactly 1 for smooth reflection), and computed for the Kd + Ks mixture.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn sample<F: FeatureSet>(
+    features: F,
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    eta: f32,
+    u_lobe: f32,
+    u1: f32,
+    u2: f32,
+) -> BsdfSample {
+    let cos_o = n.dot(wo);
+    if m.kind == material_kind::DIFFUSE {
+        let wi = sample_brdf(n, u1, u2);
+        return BsdfSample {
+            wi,
+            weight: Vec3::from(m.albedo),
+            pdf: n.dot(wi).max(0.0) * (1.0 / PI),
+            eta2: 1.0,
+            transmitted: false,
+        };
+    }
+    if !(cos_o > 0.0) {
+        return BsdfSample::NONE;
+    }
+    if features.glossy() && m.kind == material_kind::GLOSSY {
+        sample_glossy(features, m, n, wo, cos_o, u_lobe, u1, u2)
+    } else if features.conductor() && m.kind == material_kind::CONDUCTOR {
+        sample_conductor(m, n, wo, cos_o, u1, u2)
+    } else if features.dielectric() && m.kind == material_kind::DIELECTRIC {
+        sample_dielectric(m, n, wo, cos_o, eta, u_lobe, u1, u2)
+    } else {
+        BsdfSample::NONE
+    }
+}
+
+/// [`sample`] of the Kd + Ks mixture.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn sample_glossy<F: FeatureSet>(
+    features: F,
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    cos_o: f32,
+    u_lobe: f32,
+    u1: f32,
+    u2: f32,
+) -> BsdfSample {
+    let smooth = m.alpha < DELTA_ALPHA;
+    let p_glossy = glossy_lobe_probability(m, cos_o);
+    let glossy = u_lobe < p_glossy;
+    if smooth && glossy {
+        return reflection(
+            reflect(wo, n),
+            schlick(Vec3::from(m.specular), cos_o) / p_glossy,
+            DELTA_PDF,
+        );
+    }
+    let wi = if glossy {
+        reflect(wo, sample_visible_normal(n, wo, m.alpha, u1, u2))
+    } else {
+        sample_brdf(n, u1, u2)
+    };
+    if smooth {
+        // The diffuse lobe beside a delta one: (Kd/pi cos) / ((1 - p) cos/pi), exactly.
+        let weight = Vec3::from(m.albedo) / (1.0 - p_glossy);
+        return reflection(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
+    }
+    let (f, pdf) = eval(features, m, n, wo, wi, 1.0);
+    if !(pdf > 0.0) {
+        return BsdfSample::NONE;
+    }
+    reflection(wi, f / pdf, pdf)
+}
+
+/// [`sample`] of a conductor.
+#[inline]
+fn sample_conductor(m: &Material, n: Vec3, wo: Vec3, cos_o: f32, u1: f32, u2: f32) -> BsdfSample {
+    if m.alpha < DELTA_ALPHA {
+        return reflection(reflect(wo, n), conductor_fresnel(m, cos_o), DELTA_PDF);
+    }
+    let h = sample_visible_normal(n, wo, m.alpha, u1, u2);
+    let wi = reflect(wo, h);
+    let cos_i = n.dot(wi);
+    if !(cos_i > 0.0) {
+        return BsdfSample::NONE;
+    }
+    let weight = conductor_fresnel(m, wo.dot(h)) * ggx_g1(cos_i, m.alpha);
+    reflection(
+        wi,
+        weight,
+        pdf_reflected(cos_o, normal_angle(n, h), m.alpha),
+    )
+}
+
+/// [`sample`] of a dielectric: a microfacet normal (n itself when smooth), then reflection
+/// with the probability F of its Fresnel reflectance, else refraction.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn sample_dielectric(
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    cos_o: f32,
+    eta: f32,
+    u_lobe: f32,
+    u1: f32,
+    u2: f32,
+) -> BsdfSample {
+    let smooth = m.alpha < DELTA_ALPHA;
+    let h = if smooth {
+        n
+    } else {
+        sample_visible_normal(n, wo, m.alpha, u1, u2)
+    };
+    let cos_oh = wo.dot(h);
+    let (fresnel, cos_t) = dielectric(cos_oh, eta);
+    if u_lobe < fresnel {
+        let wi = reflect(wo, h);
+        if smooth {
+            return reflection(wi, Vec3::ONE, DELTA_PDF);
+        }
+        let cos_i = n.dot(wi);
+        if !(cos_i > 0.0) {
+            return BsdfSample::NONE;
+        }
+        let pdf = fresnel * pdf_reflected(cos_o, normal_angle(n, h), m.alpha);
+        return reflection(wi, Vec3::splat(ggx_g1(cos_i, m.alpha)), pdf);
+    }
+    let wi = refract(wo, h, cos_oh, eta, cos_t);
+    let eta2 = eta * eta;
+    if smooth {
+        return BsdfSample {
+            wi,
+            weight: Vec3::splat(1.0 / eta2),
+            pdf: DELTA_PDF,
+            eta2,
+            transmitted: true,
+        };
+    }
+    let cos_i = n.dot(wi);
+    if !(cos_i < 0.0) {
+        return BsdfSample::NONE;
+    }
+    let cos_ih = wi.dot(h);
+    let denom = eta * cos_ih + cos_oh;
+    let (cos_h, sin2_h) = normal_angle(n, h);
+    let d = ggx_d(cos_h, sin2_h, m.alpha);
+    let pdf = (1.0 - fresnel) * ggx_g1(cos_o, m.alpha) * cos_oh * d / cos_o
+        * (eta2 * (-cos_ih) / (denom * denom));
+    BsdfSample {
+        wi,
+        weight: Vec3::splat(ggx_g1(cos_i, m.alpha) / eta2),
+        pdf,
+        eta2,
+        transmitted: true,
+    }
+}
+
+/// A reflected sample.
+#[inline]
+fn reflection(wi: Vec3, weight: Vec3, pdf: f32) -> BsdfSample {
+    BsdfSample {
+        wi,
+        weight,
+        pdf,
+        eta2: 1.0,
+        transmitted: false,
+    }
+}

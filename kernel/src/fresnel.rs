@@ -1,0 +1,81 @@
+//! Fresnel reflectance: the fraction of light a smooth interface reflects, by the angle of
+//! incidence. Derivations and sources: `docs/materials.md` ("Fresnel").
+
+#[cfg(target_arch = "spirv")]
+use crate::Float;
+use spirv_std::glam::Vec3;
+
+/// Schlick's approximation F0 + (1 - F0) (1 - cos)^5 (Schlick, "An Inexpensive BRDF Model for
+/// Physically-based Rendering", Computer Graphics Forum 13(3), 1994, eq. 24), the seed's F with
+/// F0 = Ks. `cos` is clamped to [0, 1].
+#[inline]
+pub fn schlick(f0: Vec3, cos: f32) -> Vec3 {
+    let m = 1.0 - cos.clamp(0.0, 1.0);
+    let m2 = m * m;
+    f0 + (Vec3::ONE - f0) * (m2 * m2 * m)
+}
+
+/// Unpolarised reflectance of a conductor of complex index of refraction eta + i k (relative to
+/// the outside) for light arriving at cosine `cos` (clamped to [0, 1]); one channel.
+///
+/// With a^2 + b^2 = sqrt((eta^2 - k^2 - sin^2)^2 + 4 eta^2 k^2) and
+/// a^2 = (a^2 + b^2 + eta^2 - k^2 - sin^2) / 2, the s and p reflectances are
+/// Rs = (a^2 + b^2 - 2 a cos + cos^2) / (a^2 + b^2 + 2 a cos + cos^2) and
+/// Rp = Rs (cos^2 (a^2 + b^2) - 2 a cos sin^2 + sin^4) / (cos^2 (a^2 + b^2) + 2 a cos sin^2 + sin^4)
+/// (Born and Wolf, Principles of Optics, 14.2; the tan-free form multiplies the usual
+/// a sin tan terms by cos^2). Equal to the complex-arithmetic Fresnel equations (tested in f64).
+#[inline]
+pub fn conductor(cos: f32, eta: f32, k: f32) -> f32 {
+    let c = cos.clamp(0.0, 1.0);
+    let c2 = c * c;
+    let s2 = 1.0 - c2;
+    let (e2, k2) = (eta * eta, k * k);
+    let t0 = e2 - k2 - s2;
+    let a2b2 = (t0 * t0 + 4.0 * e2 * k2).sqrt();
+    let a = (0.5 * (a2b2 + t0)).max(0.0).sqrt();
+    let t1 = a2b2 + c2;
+    let t2 = 2.0 * a * c;
+    let rs = (t1 - t2) / (t1 + t2);
+    let t3 = c2 * a2b2 + s2 * s2;
+    let t4 = t2 * s2;
+    let rp = rs * (t3 - t4) / (t3 + t4);
+    0.5 * (rs + rp)
+}
+
+/// [`conductor`] per RGB channel.
+#[inline]
+pub fn conductor_rgb(cos: f32, eta: Vec3, k: Vec3) -> Vec3 {
+    Vec3::new(
+        conductor(cos, eta.x, k.x),
+        conductor(cos, eta.y, k.y),
+        conductor(cos, eta.z, k.z),
+    )
+}
+
+/// Unpolarised reflectance of a smooth dielectric interface for light arriving at cosine `cos`
+/// (in [0, 1], on the side it arrives from) when `eta` = index beyond / index on the arriving
+/// side; with the cosine of the refracted direction (0 under total internal reflection, where
+/// the reflectance is 1). Snell: sin_t^2 = (1 - cos^2) / eta^2;
+/// rs = (cos - eta cos_t) / (cos + eta cos_t), rp = (eta cos - cos_t) / (eta cos + cos_t),
+/// F = (rs^2 + rp^2) / 2 (Born and Wolf 1.5.2; pbrt-v4 9.3.1 `FrDielectric`).
+#[inline]
+pub fn dielectric(cos: f32, eta: f32) -> (f32, f32) {
+    let c = cos.clamp(0.0, 1.0);
+    let sin2_t = (1.0 - c * c) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return (1.0, 0.0);
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let rs = (c - eta * cos_t) / (c + eta * cos_t);
+    let rp = (eta * c - cos_t) / (eta * c + cos_t);
+    (0.5 * (rs * rs + rp * rp), cos_t)
+}
+
+/// The direction refracted from `wo` through an interface of unit normal `h` on `wo`'s side
+/// (`cos_o` = wo . h >= 0), where `eta` = index beyond / index on `wo`'s side and `cos_t` the
+/// refracted cosine ([`dielectric`]'s, nonzero): -wo / eta + (cos_o / eta - cos_t) h, a unit
+/// vector on the far side (Snell's law in vector form; pbrt-v4 9.3.2 `Refract`).
+#[inline]
+pub fn refract(wo: Vec3, h: Vec3, cos_o: f32, eta: f32, cos_t: f32) -> Vec3 {
+    -wo / eta + (cos_o / eta - cos_t) * h
+}

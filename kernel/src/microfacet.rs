@@ -1,0 +1,81 @@
+//! The GGX (Trowbridge-Reitz) microfacet distribution with Smith's masking: its normal
+//! density D, the masking G1, and the sampling of visible normals. Isotropic, roughness
+//! `alpha` as given (no remapping), as Mitsuba 3's `roughconductor` and pbrt-v4's
+//! `TrowbridgeReitzDistribution`. Derivations and sources: `docs/materials.md` ("Microfacets").
+
+use crate::frame::orthonormal_basis;
+use crate::turns::cos_sin_turns;
+#[cfg(target_arch = "spirv")]
+use crate::Float;
+use core::f32::consts::PI;
+use spirv_std::glam::Vec3;
+
+/// D(h), the density of microfacet normals per unit solid angle projected on the mean surface,
+/// for a normal at angle theta_h to it: alpha^2 / (pi (sin^2 + alpha^2 cos^2)^2) (Walter,
+/// Marschner, Li, Torrance, "Microfacet Models for Refraction through Rough Surfaces", EGSR 2007,
+/// eq. 33, with 1 + cos^2 (alpha^2 - 1) written as sin^2 + alpha^2 cos^2); 0 for cos_h <= 0.
+/// Normalised: the integral of D(h) cos_h over the hemisphere is 1. Takes sin^2 theta_h
+/// itself ([`normal_angle`]): from 1 - cos^2 it would lose all its digits near the peak of a
+/// smooth lobe, where sin^2 ~ alpha^2 ~ 1e-6.
+#[inline]
+pub fn ggx_d(cos_h: f32, sin2_h: f32, alpha: f32) -> f32 {
+    if !(cos_h > 0.0) {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let t = sin2_h + a2 * cos_h * cos_h;
+    a2 / (PI * t * t)
+}
+
+/// (cos, sin^2) of the angle between unit vectors `n` and `h`: the sine from the cross
+/// product, accurate for small angles.
+#[inline]
+pub fn normal_angle(n: Vec3, h: Vec3) -> (f32, f32) {
+    let c = n.cross(h);
+    (n.dot(h), c.dot(c))
+}
+
+/// Smith's masking G1 of GGX for a direction at cosine `cos` to the mean normal:
+/// 1 / (1 + Lambda) with Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2 (Walter et al. 2007, eq. 34;
+/// Heitz, "Understanding the Masking-Shadowing Function", JCGT 3(2), 2014, eq. 86), written as
+/// 2 |cos| / (|cos| + sqrt(alpha^2 + (1 - alpha^2) cos^2)), which needs no tangent.
+#[inline]
+pub fn ggx_g1(cos: f32, alpha: f32) -> f32 {
+    let c = cos.abs();
+    let a2 = alpha * alpha;
+    2.0 * c / (c + (a2 + (1.0 - a2) * c * c).max(0.0).sqrt())
+}
+
+/// A microfacet normal drawn from the visible normals seen from `wo` (unit, `n . wo` > 0),
+/// density D_wo(h) = G1(wo) max(0, wo . h) D(h) / (n . wo) (Heitz 2014, eq. 38), by sampling
+/// a spherical cap (Dupuy and Benyoub, "Sampling Visible GGX Normals with Spherical Caps",
+/// HPG 2023): in the frame stretched by 1/alpha the visible normals are the directions
+/// c + w_s for c uniform on the cap of the unit sphere with z >= -w_s.z, w_s = normalize(wo
+/// stretched); unstretching gives h. Only `cos_sin_turns` and square roots: the same bits on
+/// both backends. `n` is the mean normal, `u1` the azimuth in turns, `u2` the cap's height.
+#[inline]
+pub fn sample_visible_normal(n: Vec3, wo: Vec3, alpha: f32, u1: f32, u2: f32) -> Vec3 {
+    let (t, b) = orthonormal_basis(n);
+    let ws = Vec3::new(alpha * wo.dot(t), alpha * wo.dot(b), wo.dot(n)).normalize();
+    let (cos_phi, sin_phi) = cos_sin_turns(u1);
+    let z = (1.0 - u2) * (1.0 + ws.z) - ws.z;
+    let sin_theta = (1.0 - z * z).clamp(0.0, 1.0).sqrt();
+    let hs = Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, z) + ws;
+    let local = Vec3::new(alpha * hs.x, alpha * hs.y, hs.z.max(0.0));
+    let len2 = local.dot(local);
+    if !(len2 > 0.0) {
+        // c = -w_s exactly (the cap's rim opposite w_s: measure zero).
+        return n;
+    }
+    let local = local / len2.sqrt();
+    t * local.x + b * local.y + n * local.z
+}
+
+/// Density per unit solid angle of the direction reflected about a visible normal from
+/// [`sample_visible_normal`]: D_wo(h) / (4 wo . h) = G1(wo) D(h) / (4 n . wo), the Jacobian of
+/// reflection being 1 / (4 wo . h) (Walter et al. 2007, eq. 14). `cos_o` = n . wo > 0;
+/// (`cos_h`, `sin2_h`) the half vector's angle ([`normal_angle`]).
+#[inline]
+pub fn pdf_reflected(cos_o: f32, (cos_h, sin2_h): (f32, f32), alpha: f32) -> f32 {
+    ggx_g1(cos_o, alpha) * ggx_d(cos_h, sin2_h, alpha) / (4.0 * cos_o)
+}
