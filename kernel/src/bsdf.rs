@@ -13,7 +13,7 @@
 
 use crate::brdf::sample_brdf;
 use crate::features::FeatureSet;
-use crate::fresnel::{conductor_rgb, dielectric, refract, schlick};
+use crate::fresnel::{conductor_rgb, dielectric, dielectric_transmittance, refract, schlick};
 use crate::microfacet::{ggx_d, ggx_g1, normal_angle, pdf_reflected, sample_visible_normal};
 use crate::scene::{material_kind, Material};
 use core::f32::consts::PI;
@@ -218,14 +218,15 @@ fn eval_dielectric(
     if !(cos_oh > 0.0 && cos_ih < 0.0) {
         return (Vec3::ZERO, 0.0);
     }
-    let (fresnel, _) = dielectric(cos_oh, eta);
+    // h being the half vector of this refraction, Snell's cos_t is |wi . h| itself: taken from
+    // the geometry, it keeps its digits where Snell's 1 - sin_t^2 would cancel.
+    let transmitted = dielectric_transmittance(cos_oh, eta, -cos_ih);
     let (cos_h, sin2_h) = normal_angle(n, h);
     let d = ggx_d(cos_h, sin2_h, m.alpha);
     let g1o = ggx_g1(cos_o, m.alpha);
     let g = g1o * ggx_g1(cos_i, m.alpha);
     let denom = eta * cos_ih + cos_oh;
     let denom2 = denom * denom;
-    let transmitted = 1.0 - fresnel;
     // f |cos_i| = D (1 - F) G |wi.h| |wo.h| / ((eta wi.h + wo.h)^2 |cos_o|), radiance mode.
     let f = d * transmitted * g * (-cos_ih) * cos_oh / (denom2 * cos_o);
     // (1 - F) D_wo(h) |dh/dwi|, |dh/dwi| = eta^2 |wi.h| / (eta wi.h + wo.h)^2.
@@ -387,7 +388,8 @@ fn sample_dielectric(
     let denom = eta * cos_ih + cos_oh;
     let (cos_h, sin2_h) = normal_angle(n, h);
     let d = ggx_d(cos_h, sin2_h, m.alpha);
-    let pdf = (1.0 - fresnel) * ggx_g1(cos_o, m.alpha) * cos_oh * d / cos_o
+    let transmitted = dielectric_transmittance(cos_oh, eta, cos_t);
+    let pdf = transmitted * ggx_g1(cos_o, m.alpha) * cos_oh * d / cos_o
         * (eta2 * (-cos_ih) / (denom * denom));
     BsdfSample {
         wi,

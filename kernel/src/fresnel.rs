@@ -71,6 +71,22 @@ pub fn dielectric(cos: f32, eta: f32) -> (f32, f32) {
     (0.5 * (rs * rs + rp * rp), cos_t)
 }
 
+/// 1 - [`dielectric`]'s reflectance, the transmitted fraction, computed without that
+/// cancellation (it loses every digit near total internal reflection, where F -> 1):
+/// 1 - rs^2 = 4 eta cos cos_t / (cos + eta cos_t)^2, 1 - rp^2 = 4 eta cos cos_t / (eta cos + cos_t)^2.
+/// `cos_t` is [`dielectric`]'s; 0 under total internal reflection.
+#[inline]
+pub fn dielectric_transmittance(cos: f32, eta: f32, cos_t: f32) -> f32 {
+    let c = cos.clamp(0.0, 1.0);
+    let num = 4.0 * eta * c * cos_t;
+    let s = c + eta * cos_t;
+    let p = eta * c + cos_t;
+    if !(num > 0.0) {
+        return 0.0;
+    }
+    0.5 * (num / (s * s) + num / (p * p))
+}
+
 /// The direction refracted from `wo` through an interface of unit normal `h` on `wo`'s side
 /// (`cos_o` = wo . h >= 0), where `eta` = index beyond / index on `wo`'s side and `cos_t` the
 /// refracted cosine ([`dielectric`]'s, nonzero): -wo / eta + (cos_o / eta - cos_t) h, a unit

@@ -1,0 +1,272 @@
+//! An f64 reference of the kernel's materials (`kernel::bsdf`), written from the papers in
+//! forms other than the kernel's: GGX through tan and Smith's Lambda, Fresnel through complex
+//! arithmetic (total internal reflection falls out of it), the refraction's BTDF in Walter et
+//! al.'s notation with indices on both sides. The tests compare the kernel's f32 functions
+//! with it; agreement means two derivations agree, not that one was copied.
+
+use glam::DVec3;
+use std::f64::consts::PI;
+
+/// A complex number (enough for the Fresnel equations).
+#[derive(Clone, Copy, Debug)]
+struct C(f64, f64);
+
+impl C {
+    fn add(self, o: C) -> C {
+        C(self.0 + o.0, self.1 + o.1)
+    }
+    fn sub(self, o: C) -> C {
+        C(self.0 - o.0, self.1 - o.1)
+    }
+    fn mul(self, o: C) -> C {
+        C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
+    }
+    fn div(self, o: C) -> C {
+        let d = o.0 * o.0 + o.1 * o.1;
+        C(
+            (self.0 * o.0 + self.1 * o.1) / d,
+            (self.1 * o.0 - self.0 * o.1) / d,
+        )
+    }
+    /// The principal square root (non-negative real part).
+    fn sqrt(self) -> C {
+        let r = (self.0 * self.0 + self.1 * self.1).sqrt();
+        let re = ((r + self.0) / 2.0).max(0.0).sqrt();
+        let im = ((r - self.0) / 2.0).max(0.0).sqrt();
+        C(re, if self.1 < 0.0 { -im } else { im })
+    }
+    fn norm2(self) -> f64 {
+        self.0 * self.0 + self.1 * self.1
+    }
+}
+
+/// Unpolarised Fresnel reflectance at cosine `cos` (>= 0) into a medium of complex relative
+/// index eta + i k: Snell's law with a complex cosine, then the amplitudes
+/// rs = (cos - n cos_t) / (cos + n cos_t), rp = (n cos - cos_t) / (n cos + cos_t).
+pub fn fresnel(cos: f64, eta: f64, k: f64) -> f64 {
+    let n = C(eta, k);
+    let c = C(cos, 0.0);
+    let sin2 = C(1.0 - cos * cos, 0.0);
+    let cos_t = C(1.0, 0.0).sub(sin2.div(n.mul(n))).sqrt();
+    let rs = c.sub(n.mul(cos_t)).div(c.add(n.mul(cos_t)));
+    let rp = n.mul(c).sub(cos_t).div(n.mul(c).add(cos_t));
+    (rs.norm2() + rp.norm2()) / 2.0
+}
+
+/// Schlick's approximation, per channel.
+pub fn schlick(f0: DVec3, cos: f64) -> DVec3 {
+    f0 + (DVec3::ONE - f0) * (1.0 - cos).powi(5)
+}
+
+/// GGX D through the tangent: 1 / (pi alpha^2 cos^4 (1 + tan^2 / alpha^2)^2).
+pub fn ggx_d(cos: f64, alpha: f64) -> f64 {
+    if cos <= 0.0 {
+        return 0.0;
+    }
+    let tan2 = (1.0 - cos * cos) / (cos * cos);
+    1.0 / (PI * alpha * alpha * cos.powi(4) * (1.0 + tan2 / (alpha * alpha)).powi(2))
+}
+
+/// Smith's G1 of GGX through Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2.
+pub fn ggx_g1(cos: f64, alpha: f64) -> f64 {
+    let c = cos.abs();
+    let tan2 = (1.0 - c * c) / (c * c);
+    let lambda = ((1.0 + alpha * alpha * tan2).sqrt() - 1.0) / 2.0;
+    1.0 / (1.0 + lambda)
+}
+
+/// A material of the reference, with the kernel's parameters.
+#[derive(Clone, Copy, Debug)]
+pub enum RefMaterial {
+    /// Kd / pi + the GGX lobe with Schlick's F (F0 = ks).
+    Glossy { kd: DVec3, ks: DVec3, alpha: f64 },
+    /// GGX with a conductor's Fresnel (`eta`, `k`), or the constant `reflectance`.
+    Conductor {
+        eta: DVec3,
+        k: DVec3,
+        reflectance: Option<DVec3>,
+        alpha: f64,
+    },
+    /// GGX reflection and refraction; `eta` = index beyond / index on wo's side.
+    Dielectric { eta: f64, alpha: f64 },
+}
+
+impl RefMaterial {
+    /// The material as the kernel stores it.
+    pub fn kernel(&self) -> kernel::scene::Material {
+        use kernel::scene::{material_kind, Material};
+        let f = |v: DVec3| v.as_vec3().to_array();
+        match *self {
+            RefMaterial::Glossy { kd, ks, alpha } => {
+                let mut m = Material::diffuse(f(kd));
+                m.kind = material_kind::GLOSSY;
+                m.specular = f(ks);
+                m.alpha = alpha as f32;
+                m
+            }
+            RefMaterial::Conductor {
+                eta,
+                k,
+                reflectance,
+                alpha,
+            } => {
+                let mut m = Material::diffuse([0.0; 3]);
+                m.kind = material_kind::CONDUCTOR;
+                m.alpha = alpha as f32;
+                match reflectance {
+                    Some(r) => m.specular = f(r),
+                    None => {
+                        m.eta = f(eta);
+                        m.k = f(k);
+                        m.complex = 1;
+                    }
+                }
+                m
+            }
+            RefMaterial::Dielectric { alpha, eta } => {
+                let mut m = Material::diffuse([0.0; 3]);
+                m.kind = material_kind::DIELECTRIC;
+                m.alpha = alpha as f32;
+                m.ior = eta as f32;
+                m
+            }
+        }
+    }
+
+    /// The eta the kernel's functions take (the dielectric's, else 1).
+    pub fn eta(&self) -> f64 {
+        match *self {
+            RefMaterial::Dielectric { eta, .. } => eta,
+            _ => 1.0,
+        }
+    }
+
+    /// The BSDF f(wo, wi) (not times the cosine), for unit `n` on wo's side.
+    pub fn f(&self, n: DVec3, wo: DVec3, wi: DVec3) -> DVec3 {
+        let (co, ci) = (n.dot(wo), n.dot(wi));
+        if co <= 0.0 || ci == 0.0 {
+            return DVec3::ZERO;
+        }
+        match *self {
+            RefMaterial::Glossy { kd, ks, alpha } => {
+                if ci < 0.0 {
+                    return DVec3::ZERO;
+                }
+                let h = (wo + wi).normalize();
+                let spec = ggx_d(n.dot(h), alpha) * ggx_g1(co, alpha) * ggx_g1(ci, alpha)
+                    / (4.0 * co * ci);
+                kd / PI + schlick(ks, wi.dot(h)) * spec
+            }
+            RefMaterial::Conductor {
+                eta,
+                k,
+                reflectance,
+                alpha,
+            } => {
+                if ci < 0.0 {
+                    return DVec3::ZERO;
+                }
+                let h = (wo + wi).normalize();
+                let c = wo.dot(h);
+                let fr = reflectance.unwrap_or_else(|| {
+                    DVec3::new(
+                        fresnel(c, eta.x, k.x),
+                        fresnel(c, eta.y, k.y),
+                        fresnel(c, eta.z, k.z),
+                    )
+                });
+                fr * (ggx_d(n.dot(h), alpha) * ggx_g1(co, alpha) * ggx_g1(ci, alpha)
+                    / (4.0 * co * ci))
+            }
+            RefMaterial::Dielectric { eta, alpha } => {
+                if ci > 0.0 {
+                    let h = (wo + wi).normalize();
+                    let fr = fresnel(wo.dot(h), eta, 0.0);
+                    return DVec3::splat(
+                        fr * ggx_d(n.dot(h), alpha) * ggx_g1(co, alpha) * ggx_g1(ci, alpha)
+                            / (4.0 * co * ci),
+                    );
+                }
+                // Walter et al. 2007, eq. 21, with i = wi (index eta_i = eta) and o = wo
+                // (index eta_o = 1): h_t = -(eta_i i + eta_o o) / |.|, taken toward n.
+                let (eta_i, eta_o) = (eta, 1.0);
+                let mut h = -(eta_i * wi + eta_o * wo).normalize();
+                if h.dot(n) < 0.0 {
+                    h = -h;
+                }
+                let (ih, oh) = (wi.dot(h), wo.dot(h));
+                if !(oh > 0.0 && ih < 0.0) {
+                    return DVec3::ZERO;
+                }
+                // The Fresnel transmittance, from wo's side: from wi's it is the same in exact
+                // arithmetic, but ill-conditioned where wo grazes the microfacet (Snell's
+                // 1 - eta^2 sin^2 cancels), which f32 inputs then show.
+                let t = 1.0 - fresnel(oh, eta_i / eta_o, 0.0);
+                let g = ggx_g1(co, alpha) * ggx_g1(ci, alpha);
+                DVec3::splat(
+                    ih.abs() * oh.abs() / (ci.abs() * co.abs())
+                        * eta_o
+                        * eta_o
+                        * t
+                        * g
+                        * ggx_d(n.dot(h), alpha)
+                        / (eta_i * ih + eta_o * oh).powi(2),
+                )
+            }
+        }
+    }
+
+    /// The density of the kernel's sampler for `wi` given `wo`: visible normals (Heitz 2014,
+    /// D_wo(h) = G1(wo) max(0, wo . h) D(h) / cos_o), reflection's Jacobian 1 / (4 |wo . h|),
+    /// refraction's eta_i^2 |wi . h| / (eta_i wi . h + eta_o wo . h)^2, the dielectric's
+    /// choice by F, the mixture's by the kernel's lobe probability.
+    pub fn pdf(&self, n: DVec3, wo: DVec3, wi: DVec3) -> f64 {
+        let (co, ci) = (n.dot(wo), n.dot(wi));
+        if co <= 0.0 {
+            return 0.0;
+        }
+        let vndf = |h: DVec3, alpha: f64| {
+            ggx_g1(co, alpha) * wo.dot(h).max(0.0) * ggx_d(n.dot(h), alpha) / co
+        };
+        let reflected = |alpha: f64| {
+            let h = (wo + wi).normalize();
+            vndf(h, alpha) / (4.0 * wo.dot(h).abs())
+        };
+        match *self {
+            RefMaterial::Glossy { kd, ks, alpha } => {
+                if ci <= 0.0 {
+                    return 0.0;
+                }
+                let fs = schlick(ks, co).element_sum();
+                let p = fs / (fs + kd.element_sum());
+                (1.0 - p) * ci / PI + p * reflected(alpha)
+            }
+            RefMaterial::Conductor { alpha, .. } => {
+                if ci <= 0.0 {
+                    0.0
+                } else {
+                    reflected(alpha)
+                }
+            }
+            RefMaterial::Dielectric { eta, alpha } => {
+                if ci > 0.0 {
+                    let h = (wo + wi).normalize();
+                    return fresnel(wo.dot(h), eta, 0.0) * reflected(alpha);
+                }
+                if ci == 0.0 {
+                    return 0.0;
+                }
+                let mut h = -(eta * wi + wo).normalize();
+                if h.dot(n) < 0.0 {
+                    h = -h;
+                }
+                let (ih, oh) = (wi.dot(h), wo.dot(h));
+                if !(oh > 0.0 && ih < 0.0) {
+                    return 0.0;
+                }
+                let t = 1.0 - fresnel(oh, eta, 0.0);
+                t * vndf(h, alpha) * eta * eta * ih.abs() / (eta * ih + oh).powi(2)
+            }
+        }
+    }
+}
