@@ -41,6 +41,22 @@ def quad(p0, p1, p3, material):
             "bsdf": {"type": "ref", "id": material}}
 
 
+GOLD_ETA = (0.143036, 0.375307, 1.44205)
+GOLD_K = (3.983, 2.38556, 1.60336)
+
+
+def cornell_materials_dict(spp, seed, sampler="independent"):
+    """scenes/cornell_materials.toml: the Cornell scene with a rough gold left sphere (GGX alpha
+    0.2, Mitsuba's RGB eta and k of Au, as twinpath's named "gold") and a smooth glass right
+    sphere (index 1.5)."""
+    d = scene_dict(spp, seed, sampler)
+    d["sphere_left"]["bsdf"] = {"type": "roughconductor", "distribution": "ggx", "alpha": 0.2,
+                                "eta": {"type": "rgb", "value": GOLD_ETA},
+                                "k": {"type": "rgb", "value": GOLD_K}}
+    d["sphere_right"]["bsdf"] = {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}
+    return d
+
+
 def scene_dict(spp, seed, sampler="independent"):
     white, red, green, blue = (0.73, 0.73, 0.73), (0.65, 0.05, 0.05), (0.12, 0.45, 0.15), \
         (0.25, 0.35, 0.75)

@@ -89,6 +89,7 @@ pub fn white_cornell_toml() -> String {
 pub fn repo_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
+pub mod cubature;
 pub mod gpu;
 pub mod reference_bsdf;
 pub mod spirv;

@@ -9,6 +9,7 @@ use kernel::features::Dynamic;
 use kernel::rng::SampleRng;
 use rayon::prelude::*;
 use std::f64::consts::PI;
+use twinpath_tests::cubature::integrate;
 use twinpath_tests::reference_bsdf::{fresnel, schlick, RefMaterial};
 use twinpath_tests::{chi_square, z_critical, SplitMix};
 
@@ -88,52 +89,6 @@ fn bin(n: Vec3, w: Vec3) -> usize {
     let i = (((c + 1.0) / 2.0 * THETA_BINS as f64) as usize).min(THETA_BINS - 1);
     let j = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
     i * PHI_BINS + j
-}
-
-/// 3-point Gauss-Legendre nodes and weights on [-1, 1].
-const GL: [(f64, f64); 3] = [
-    (-0.774_596_669_241_483_4, 5.0 / 9.0),
-    (0.0, 8.0 / 9.0),
-    (0.774_596_669_241_483_4, 5.0 / 9.0),
-];
-
-/// The integral of `f(cos theta, phi)` over a rectangle of (cos theta, phi), dw = dcos dphi:
-/// product Gauss-Legendre, subdivided into quarters until they agree with the whole to
-/// `tol` (an adaptive cubature: the lobes of alpha 0.05 are far narrower than a bin).
-fn integrate(
-    f: &dyn Fn(f64, f64) -> f64,
-    c: (f64, f64),
-    p: (f64, f64),
-    tol: f64,
-    depth: u32,
-) -> f64 {
-    let rule = |c: (f64, f64), p: (f64, f64)| {
-        let (hc, hp) = ((c.1 - c.0) / 2.0, (p.1 - p.0) / 2.0);
-        let (mc, mp) = ((c.1 + c.0) / 2.0, (p.1 + p.0) / 2.0);
-        let mut s = 0.0;
-        for (x, wx) in GL {
-            for (y, wy) in GL {
-                s += wx * wy * f(mc + hc * x, mp + hp * y);
-            }
-        }
-        s * hc * hp
-    };
-    let whole = rule(c, p);
-    let (cm, pm) = ((c.0 + c.1) / 2.0, (p.0 + p.1) / 2.0);
-    let quarters = [
-        ((c.0, cm), (p.0, pm)),
-        ((cm, c.1), (p.0, pm)),
-        ((c.0, cm), (pm, p.1)),
-        ((cm, c.1), (pm, p.1)),
-    ];
-    let parts: f64 = quarters.iter().map(|&(c, p)| rule(c, p)).sum();
-    if depth == 0 || (parts - whole).abs() <= tol {
-        return parts;
-    }
-    quarters
-        .iter()
-        .map(|&(c, p)| integrate(f, c, p, tol / 2.0, depth - 1))
-        .sum()
 }
 
 /// Expected counts per bin of `samples` draws from the solid-angle density `pdf`, and the
