@@ -1,8 +1,12 @@
 //! Agreement with an independent renderer: `scenes/cornell.toml` against Mitsuba 3's converged
-//! render of the same scene (../shared/reference/cornell_spheres, 13312 spp). Both estimators
-//! are unbiased, so the images must agree within noise: a per-pixel z-test with our per-pixel
-//! variance plus the reference's (from its two independent halves).
+//! render of the same scene (../shared/reference/cornell_spheres, 13312 spp), and
+//! `scenes/cornell_materials.toml` (a rough gold and a glass sphere) against Mitsuba's
+//! `roughconductor` and `dielectric` (tests/reference/cornell_materials, 8192 spp, rendered by
+//! `scripts/mitsuba_reference.sh cornell_materials`). Both estimators are unbiased, so the
+//! images must agree within noise: a per-pixel z-test with our per-pixel variance plus the
+//! reference's (from its two independent halves).
 
+use statrs::distribution::{ContinuousCDF, StudentsT};
 use twinpath::cpu::CpuRenderer;
 use twinpath::film::{diff_images, Film, RgbImage};
 use twinpath::scene::Scene;
@@ -10,10 +14,27 @@ use twinpath_tests::stats::pixel_z_test;
 use twinpath_tests::{repo_root, with_independent_samples, z_critical};
 
 const SPP: u32 = 1024;
+const BATCHES: u32 = 16;
 
 #[test]
 fn cornell_agrees_with_mitsuba_reference() {
-    let reference_dir = repo_root().join("../shared/reference/cornell_spheres");
+    agrees_with_mitsuba(
+        "scenes/cornell.toml",
+        &repo_root().join("../shared/reference/cornell_spheres"),
+    );
+}
+
+#[test]
+fn cornell_with_gold_and_glass_agrees_with_mitsuba_reference() {
+    agrees_with_mitsuba(
+        "scenes/cornell_materials.toml",
+        &repo_root().join("tests/reference/cornell_materials"),
+    );
+}
+
+/// Renders `scene` (relative to the repository) at SPP and compares it with the Mitsuba
+/// reference in `reference_dir` (mitsuba_ref.exr and its halves).
+fn agrees_with_mitsuba(scene_file: &str, reference_dir: &std::path::Path) {
     let reference = RgbImage::read(&reference_dir.join("mitsuba_ref.exr")).unwrap();
     let half_a = RgbImage::read(&reference_dir.join("mitsuba_ref_half_a.exr")).unwrap();
     let half_b = RgbImage::read(&reference_dir.join("mitsuba_ref_half_b.exr")).unwrap();
@@ -25,36 +46,80 @@ fn cornell_agrees_with_mitsuba_reference() {
         .map(|(a, b)| std::array::from_fn(|c| (a[c] - b[c]) * (a[c] - b[c]) / 4.0))
         .collect();
 
-    let scene =
-        with_independent_samples(Scene::load(&repo_root().join("scenes/cornell.toml")).unwrap());
+    let scene = with_independent_samples(Scene::load(&repo_root().join(scene_file)).unwrap());
     assert_eq!(
         (scene.camera.width, scene.camera.height),
         (reference.width, reference.height)
     );
+    // BATCHES independent renders of SPP / BATCHES samples (consecutive sample ranges of the
+    // independent sampler): their mean is the image, and the spread of their image means is the
+    // image mean's error (batch means). A render's own per-pixel variances understate the
+    // heavy tails of caustics (light through the glass sphere, found only by BSDF sampling):
+    // summed, they made a correct image's mean read z = +3.6.
     let cpu = CpuRenderer::new(&scene);
-    let mut film = Film::new(scene.camera.width, scene.camera.height);
-    cpu.render_into(&scene.params(0, SPP), 0, SPP, &mut film, None);
-    assert_eq!(film.discarded, 0, "non-finite samples");
-    let image = RgbImage::from_film(&film);
-    let var = film.variance_of_mean();
+    let per = SPP / BATCHES;
+    let films: Vec<Film> = (0..BATCHES)
+        .map(|k| {
+            let mut film = Film::new(scene.camera.width, scene.camera.height);
+            cpu.render_into(&scene.params(k * per, per), k * per, per, &mut film, None);
+            assert_eq!(film.discarded, 0, "non-finite samples");
+            film
+        })
+        .collect();
+    let b = BATCHES as f32;
+    let means: Vec<Vec<[f32; 3]>> = films.iter().map(Film::mean).collect();
+    let vars: Vec<Vec<[f32; 3]>> = films.iter().map(Film::variance_of_mean).collect();
+    let image = RgbImage {
+        width: scene.camera.width,
+        height: scene.camera.height,
+        pixels: (0..reference.pixels.len())
+            .map(|i| std::array::from_fn(|c| means.iter().map(|m| m[i][c]).sum::<f32>() / b))
+            .collect(),
+    };
+    let var: Vec<[f32; 3]> = (0..reference.pixels.len())
+        .map(|i| std::array::from_fn(|c| vars.iter().map(|v| v[i][c]).sum::<f32>() / (b * b)))
+        .collect();
 
     // Per channel |z| <= z at alpha = 1e-3 per pixel (3 channels): a correct renderer passes
     // about 99.9% of pixels; the issue asks for at least 99.5%.
     let z_max = z_critical(1e-3, 3);
     let t = pixel_z_test(&image, &var, &reference, Some(&reference_var), z_max);
     let d = diff_images(&image, &reference).unwrap();
-    // The mean over the whole image, z-tested with the summed variances.
+    // The image means: ours from the spread of the batches' (t with BATCHES - 1 degrees of
+    // freedom), the reference's from its halves pixel by pixel.
     let n = (3 * image.pixels.len()) as f64;
-    let total_var: f64 = var
+    let batch_means: Vec<f64> = means
         .iter()
-        .chain(&reference_var)
+        .map(|m| m.iter().flatten().map(|&x| x as f64).sum::<f64>() / n)
+        .collect();
+    let k = BATCHES as f64;
+    let ours = batch_means.iter().sum::<f64>() / k;
+    let ours_var = batch_means
+        .iter()
+        .map(|m| (m - ours) * (m - ours))
+        .sum::<f64>()
+        / (k - 1.0)
+        / k;
+    let reference_mean = reference
+        .pixels
+        .iter()
+        .flatten()
+        .map(|&x| x as f64)
+        .sum::<f64>()
+        / n;
+    let reference_mean_var = reference_var
+        .iter()
         .flatten()
         .map(|&v| v as f64)
-        .sum();
-    let z_mean = t.mean_signed_diff / (total_var.sqrt() / n);
+        .sum::<f64>()
+        / (n * n);
+    let z_mean = (ours - reference_mean) / (ours_var + reference_mean_var).sqrt();
+    let t_max = StudentsT::new(0.0, 1.0, k - 1.0)
+        .unwrap()
+        .inverse_cdf(1.0 - 1e-3 / 2.0);
     println!(
-        "cornell {SPP} spp vs Mitsuba: {:.3}% of pixels pass |z| <= {z_max:.2} (max |z| {:.2}); \
-         mean signed difference {:+.3e} (z = {z_mean:+.2}); relMSE {:.3e}, RMSE {:.3e}",
+        "{scene_file} {SPP} spp vs Mitsuba: {:.3}% of pixels pass |z| <= {z_max:.2} (max |z| {:.2}); \
+         mean signed difference {:+.3e} (t = {z_mean:+.2}, bound {t_max:.2}); relMSE {:.3e}, RMSE {:.3e}",
         100.0 * t.pass_fraction(),
         t.max_abs_z,
         t.mean_signed_diff,
@@ -66,8 +131,5 @@ fn cornell_agrees_with_mitsuba_reference() {
         "only {:.3}% of pixels pass",
         100.0 * t.pass_fraction()
     );
-    assert!(
-        z_mean.abs() < z_critical(1e-3, 1),
-        "image means differ: z = {z_mean:.2}"
-    );
+    assert!(z_mean.abs() < t_max, "image means differ: z = {z_mean:.2}");
 }
