@@ -292,10 +292,10 @@ fn sample_glossy<F: FeatureSet>(
     let p_glossy = glossy_lobe_probability(m, cos_o);
     let glossy = u_lobe < p_glossy;
     if smooth && glossy {
-        return reflection(
+        return mirror(
+            n,
             reflect(wo, n),
             schlick(Vec3::from(m.specular), cos_o) / p_glossy,
-            DELTA_PDF,
         );
     }
     let wi = if glossy {
@@ -319,7 +319,7 @@ fn sample_glossy<F: FeatureSet>(
 #[inline]
 fn sample_conductor(m: &Material, n: Vec3, wo: Vec3, cos_o: f32, u1: f32, u2: f32) -> BsdfSample {
     if m.alpha < DELTA_ALPHA {
-        return reflection(reflect(wo, n), conductor_fresnel(m, cos_o), DELTA_PDF);
+        return mirror(n, reflect(wo, n), conductor_fresnel(m, cos_o));
     }
     let h = sample_visible_normal(n, wo, m.alpha, u1, u2);
     let wi = reflect(wo, h);
@@ -360,7 +360,7 @@ fn sample_dielectric(
     if u_lobe < fresnel {
         let wi = reflect(wo, h);
         if smooth {
-            return reflection(wi, Vec3::ONE, DELTA_PDF);
+            return mirror(n, wi, Vec3::ONE);
         }
         let cos_i = n.dot(wi);
         if !(cos_i > 0.0) {
@@ -372,6 +372,10 @@ fn sample_dielectric(
     let wi = refract(wo, h, cos_oh, eta, cos_t);
     let eta2 = eta * eta;
     if smooth {
+        if !(n.dot(wi) < 0.0) {
+            // A grazing wo refracts to a grazing wi, which rounding may put on wo's side.
+            return BsdfSample::NONE;
+        }
         return BsdfSample {
             wi,
             weight: Vec3::splat(1.0 / eta2),
@@ -398,6 +402,17 @@ fn sample_dielectric(
         eta2,
         transmitted: true,
     }
+}
+
+/// A delta lobe's reflection `wi` (about `n` or a microfacet), unless rounding put it below
+/// the surface (a grazing `wo` has a grazing mirror image): then the path ends, as for the
+/// rough lobes' directions below the surface.
+#[inline]
+fn mirror(n: Vec3, wi: Vec3, weight: Vec3) -> BsdfSample {
+    if !(n.dot(wi) > 0.0) {
+        return BsdfSample::NONE;
+    }
+    reflection(wi, weight, DELTA_PDF)
 }
 
 /// A reflected sample.

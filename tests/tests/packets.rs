@@ -44,6 +44,11 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("cornell, adaptive 0.05", adaptive),
         ("many_lights", small("many_lights.toml")),
         ("many_lights with a background", sky),
+        ("materials (every material kind)", small("materials.toml")),
+        (
+            "cornell with gold and glass",
+            small("cornell_materials.toml"),
+        ),
     ]
 }
 
@@ -223,7 +228,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 1 => f32::NAN,
                 _ => unit(lane, 17),
             };
-            let lambertian = h(lane, 21) % 3 != 0;
+            let lambertian = h(lane, 21) % 2 != 0;
             let query = VertexQuery {
                 depth: 1 + h(lane, 6) % 40,
                 x,
@@ -238,7 +243,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 roulette: h(lane, 20) % 3 != 0,
                 survival,
                 lambertian,
-                chooses_lobe: !lambertian && h(lane, 22) % 2 == 0,
+                chooses_lobe: !lambertian && h(lane, 22) % 4 != 0,
             };
             Some((rng, query))
         });

@@ -98,6 +98,39 @@ fn point(lo: f32, hi: f32) -> impl Strategy<Value = Vec3> {
     (scalar(lo, hi), scalar(lo, hi), scalar(lo, hi)).prop_map(|(x, y, z)| Vec3::new(x, y, z))
 }
 
+/// GGX roughness: exactly 0, at and around the delta threshold, 10^U(-3, 0), exactly 1.
+fn roughness() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        1 => Just(0.0f32),
+        1 => prop_oneof![Just(9.99e-4f32), Just(1e-3), Just(1.001e-3)],
+        6 => (-3.0f32..0.0).prop_map(|e| 10f32.powf(e)),
+        1 => Just(1.0f32),
+    ]
+}
+
+/// A dielectric's relative index: 1.5 and 1/1.5, within 10^U(-7, -2) of 1 on either side, any
+/// in 0.1..10.
+fn relative_index() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        2 => prop_oneof![Just(1.5f32), Just(1.0 / 1.5)],
+        2 => (-7.0f32..-2.0, any::<bool>()).prop_map(|(e, up)| if up { 1.0 + 10f32.powf(e) } else { 1.0 - 10f32.powf(e) }),
+        1 => 0.1f32..10.0,
+    ]
+}
+
+/// A unit normal and a direction on its side: anywhere, or grazing it within 10^U(-7, -1).
+fn normal_and_outgoing() -> impl Strategy<Value = (Vec3, Vec3)> {
+    (unit(), unit(), -7.0f32..-1.0, any::<bool>()).prop_map(|(n, d, e, graze)| {
+        let wo = if graze {
+            let t = (d - n * d.dot(n)).normalize_or(kernel::frame::orthonormal_basis(n).0);
+            (t + n * 10f32.powf(e)).normalize()
+        } else {
+            d
+        };
+        (n, if wo.dot(n) < 0.0 { -wo } else { wo })
+    })
+}
+
 fn is_unit(v: Vec3) -> bool {
     (v.length() - 1.0).abs() <= UNIT_TOL
 }
@@ -131,6 +164,36 @@ proptest! {
         prop_assert!(f.is_finite() && f.min_element() >= 0.0 && f.max_element() <= albedo * std::f32::consts::FRAC_1_PI * (1.0 + UNIT_TOL));
         let p = pdf_brdf(n, wi);
         prop_assert!(p.is_finite() && p >= 0.0);
+    }
+
+    #[test]
+    fn bsdfs_are_finite_and_non_negative(
+        (n, wo) in normal_and_outgoing(),
+        wi in unit(),
+        kind in 1u32..4,
+        complex in 0u32..2,
+        alpha in roughness(),
+        eta in relative_index(),
+        u in (0.0f32..1.0, 0.0f32..1.0, 0.0f32..1.0),
+    ) {
+        let m = kernel::probe::probe_material(kind, complex, alpha, eta);
+        let (f, pdf) = kernel::bsdf::eval(kernel::features::Dynamic(0), &m, n, wo, wi, eta);
+        prop_assert!(f.is_finite() && f.min_element() >= 0.0, "eval {f} for {m:?}");
+        prop_assert!(pdf.is_finite() && pdf >= 0.0, "pdf {pdf} for {m:?}");
+        let s = kernel::bsdf::sample(kernel::features::Dynamic(0), &m, n, wo, eta, u.0, u.1, u.2);
+        prop_assert!(s.weight.is_finite() && s.weight.min_element() >= 0.0, "weight {} for {m:?}", s.weight);
+        prop_assert!(s.eta2.is_finite() && s.eta2 > 0.0);
+        if s.weight.max_element() > 0.0 {
+            prop_assert!(is_unit(s.wi) || (s.wi.length() - 1.0).abs() < 1e-5, "wi {} ({})", s.wi, s.wi.length());
+            // Delta lobes only where the roughness says so; else a finite positive density.
+            if s.pdf == kernel::bsdf::DELTA_PDF {
+                prop_assert!(alpha < kernel::bsdf::DELTA_ALPHA, "delta at alpha {alpha}");
+            } else {
+                prop_assert!(s.pdf.is_finite() && s.pdf > 0.0, "pdf {} for {m:?}", s.pdf);
+            }
+            // The direction is on the side the sample says.
+            prop_assert!((s.wi.dot(n) < 0.0) == s.transmitted || s.wi.dot(n) == 0.0);
+        }
     }
 
     #[test]

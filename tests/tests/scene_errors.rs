@@ -365,19 +365,19 @@ fn not_utf8_scene_file() {
 
 #[test]
 fn render_keywords_name_their_choices() {
-    for (key, a, b) in [
-        ("roulette", "constant", "throughput"),
-        ("mis", "power", "half"),
-        ("light_sampling", "cone", "area"),
-        ("light_selection", "power", "uniform"),
-        ("sampler", "independent", "sobol"),
+    for (key, choices) in [
+        ("roulette", "\"constant\" or \"throughput\""),
+        ("mis", "\"power\", \"half\", \"light\" or \"bsdf\""),
+        ("light_sampling", "\"cone\" or \"area\""),
+        ("light_selection", "\"power\" or \"uniform\""),
+        ("sampler", "\"independent\" or \"sobol\""),
     ] {
         let text = format!("{GOOD}\n[render]\n{key} = \"bogus\"\n");
         assert_error(
             &text,
             &format!("{key} = "),
             &format!("render.{key}"),
-            &format!("'bogus' is not \"{a}\" or \"{b}\""),
+            &format!("'bogus' is not {choices}"),
         );
     }
     // Throughput roulette starts at depth 5 unless the scene says otherwise.
@@ -408,4 +408,203 @@ fn render_keywords_name_their_choices() {
     assert_eq!(parse("").render.sampler, Sampler::Sobol);
     let s = parse("sampler = \"independent\"\n");
     assert_eq!(s.render.sampler, Sampler::Independent);
+}
+
+/// The good scene with material `white` replaced by `white_def`.
+fn with_white(white_def: &str) -> String {
+    with(
+        "white = { kd = [0.5, 0.5, 0.5] }",
+        &format!("white = {white_def}"),
+    )
+}
+
+#[test]
+fn every_material_kind_parses() {
+    use kernel::scene::material_kind;
+    for (def, kind) in [
+        ("{ kd = [0.5, 0.5, 0.5] }", material_kind::DIFFUSE),
+        (
+            "{ kd = [0.5, 0.4, 0.3], ks = [0.5, 0.6, 0.7], alpha = 0.1 }",
+            material_kind::GLOSSY,
+        ),
+        ("{ ks = [0.9, 0.9, 0.9], alpha = 0 }", material_kind::GLOSSY),
+        (
+            "{ conductor = \"gold\", alpha = 0.2 }",
+            material_kind::CONDUCTOR,
+        ),
+        ("{ conductor = \"aluminium\" }", material_kind::CONDUCTOR),
+        (
+            "{ conductor = { eta = [0.2, 0.9, 1.1], k = [3.9, 2.4, 2.1] }, alpha = 1 }",
+            material_kind::CONDUCTOR,
+        ),
+        (
+            "{ conductor = { reflectance = [1, 1, 1] } }",
+            material_kind::CONDUCTOR,
+        ),
+        (
+            "{ dielectric = { ior = 1.5 }, alpha = 0.3 }",
+            material_kind::DIELECTRIC,
+        ),
+    ] {
+        // The sphere is white; the quad gets a diffuse material (a dielectric quad is an error).
+        let text = with_white(def).replace(
+            "edge2 = [0, 0, -2]\nmaterial = \"white\"",
+            "edge2 = [0, 0, -2]\nmaterial = \"floor\"",
+        ) + "";
+        let text = text.replace(
+            "[materials]\n",
+            "[materials]\nfloor = { kd = [0.5, 0.5, 0.5] }\n",
+        );
+        let s = parse_scene(&text, &scene_path()).unwrap_or_else(|e| panic!("{def}: {e}"));
+        let m = s.materials[s.material_names.iter().position(|n| n == "white").unwrap()];
+        assert_eq!(m.kind, kind, "{def}");
+    }
+}
+
+#[test]
+fn bad_materials_name_their_field() {
+    let line = "white = {";
+    for (def, field, message) in [
+        (
+            "{ kd = [0.6, 0.5, 0.5], ks = [0.5, 0.1, 0.1], alpha = 0.1 }",
+            "materials.white.ks",
+            "exceeds 1",
+        ),
+        (
+            "{ kd = [0.5, 0.5, 0.5], ks = [0.1, 0.1, 0.1] }",
+            "materials.white",
+            "no alpha",
+        ),
+        (
+            "{ kd = [0.5, 0.5, 0.5], alpha = 0.1 }",
+            "materials.white",
+            "no ks",
+        ),
+        (
+            "{ ks = [0.1, 0.1, 0.1], alpha = 1.5 }",
+            "materials.white.alpha",
+            "outside",
+        ),
+        (
+            "{ ks = [0.1, 0.1, 0.1], alpha = -0.1 }",
+            "materials.white.alpha",
+            "outside",
+        ),
+        (
+            "{ conductor = \"unobtainium\" }",
+            "materials.white.conductor",
+            "unknown metal",
+        ),
+        (
+            "{ conductor = { eta = [1, 1, 1] } }",
+            "materials.white.conductor",
+            "together",
+        ),
+        (
+            "{ conductor = { eta = [0, 1, 1], k = [1, 1, 1] } }",
+            "materials.white.conductor",
+            "> 0",
+        ),
+        (
+            "{ conductor = { reflectance = [1.2, 1, 1] } }",
+            "materials.white.conductor",
+            "above 1",
+        ),
+        (
+            "{ conductor = { reflectance = [1, 1] } }",
+            "materials.white.conductor",
+            "[r, g, b]",
+        ),
+        (
+            "{ conductor = { colour = [1, 1, 1] } }",
+            "materials.white.conductor",
+            "unknown field",
+        ),
+        (
+            "{ conductor = 3 }",
+            "materials.white.conductor",
+            "metal's name",
+        ),
+        (
+            "{ conductor = \"gold\", kd = [0.5, 0.5, 0.5] }",
+            "materials.white",
+            "kd belongs",
+        ),
+        (
+            "{ conductor = \"gold\", dielectric = { ior = 1.5 } }",
+            "materials.white",
+            "more than one",
+        ),
+        (
+            "{ dielectric = { ior = 0 } }",
+            "materials.white.dielectric.ior",
+            "outside",
+        ),
+        (
+            "{ dielectric = { ior = 1.5, abbe = 30 } }",
+            "syntax",
+            "unknown field",
+        ),
+        (
+            "{ kd = [0.5, 0.5, 0.5], emission = [1, 1, 1] }",
+            "materials.white",
+            "emission and reflection",
+        ),
+        ("{ }", "materials.white", "needs kd"),
+    ] {
+        assert_error(&with_white(def), line, field, message);
+    }
+}
+
+#[test]
+fn dielectric_needs_a_closed_outward_surface() {
+    // On a quad: rejected at the quad's material.
+    let glass = with_white("{ dielectric = { ior = 1.5 } }");
+    let e = error_of(&glass);
+    assert_eq!(e.field, "quad[0].material");
+    assert!(e.message.contains("closed surface"), "{e}");
+    // A tetrahedron: closed and outward is accepted; open, or wound inward, names the mesh.
+    let dir = temp_dir("dielectric");
+    let tetra = |faces: &str| format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n{faces}");
+    let outward = "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    let inward = "f 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n";
+    let open = "f 1 3 2\nf 1 2 4\nf 1 4 3\n";
+    let mismatched = "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 4 3\n";
+    for (name, faces) in [
+        ("out", outward),
+        ("in", inward),
+        ("open", open),
+        ("mixed", mismatched),
+    ] {
+        std::fs::write(dir.join(format!("{name}.obj")), tetra(faces)).unwrap();
+    }
+    let scene = |file: &str| {
+        GOOD.replace(
+            "white = { kd",
+            "glass = { dielectric = { ior = 1.5 } }\nwhite = { kd",
+        ) + &format!("\n[[mesh]]\nfile = \"{file}\"\nmaterial = \"glass\"\n")
+    };
+    let s = parse_scene(&scene("out.obj"), &dir.join("s.toml")).unwrap();
+    assert_eq!(s.triangles.len(), 2 + 4);
+    for (file, message) in [
+        ("in.obj", "signed volume"),
+        ("open.obj", "not a closed"),
+        ("mixed.obj", "not a closed"),
+    ] {
+        let e = parse_scene(&scene(file), &dir.join("s.toml")).unwrap_err();
+        println!("{e}");
+        assert_eq!(e.file, dir.join(file));
+        assert!(e.field.contains("mesh[0]"), "{e}");
+        assert!(e.message.contains(message), "{e}");
+    }
+    // The shipped icosphere is closed and outward: it can be glass.
+    let icosphere = GOOD.replace(
+        "white = { kd",
+        "glass = { dielectric = { ior = 1.5 } }\nwhite = { kd",
+    ) + "\n[[mesh]]\nfile = \"meshes/icosphere.obj\"\nmaterial = \"glass\"\n";
+    parse_scene(
+        &icosphere,
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/s.toml"),
+    )
+    .unwrap();
 }

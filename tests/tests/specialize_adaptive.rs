@@ -33,6 +33,16 @@ fn many_lights() -> Scene {
     small(Scene::load(&repo_root().join("scenes/many_lights.toml")).unwrap())
 }
 
+/// Every material kind.
+fn materials() -> Scene {
+    small(Scene::load(&repo_root().join("scenes/materials.toml")).unwrap())
+}
+
+/// Cornell with a rough gold and a glass sphere: conductor and dielectric bits, no Kd + Ks.
+fn cornell_materials() -> Scene {
+    small(Scene::load(&repo_root().join("scenes/cornell_materials.toml")).unwrap())
+}
+
 fn scenes() -> Vec<(&'static str, Scene)> {
     let mut half = cornell();
     half.render.mis = Mis::Half;
@@ -45,6 +55,8 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("cornell, half weights + area sampling", half),
         ("sky_meshes", sky_meshes()),
         ("many_lights", many_lights()),
+        ("materials", materials()),
+        ("cornell with gold and glass", cornell_materials()),
     ]
 }
 
@@ -64,6 +76,15 @@ fn scene_analysis_finds_the_features_present() {
     assert!(f & features::BACKGROUND != 0 && f & features::LIGHTS == 0);
     let f = many_lights().features();
     assert!(f & features::LIGHTS != 0 && f & features::SINGLE_LIGHT == 0);
+    // One bit per material kind present; Cornell (Lambertian only) has none.
+    assert_eq!(
+        materials().features() & features::MATERIALS,
+        features::MATERIALS
+    );
+    assert_eq!(
+        cornell_materials().features() & features::MATERIALS,
+        features::CONDUCTOR | features::DIELECTRIC
+    );
     let mut generic = cornell();
     generic.render.specialize = false;
     assert_eq!(generic.features(), 0);
