@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The device check of a borrowed GPU machine, from what scripts/gpu_machine_prepare.sh put into
 # .gpu/: is there a Vulkan ray-tracing device, how fast is a render against the CPU backend
-# (Cornell, meshes.toml, tori of 4k to 1M triangles), do the GPU tests pass. Writes
+# (Cornell, meshes.toml, materials.toml, tori of 4k to 1M triangles), do the GPU tests pass. Writes
 # $OUT/log.txt. About 3 minutes on an H200.
 exec > >(tee "${OUT:-/tmp}/log.txt") 2>&1
 set -x
@@ -24,11 +24,12 @@ if timeout 60 $B/twinpath info | grep -q "gpu backend: unavailable"; then echo "
 echo "== speed"
 python3 scripts/torus_scenes.py /tmp/gs 4000 16000 65000 262000 1000000
 sp() { echo "-- $1"; for b in gpu gpu cpu; do n=${GPU_SPP:-4096}; [ $b = cpu ] && n=${CPU_SPP:-256}; timeout 25 $B/twinpath render $1 --backend $b --spp $n -o /tmp/x.exr 2>&1 | grep -E "backend|rror"; done; }
-sp scenes/cornell.toml; sp scenes/meshes.toml
+sp scenes/cornell.toml; sp scenes/meshes.toml; sp scenes/materials.toml
 timeout 30 $B/twinpath render scenes/cornell.toml --backend gpu --spp 1024 -o ${OUT:-/tmp}/cornell_gpu.png 2>&1 | grep -E "backend|rror"
 timeout 30 $B/twinpath render scenes/cornell.toml --backend gpu --spp 1024 --validation -o /tmp/v.exr 2>&1 | tail -5
 echo "== tests"
 for t in spirv_module gpu_functions gpu_render; do echo "-- $t"; timeout ${TT:-120} $B/$t --test-threads=1 2>&1 | grep -vE "^test .* ok$|^$"; done
+echo "-- closed_form_materials"; timeout 120 $B/closed_form_materials --test-threads=1 2>&1 | grep -vE "^test .* ok$|^$"
 for t in scene_scale specialize_adaptive hard_lighting light_selection sobol; do echo "-- $t gpu"; timeout 60 $B/$t gpu both_backends --test-threads=1 2>&1 | grep -vE "^test .* ok$|^$"; done
 echo "-- furnace gpu, 10^8 samples"; TWINPATH_FURNACE_GPU_SPP=24576 timeout 90 $B/furnace gpu --nocapture 2>&1 | tail -15
 echo "== mesh scaling"
