@@ -14,7 +14,9 @@
 use crate::brdf::sample_brdf;
 use crate::features::FeatureSet;
 use crate::fresnel::{conductor_rgb, dielectric, dielectric_transmittance, refract, schlick};
-use crate::microfacet::{ggx_d, ggx_g1, normal_angle, pdf_reflected, sample_visible_normal};
+use crate::microfacet::{
+    ggx_d, ggx_g1, normal_angle, pdf_reflected, reflection, sample_visible_normal,
+};
 use crate::scene::{material_kind, Material};
 use core::f32::consts::PI;
 use spirv_std::glam::Vec3;
@@ -150,13 +152,9 @@ fn eval_glossy(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32
     let mut f = Vec3::from(m.albedo) * c;
     let mut pdf = (1.0 - p_glossy) * c;
     if !(m.alpha < DELTA_ALPHA) {
-        let h = (wo + wi).normalize();
-        let angle = normal_angle(n, h);
-        let d = ggx_d(angle.0, angle.1, m.alpha);
-        let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_i, m.alpha);
-        let fresnel = schlick(Vec3::from(m.specular), wi.dot(h));
-        f += fresnel * (d * g / (4.0 * cos_o));
-        pdf += p_glossy * pdf_reflected(cos_o, angle, m.alpha);
+        let r = reflection(n, wo, wi, cos_o, cos_i, m.alpha);
+        f += schlick(Vec3::from(m.specular), wi.dot(r.h)) * r.value;
+        pdf += p_glossy * r.pdf;
     }
     (f, pdf)
 }
@@ -174,12 +172,8 @@ fn eval_conductor(
     if !(cos_i > 0.0) {
         return (Vec3::ZERO, 0.0);
     }
-    let h = (wo + wi).normalize();
-    let angle = normal_angle(n, h);
-    let d = ggx_d(angle.0, angle.1, m.alpha);
-    let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_i, m.alpha);
-    let f = conductor_fresnel(m, wo.dot(h)) * (d * g / (4.0 * cos_o));
-    (f, pdf_reflected(cos_o, angle, m.alpha))
+    let r = reflection(n, wo, wi, cos_o, cos_i, m.alpha);
+    (conductor_fresnel(m, wo.dot(r.h)) * r.value, r.pdf)
 }
 
 /// [`eval`] of a rough dielectric: Walter et al. 2007, eqs. 20-21 (radiance transport).
@@ -194,22 +188,20 @@ fn eval_dielectric(
     eta: f32,
 ) -> (Vec3, f32) {
     if cos_i > 0.0 {
-        let h = (wo + wi).normalize();
-        let angle = normal_angle(n, h);
-        let (fresnel, _) = dielectric(wo.dot(h), eta);
-        let d = ggx_d(angle.0, angle.1, m.alpha);
-        let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_i, m.alpha);
-        let f = fresnel * d * g / (4.0 * cos_o);
-        return (
-            Vec3::splat(f),
-            fresnel * pdf_reflected(cos_o, angle, m.alpha),
-        );
+        let r = reflection(n, wo, wi, cos_o, cos_i, m.alpha);
+        let (fresnel, _) = dielectric(wo.dot(r.h), eta);
+        return (Vec3::splat(fresnel * r.value), fresnel * r.pdf);
     }
     if !(cos_i < 0.0) {
         return (Vec3::ZERO, 0.0);
     }
     // The generalised half vector of a refraction (Walter et al. 2007, eq. 16), on n's side.
-    let mut h = (wo + eta * wi).normalize();
+    let sum = wo + eta * wi;
+    if !(sum.dot(sum) > 0.0) {
+        // wi = -wo through an index-matched interface (eta 1): no half vector, measure zero.
+        return (Vec3::ZERO, 0.0);
+    }
+    let mut h = sum.normalize();
     if n.dot(h) < 0.0 {
         h = -h;
     }
@@ -225,13 +217,12 @@ fn eval_dielectric(
     let d = ggx_d(cos_h, sin2_h, m.alpha);
     let g1o = ggx_g1(cos_o, m.alpha);
     let g = g1o * ggx_g1(cos_i, m.alpha);
-    let denom = eta * cos_ih + cos_oh;
-    let denom2 = denom * denom;
+    let denom2 = refraction_denominator(eta, cos_ih, cos_oh);
     // f |cos_i| = D (1 - F) G |wi.h| |wo.h| / ((eta wi.h + wo.h)^2 |cos_o|), radiance mode.
-    let f = d * transmitted * g * (-cos_ih) * cos_oh / (denom2 * cos_o);
+    let f = (d * transmitted * g * (-cos_ih) * cos_oh / (denom2 * cos_o)).min(f32::MAX);
     // (1 - F) D_wo(h) |dh/dwi|, |dh/dwi| = eta^2 |wi.h| / (eta wi.h + wo.h)^2.
     let pdf = transmitted * g1o * cos_oh * d / cos_o * (eta * eta * (-cos_ih) / denom2);
-    (Vec3::splat(f), pdf)
+    (Vec3::splat(f), pdf.min(f32::MAX))
 }
 
 /// Draws `wi` for `wo` from the material's lobes: `u_lobe` chooses a lobe (where
@@ -306,13 +297,13 @@ fn sample_glossy<F: FeatureSet>(
     if smooth {
         // The diffuse lobe beside a delta one: (Kd/pi cos) / ((1 - p) cos/pi), exactly.
         let weight = Vec3::from(m.albedo) / (1.0 - p_glossy);
-        return reflection(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
+        return reflected(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
     }
     let (f, pdf) = eval(features, m, n, wo, wi, 1.0);
     if !(pdf > 0.0) {
         return BsdfSample::NONE;
     }
-    reflection(wi, f / pdf, pdf)
+    reflected(wi, f / pdf, pdf)
 }
 
 /// [`sample`] of a conductor.
@@ -328,7 +319,7 @@ fn sample_conductor(m: &Material, n: Vec3, wo: Vec3, cos_o: f32, u1: f32, u2: f3
         return BsdfSample::NONE;
     }
     let weight = conductor_fresnel(m, wo.dot(h)) * ggx_g1(cos_i, m.alpha);
-    reflection(
+    reflected(
         wi,
         weight,
         pdf_reflected(cos_o, normal_angle(n, h), m.alpha),
@@ -367,7 +358,7 @@ fn sample_dielectric(
             return BsdfSample::NONE;
         }
         let pdf = fresnel * pdf_reflected(cos_o, normal_angle(n, h), m.alpha);
-        return reflection(wi, Vec3::splat(ggx_g1(cos_i, m.alpha)), pdf);
+        return reflected(wi, Vec3::splat(ggx_g1(cos_i, m.alpha)), pdf);
     }
     let wi = refract(wo, h, cos_oh, eta, cos_t);
     let eta2 = eta * eta;
@@ -389,19 +380,30 @@ fn sample_dielectric(
         return BsdfSample::NONE;
     }
     let cos_ih = wi.dot(h);
-    let denom = eta * cos_ih + cos_oh;
+    let denom2 = refraction_denominator(eta, cos_ih, cos_oh);
     let (cos_h, sin2_h) = normal_angle(n, h);
     let d = ggx_d(cos_h, sin2_h, m.alpha);
     let transmitted = dielectric_transmittance(cos_oh, eta, cos_t);
-    let pdf = transmitted * ggx_g1(cos_o, m.alpha) * cos_oh * d / cos_o
-        * (eta2 * (-cos_ih) / (denom * denom));
+    let pdf =
+        transmitted * ggx_g1(cos_o, m.alpha) * cos_oh * d / cos_o * (eta2 * (-cos_ih) / denom2);
     BsdfSample {
         wi,
         weight: Vec3::splat(ggx_g1(cos_i, m.alpha) / eta2),
-        pdf,
+        pdf: pdf.min(f32::MAX),
         eta2,
         transmitted: true,
     }
+}
+
+/// (eta wi . h + wo . h)^2, the refraction's Jacobian denominator (Walter et al. 2007, eq. 17),
+/// kept off zero: it vanishes as eta -> 1, where every microfacet refracts wo to -wo and the
+/// rough lobe becomes a spike. Its density and value then stay finite (at most f32::MAX):
+/// unbounded in the limit, they are what MIS and next-event estimation weigh, while the
+/// sample's weight, G1(wi) / eta^2, needs neither.
+#[inline]
+fn refraction_denominator(eta: f32, cos_ih: f32, cos_oh: f32) -> f32 {
+    let d = eta * cos_ih + cos_oh;
+    (d * d).max(f32::MIN_POSITIVE)
 }
 
 /// A delta lobe's reflection `wi` (about `n` or a microfacet), unless rounding put it below
@@ -412,12 +414,12 @@ fn mirror(n: Vec3, wi: Vec3, weight: Vec3) -> BsdfSample {
     if !(n.dot(wi) > 0.0) {
         return BsdfSample::NONE;
     }
-    reflection(wi, weight, DELTA_PDF)
+    reflected(wi, weight, DELTA_PDF)
 }
 
 /// A reflected sample.
 #[inline]
-fn reflection(wi: Vec3, weight: Vec3, pdf: f32) -> BsdfSample {
+fn reflected(wi: Vec3, weight: Vec3, pdf: f32) -> BsdfSample {
     BsdfSample {
         wi,
         weight,

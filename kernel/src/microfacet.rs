@@ -79,3 +79,27 @@ pub fn sample_visible_normal(n: Vec3, wo: Vec3, alpha: f32, u1: f32, u2: f32) ->
 pub fn pdf_reflected(cos_o: f32, (cos_h, sin2_h): (f32, f32), alpha: f32) -> f32 {
     ggx_g1(cos_o, alpha) * ggx_d(cos_h, sin2_h, alpha) / (4.0 * cos_o)
 }
+
+/// A microfacet reflection from `wo` to `wi` (unit, both above `n`, cosines `cos_o`, `cos_i`):
+/// its half vector, D G / (4 cos_o) (the value times cos_i, without the Fresnel factor), and the
+/// density of `wi` from [`sample_visible_normal`] ([`pdf_reflected`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Reflection {
+    pub h: Vec3,
+    pub value: f32,
+    pub pdf: f32,
+}
+
+/// The [`Reflection`] from `wo` to `wi` with separable Smith G = G1(wo) G1(wi).
+#[inline]
+pub fn reflection(n: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32, alpha: f32) -> Reflection {
+    let h = (wo + wi).normalize();
+    let angle = normal_angle(n, h);
+    let d = ggx_d(angle.0, angle.1, alpha);
+    let g = ggx_g1(cos_o, alpha) * ggx_g1(cos_i, alpha);
+    Reflection {
+        h,
+        value: d * g / (4.0 * cos_o),
+        pdf: pdf_reflected(cos_o, angle, alpha),
+    }
+}

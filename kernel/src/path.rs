@@ -10,7 +10,7 @@ use crate::geometry::{
     offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error, triangle_point,
     triangle_point_error_conditioned, TriangleShape,
 };
-use crate::light::{eval_radiance, pdf_light_from};
+use crate::light::{eval_radiance, pdf_light_from, DirectionalLightSample};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{
@@ -476,28 +476,18 @@ impl PathState {
             if cos_x > 0.0 && cos_y > 0.0 && pdf_w > 0.0 {
                 let emitted = Vec3::from(lights[ls.light as usize].radiance);
                 let weight = light_strategy_weight(features, params, pdf_w, pdf_brdf(n, wi));
-                self.shadow = true;
-                self.shadow_from = ray_origin;
-                self.shadow_to = shadow_ray_end(
-                    ray_origin,
-                    y,
-                    ls.point.normal,
-                    light_point_error(lights, ls.light),
-                );
-                self.shadow_radiance =
+                let radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
+                self.await_shadow(lights, ray_origin, &ls, radiance);
             }
         }
 
         if !query.extend {
             return;
         }
-        // 4: Russian roulette on the extension (no number is drawn where survival is certain).
-        if query.draws_roulette() {
-            if !query.survives(samples.u_roulette) {
-                return;
-            }
-            self.throughput /= query.survival;
+        // 4: Russian roulette on the extension.
+        if !self.survives_roulette(query, samples) {
+            return;
         }
 
         // 3: extension by BRDF sampling. Every direction the sampler returns continues the
@@ -509,11 +499,7 @@ impl PathState {
         if self.throughput.max_element() <= 0.0 {
             return;
         }
-        self.extend = true;
-        self.ray_origin = ray_origin;
-        self.ray_dir = wi;
-        self.previous_vertex = x;
-        self.previous_pdf = pdf_b;
+        self.await_extension(ray_origin, wi, x, pdf_b);
     }
 
     /// [`PathState::vertex`] on any other material: the light sample weighed by the BSDF's
@@ -554,27 +540,17 @@ impl PathState {
                 let emitted = Vec3::from(lights[ls.light as usize].radiance);
                 let weight = light_strategy_weight(features, params, pdf_w, pdf_b);
                 let from = offset_ray_origin(x, side(n, n.dot(wi) > 0.0), hit.error);
-                self.shadow = true;
-                self.shadow_from = from;
-                self.shadow_to = shadow_ray_end(
-                    from,
-                    y,
-                    ls.point.normal,
-                    light_point_error(lights, ls.light),
-                );
-                self.shadow_radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
+                let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
+                self.await_shadow(lights, from, &ls, radiance);
             }
         }
 
         if !query.extend {
             return;
         }
-        // 4: Russian roulette, as on a Lambertian vertex.
-        if query.draws_roulette() {
-            if !query.survives(samples.u_roulette) {
-                return;
-            }
-            self.throughput /= query.survival;
+        // 4: Russian roulette on the extension.
+        if !self.survives_roulette(query, samples) {
+            return;
         }
 
         // 3: extension by BSDF sampling.
@@ -587,11 +563,54 @@ impl PathState {
         if !(self.throughput.max_element() > 0.0) {
             return;
         }
+        let origin = offset_ray_origin(x, side(n, !s.transmitted), hit.error);
+        self.await_extension(origin, s.wi, x, s.pdf);
+    }
+
+    /// Step 4 at the vertex of `query`: whether the path survives Russian roulette, dividing
+    /// its throughput by the survival probability if so (no number is drawn, and the path
+    /// always survives, where survival is certain).
+    #[inline]
+    fn survives_roulette(&mut self, query: &VertexQuery, samples: &VertexSamples) -> bool {
+        if query.draws_roulette() {
+            if !query.survives(samples.u_roulette) {
+                return false;
+            }
+            self.throughput /= query.survival;
+        }
+        true
+    }
+
+    /// The light sample `ls` waits for its shadow segment from `from` (offset off the surface)
+    /// to the light point; `radiance` is what it adds if the segment is clear.
+    #[inline]
+    fn await_shadow(
+        &mut self,
+        lights: &[SphereLight],
+        from: Vec3,
+        ls: &DirectionalLightSample,
+        radiance: Vec3,
+    ) {
+        self.shadow = true;
+        self.shadow_from = from;
+        self.shadow_to = shadow_ray_end(
+            from,
+            ls.point.position,
+            ls.point.normal,
+            light_point_error(lights, ls.light),
+        );
+        self.shadow_radiance = radiance;
+    }
+
+    /// The extension ray `origin + t dir` waits to be traced, leaving vertex `x`, drawn with
+    /// density `pdf` (`bsdf::DELTA_PDF` for a delta lobe).
+    #[inline]
+    fn await_extension(&mut self, origin: Vec3, dir: Vec3, x: Vec3, pdf: f32) {
         self.extend = true;
-        self.ray_origin = offset_ray_origin(x, side(n, !s.transmitted), hit.error);
-        self.ray_dir = s.wi;
+        self.ray_origin = origin;
+        self.ray_dir = dir;
         self.previous_vertex = x;
-        self.previous_pdf = s.pdf;
+        self.previous_pdf = pdf;
     }
 }
 
