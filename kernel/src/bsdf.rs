@@ -11,7 +11,7 @@
 //! (pbrt-v4's `TransportMode::Radiance`): refraction into a denser medium scales radiance by
 //! 1 / eta^2.
 
-use crate::brdf::sample_brdf;
+use crate::brdf::{eval_scattering, pdf_brdf, sample_brdf, sampled_brdf_weight};
 use crate::features::FeatureSet;
 use crate::fresnel::{conductor_rgb, dielectric, dielectric_transmittance, refract, schlick};
 use crate::microfacet::{
@@ -117,12 +117,10 @@ pub fn eval<F: FeatureSet>(
     let cos_o = n.dot(wo);
     let cos_i = n.dot(wi);
     if m.kind == material_kind::DIFFUSE {
-        return if cos_i > 0.0 {
-            let c = cos_i * (1.0 / PI);
-            (Vec3::from(m.albedo) * c, c)
-        } else {
-            (Vec3::ZERO, 0.0)
-        };
+        return (
+            eval_scattering(n, wi, Vec3::from(m.albedo)),
+            pdf_brdf(n, wi),
+        );
     }
     if !(cos_o > 0.0) {
         return (Vec3::ZERO, 0.0);
@@ -244,13 +242,11 @@ pub fn sample<F: FeatureSet>(
     let cos_o = n.dot(wo);
     if m.kind == material_kind::DIFFUSE {
         let wi = sample_brdf(n, u1, u2);
-        return BsdfSample {
+        return reflected(
             wi,
-            weight: Vec3::from(m.albedo),
-            pdf: n.dot(wi).max(0.0) * (1.0 / PI),
-            eta2: 1.0,
-            transmitted: false,
-        };
+            sampled_brdf_weight(Vec3::from(m.albedo)),
+            pdf_brdf(n, wi),
+        );
     }
     if !(cos_o > 0.0) {
         return BsdfSample::NONE;

@@ -393,7 +393,7 @@ impl PathState {
             !bsdf::is_delta(material)
         };
         let light_count = if !(features.lights(params) && reflects)
-            || (!features.mis_power(params) && params.mis_mode == mis::BSDF_ONLY)
+            || features.mis_mode(params) == mis::BSDF_ONLY
         {
             0
         } else if features.single_light(params) {
