@@ -65,11 +65,12 @@ choice! {
 }
 
 choice! {
-    /// How next-event estimation picks a point on a sphere light.
+    /// How next-event estimation picks a point on a light.
     LightSampling {
-        /// A direction uniform in the cone the sphere subtends.
-        Cone = "cone" => light_sampling::CONE,
-        /// The seed's uniform point on the whole sphere.
+        /// By the solid angle the light subtends: a direction uniform in a sphere's cone, or
+        /// in a triangle's spherical triangle where its solid angle allows.
+        SolidAngle = "solid_angle" => light_sampling::SOLID_ANGLE,
+        /// A uniform point on the light's surface (the seed's way for spheres).
         Area = "area" => light_sampling::AREA,
     }
 }
@@ -131,7 +132,7 @@ impl Default for RenderSettings {
             rr_start_depth: None,
             mis: Mis::Power,
             max_depth: u32::MAX,
-            light_sampling: LightSampling::Cone,
+            light_sampling: LightSampling::SolidAngle,
             light_selection: LightSelection::Power,
             sampler: Sampler::Sobol,
             specialize: true,
@@ -156,7 +157,7 @@ pub const SETTINGS: &[(&str, &str)] = &[
     ),
     ("mis", "power | half | light | bsdf"),
     ("max_depth", "guard on the path length, an integer >= 1"),
-    ("light_sampling", "cone | area"),
+    ("light_sampling", "solid_angle | area"),
     ("light_selection", "power | uniform"),
     ("sampler", "sobol | independent"),
     ("specialize", "on | off"),

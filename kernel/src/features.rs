@@ -7,7 +7,9 @@
 //! Both paths compute the same values: a feature bit may only be cleared when the run-time
 //! answer is the same (`scene_features` derives both from the same parameters).
 
-use crate::scene::{light_sampling, material_kind, mis, roulette, Material, RenderParams};
+use crate::scene::{
+    light_kind, light_sampling, material_kind, mis, roulette, Light, Material, RenderParams,
+};
 
 /// The bits are answers fixed before the render; without it, they are ignored.
 pub const SPECIALIZED: u32 = 1 << 0;
@@ -17,8 +19,8 @@ pub const LIGHTS: u32 = 1 << 1;
 pub const BACKGROUND: u32 = 1 << 2;
 /// MIS uses the power heuristic (else the seed's 1/2 weights).
 pub const MIS_POWER: u32 = 1 << 3;
-/// Sphere lights are sampled by their cone (else by area).
-pub const LIGHT_CONE: u32 = 1 << 4;
+/// Lights are sampled by the solid angle they subtend (else by area).
+pub const LIGHT_SOLID_ANGLE: u32 = 1 << 4;
 /// Russian roulette is driven by the throughput (else constant).
 pub const RR_THROUGHPUT: u32 = 1 << 5;
 /// The scene has exactly one light: no light choice.
@@ -31,6 +33,9 @@ pub const CONDUCTOR: u32 = 1 << 8;
 pub const DIELECTRIC: u32 = 1 << 9;
 /// Every material bit: a scene with none of them is Lambertian only and runs the diffuse path.
 pub const MATERIALS: u32 = GLOSSY | CONDUCTOR | DIELECTRIC;
+/// The light table may hold triangles (emissive quads and meshes): without it every light is
+/// a sphere.
+pub const TRIANGLE_LIGHTS: u32 = 1 << 10;
 
 /// The material bits of a scene with these materials: one per kind present besides the
 /// Lambertian. (A bit may also be set for a kind that is absent: it only keeps that kind's
@@ -49,6 +54,16 @@ pub fn material_features(materials: &[Material]) -> u32 {
     f
 }
 
+/// The light bits of a scene with these lights: [`TRIANGLE_LIGHTS`] if any is a triangle.
+#[inline]
+pub fn light_features(lights: &[Light]) -> u32 {
+    if lights.iter().any(|l| l.kind == light_kind::TRIANGLE) {
+        TRIANGLE_LIGHTS
+    } else {
+        0
+    }
+}
+
 /// The feature bits of a render with these parameters.
 #[inline]
 pub fn scene_features(params: &RenderParams) -> u32 {
@@ -65,8 +80,8 @@ pub fn scene_features(params: &RenderParams) -> u32 {
     if params.mis_mode == mis::POWER {
         f |= MIS_POWER;
     }
-    if params.light_sampling == light_sampling::CONE {
-        f |= LIGHT_CONE;
+    if params.light_sampling == light_sampling::SOLID_ANGLE {
+        f |= LIGHT_SOLID_ANGLE;
     }
     if params.rr_mode == roulette::THROUGHPUT {
         f |= RR_THROUGHPUT;
@@ -135,9 +150,17 @@ pub trait FeatureSet: Copy {
     fn dielectric(self) -> bool {
         self.answer(DIELECTRIC, true)
     }
+    /// Whether a light may be a triangle (see [`TRIANGLE_LIGHTS`]).
     #[inline]
-    fn light_cone(self, p: &RenderParams) -> bool {
-        self.answer(LIGHT_CONE, p.light_sampling == light_sampling::CONE)
+    fn triangle_lights(self) -> bool {
+        self.answer(TRIANGLE_LIGHTS, true)
+    }
+    #[inline]
+    fn light_solid_angle(self, p: &RenderParams) -> bool {
+        self.answer(
+            LIGHT_SOLID_ANGLE,
+            p.light_sampling == light_sampling::SOLID_ANGLE,
+        )
     }
     #[inline]
     fn rr_throughput(self, p: &RenderParams) -> bool {

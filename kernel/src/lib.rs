@@ -29,6 +29,7 @@ pub mod scene;
 #[cfg(target_arch = "spirv")]
 pub mod shaders;
 pub mod sobol;
+pub mod spherical_triangle;
 pub mod turns;
 pub mod vertex_samples;
 pub mod word;

@@ -1,10 +1,15 @@
-//! Spherical area lights: choosing one, a point on it, and the densities of those choices.
+//! Area lights (spheres and triangles): choosing one, a point on it, and the densities of
+//! those choices.
 
-use crate::geometry::area_to_solid_angle_pdf;
-use crate::sampling::{
-    pdf_sphere_area, pdf_sphere_cone, sample_sphere, sample_sphere_cone, ConeSample, SurfacePoint,
+use crate::geometry::{
+    area_to_solid_angle_pdf, sphere_point_error, triangle_normal, triangle_point,
 };
-use crate::scene::{light_sampling, SphereLight};
+use crate::sampling::{
+    pdf_sphere_area, pdf_sphere_cone, sample_sphere, sample_sphere_cone,
+    sample_triangle_barycentrics, ConeSample, SurfacePoint,
+};
+use crate::scene::{light_kind, light_sampling, Light};
+use crate::spherical_triangle::{self, barycentrics_along};
 use spirv_std::glam::Vec3;
 
 /// A point chosen on a light, and the density of having chosen it.
@@ -24,7 +29,7 @@ pub struct LightSample {
 /// (threshold_i + sum over slots j aliasing to i of (1 - threshold_j)) / n, which the host's
 /// construction makes equal to `select_pmf[i]`.
 #[inline]
-pub fn choose_light(lights: &[SphereLight], light_count: u32, u: f32) -> u32 {
+pub fn choose_light(lights: &[Light], light_count: u32, u: f32) -> u32 {
     if light_count == 1 {
         return 0;
     }
@@ -45,10 +50,11 @@ const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Seed: `SampleLight()`. Chooses a light by its selection probability (the host sets it
 /// uniform, 1 / number of lights, as the seed does) and a uniformly distributed point on its
-/// sphere (seed `SampleSphere`).
+/// sphere (seed `SampleSphere`). Sphere lights only (the seed's; the renderer samples with
+/// [`sample_light_from`]).
 #[inline]
 pub fn sample_light(
-    lights: &[SphereLight],
+    lights: &[Light],
     light_count: u32,
     u_select: f32,
     u1: f32,
@@ -56,7 +62,7 @@ pub fn sample_light(
 ) -> LightSample {
     let light = choose_light(lights, light_count, u_select);
     let l = lights[light as usize];
-    let point = sample_sphere(Vec3::from(l.center), l.radius, u1, u2);
+    let point = sample_sphere(Vec3::from(l.position), l.radius, u1, u2);
     LightSample {
         point,
         light,
@@ -67,18 +73,19 @@ pub fn sample_light(
 /// Seed: `PdfLight(L)`. Area density with which [`sample_light`] produces a given point of light
 /// `light`: select_pmf / (4 pi r^2), i.e. 1 / (number of lights * area) for uniform selection.
 #[inline]
-pub fn pdf_light(lights: &[SphereLight], light: u32) -> f32 {
+pub fn pdf_light(lights: &[Light], light: u32) -> f32 {
     let l = lights[light as usize];
     l.select_pmf * pdf_sphere_area(l.radius)
 }
 
 /// Seed: `EvalRadiance(L)`. Radiance a light sends back along a ray that met it: the constant
-/// emission on its outer surface, zero on the inside. `arrived_behind` is the hit record's
-/// side (`path::SurfaceHit::arrived_behind`), decided robustly where the record is made rather
-/// than from the sign of `normal . w_out`, which rounding flips at grazing hits.
+/// emission on its emitting side (a sphere's outside, a triangle's front), zero on the other,
+/// unless `two_sided`. `arrived_behind` is the hit record's side
+/// (`path::SurfaceHit::arrived_behind`), decided robustly where the record is made rather than
+/// from the sign of `normal . w_out`, which rounding flips at grazing hits.
 #[inline]
-pub fn eval_radiance(emission: Vec3, arrived_behind: bool) -> Vec3 {
-    if arrived_behind {
+pub fn eval_radiance(emission: Vec3, arrived_behind: bool, two_sided: bool) -> Vec3 {
+    if arrived_behind && !two_sided {
         Vec3::ZERO
     } else {
         emission
@@ -94,21 +101,33 @@ pub struct DirectionalLightSample {
     pub pdf_solid_angle: f32,
 }
 
-/// Whether `mode` samples light `l` by its cone from receiver `x` (x strictly outside).
+/// Whether light `l` is a triangle, where the light table may hold triangles (`triangles`:
+/// `features::TRIANGLE_LIGHTS`; without it every light is a sphere and this is false).
 #[inline]
-pub fn uses_cone(mode: u32, l: &SphereLight, x: Vec3) -> bool {
-    let d = Vec3::from(l.center) - x;
-    mode == light_sampling::CONE && d.dot(d) > l.radius * l.radius
+pub fn is_triangle(triangles: bool, l: &Light) -> bool {
+    triangles && l.kind == light_kind::TRIANGLE
 }
 
-/// Chooses a light and a point on it for receiver `x`: by the seed's uniform area sampling
-/// ([`sample_light`], density converted to solid angle), or by the cone the sphere subtends
-/// ([`sample_sphere_cone`]) when `mode` is [`light_sampling::CONE`] and `x` is outside it.
+/// Whether `mode` samples light `l` by its cone from receiver `x`: a sphere (the caller knows it
+/// is one) with `x` strictly outside.
 #[inline]
+pub fn uses_cone(mode: u32, l: &Light, x: Vec3) -> bool {
+    let d = Vec3::from(l.position) - x;
+    mode == light_sampling::SOLID_ANGLE && d.dot(d) > l.radius * l.radius
+}
+
+/// Chooses a light and a point on it for receiver `x`. A sphere: by the seed's uniform area
+/// sampling ([`sample_light`], density converted to solid angle), or by the cone the sphere
+/// subtends ([`sample_sphere_cone`]) when `mode` is [`light_sampling::SOLID_ANGLE`] and `x` is
+/// outside it. A triangle (only where `triangles`, see [`is_triangle`]): by
+/// [`sample_triangle_light`].
+#[inline]
+#[allow(clippy::too_many_arguments)]
 pub fn sample_light_from(
-    lights: &[SphereLight],
+    lights: &[Light],
     light_count: u32,
     mode: u32,
+    triangles: bool,
     x: Vec3,
     u_select: f32,
     u1: f32,
@@ -116,7 +135,10 @@ pub fn sample_light_from(
 ) -> DirectionalLightSample {
     let light = choose_light(lights, light_count, u_select);
     let l = lights[light as usize];
-    let center = Vec3::from(l.center);
+    if is_triangle(triangles, &l) {
+        return sample_triangle_light(&l, light, mode, x, u1, u2);
+    }
+    let center = Vec3::from(l.position);
     if uses_cone(mode, &l, x) {
         cone_light_sample(&l, light, sample_sphere_cone(center, l.radius, x, u1, u2))
     } else {
@@ -137,7 +159,7 @@ pub fn sample_light_from(
 /// The light sample of [`sample_light_from`] that samples light `l` (index `light`) by its cone:
 /// the cone's sample `s`, its density times the light's selection probability.
 #[inline]
-pub fn cone_light_sample(l: &SphereLight, light: u32, s: ConeSample) -> DirectionalLightSample {
+pub fn cone_light_sample(l: &Light, light: u32, s: ConeSample) -> DirectionalLightSample {
     DirectionalLightSample {
         point: s.point,
         light,
@@ -149,17 +171,115 @@ pub fn cone_light_sample(l: &SphereLight, light: u32, s: ConeSample) -> Directio
 /// `n_y`) of light `light` for receiver `x`: what MIS needs when BRDF sampling finds the light.
 #[inline]
 pub fn pdf_light_from(
-    lights: &[SphereLight],
+    lights: &[Light],
     mode: u32,
+    triangles: bool,
     light: u32,
     x: Vec3,
     y: Vec3,
     n_y: Vec3,
 ) -> f32 {
     let l = lights[light as usize];
-    if uses_cone(mode, &l, x) {
-        l.select_pmf * pdf_sphere_cone(Vec3::from(l.center), l.radius, x)
+    if is_triangle(triangles, &l) {
+        pdf_triangle_light(&l, mode, x, y, n_y)
+    } else if uses_cone(mode, &l, x) {
+        l.select_pmf * pdf_sphere_cone(Vec3::from(l.position), l.radius, x)
     } else {
         area_to_solid_angle_pdf(pdf_light(lights, light), x, y, n_y)
+    }
+}
+
+/// The solid angle triangle light `l` subtends at `x` where `mode` samples it so (then the
+/// density of a direction is select_pmf / that), else 0 (sampled by area): see
+/// `spherical_triangle::sampled_solid_angle`.
+#[inline]
+fn triangle_solid_angle_used(l: &Light, mode: u32, x: Vec3) -> f32 {
+    if mode != light_sampling::SOLID_ANGLE {
+        return 0.0;
+    }
+    spherical_triangle::sampled_solid_angle(
+        x,
+        Vec3::from(l.position),
+        Vec3::from(l.edge1),
+        Vec3::from(l.edge2),
+    )
+}
+
+/// The normal a triangle light's point shows receiver `x`: the geometric one
+/// (`geometry::triangle_normal`, as a hit's), turned toward `x` if the light is two-sided.
+#[inline]
+fn triangle_light_normal(l: &Light, point: Vec3, x: Vec3) -> Vec3 {
+    let n = triangle_normal(Vec3::from(l.edge1), Vec3::from(l.edge2));
+    if l.two_sided != 0 && n.dot(x - point) < 0.0 {
+        -n
+    } else {
+        n
+    }
+}
+
+/// A point on triangle light `l` (index `light`) for receiver `x`: uniform in the solid angle
+/// it subtends (`spherical_triangle::sample`, then the point that direction meets) where `mode`
+/// is [`light_sampling::SOLID_ANGLE`] and `spherical_triangle::sampled_solid_angle` allows,
+/// else uniform in area (density 1 / area,
+/// converted to solid angle). Either way the point is placed by barycentrics on the triangle
+/// (`geometry::triangle_point`, as hits are), so its error bound is `Light::point_error`.
+/// A one-sided light seen from behind gets a point whose normal faces away, which the caller
+/// skips as it skips a sphere's far side.
+#[inline]
+pub fn sample_triangle_light(
+    l: &Light,
+    light: u32,
+    mode: u32,
+    x: Vec3,
+    u1: f32,
+    u2: f32,
+) -> DirectionalLightSample {
+    let p0 = Vec3::from(l.position);
+    let (e1, e2) = (Vec3::from(l.edge1), Vec3::from(l.edge2));
+    let omega = triangle_solid_angle_used(l, mode, x);
+    if omega > 0.0 {
+        let s = spherical_triangle::sample(x, p0, e1, e2, u1, u2);
+        let (u, v) = barycentrics_along(x, s.direction, p0, e1, e2);
+        let position = triangle_point(p0, e1, e2, u, v);
+        DirectionalLightSample {
+            point: SurfacePoint {
+                position,
+                normal: triangle_light_normal(l, position, x),
+            },
+            light,
+            pdf_solid_angle: l.select_pmf / omega,
+        }
+    } else {
+        let (u, v) = sample_triangle_barycentrics(u1, u2);
+        let position = triangle_point(p0, e1, e2, u, v);
+        let normal = triangle_light_normal(l, position, x);
+        DirectionalLightSample {
+            point: SurfacePoint { position, normal },
+            light,
+            pdf_solid_angle: area_to_solid_angle_pdf(l.select_pmf / l.area, x, position, normal),
+        }
+    }
+}
+
+/// Solid-angle density with which [`sample_triangle_light`] produces point `y` (normal `n_y`)
+/// of triangle light `l` for receiver `x`.
+#[inline]
+pub fn pdf_triangle_light(l: &Light, mode: u32, x: Vec3, y: Vec3, n_y: Vec3) -> f32 {
+    let omega = triangle_solid_angle_used(l, mode, x);
+    if omega > 0.0 {
+        l.select_pmf / omega
+    } else {
+        area_to_solid_angle_pdf(l.select_pmf / l.area, x, y, n_y)
+    }
+}
+
+/// Rounding-error bound of a point sampled on light `l` (c + r n on a sphere, barycentrics on a
+/// triangle): what lifts the end of its shadow ray off the surface.
+#[inline]
+pub fn light_point_error(triangles: bool, l: &Light) -> f32 {
+    if is_triangle(triangles, l) {
+        l.point_error
+    } else {
+        sphere_point_error(Vec3::from(l.position), l.radius)
     }
 }

@@ -10,11 +10,11 @@ use crate::geometry::{
     offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error, triangle_point,
     triangle_point_error_conditioned, TriangleShape,
 };
-use crate::light::{eval_radiance, pdf_light_from, DirectionalLightSample};
+use crate::light::{eval_radiance, light_point_error, pdf_light_from, DirectionalLightSample};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{
-    light_sampling, material_kind, mis, Material, RenderParams, Sphere, SphereLight, Triangle, NONE,
+    light_sampling, material_kind, mis, Light, Material, RenderParams, Sphere, Triangle, NONE,
 };
 use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION};
 use spirv_std::glam::Vec3;
@@ -101,7 +101,7 @@ impl SurfaceHit {
             t,
             normal: shape.normal,
             material: tri.material,
-            light: NONE,
+            light: tri.light,
             error: triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition),
             arrived_behind: Self::behind_plane(shape.normal, dir),
         }
@@ -202,7 +202,7 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
     features: F,
     params: &RenderParams,
     materials: &[Material],
-    lights: &[SphereLight],
+    lights: &[Light],
     origin: Vec3,
     dir: Vec3,
     rng: &mut SampleRng,
@@ -290,7 +290,7 @@ impl PathState {
         features: F,
         params: &RenderParams,
         materials: &[Material],
-        lights: &[SphereLight],
+        lights: &[Light],
     ) -> Self {
         loop {
             let hit = if self.extend {
@@ -323,7 +323,7 @@ impl PathState {
         features: F,
         params: &RenderParams,
         materials: &[Material],
-        lights: &[SphereLight],
+        lights: &[Light],
         hit: &SurfaceHit,
         occluded: bool,
     ) -> bool {
@@ -346,7 +346,9 @@ impl PathState {
         }
         let material = materials[hit.material as usize];
         if hit.light != NONE {
-            let emitted = eval_radiance(Vec3::from(material.emission), hit.arrived_behind);
+            let two_sided = features.triangle_lights() && lights[hit.light as usize].two_sided != 0;
+            let emitted =
+                eval_radiance(Vec3::from(material.emission), hit.arrived_behind, two_sided);
             if self.depth == 0 {
                 // 1: a light seen directly (it reflects nothing, so the path ends).
                 self.radiance = emitted;
@@ -358,8 +360,15 @@ impl PathState {
                 let weight = if mode == mis::POWER {
                     let sampling = light_sampling_of(features, params);
                     let x = self.previous_vertex;
-                    let pdf_l =
-                        pdf_light_from(lights, sampling, hit.light, x, hit.position, hit.normal);
+                    let pdf_l = pdf_light_from(
+                        lights,
+                        sampling,
+                        features.triangle_lights(),
+                        hit.light,
+                        x,
+                        hit.position,
+                        hit.normal,
+                    );
                     power_heuristic(self.previous_pdf, pdf_l)
                 } else if features.materials() && self.previous_pdf == DELTA_PDF {
                     1.0
@@ -416,6 +425,7 @@ impl PathState {
             n: hit.facing_normal(),
             light_count,
             mode: light_sampling_of(features, params),
+            triangle_lights: features.triangle_lights(),
             extend: self.depth < params.max_depth,
             roulette: self.depth >= params.rr_start_depth,
             survival,
@@ -435,7 +445,7 @@ impl PathState {
         &mut self,
         features: F,
         params: &RenderParams,
-        lights: &[SphereLight],
+        lights: &[Light],
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
@@ -455,7 +465,7 @@ impl PathState {
         &mut self,
         features: F,
         params: &RenderParams,
-        lights: &[SphereLight],
+        lights: &[Light],
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
@@ -478,7 +488,7 @@ impl PathState {
                 let weight = light_strategy_weight(features, params, pdf_w, pdf_brdf(n, wi));
                 let radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
-                self.await_shadow(lights, ray_origin, &ls, radiance);
+                self.await_shadow(features, lights, ray_origin, &ls, radiance);
             }
         }
 
@@ -512,7 +522,7 @@ impl PathState {
         &mut self,
         features: F,
         params: &RenderParams,
-        lights: &[SphereLight],
+        lights: &[Light],
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
@@ -541,7 +551,7 @@ impl PathState {
                 let weight = light_strategy_weight(features, params, pdf_w, pdf_b);
                 let from = offset_ray_origin(x, side(n, n.dot(wi) > 0.0), hit.error);
                 let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
-                self.await_shadow(lights, from, &ls, radiance);
+                self.await_shadow(features, lights, from, &ls, radiance);
             }
         }
 
@@ -584,9 +594,10 @@ impl PathState {
     /// The light sample `ls` waits for its shadow segment from `from` (offset off the surface)
     /// to the light point; `radiance` is what it adds if the segment is clear.
     #[inline]
-    fn await_shadow(
+    fn await_shadow<F: FeatureSet>(
         &mut self,
-        lights: &[SphereLight],
+        features: F,
+        lights: &[Light],
         from: Vec3,
         ls: &DirectionalLightSample,
         radiance: Vec3,
@@ -597,7 +608,7 @@ impl PathState {
             from,
             ls.point.position,
             ls.point.normal,
-            light_point_error(lights, ls.light),
+            light_point_error(features.triangle_lights(), &lights[ls.light as usize]),
         );
         self.shadow_radiance = radiance;
     }
@@ -670,18 +681,11 @@ fn background(params: &RenderParams) -> Vec3 {
 /// How this render samples points on lights (`scene::light_sampling`).
 #[inline]
 pub fn light_sampling_of<F: FeatureSet>(features: F, params: &RenderParams) -> u32 {
-    if features.light_cone(params) {
-        light_sampling::CONE
+    if features.light_solid_angle(params) {
+        light_sampling::SOLID_ANGLE
     } else {
         light_sampling::AREA
     }
-}
-
-/// Rounding-error bound of a point sampled on light `light` (c + r n).
-#[inline]
-fn light_point_error(lights: &[SphereLight], light: u32) -> f32 {
-    let l = lights[light as usize];
-    sphere_point_error(Vec3::from(l.center), l.radius)
 }
 
 /// One sample of pixel (px, py) (column from the left, row from the top): a uniformly random
@@ -696,7 +700,7 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
     features: F,
     params: &RenderParams,
     materials: &[Material],
-    lights: &[SphereLight],
+    lights: &[Light],
     px: u32,
     py: u32,
     sample: u32,

@@ -13,11 +13,13 @@ use crate::geometry::{
     geometry_factor, intersect_sphere, intersect_triangle_uv, offset_ray_origin,
     reproject_to_sphere, shadow_ray_end, triangle_point, triangle_point_error,
 };
+use crate::light::sample_triangle_light;
 use crate::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal};
 use crate::rng::{pcg4d, u32_to_unit_f32};
 use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
-use crate::scene::{Camera, Material};
+use crate::scene::{light_kind, Camera, Light, Material};
 use crate::sobol::{sobol_pair, sobol_single};
+use crate::spherical_triangle;
 use spirv_std::glam::{UVec4, Vec3, Vec4};
 
 /// Which function a probe record evaluates (input layout -> output layout).
@@ -66,7 +68,12 @@ pub mod function {
     /// As [`BSDF_EVAL`] with (u_lobe, u1, u2) = in2.xyz -> bsdf::sample's out0 = (wi, pdf),
     /// out1 = (weight, eta2)
     pub const BSDF_SAMPLE: u32 = 14;
-    pub const COUNT: u32 = 15;
+    /// x = in0.xyz, mode = in0.w as u32 (`scene::light_sampling`), p0 = in1.xyz, u1 = in1.w,
+    /// e1 = in2.xyz, u2 = in2.w, e2 = in3.xyz, two-sided = in3.w as u32 ->
+    /// out0 = light::sample_triangle_light's (position, pdf) for [`probe_triangle_light`],
+    /// out1 = (its normal, spherical_triangle::solid_angle(x, vertices))
+    pub const TRIANGLE_LIGHT: u32 = 15;
+    pub const COUNT: u32 = 16;
 }
 
 #[inline]
@@ -107,6 +114,26 @@ pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material
         [0.9, 0.8, 0.7]
     };
     m
+}
+
+/// The light of the triangle-light probe: triangle p0, p0 + e1, p0 + e2 chosen with
+/// probability 1, its area in f32, radiance 1.
+#[inline]
+pub fn probe_triangle_light(p0: Vec3, e1: Vec3, e2: Vec3, two_sided: u32) -> Light {
+    Light {
+        position: p0.to_array(),
+        radius: 0.0,
+        edge1: e1.to_array(),
+        kind: light_kind::TRIANGLE,
+        edge2: e2.to_array(),
+        two_sided,
+        radiance: [1.0; 3],
+        select_pmf: 1.0,
+        alias_threshold: 1.0,
+        alias: 0,
+        area: 0.5 * e1.cross(e2).length(),
+        point_error: 0.0,
+    }
 }
 
 /// Evaluates `function` on one input record; see [`function`] for the layouts.
@@ -223,6 +250,16 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
             let s = bsdf::sample(Dynamic(0), &m, n, wo, i1.w, i2.x, i2.y, i2.z);
             (s.wi.extend(s.pdf), s.weight.extend(s.eta2))
         }
+    } else if function == function::TRIANGLE_LIGHT {
+        let (x, p0, e1, e2) = (i0.truncate(), i1.truncate(), i2.truncate(), i3.truncate());
+        let l = probe_triangle_light(p0, e1, e2, input[3].w);
+        let s = sample_triangle_light(&l, 0, input[0].w, x, i1.w, i2.w);
+        (
+            s.point.position.extend(s.pdf_solid_angle),
+            s.point
+                .normal
+                .extend(spherical_triangle::solid_angle(x, p0, e1, e2)),
+        )
     } else {
         (Vec4::ZERO, Vec4::ZERO)
     };

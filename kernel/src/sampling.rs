@@ -1,4 +1,4 @@
-//! Sampling routines: directions around an axis and points on spheres.
+//! Sampling routines: directions around an axis, points on spheres and triangles.
 
 use crate::frame::orthonormal_basis_v3;
 // `real::Real` by its path: imported, its f32 methods would clash with `Float`'s on the GPU.
@@ -203,4 +203,15 @@ pub struct ConeSampleV3<R> {
 pub fn pdf_sphere_cone(center: Vec3, radius: f32, p: Vec3) -> f32 {
     let d = center - p;
     1.0 / (2.0 * PI * cone_one_minus_cos(radius, d.dot(d)))
+}
+
+/// Barycentric coordinates (u, v) of a point uniformly distributed over a triangle's area
+/// (the point p0 + u edge1 + v edge2, density 1 / area): the sum s = u + v has density 2 s on
+/// [0, 1] (the triangle's cross-section at s grows as s), so s = sqrt(u1) by inversion, and
+/// given s the point is uniform on its segment, v = s u2 (Turk, "Generating Random Points in
+/// Triangles", Graphics Gems, 1990).
+#[inline]
+pub fn sample_triangle_barycentrics(u1: f32, u2: f32) -> (f32, f32) {
+    let s = u1.sqrt();
+    (s - s * u2, s * u2)
 }

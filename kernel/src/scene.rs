@@ -6,7 +6,7 @@
 /// Index meaning "none" in `u32` index fields (no light, no hit).
 pub const NONE: u32 = u32::MAX;
 
-/// A sphere, the only shape that can be a light. 32 bytes.
+/// A sphere. 32 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
@@ -28,9 +28,10 @@ pub struct Triangle {
     pub p0: [f32; 3],
     pub material: u32,
     pub edge1: [f32; 3],
-    pub _pad0: u32,
+    /// Index into the light table when the triangle emits, else [`NONE`].
+    pub light: u32,
     pub edge2: [f32; 3],
-    pub _pad1: u32,
+    pub _pad: u32,
 }
 
 /// The kinds of surface a [`Material`] describes (`Material::kind`); `crate::bsdf` derives each.
@@ -72,7 +73,9 @@ pub struct Material {
     pub complex: u32,
     /// CONDUCTOR with `complex`: the extinction coefficient k.
     pub k: [f32; 3],
-    pub _pad: f32,
+    /// A light on triangles: 1 if both faces emit, 0 for the front face alone (copied into
+    /// each of its triangles' `Light::two_sided`).
+    pub two_sided: u32,
 }
 
 impl Material {
@@ -88,7 +91,7 @@ impl Material {
             eta: [0.0; 3],
             complex: 0,
             k: [0.0; 3],
-            _pad: 0.0,
+            two_sided: 0,
         }
     }
 
@@ -100,23 +103,46 @@ impl Material {
     }
 }
 
-/// A spherical area light: the light table lists every emissive sphere. 48 bytes.
+/// The shapes a [`Light`] can have (`Light::kind`).
+pub mod light_kind {
+    /// An emissive sphere: emits from its outer surface.
+    pub const SPHERE: u32 = 0;
+    /// An emissive triangle (of a quad or a mesh): emits from its front face, the side
+    /// edge1 x edge2 points to, or from both faces when `Light::two_sided`.
+    pub const TRIANGLE: u32 = 1;
+}
+
+/// An area light: the light table lists every emissive sphere and every emissive triangle.
+/// 80 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
-pub struct SphereLight {
-    pub center: [f32; 3],
+pub struct Light {
+    /// SPHERE: the centre. TRIANGLE: the vertex p0.
+    pub position: [f32; 3],
+    /// SPHERE: the radius (0 for a triangle).
     pub radius: f32,
-    /// Emitted radiance, uniform over the outer surface and all outgoing directions.
+    /// TRIANGLE: p1 - p0 and p2 - p0, the triangle's own edges (`Triangle::edge1`, `edge2`).
+    pub edge1: [f32; 3],
+    /// One of [`light_kind`].
+    pub kind: u32,
+    pub edge2: [f32; 3],
+    /// TRIANGLE: 1 if both faces emit, 0 for the front face alone.
+    pub two_sided: u32,
+    /// Emitted radiance, uniform over the emitting surface and all outgoing directions.
     pub radiance: [f32; 3],
     /// Probability of choosing this light in next-event estimation.
     pub select_pmf: f32,
     /// Alias table (Walker; Vose's construction): slot i of n keeps light i with this
-    /// probability, else gives [`SphereLight::alias`]. See `light::choose_light`.
+    /// probability, else gives [`Light::alias`]. See `light::choose_light`.
     pub alias_threshold: f32,
     /// The light slot i gives when it does not keep light i.
     pub alias: u32,
-    pub _pad: [f32; 2],
+    /// TRIANGLE: the area |edge1 x edge2| / 2.
+    pub area: f32,
+    /// TRIANGLE: a bound on the rounding error of any point sampled on it
+    /// (`geometry::triangle_point_error` at u = v = 1, which bounds every point of it).
+    pub point_error: f32,
 }
 
 /// Pinhole camera: a ray through image-plane point (x, y) in [-1, 1]^2 (y up) has direction
@@ -153,13 +179,16 @@ pub mod mis {
     pub const BSDF_ONLY: u32 = 3;
 }
 
-/// How a point on a sphere light is chosen for next-event estimation.
+/// How a point on a light is chosen for next-event estimation.
 pub mod light_sampling {
-    /// The seed's uniform point on the whole sphere (half of them face away).
+    /// A uniform point on the light's surface: the seed's way for spheres (half of the points
+    /// face away), and uniform in area for triangles.
     pub const AREA: u32 = 0;
-    /// A direction uniform in the cone the sphere subtends (pbrt-v4 `Sphere::Sample`);
-    /// area sampling from inside the sphere.
-    pub const CONE: u32 = 1;
+    /// By the solid angle the light subtends: a direction uniform in the cone of a sphere
+    /// (pbrt-v4 `Sphere::Sample`; area sampling from inside it), uniform in the spherical
+    /// triangle of a triangle (Arvo 1995) where its solid angle is neither tiny nor nearly a
+    /// hemisphere (`spherical_triangle::USES_SOLID_ANGLE`; area sampling otherwise).
+    pub const SOLID_ANGLE: u32 = 1;
 }
 
 /// How next-event estimation picks one of several lights (the host fills the light table's

@@ -14,7 +14,7 @@ use crate::adaptive::{is_pilot_sample, luminance, pixel_converged};
 use crate::features::Dynamic;
 use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::path::{render_sample, SurfaceHit, Tracer};
-use crate::scene::{Material, RenderParams, Sphere, SphereLight, Triangle};
+use crate::scene::{Light, Material, RenderParams, Sphere, Triangle};
 use spirv_std::glam::{UVec2, UVec3, UVec4, Vec2, Vec3, Vec4};
 use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
@@ -131,7 +131,7 @@ pub fn raygen(
     ),
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] params: &RenderParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] materials: &[Material],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] lights: &[SphereLight],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] lights: &[Light],
     #[spirv(descriptor_set = 0, binding = 7)] accum_m2: &Image!(
         2D,
         format = rgba32f,

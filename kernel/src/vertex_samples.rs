@@ -13,7 +13,7 @@ use crate::brdf::sample_brdf;
 use crate::light::{sample_light_from, DirectionalLightSample};
 use crate::rng::SampleRng;
 use crate::sampling::SurfacePoint;
-use crate::scene::{SphereLight, NONE};
+use crate::scene::{Light, NONE};
 use spirv_std::glam::Vec3;
 
 /// Random dimensions per path vertex: light choice (1) and point (2), roulette (1), BRDF (2).
@@ -50,6 +50,8 @@ pub struct VertexQuery {
     pub light_count: u32,
     /// How a point on the chosen light is sampled (`scene::light_sampling`).
     pub mode: u32,
+    /// Whether a light may be a triangle (`features::TRIANGLE_LIGHTS`).
+    pub triangle_lights: bool,
     /// Whether the vertex may extend the path (its depth is below `max_depth`).
     pub extend: bool,
     /// The roulette's survival probability: a number is drawn only where `roulette` and not
@@ -141,7 +143,8 @@ pub struct VertexSamples {
     /// The lobe choice, where [`VertexQuery::lobe_dimension`] names one and the path survives
     /// roulette.
     pub u_lobe: f32,
-    /// `sample_light_from(lights, light_count, mode, x, u_select, u_light)`, if `has_light`.
+    /// `sample_light_from(lights, light_count, mode, triangle_lights, x, u_select, u_light)`,
+    /// if `has_light`.
     pub light: DirectionalLightSample,
     pub has_light: bool,
     /// `sample_brdf(n, u_brdf)`, if `has_brdf_dir`.
@@ -228,11 +231,7 @@ impl VertexSamples {
 
     /// The light sample for `query`: the one given, or computed now.
     #[inline]
-    pub fn light_sample(
-        &self,
-        query: &VertexQuery,
-        lights: &[SphereLight],
-    ) -> DirectionalLightSample {
+    pub fn light_sample(&self, query: &VertexQuery, lights: &[Light]) -> DirectionalLightSample {
         if self.has_light {
             return self.light;
         }
@@ -241,6 +240,7 @@ impl VertexSamples {
             lights,
             query.light_count,
             query.mode,
+            query.triangle_lights,
             query.x,
             self.u_select,
             u1,

@@ -163,8 +163,18 @@ pub fn transform_scene(scene: &Scene, scale: f32, translate: glam::Vec3) -> Scen
         sp.radius *= scale;
     }
     for l in &mut s.lights {
-        l.center = p(l.center);
+        l.position = p(l.position);
         l.radius *= scale;
+        l.edge1 = e(l.edge1);
+        l.edge2 = e(l.edge2);
+        l.area *= scale * scale;
+        l.point_error = kernel::geometry::triangle_point_error(
+            Vec3::from(l.position),
+            Vec3::from(l.edge1),
+            Vec3::from(l.edge2),
+            1.0,
+            1.0,
+        );
     }
     for t in &mut s.triangles {
         t.p0 = p(t.p0);

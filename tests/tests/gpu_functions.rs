@@ -240,6 +240,29 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                 x[3][1] = (g.u64() % 2) as u32;
                 x
             }
+            function::TRIANGLE_LIGHT => {
+                let size = g.scale();
+                let p0 = size * g.vec();
+                let (e1, e2) = (size * g.vec(), size * g.vec());
+                // Receivers near (large solid angles, up to a hemisphere), at a few sizes and
+                // far (area sampling's range), in the triangle's plane, and anywhere.
+                let centroid = p0 + (e1 + e2) / 3.0;
+                let x = match g.u64() % 4 {
+                    0 => centroid + size * g.range(1e-3, 0.1) * g.dir(),
+                    1 => centroid + size * g.range(0.5, 3.0) * g.dir(),
+                    2 => centroid + size * g.range(10.0, 1e3) * g.dir(),
+                    _ => p0 + g.range(-1.0, 2.0) * e1 + g.range(-1.0, 2.0) * e2,
+                };
+                let mode = g.pick(&[
+                    kernel::scene::light_sampling::AREA,
+                    kernel::scene::light_sampling::SOLID_ANGLE,
+                    kernel::scene::light_sampling::SOLID_ANGLE,
+                ]);
+                let mut r = rec([w(x, 0.0), w(p0, g.unit()), w(e1, g.unit()), w(e2, 0.0)]);
+                r[0][3] = mode;
+                r[3][3] = (g.u64() % 2) as u32;
+                r
+            }
             _ => unreachable!(),
         })
         .collect()
@@ -309,15 +332,38 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "microfacet (visible normal, D, G1, pdf)", func: function::MICROFACET, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "square roots and normalisations (FMA contraction): 64 ULP or 64 eps; alpha < 0.01: 1% relative" },
     Bound { name: "bsdf::eval", func: function::BSDF_EVAL, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "D, G1, Fresnel and the refraction Jacobian (FMA contraction): 64 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: 1% relative" },
     Bound { name: "bsdf::sample", func: function::BSDF_SAMPLE, max_ulps: 2048, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "the visible-normal sampler, Fresnel choice and pdf (FMA contraction); weights of grazing directions carry G1 ~ n . wi, whose rounding moves them relatively (measured 648 ULP): 2048 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: 1% relative" },
+    Bound { name: "sample_triangle_light / solid_angle", func: function::TRIANGLE_LIGHT, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "atan2_turns, normalisations and the ray/plane step (FMA contraction): 64 eps relative to the solid angle, density and geometry size, divided by h, the receiver's elevation above the light's plane (all are 0 / 0 in it); normals 64 eps" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
 
-/// The absolute error allowed for output component (k, j) of record `r` under bound `b`:
-/// unit vectors and pdfs take `b.abs`; positions on a sphere take `b.abs` times the size of
-/// the geometry (|centre| + radius), since a unit-vector error scales with it.
-fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize) -> f32 {
+/// The absolute error allowed for output component (k, j) of record `r` under bound `b`, whose
+/// larger magnitude on the two sides is `value`: unit vectors and pdfs take `b.abs`; positions on a sphere take `b.abs`
+/// times the size of the geometry (|centre| + radius), since a unit-vector error scales with it.
+fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> f32 {
     let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
     match b.func {
+        // Triangle lights: the solid angle (its triple product), the density (its cosine at
+        // the light, or the solid angle) and the point (where a direction meets the plane) are
+        // proportional to, or divided by, h, the sine of the receiver's elevation above the
+        // triangle's plane, which the rounding of x - p0 moves by a few eps: relative error
+        // b.abs / h (points relative to the size of the geometry, |x| + |p0| + |e1| + |e2|). In
+        // the plane (h within rounding) they are 0 / 0, and a two-sided light's normal may face
+        // either way.
+        function::TRIANGLE_LIGHT => {
+            let v = |i: usize| glam::Vec3::new(f(i, 0), f(i, 1), f(i, 2));
+            let to_x = v(0) - v(1);
+            let h = to_x.dot(v(2).cross(v(3)).normalize()).abs() / to_x.length();
+            if j == 3 {
+                b.abs * value / h
+            } else if k == 0 {
+                // Points, where the sampled direction meets the plane at the angle h.
+                b.abs * (v(0).length() + v(1).length() + v(2).length() + v(3).length()) / h
+            } else if h > b.abs {
+                b.abs
+            } else {
+                2.0
+            }
+        }
         // Triangle points (out1.xyz): relative to |p0| + |e1| + |e2|.
         function::INTERSECT_TRIANGLE if k == 1 && j < 3 => {
             let p0 = glam::Vec3::new(f(2, 0), f(2, 1), f(2, 2));
@@ -374,8 +420,8 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
                     if d.is_finite() {
                         max_abs = max_abs.max(d);
                     }
-                    let allowed = allowed_abs(b, r, k, j);
-                    if allowed > b.abs && d.is_finite() {
+                    let allowed = allowed_abs(b, r, k, j, x.abs().max(y.abs()));
+                    if allowed > b.abs && d.is_finite() && j < 3 {
                         max_rel_scale = max_rel_scale.max(d / (allowed / b.abs));
                     }
                     let loose = b

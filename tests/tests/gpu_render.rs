@@ -81,6 +81,14 @@ fn materials_same_image_on_cpu_and_gpu() {
     assert_backends_agree("scenes/materials.toml", 16, 1e-3);
 }
 
+/// Triangle lights (a ceiling panel, sampled as spherical triangles): their solid angles and
+/// samples differ between the backends by the bounds of `gpu_functions.rs`, so pixels are
+/// compared to 1e-3, as for materials.
+#[test]
+fn panel_light_same_image_on_cpu_and_gpu() {
+    assert_backends_agree("scenes/cornell_panel.toml", 16, 1e-3);
+}
+
 #[test]
 fn mesh_scene_same_image_on_cpu_and_gpu() {
     assert_backends_agree("scenes/meshes.toml", 16, 1e-4);

@@ -5,9 +5,11 @@
 
 use glam::Vec3;
 use kernel::light::choose_light;
-use kernel::scene::{light_selection, SphereLight};
+use kernel::scene::{light_selection, Light};
 use twinpath::render::Backend;
-use twinpath::scene::light_table::{alias_table, assign_light_selection, light_power};
+use twinpath::scene::light_table::{
+    alias_table, assign_light_selection, light_power, sphere_light,
+};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
     assert_film_matches_with_variance, chi_square, plane_exact, plane_under_lamps, render_film,
@@ -16,25 +18,17 @@ use twinpath_tests::{
 
 const DRAWS: usize = 1_000_000;
 
-fn light(radius: f32, radiance: f32) -> SphereLight {
-    SphereLight {
-        center: [0.0; 3],
-        radius,
-        radiance: [radiance; 3],
-        select_pmf: 0.0,
-        alias_threshold: 0.0,
-        alias: 0,
-        _pad: [0.0; 2],
-    }
+fn light(radius: f32, radiance: f32) -> Light {
+    sphere_light(Vec3::ZERO, radius, [radiance; 3])
 }
 
 /// A light table whose selection follows `weights` through the alias table.
-fn table(weights: &[f64]) -> Vec<SphereLight> {
+fn table(weights: &[f64]) -> Vec<Light> {
     let total: f64 = weights.iter().sum();
     weights
         .iter()
         .zip(alias_table(weights))
-        .map(|(w, (threshold, alias))| SphereLight {
+        .map(|(w, (threshold, alias))| Light {
             select_pmf: (w / total) as f32,
             alias_threshold: threshold,
             alias,
@@ -44,7 +38,7 @@ fn table(weights: &[f64]) -> Vec<SphereLight> {
 }
 
 /// Counts of `choose_light` over `DRAWS` uniform numbers.
-fn histogram(lights: &[SphereLight], seed: u64) -> Vec<f64> {
+fn histogram(lights: &[Light], seed: u64) -> Vec<f64> {
     let mut rng = SplitMix(seed);
     let mut counts = vec![0.0; lights.len()];
     for _ in 0..DRAWS {

@@ -49,6 +49,10 @@ fn scenes() -> Vec<(&'static str, Scene)> {
             "cornell with gold and glass",
             small("cornell_materials.toml"),
         ),
+        (
+            "cornell lit by a panel (triangle lights)",
+            small("cornell_panel.toml"),
+        ),
     ]
 }
 
@@ -166,7 +170,8 @@ fn numbers_computed_for_sixteen_streams_are_sample_rng_numbers() {
 /// (`cpu::packet_vertices`: numbers, cone light samples and BRDF directions on SIMD lanes; other
 /// light samples left to the vertex) are, bit for bit, what one vertex at a time uses
 /// (`VertexSamples::draw`, then the scalar samplers), for every sample the query asks for. Lanes mix: no light
-/// sample, one light and several (many_lights' alias table), cone and area sampling, receivers
+/// sample, one light and several (many_lights' alias table), triangle lights (cornell_panel's,
+/// which the packets leave to the vertex), cone and area sampling, receivers
 /// inside a light, vertices that may not extend, roulette with survival below 1, at 1 and
 /// NaN, an empty lane; both samplers.
 #[test]
@@ -180,16 +185,19 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
 
     let many = small("many_lights.toml").lights;
     let one = small("cornell.toml").lights;
-    assert!(many.len() > 1 && one.len() == 1);
+    let panel = small("cornell_panel.toml").lights;
+    assert!(many.len() > 1 && one.len() == 1 && panel.len() == 2);
     let bits = |v: Vec3| v.to_array().map(f32::to_bits);
     let mut checked = [0usize; 5];
     // Of those, the light samples and BRDF directions computed on lanes.
     let mut given = [0usize; 2];
     let mut lambertian_extensions = 0;
+    // Light samples of sphere lights (the lanes compute those from outside a sphere).
+    let mut sphere_samples = 0;
     for round in 0..256u32 {
         let h = |lane: usize, k: u32| pcg4d([round, lane as u32, k, 0x7e58])[0];
         let unit = |lane: usize, k: u32| u32_to_unit_f32(h(lane, k));
-        let lights = if round % 2 == 0 { &one } else { &many };
+        let lights = [&one, &many, &panel][round as usize % 3];
         let queries: [Option<(SampleRng, VertexQuery)>; LANES] = std::array::from_fn(|lane| {
             if lane == 3 {
                 return None;
@@ -201,7 +209,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
             };
             let rng = SampleRng::with_sampler(h(lane, 1), h(lane, 2), h(lane, 3) % 4096, kind);
             let l = &lights[(h(lane, 8) % lights.len() as u32) as usize];
-            let c = Vec3::from(l.center);
+            let c = Vec3::from(l.position);
             let x = if h(lane, 7) % 6 == 0 {
                 // Inside a light: no cone from there.
                 c + 0.5 * l.radius * Vec3::new(unit(lane, 9), -unit(lane, 10), 0.1)
@@ -237,8 +245,10 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 mode: if h(lane, 18) % 4 == 0 {
                     light_sampling::AREA
                 } else {
-                    light_sampling::CONE
+                    light_sampling::SOLID_ANGLE
                 },
+                // A table with triangles needs the bit; a table of spheres runs either way.
+                triangle_lights: round % 3 == 2 || h(lane, 23) % 2 == 0,
                 extend: h(lane, 19) % 5 != 0,
                 roulette: h(lane, 20) % 3 != 0,
                 survival,
@@ -277,6 +287,9 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 );
                 checked[0] += 1;
                 given[0] += got.has_light as usize;
+                if lights[w.light as usize].kind == kernel::scene::light_kind::SPHERE {
+                    sphere_samples += 1;
+                }
             }
             if q.draws_roulette() {
                 assert_eq!(got.u_roulette.to_bits(), want.u_roulette.to_bits());
@@ -311,7 +324,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
         "{checked:?}"
     );
     assert!(
-        given[0] > checked[0] / 2 && given[1] == lambertian_extensions,
+        given[0] > sphere_samples / 2 && given[1] == lambertian_extensions,
         "{given:?}"
     );
 }

@@ -19,11 +19,14 @@ use kernel::geometry::{
     intersect_triangle_uv, offset_ray_origin, shadow_ray_end, sphere_point_error, triangle_point,
     triangle_point_error,
 };
+use kernel::light::{pdf_triangle_light, sample_triangle_light};
+use kernel::probe::probe_triangle_light;
 use kernel::rng::{pcg4d, u32_to_unit_f32};
 use kernel::sampling::{
     cone_one_minus_cos, pdf_sphere_cone, power_heuristic, sample_lobe, sample_sphere,
     sample_sphere_cone,
 };
+use kernel::scene::light_sampling;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use std::hash::BuildHasher;
@@ -221,6 +224,39 @@ proptest! {
         // The sampled point faces the receiver (up to the point's rounding).
         let to_x = x - s.point.position;
         prop_assert!(s.point.normal.dot(to_x) >= -2.0 * sphere_point_error(c, r));
+    }
+
+    /// Triangle lights of any shape and size (edges along the same or nearly the same axis,
+    /// 1e-6 to 1e6 long), receivers near, far, in
+    /// the plane and on the triangle, both modes: a finite point on the triangle, a unit normal,
+    /// and a finite, non-negative pdf equal to what MIS computes for that point.
+    #[test]
+    fn triangle_light_samples_are_finite_and_on_the_light(p0 in point(-6.0, 6.0), d1 in unit(), s1 in -6.0f32..6.0, d2 in unit(), s2 in -6.0f32..6.0, d in unit(), k in -8.0f32..6.0, in_plane in any::<bool>(), solid_angle in any::<bool>(), two_sided in any::<bool>(), u1 in 0.0f32..1.0, u2 in 0.0f32..1.0) {
+        let (e1, e2) = (d1 * 10f32.powf(s1), d2 * 10f32.powf(s2));
+        let cross = e1.cross(e2);
+        // Only triangles with a normal f32 can normalise, |e1 x e2|^2 a normal float (a hit's
+        // normal is the same `triangle_normal`); parallel edges (often drawn) are skipped.
+        if !(cross.length_squared() >= f32::MIN_POSITIVE && cross.length().is_finite()) {
+            return Ok(());
+        }
+        let size = e1.length().max(e2.length());
+        let centroid = p0 + (e1 + e2) / 3.0;
+        let x = if in_plane {
+            p0 + u2 * e1 + u1 * e2 + (d - cross.normalize() * d.dot(cross.normalize())) * size * 10f32.powf(k)
+        } else {
+            centroid + d * size * 10f32.powf(k)
+        };
+        // Within the scene domain (coordinates up to 1e15).
+        prop_assume!(x.abs().max_element() <= 1e15 && (p0 + e1).abs().max_element() <= 1e15 && (p0 + e2).abs().max_element() <= 1e15);
+        let mode = if solid_angle { light_sampling::SOLID_ANGLE } else { light_sampling::AREA };
+        let l = probe_triangle_light(p0, e1, e2, two_sided as u32);
+        let s = sample_triangle_light(&l, 0, mode, x, u1, u2);
+        prop_assert!(s.point.position.is_finite() && is_unit(s.point.normal), "{:?}", s);
+        prop_assert!(s.pdf_solid_angle.is_finite() && s.pdf_solid_angle >= 0.0, "pdf {}", s.pdf_solid_angle);
+        prop_assert_eq!(s.pdf_solid_angle.to_bits(), pdf_triangle_light(&l, mode, x, s.point.position, s.point.normal).to_bits());
+        // On the triangle's plane to within the error bound of its points.
+        let err = triangle_point_error(p0, e1, e2, 1.0, 1.0);
+        prop_assert!((s.point.position - p0).dot(cross.normalize()).abs() <= 4.0 * err, "off the plane by {}", (s.point.position - p0).dot(cross.normalize()));
     }
 
     #[test]

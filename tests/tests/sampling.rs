@@ -9,9 +9,9 @@ use kernel::rng::SampleRng;
 use kernel::sampling::{
     pdf_sphere_area, pdf_sphere_cone, sample_lobe, sample_sphere, sample_sphere_cone,
 };
-use kernel::scene::{light_selection, SphereLight};
+use kernel::scene::light_selection;
 use std::f64::consts::PI;
-use twinpath::scene::light_table::assign_light_selection;
+use twinpath::scene::light_table::{assign_light_selection, sphere_light};
 use twinpath_tests::chi_square;
 
 /// Family-wise significance of all chi-square tests in this file (Sidak-style split below).
@@ -170,15 +170,7 @@ fn sample_sphere_is_uniform_in_area() {
 
 #[test]
 fn sample_light_selects_by_pmf_and_pdf_light_matches() {
-    let mk = |x: f32, radius: f32| SphereLight {
-        center: [x, 0.0, 0.0],
-        radius,
-        radiance: [1.0; 3],
-        select_pmf: 0.0,
-        alias_threshold: 0.0,
-        alias: 0,
-        _pad: [0.0; 2],
-    };
+    let mk = |x: f32, radius: f32| sphere_light(Vec3::new(x, 0.0, 0.0), radius, [1.0; 3]);
     let mut lights = vec![mk(0.0, 0.5), mk(3.0, 1.0), mk(-3.0, 0.25)];
     let n = lights.len();
     assign_light_selection(&mut lights, light_selection::UNIFORM);
@@ -188,7 +180,7 @@ fn sample_light_selects_by_pmf_and_pdf_light_matches() {
         let s = sample_light(&lights, n as u32, r.next_f32(), r.next_f32(), r.next_f32());
         observed[s.light as usize] += 1.0;
         let l = lights[s.light as usize];
-        assert!(((s.point.position - Vec3::from(l.center)).length() - l.radius).abs() < 1e-5);
+        assert!(((s.point.position - Vec3::from(l.position)).length() - l.radius).abs() < 1e-5);
         assert_eq!(s.pdf_area, pdf_light(&lights, s.light));
         let want = 1.0 / (n as f64 * 4.0 * PI * (l.radius as f64).powi(2));
         assert!((s.pdf_area as f64 / want - 1.0).abs() < 1e-6);
@@ -319,4 +311,64 @@ fn cos_sin_turns_matches_f64_on_every_sampler_value() {
         worst.0,
         worst.1
     );
+}
+
+/// `atan2_turns` against f64 over every octant and its reduction points: within the error its
+/// doc derives (2^-24 turn plus 2 ulp of the result), and small angles within a few ulp.
+#[test]
+fn atan2_turns_matches_f64() {
+    use kernel::turns::atan2_turns;
+    let mut r = rng(77);
+    let mut worst = (0.0f64, 0.0f32, 0.0f32);
+    let mut check = |y: f32, x: f32| {
+        let got = atan2_turns(y, x) as f64;
+        let want = (y as f64).atan2(x as f64) / (2.0 * PI);
+        let allowed = 1.0 / 16_777_216.0 + 2.0 * (f32::EPSILON as f64) * want.abs();
+        let err = (got - want).abs() / allowed;
+        if err > worst.0 {
+            worst = (err, y, x);
+        }
+    };
+    for _ in 0..2_000_000 {
+        let (a, b) = (r.next_f32(), r.next_f32());
+        let scale = 10f32.powf(12.0 * r.next_f32() - 6.0);
+        check(scale * a, scale * (2.0 * b - 1.0));
+    }
+    // The reduction's edges: tan(pi/8), the diagonal, the axes; and tiny angles.
+    for (y, x) in [
+        (0.414_213_57f32, 1.0f32),
+        (1.0, 1.0),
+        (1.0, 0.0),
+        (0.0, 1.0),
+        (0.0, -1.0),
+    ] {
+        let (mut y1, mut y2) = (y, y);
+        for _ in 0..64 {
+            check(y1, x);
+            check(y2, x);
+            check(y1, -x);
+            check(x.abs(), y1);
+            y1 = y1.next_up();
+            y2 = y2.next_down().max(0.0);
+        }
+    }
+    // Down to 1e-36 (below f32's normal range the result's own precision goes).
+    for k in 0..180 {
+        let y = 10f32.powf(-(k as f32) / 5.0);
+        check(y, 1.0);
+        check(y, -1.0);
+        let got = atan2_turns(y, 1.0) as f64;
+        let want = (y as f64).atan2(1.0) / (2.0 * PI);
+        assert!(
+            (got / want - 1.0).abs() < 4.0 * f32::EPSILON as f64,
+            "small angle {y}: relative error {:.1e}",
+            got / want - 1.0
+        );
+    }
+    assert_eq!(atan2_turns(0.0, 0.0), 0.0);
+    println!(
+        "atan2_turns: worst error {:.2} of its bound at (y, x) = ({}, {})",
+        worst.0, worst.1, worst.2
+    );
+    assert!(worst.0 <= 1.0, "atan2_turns beyond its bound at {worst:?}");
 }

@@ -200,17 +200,51 @@ fn zero_width() {
     );
 }
 
+/// An emissive quad is two triangle lights, one-sided unless its material says `two_sided`;
+/// `two_sided` belongs to emitters, and a sphere emits from its outside only.
 #[test]
-fn emissive_quad_is_rejected() {
+fn emissive_quads_and_two_sided_emitters() {
     let t = with(
         "edge2 = [0, 0, -2]\nmaterial = \"white\"",
         "edge2 = [0, 0, -2]\nmaterial = \"lamp\"",
     );
+    let s = parse_scene(&t, &scene_path()).unwrap();
+    assert_eq!(s.lights.len(), 2);
+    assert!(s
+        .lights
+        .iter()
+        .all(|l| l.kind == kernel::scene::light_kind::TRIANGLE
+            && l.two_sided == 0
+            && (l.area - 2.0).abs() < 1e-6));
+    assert_eq!(
+        s.triangles.iter().map(|t| t.light).collect::<Vec<_>>(),
+        vec![0, 1]
+    );
+    let two = t.replace(
+        "lamp = { emission = [4, 4, 4] }",
+        "lamp = { emission = [4, 4, 4], two_sided = true }",
+    );
+    let s = parse_scene(&two, &scene_path()).unwrap();
+    assert!(s.lights.iter().all(|l| l.two_sided == 1));
     assert_error(
-        &t,
+        &with(
+            "white = { kd = [0.5, 0.5, 0.5] }",
+            "white = { kd = [0.5, 0.5, 0.5], two_sided = true }",
+        ),
+        "two_sided",
+        "materials.white.two_sided",
+        "belongs to emitters",
+    );
+    let sphere_lamp = with(
+        "lamp = { emission = [4, 4, 4] }",
+        "lamp = { emission = [4, 4, 4], two_sided = true }",
+    )
+    .replacen("material = \"white\"", "material = \"lamp\"", 1);
+    assert_error(
+        &sphere_lamp,
         "\"lamp\"",
-        "quad[0].material",
-        "only spheres can be lights",
+        "sphere[0].material",
+        "outside only",
     );
 }
 
@@ -368,7 +402,7 @@ fn render_keywords_name_their_choices() {
     for (key, choices) in [
         ("roulette", "\"constant\" or \"throughput\""),
         ("mis", "\"power\", \"half\", \"light\" or \"bsdf\""),
-        ("light_sampling", "\"cone\" or \"area\""),
+        ("light_sampling", "\"solid_angle\" or \"area\""),
         ("light_selection", "\"power\" or \"uniform\""),
         ("sampler", "\"independent\" or \"sobol\""),
     ] {

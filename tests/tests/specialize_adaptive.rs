@@ -43,6 +43,11 @@ fn cornell_materials() -> Scene {
     small(Scene::load(&repo_root().join("scenes/cornell_materials.toml")).unwrap())
 }
 
+/// Cornell lit by a ceiling panel: triangle lights.
+fn cornell_panel() -> Scene {
+    small(Scene::load(&repo_root().join("scenes/cornell_panel.toml")).unwrap())
+}
+
 fn scenes() -> Vec<(&'static str, Scene)> {
     let mut half = cornell();
     half.render.mis = Mis::Half;
@@ -57,6 +62,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("many_lights", many_lights()),
         ("materials", materials()),
         ("cornell with gold and glass", cornell_materials()),
+        ("cornell lit by a panel (triangle lights)", cornell_panel()),
     ]
 }
 
@@ -69,7 +75,7 @@ fn scene_analysis_finds_the_features_present() {
             | features::LIGHTS
             | features::SINGLE_LIGHT
             | features::MIS_POWER
-            | features::LIGHT_CONE
+            | features::LIGHT_SOLID_ANGLE
             | features::RR_THROUGHPUT
     );
     let f = sky_meshes().features();
@@ -85,6 +91,12 @@ fn scene_analysis_finds_the_features_present() {
         cornell_materials().features() & features::MATERIALS,
         features::CONDUCTOR | features::DIELECTRIC
     );
+    // Triangle lights: their own bit, which sphere-lit scenes lack.
+    assert_eq!(
+        cornell_panel().features() & features::TRIANGLE_LIGHTS,
+        features::TRIANGLE_LIGHTS
+    );
+    assert_eq!(cornell().features() & features::TRIANGLE_LIGHTS, 0);
     let mut generic = cornell();
     generic.render.specialize = false;
     assert_eq!(generic.features(), 0);

@@ -2,7 +2,7 @@
 //! exactly the entry points the Vulkan backend binds (rust-gpu can silently drop one), and laying
 //! out every shared struct exactly as the host does.
 
-use kernel::scene::{Material, RenderParams, Sphere, SphereLight, Triangle};
+use kernel::scene::{Light, Material, RenderParams, Sphere, Triangle};
 use std::collections::BTreeSet;
 use std::mem::{offset_of, size_of};
 use std::process::Command;
@@ -138,23 +138,28 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
             binding::MATERIALS,
             host_layout!(
                 Material,
-                [albedo, kind, emission, alpha, specular, ior, eta, complex, k, _pad],
+                [albedo, kind, emission, alpha, specular, ior, eta, complex, k, two_sided],
                 true
             ),
         ),
         (
-            "SphereLight",
+            "Light",
             binding::LIGHTS,
             host_layout!(
-                SphereLight,
+                Light,
                 [
-                    center,
+                    position,
                     radius,
+                    edge1,
+                    kind,
+                    edge2,
+                    two_sided,
                     radiance,
                     select_pmf,
                     alias_threshold,
                     alias,
-                    _pad
+                    area,
+                    point_error
                 ],
                 true
             ),
@@ -162,7 +167,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
         (
             "Triangle",
             binding::TRIANGLES,
-            host_layout!(Triangle, [p0, material, edge1, _pad0, edge2, _pad1], true),
+            host_layout!(Triangle, [p0, material, edge1, light, edge2, _pad], true),
         ),
         (
             "Sphere",

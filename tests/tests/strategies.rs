@@ -1,6 +1,8 @@
 //! Light sampling alone, BSDF sampling alone, and their MIS combination estimate the same
 //! image: a glossy scene (a Kd + Ks floor, a rough gold sphere, a sharp Kd + Ks sphere, a
-//! sphere light) rendered in each mode (`mis = light | bsdf | half` against `power`) agrees
+//! sphere light) and a scene lit by triangle lights (a two-sided tilted panel, a one-sided
+//! panel, an emissive mesh; sampled by solid angle, and by area as a fifth variant) rendered in
+//! each mode (`mis = light | bsdf | half` against `power`) agree
 //! block by block of 2 x 2 pixels and in the image mean: Welch t-tests on the means of 16
 //! independent renders (batch means), since light sampling of a sharp lobe and BSDF sampling
 //! of a small light are heavy-tailed, and a render's own sample variance understates them
@@ -12,10 +14,10 @@ use statrs::distribution::{ContinuousCDF, StudentsT};
 use twinpath::film::Film;
 use twinpath::render::Backend;
 use twinpath::scene::Scene;
-use twinpath::settings::Mis;
+use twinpath::settings::{LightSampling, Mis};
 use twinpath_tests::{render_film, scene_from_toml};
 
-const SCENE: &str = r#"
+const SPHERE_LIGHT_SCENE: &str = r#"
 [camera]
 eye = [0.0, 1.2, 3.5]
 look_at = [0.0, 0.4, 0.0]
@@ -56,18 +58,84 @@ radius = 1.0
 material = "light"
 "#;
 
+const TRIANGLE_LIGHT_SCENE: &str = r#"
+[camera]
+eye = [0.0, 1.2, 3.5]
+look_at = [0.0, 0.4, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40.0
+width = 32
+height = 32
+
+[render]
+seed = 5
+sampler = "independent"
+
+[materials]
+floor = { kd = [0.4, 0.4, 0.4], ks = [0.3, 0.3, 0.3], alpha = 0.3 }
+gold = { conductor = "gold", alpha = 0.4 }
+white = { kd = [0.7, 0.7, 0.7] }
+panel = { emission = [3.0, 3.0, 3.0], two_sided = true }
+front = { emission = [1.0, 2.0, 4.0] }
+mesh = { emission = [0.5, 0.4, 0.1] }
+
+[[quad]]
+corner = [-3.0, 0.0, 3.0]
+edge1 = [6.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, -6.0]
+material = "floor"
+
+[[sphere]]
+center = [-0.6, 0.5, 0.0]
+radius = 0.5
+material = "gold"
+
+[[sphere]]
+center = [0.6, 0.4, 0.2]
+radius = 0.4
+material = "white"
+
+[[quad]] # tilted, two-sided: lights the scene with both faces
+corner = [-1.2, 1.2, -0.8]
+edge1 = [2.4, 0.0, 0.0]
+edge2 = [0.0, 0.9, 0.6]
+material = "panel"
+
+[[quad]] # one-sided, facing down and toward the camera
+corner = [0.4, 1.6, 1.2]
+edge1 = [0.0, 0.0, -0.5]
+edge2 = [0.5, -0.1, 0.0]
+material = "front"
+
+[[mesh]]
+file = "meshes/icosphere.obj"
+scale = 0.2
+translate = [0.0, 0.25, 0.9]
+material = "mesh"
+"#;
+
 /// Independent renders per mode, and samples per pixel of each.
 const BATCHES: u32 = 16;
 const SPP: u32 = 512;
 /// Blocks of BLOCK x BLOCK pixels of the 32 x 32 image.
 const BLOCK: usize = 2;
 
-fn render(mis: Mis, batch: u32) -> Film {
-    let mut scene: Scene = scene_from_toml(SCENE);
-    scene.render.mis = mis;
-    scene.render.seed = 1000 * (mis as u32 + 1) + batch;
+/// A way to render a scene: MIS mode, and whether points on lights are sampled by area.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Variant {
+    mis: Mis,
+    area: bool,
+}
+
+fn render(text: &str, v: Variant, batch: u32) -> Film {
+    let mut scene: Scene = scene_from_toml(text);
+    scene.render.mis = v.mis;
+    if v.area {
+        scene.render.light_sampling = LightSampling::Area;
+    }
+    scene.render.seed = 1000 * (v.mis as u32 + 1) + 100 * v.area as u32 + batch;
     // The specialised path and the generic one must agree too: only power runs specialised.
-    scene.render.specialize = mis == Mis::Power;
+    scene.render.specialize = v.mis == Mis::Power;
     render_film(&scene, Backend::Cpu, SPP)
 }
 
@@ -114,17 +182,23 @@ fn welch(a: &[f64], b: &[f64]) -> (f64, f64) {
     ((ma - mb) / v.sqrt(), dof)
 }
 
-#[test]
-fn light_only_bsdf_only_and_mis_agree() {
-    let batches = |mode: Mis| -> Vec<Vec<[f64; 3]>> {
+/// Every variant of `text` agrees with power-heuristic MIS (by solid angle), block by block and
+/// in the image mean.
+fn variants_agree(label: &str, text: &str, variants: &[Variant]) {
+    let power = Variant {
+        mis: Mis::Power,
+        area: false,
+    };
+    let batches = |v: Variant| -> Vec<Vec<[f64; 3]>> {
         (0..BATCHES)
-            .map(|b| block_means(&render(mode, b)))
+            .map(|b| block_means(&render(text, v, b)))
             .collect()
     };
-    let reference = batches(Mis::Power);
+    let reference = batches(power);
     let blocks = reference[0].len() - 1;
-    for mode in [Mis::Light, Mis::Bsdf, Mis::Half] {
-        let other = batches(mode);
+    let tests = 3 * variants.len();
+    for &v in variants {
+        let other = batches(v);
         let mut worst_p = 1f64;
         for k in 0..reference[0].len() {
             for c in 0..3 {
@@ -132,17 +206,17 @@ fn light_only_bsdf_only_and_mis_agree() {
                 let b: Vec<f64> = other.iter().map(|r| r[k][c]).collect();
                 let (t, dof) = welch(&a, &b);
                 let p = 2.0 * (1.0 - StudentsT::new(0.0, 1.0, dof).unwrap().cdf(t.abs()));
-                // Family-wise 1e-3 over the blocks, channels and modes (Bonferroni), and 1e-3
-                // over the images' channels and modes.
+                // Family-wise 1e-3 over the blocks, channels and variants (Bonferroni), and
+                // 1e-3 over the images' channels and variants.
                 let (what, bound) = if k == blocks {
-                    ("image".to_string(), 1e-3 / 9.0)
+                    ("image".to_string(), 1e-3 / tests as f64)
                 } else {
                     worst_p = worst_p.min(p);
-                    (format!("block {k}"), 1e-3 / (9 * blocks) as f64)
+                    (format!("block {k}"), 1e-3 / (tests * blocks) as f64)
                 };
                 assert!(
                     p > bound,
-                    "{mode:?}: {what} channel {c}: {:.5} vs {:.5} (t = {t:.2}, dof {dof:.1}, p = {p:.1e})",
+                    "{label}, {v:?}: {what} channel {c}: {:.5} vs {:.5} (t = {t:.2}, dof {dof:.1}, p = {p:.1e})",
                     b.iter().sum::<f64>() / b.len() as f64,
                     a.iter().sum::<f64>() / a.len() as f64
                 );
@@ -152,8 +226,38 @@ fn light_only_bsdf_only_and_mis_agree() {
             |x: &Vec<Vec<[f64; 3]>>| x.iter().map(|r| r.last().unwrap()[0]).collect::<Vec<_>>();
         let (t, _) = welch(&image(&reference), &image(&other));
         println!(
-            "{mode:?} vs power: smallest p over the blocks {worst_p:.2e} (bound {:.1e}); image mean t = {t:+.2}",
-            1e-3 / (9 * blocks) as f64
+            "{label}, {v:?} vs power: smallest p over the blocks {worst_p:.2e} (bound {:.1e}); image mean t = {t:+.2}",
+            1e-3 / (tests * blocks) as f64
         );
     }
+}
+
+const MODES: [Variant; 3] = [
+    Variant {
+        mis: Mis::Light,
+        area: false,
+    },
+    Variant {
+        mis: Mis::Bsdf,
+        area: false,
+    },
+    Variant {
+        mis: Mis::Half,
+        area: false,
+    },
+];
+
+#[test]
+fn light_only_bsdf_only_and_mis_agree() {
+    variants_agree("sphere light", SPHERE_LIGHT_SCENE, &MODES);
+}
+
+#[test]
+fn light_only_bsdf_only_and_mis_agree_under_triangle_lights() {
+    let mut variants = MODES.to_vec();
+    variants.push(Variant {
+        mis: Mis::Power,
+        area: true,
+    });
+    variants_agree("triangle lights", TRIANGLE_LIGHT_SCENE, &variants);
 }

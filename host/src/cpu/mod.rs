@@ -19,7 +19,7 @@ use glam::Vec3;
 use indicatif::ProgressBar;
 use kernel::features::{self, Dynamic, FeatureSet, Static};
 use kernel::path::render_sample;
-use kernel::scene::{Material, RenderParams, SphereLight};
+use kernel::scene::{Light, Material, RenderParams};
 use kernel::{SurfaceHit, Tracer};
 use packet::SmallScene;
 use rayon::prelude::*;
@@ -48,7 +48,7 @@ impl Tracer for BvhTracer<'_> {
 pub struct CpuRenderer {
     pub bvh: Bvh,
     pub materials: Vec<Material>,
-    pub lights: Vec<SphereLight>,
+    pub lights: Vec<Light>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path).
     pub features: u32,
     /// How a tile's samples are computed, chosen once when the renderer is built.
@@ -84,16 +84,17 @@ macro_rules! monomorphised {
 
 /// The feature combinations with their own monomorphised `trace_path`: every combination of
 /// the scene features (lights: none, one, several; background; constant or throughput
-/// roulette; Lambertian only or any materials) under the default MIS (power) and light
-/// sampling (cone). Others run the [`Dynamic`] path with the same bits.
+/// roulette; Lambertian only with sphere lights, or anything: [`EXTENDED`]) under the default
+/// MIS (power) and light sampling (by solid angle). Others run the [`Dynamic`] path with the
+/// same bits.
 macro_rules! with_features {
     ($bits:expr, $f:ident => $body:expr) => {{
-        const BASE: u32 = features::SPECIALIZED | features::MIS_POWER | features::LIGHT_CONE;
+        const BASE: u32 = features::SPECIALIZED | features::MIS_POWER | features::LIGHT_SOLID_ANGLE;
         const L: u32 = features::LIGHTS;
         const L1: u32 = features::LIGHTS | features::SINGLE_LIGHT;
         const B: u32 = features::BACKGROUND;
         const R: u32 = features::RR_THROUGHPUT;
-        const M: u32 = features::MATERIALS;
+        const M: u32 = EXTENDED;
         monomorphised!($bits, $f => $body;
             BASE, BASE | B, BASE | R, BASE | B | R,
             BASE | L, BASE | L | B, BASE | L | R, BASE | L | B | R,
@@ -104,12 +105,16 @@ macro_rules! with_features {
     }};
 }
 
-/// `bits` with every material bit set if any is: the CPU compiles one path for scenes with
-/// other materials than the Lambertian (a material bit only keeps code, see
-/// `kernel::features::material_features`), not one per combination of them.
-fn with_all_materials(bits: u32) -> u32 {
-    if bits & features::MATERIALS != 0 {
-        bits | features::MATERIALS
+/// The feature bits beyond the diffuse renderer's: other materials than the Lambertian and
+/// triangle lights.
+const EXTENDED: u32 = features::MATERIALS | features::TRIANGLE_LIGHTS;
+
+/// `bits` with every [`EXTENDED`] bit set if any is: the CPU compiles one path for scenes with
+/// other materials or triangle lights (such a bit only keeps code, which the material's `kind`
+/// and the light's `kind` then skip where absent), not one per combination of them.
+fn with_all_extended(bits: u32) -> u32 {
+    if bits & EXTENDED != 0 {
+        bits | EXTENDED
     } else {
         bits
     }
@@ -130,7 +135,7 @@ impl CpuRenderer {
             bvh,
             materials: scene.materials.clone(),
             lights: scene.light_table(),
-            features: with_all_materials(scene.features()),
+            features: with_all_extended(scene.features()),
             tiles: small.map_or(TileStrategy::OnePath, TileStrategy::Packets),
         }
     }

@@ -1,6 +1,6 @@
 //! The samples of sixteen path vertices at once, filled from their sixteen
 //! [`VertexQuery`]s: the numbers on SIMD lanes (`packet_numbers`), and from them the cone light
-//! samples and the Lambertian BRDF directions (other materials' directions are the vertex's
+//! samples of sphere lights and the Lambertian BRDF directions (other materials' directions are the vertex's
 //! own, from the numbers; the lobe choice is drawn one lane at a time) by the kernel's samplers in their
 //! [`kernel::real::Real`] form (`sample_sphere_cone_v3`, `brdf::sample_brdf_v3`) on lanes. Any
 //! other sample (area sampling, a receiver inside its light) is left to the vertex, which
@@ -13,11 +13,11 @@ use super::packet_numbers::NumberRequests;
 use super::simd::widest_simd;
 use glam::Vec3;
 use kernel::brdf::sample_brdf_v3;
-use kernel::light::{choose_light, cone_light_sample, uses_cone};
+use kernel::light::{choose_light, cone_light_sample, is_triangle, uses_cone};
 use kernel::real::V3;
 use kernel::rng::SampleRng;
 use kernel::sampling::{sample_sphere_cone_v3, ConeSample, SurfacePoint};
-use kernel::scene::SphereLight;
+use kernel::scene::Light;
 use kernel::vertex_samples::{VertexQuery, VertexSamples, NO_DIMENSION};
 use std::simd::Simd;
 
@@ -106,7 +106,7 @@ impl Arguments {
 /// lanes).
 pub fn fill_vertex_samples(
     queries: &[Option<(SampleRng, VertexQuery)>; LANES],
-    lights: &[SphereLight],
+    lights: &[Light],
 ) -> [VertexSamples; LANES] {
     let dimensions = queries.map(|entry| entry.map(|(_, q)| q.dimensions()));
     let mut requests = NumberRequests::default();
@@ -138,8 +138,8 @@ pub fn fill_vertex_samples(
         if q.samples_light() {
             let light = choose_light(lights, q.light_count, s.u_select);
             let l = &lights[light as usize];
-            if uses_cone(q.mode, l, q.x) {
-                set_lane3(&mut args.center, lane, Vec3::from(l.center));
+            if !is_triangle(q.triangle_lights, l) && uses_cone(q.mode, l, q.x) {
+                set_lane3(&mut args.center, lane, Vec3::from(l.position));
                 args.radius[lane] = l.radius;
                 set_lane3(&mut args.receiver, lane, q.x);
                 (args.u_light[0][lane], args.u_light[1][lane]) = s.u_light;

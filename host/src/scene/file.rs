@@ -3,11 +3,12 @@
 
 use super::closed_surface::check_closed_outward;
 use super::error::{line_of, SceneError};
+use super::light_table::{sphere_light, triangle_light};
 use super::mesh::load_mesh;
 use super::{CameraDesc, Scene, TriangleGroup};
 use crate::settings::RenderSettings;
 use glam::Vec3;
-use kernel::scene::{material_kind, Sphere, SphereLight, Triangle, NONE};
+use kernel::scene::{material_kind, Light, Sphere, Triangle, NONE};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -68,6 +69,8 @@ pub(super) struct MaterialFile {
     pub conductor: Option<Spanned<toml::Value>>,
     pub dielectric: Option<Spanned<DielectricFile>>,
     pub emission: Option<V3>,
+    /// With `emission`, on quads and meshes: both faces emit (default: the front face).
+    pub two_sided: Option<Spanned<bool>>,
 }
 
 #[derive(Deserialize)]
@@ -295,16 +298,23 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             ));
         }
         let material = find_material(&sf.material, &format!("sphere[{i}].material"))?;
+        if materials[material as usize].two_sided != 0 {
+            return Err(ck.err(
+                sf.material.span(),
+                &format!("sphere[{i}].material"),
+                format!(
+                    "'{}' is two-sided: a sphere emits from its outside only (two_sided is for \
+                     quads and meshes)",
+                    sf.material.get_ref()
+                ),
+            ));
+        }
         let light = if is_emissive(material) {
-            lights.push(SphereLight {
-                center: center.to_array(),
+            lights.push(sphere_light(
+                center,
                 radius,
-                radiance: materials[material as usize].emission,
-                select_pmf: 0.0,
-                alias_threshold: 0.0,
-                alias: 0,
-                _pad: [0.0; 2],
-            });
+                materials[material as usize].emission,
+            ));
             (lights.len() - 1) as u32
         } else {
             NONE
@@ -317,14 +327,20 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             _pad: [0; 2],
         });
     }
-    super::light_table::assign_light_selection(&mut lights, render.light_selection.code());
 
-    // Quads (two triangles each) and meshes.
+    // Quads (two triangles each) and meshes; each triangle of an emissive one is a light.
     let mut triangles = Vec::new();
     let mut triangle_groups = Vec::new();
-    let push_triangle = |triangles: &mut Vec<Triangle>, p: [Vec3; 3], material: u32| {
-        triangles.push(super::triangle(p, material));
-    };
+    let push_triangle =
+        |triangles: &mut Vec<Triangle>, lights: &mut Vec<Light>, p: [Vec3; 3], material: u32| {
+            let mut tri = super::triangle(p, material);
+            let m = &materials[material as usize];
+            if is_emissive(material) {
+                tri.light = lights.len() as u32;
+                lights.push(triangle_light(&tri, m.emission, m.two_sided != 0));
+            }
+            triangles.push(tri);
+        };
     let quads_start = triangles.len();
     for (i, q) in file.quad.iter().enumerate() {
         let qf = q.get_ref();
@@ -341,16 +357,6 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             ));
         }
         let material = find_material(&qf.material, &format!("{field}.material"))?;
-        if is_emissive(material) {
-            return Err(ck.err(
-                qf.material.span(),
-                &format!("{field}.material"),
-                format!(
-                    "'{}' is emissive: only spheres can be lights so far",
-                    qf.material.get_ref()
-                ),
-            ));
-        }
         if is_dielectric(material) {
             return Err(ck.err(
                 qf.material.span(),
@@ -364,11 +370,13 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         }
         push_triangle(
             &mut triangles,
+            &mut lights,
             [corner, corner + e1, corner + e1 + e2],
             material,
         );
         push_triangle(
             &mut triangles,
+            &mut lights,
             [corner, corner + e1 + e2, corner + e2],
             material,
         );
@@ -384,16 +392,6 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         let mf = m.get_ref();
         let field = format!("mesh[{i}]");
         let material = find_material(&mf.material, &format!("{field}.material"))?;
-        if is_emissive(material) {
-            return Err(ck.err(
-                mf.material.span(),
-                &format!("{field}.material"),
-                format!(
-                    "'{}' is emissive: only spheres can be lights so far",
-                    mf.material.get_ref()
-                ),
-            ));
-        }
         let mesh_path = base_dir.join(mf.file.get_ref());
         if !mesh_path.is_file() {
             return Err(ck.err(
@@ -443,7 +441,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             }
             // Degenerate (zero-area) triangles cannot be hit; they are dropped.
             if (p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0 {
-                push_triangle(&mut triangles, p, material);
+                push_triangle(&mut triangles, &mut lights, p, material);
             }
         }
         triangle_groups.push(TriangleGroup {
@@ -451,6 +449,8 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             range: start..triangles.len(),
         });
     }
+
+    super::light_table::assign_light_selection(&mut lights, render.light_selection.code());
 
     let background = match &file.background {
         Some(b) => ck.color(&b.radiance, "background.radiance", None)?,

@@ -1,20 +1,72 @@
-//! The light table's selection probabilities and alias table (what `kernel::light::choose_light`
-//! reads), for uniform or power-proportional light selection.
+//! The light table: its entries for emissive spheres and triangles, and their selection
+//! probabilities and alias table (what `kernel::light::choose_light` reads), for uniform or
+//! power-proportional light selection.
 
-use kernel::scene::{light_selection, SphereLight};
+use glam::Vec3;
+use kernel::geometry::triangle_point_error;
+use kernel::scene::{light_kind, light_selection, Light, Triangle};
 
-/// Emitted power of a sphere light up to a constant: luminance of its radiance times its
-/// area (power = pi x area x radiance for a uniform Lambertian emitter).
-pub fn light_power(l: &SphereLight) -> f64 {
+/// The light of an emissive sphere (selection filled later by [`assign_light_selection`]).
+pub fn sphere_light(center: Vec3, radius: f32, radiance: [f32; 3]) -> Light {
+    Light {
+        position: center.to_array(),
+        radius,
+        edge1: [0.0; 3],
+        kind: light_kind::SPHERE,
+        edge2: [0.0; 3],
+        two_sided: 0,
+        radiance,
+        select_pmf: 0.0,
+        alias_threshold: 0.0,
+        alias: 0,
+        area: 0.0,
+        point_error: 0.0,
+    }
+}
+
+/// The light of an emissive triangle `tri` (its own p0 and edges, so a sample and a hit see
+/// the same triangle): its area (in f64, then rounded) and the error bound of its points.
+pub fn triangle_light(tri: &Triangle, radiance: [f32; 3], two_sided: bool) -> Light {
+    let (p0, e1, e2) = (
+        Vec3::from(tri.p0),
+        Vec3::from(tri.edge1),
+        Vec3::from(tri.edge2),
+    );
+    let area = 0.5 * e1.as_dvec3().cross(e2.as_dvec3()).length();
+    Light {
+        position: tri.p0,
+        radius: 0.0,
+        edge1: tri.edge1,
+        kind: light_kind::TRIANGLE,
+        edge2: tri.edge2,
+        two_sided: two_sided as u32,
+        radiance,
+        select_pmf: 0.0,
+        alias_threshold: 0.0,
+        alias: 0,
+        area: area as f32,
+        point_error: triangle_point_error(p0, e1, e2, 1.0, 1.0),
+    }
+}
+
+/// Emitted power of a light up to a constant: luminance of its radiance times its emitting
+/// area (power = pi x area x radiance for a uniform Lambertian emitter; a two-sided triangle
+/// emits from twice its area).
+pub fn light_power(l: &Light) -> f64 {
     let [r, g, b] = l.radiance.map(f64::from);
     let luminance = 0.2126 * r + 0.7152 * g + 0.0722 * b;
-    luminance.max(0.0) * 4.0 * std::f64::consts::PI * (l.radius as f64).powi(2)
+    let area = if l.kind == light_kind::TRIANGLE {
+        l.area as f64 * if l.two_sided != 0 { 2.0 } else { 1.0 }
+    } else {
+        4.0 * std::f64::consts::PI * (l.radius as f64).powi(2)
+    };
+    luminance.max(0.0) * area
 }
 
 /// Fills `select_pmf`, `alias_threshold` and `alias` of every light for `mode` (one of
 /// `kernel::scene::light_selection`). Power selection falls back to uniform when every light
 /// has zero power.
-pub fn assign_light_selection(lights: &mut [SphereLight], mode: u32) {
+pub fn assign_light_selection(lights: &mut [Light], mode: u32) {
     let weights: Vec<f64> = match mode {
         light_selection::POWER => lights.iter().map(light_power).collect(),
         _ => vec![1.0; lights.len()],

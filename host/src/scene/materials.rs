@@ -77,8 +77,17 @@ pub(super) fn material(
                 "has emission and reflection: a light reflects nothing, give emission alone",
             ));
         }
-        return Ok(Material::emitter(
-            ck.color(e, &format!("{field}.emission"), None)?.to_array(),
+        let mut out =
+            Material::emitter(ck.color(e, &format!("{field}.emission"), None)?.to_array());
+        out.two_sided = mf.two_sided.as_ref().is_some_and(|t| *t.get_ref()) as u32;
+        return Ok(out);
+    }
+    if let Some(t) = &mf.two_sided {
+        return Err(ck.err(
+            t.span(),
+            &format!("{field}.two_sided"),
+            "belongs to emitters: only a light's faces can be one- or two-sided (surfaces \
+             reflect on both sides)",
         ));
     }
     if mf.conductor.is_some() || mf.dielectric.is_some() {

@@ -13,7 +13,7 @@ pub use file::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
 
 use crate::settings::RenderSettings;
 use glam::Vec3;
-use kernel::scene::{Camera, Material, RenderParams, Sphere, SphereLight, Triangle};
+use kernel::scene::{Camera, Light, Material, RenderParams, Sphere, Triangle};
 use std::ops::Range;
 use std::path::Path;
 
@@ -54,15 +54,16 @@ pub const MIN_PILOT_SAMPLES: u32 = 4;
 /// Samples per pixel per adaptive pass: both backends decide at the same sample indices.
 pub const ADAPTIVE_PASS: u32 = 8;
 
-/// The kernel's triangle with vertices `p` (p0 and the edges p1 - p0, p2 - p0) and `material`.
+/// The kernel's triangle with vertices `p` (p0 and the edges p1 - p0, p2 - p0) and `material`,
+/// not a light (`light` is set where it emits).
 pub fn triangle(p: [Vec3; 3], material: u32) -> Triangle {
     Triangle {
         p0: p[0].to_array(),
         material,
         edge1: (p[1] - p[0]).to_array(),
-        _pad0: 0,
+        light: kernel::scene::NONE,
         edge2: (p[2] - p[0]).to_array(),
-        _pad1: 0,
+        _pad: 0,
     }
 }
 
@@ -86,7 +87,7 @@ pub struct Scene {
     pub spheres: Vec<Sphere>,
     pub triangles: Vec<Triangle>,
     pub triangle_groups: Vec<TriangleGroup>,
-    pub lights: Vec<SphereLight>,
+    pub lights: Vec<Light>,
 }
 
 impl Scene {
@@ -146,13 +147,14 @@ impl Scene {
         if self.render.specialize {
             kernel::features::scene_features(&self.params(0, 1))
                 | kernel::features::material_features(&self.materials)
+                | kernel::features::light_features(&self.lights)
         } else {
             0
         }
     }
 
     /// The light table with selection probabilities for `render.light_selection`.
-    pub fn light_table(&self) -> Vec<SphereLight> {
+    pub fn light_table(&self) -> Vec<Light> {
         let mut lights = self.lights.clone();
         light_table::assign_light_selection(&mut lights, self.render.light_selection.code());
         lights
