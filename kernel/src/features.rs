@@ -36,6 +36,9 @@ pub const MATERIALS: u32 = GLOSSY | CONDUCTOR | DIELECTRIC;
 /// The light table may hold triangles (emissive quads and meshes): without it every light is
 /// a sphere.
 pub const TRIANGLE_LIGHTS: u32 = 1 << 10;
+/// The camera may have a thin lens (a lens radius above 0; with the bit, a pinhole camera still
+/// runs as one).
+pub const THIN_LENS: u32 = 1 << 11;
 
 /// The material bits of a scene with these materials: one per kind present besides the
 /// Lambertian. (A bit may also be set for a kind that is absent: it only keeps that kind's
@@ -85,6 +88,9 @@ pub fn scene_features(params: &RenderParams) -> u32 {
     }
     if params.rr_mode == roulette::THROUGHPUT {
         f |= RR_THROUGHPUT;
+    }
+    if params.camera.eye[3] > 0.0 {
+        f |= THIN_LENS;
     }
     f
 }
@@ -149,6 +155,11 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn dielectric(self) -> bool {
         self.answer(DIELECTRIC, true)
+    }
+    /// Whether the camera may have a lens (see [`THIN_LENS`]).
+    #[inline]
+    fn thin_lens(self) -> bool {
+        self.answer(THIN_LENS, true)
     }
     /// Whether a light may be a triangle (see [`TRIANGLE_LIGHTS`]).
     #[inline]

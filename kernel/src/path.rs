@@ -4,7 +4,7 @@
 use crate::adaptive::sample_stream;
 use crate::brdf::{eval_scattering, pdf_brdf, sampled_brdf_weight};
 use crate::bsdf::{self, DELTA_PDF};
-use crate::camera::{camera_origin, camera_ray_direction};
+use crate::camera::{camera_origin, camera_ray_direction, lens_radius, thin_lens_ray};
 use crate::features::FeatureSet;
 use crate::geometry::{
     offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error, triangle_point,
@@ -16,7 +16,7 @@ use crate::sampling::power_heuristic;
 use crate::scene::{
     light_sampling, material_kind, mis, Light, Material, RenderParams, Sphere, Triangle, NONE,
 };
-use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION};
+use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION, LENS_DIMENSION};
 use spirv_std::glam::Vec3;
 
 /// Where a ray meets the scene first. `t < 0` means it met nothing.
@@ -689,10 +689,10 @@ pub fn light_sampling_of<F: FeatureSet>(features: F, params: &RenderParams) -> u
 }
 
 /// One sample of pixel (px, py) (column from the left, row from the top): a uniformly random
-/// position inside the pixel (box filter), the camera ray through it, and [`trace_path`].
-/// Both backends compute exactly this, so a sample is the same function of (seed, pixel,
-/// sample): the GPU by this function, the CPU's packets by [`start_sample`] and
-/// [`PathState::advance`].
+/// position inside the pixel (box filter), the camera ray through it (and through a point of
+/// the lens, with a thin lens), and [`trace_path`]. Both backends compute exactly this, so a
+/// sample is the same function of (seed, pixel, sample): the GPU by this function, the CPU's
+/// packets by [`start_sample`] and [`PathState::advance`].
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn render_sample<T: Tracer, F: FeatureSet>(
@@ -705,7 +705,7 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
     py: u32,
     sample: u32,
 ) -> Vec3 {
-    start_sample(params, px, py, sample)
+    start_sample(features, params, px, py, sample)
         .run(tracer, features, params, materials, lights)
         .radiance
 }
@@ -713,8 +713,14 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
 /// The path of sample `sample` of pixel (px, py) with its camera ray waiting (see
 /// [`render_sample`]).
 #[inline]
-pub fn start_sample(params: &RenderParams, px: u32, py: u32, sample: u32) -> PathState {
-    start_path(params, px, py, sample_rng(params, px, py, sample))
+pub fn start_sample<F: FeatureSet>(
+    features: F,
+    params: &RenderParams,
+    px: u32,
+    py: u32,
+    sample: u32,
+) -> PathState {
+    start_path(features, params, px, py, sample_rng(params, px, py, sample))
 }
 
 /// The random numbers of sample `sample` of pixel (px, py) (its sampler and sequence index
@@ -728,22 +734,37 @@ pub fn sample_rng(params: &RenderParams, px: u32, py: u32, sample: u32) -> Sampl
 /// The path of pixel (px, py) that draws its numbers from `rng`, with its camera ray waiting:
 /// through a uniformly random position inside the pixel, the camera's pair of numbers.
 #[inline]
-pub fn start_path(params: &RenderParams, px: u32, py: u32, mut rng: SampleRng) -> PathState {
-    rng.seek(CAMERA_DIMENSION);
-    let (u, v) = rng.next_2d();
-    start_path_at(params, px, py, rng, (u, v))
-}
-
-/// [`start_path`] with the camera's pair `(u, v)` already drawn (the CPU's packets draw
-/// sixteen at once).
-#[inline]
-pub fn start_path_at(
+pub fn start_path<F: FeatureSet>(
+    features: F,
     params: &RenderParams,
     px: u32,
     py: u32,
-    rng: SampleRng,
+    mut rng: SampleRng,
+) -> PathState {
+    rng.seek(CAMERA_DIMENSION);
+    let (u, v) = rng.next_2d();
+    start_path_at(features, params, px, py, rng, (u, v))
+}
+
+/// [`start_path`] with the camera's pair `(u, v)` already drawn (the CPU's packets draw
+/// sixteen at once). With a thin lens, the lens point's pair is drawn here, from its own
+/// dimensions (`vertex_samples::LENS_DIMENSION`).
+#[inline]
+pub fn start_path_at<F: FeatureSet>(
+    features: F,
+    params: &RenderParams,
+    px: u32,
+    py: u32,
+    mut rng: SampleRng,
     (u, v): (f32, f32),
 ) -> PathState {
-    let dir = camera_ray_direction(&params.camera, params.width, params.height, px, py, u, v);
-    PathState::new(camera_origin(&params.camera), dir, rng)
+    let camera = &params.camera;
+    let dir = camera_ray_direction(camera, params.width, params.height, px, py, u, v);
+    if features.thin_lens() && lens_radius(camera) > 0.0 {
+        rng.seek(LENS_DIMENSION);
+        let (u1, u2) = rng.next_2d();
+        let (origin, dir) = thin_lens_ray(camera, dir, u1, u2);
+        return PathState::new(origin, dir, rng);
+    }
+    PathState::new(camera_origin(camera), dir, rng)
 }

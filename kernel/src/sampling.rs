@@ -215,3 +215,24 @@ pub fn sample_triangle_barycentrics(u1: f32, u2: f32) -> (f32, f32) {
     let s = u1.sqrt();
     (s - s * u2, s * u2)
 }
+
+/// A point uniformly distributed on the unit disk, by Shirley and Chiu's concentric map ("A
+/// Low Distortion Map Between Disk and Square", 1997): the square [-1, 1]^2 is cut into four
+/// triangles by its diagonals, and the one of (a, b) = 2 (u1, u2) - 1 with |a| > |b| maps to
+/// radius a and angle (pi/4)(b/a) (the others alike), which preserves areas and keeps strata
+/// compact. The angle is in turns for `cos_sin_turns`.
+#[inline]
+pub fn sample_concentric_disk(u1: f32, u2: f32) -> (f32, f32) {
+    let a = 2.0 * u1 - 1.0;
+    let b = 2.0 * u2 - 1.0;
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, turns) = if a.abs() > b.abs() {
+        (a, 0.125 * (b / a))
+    } else {
+        (b, 0.25 - 0.125 * (a / b))
+    };
+    let (c, s) = cos_sin_turns(turns);
+    (r * c, r * s)
+}

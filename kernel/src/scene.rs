@@ -145,9 +145,11 @@ pub struct Light {
     pub point_error: f32,
 }
 
-/// Pinhole camera: a ray through image-plane point (x, y) in [-1, 1]^2 (y up) has direction
-/// `forward + x * right + y * up`, where `right` and `up` already carry the half-extents
-/// tan(vfov/2) * aspect and tan(vfov/2). 64 bytes.
+/// Pinhole or thin-lens camera: a ray through image-plane point (x, y) in [-1, 1]^2 (y up) has
+/// the pinhole direction `forward + x * right + y * up`, where `right` and `up` already carry
+/// the half-extents tan(vfov/2) * aspect and tan(vfov/2); `eye[3]` is the lens radius (0: a
+/// pinhole) and `forward[3]` the focus distance along `forward` (`camera::thin_lens_ray`).
+/// 64 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]

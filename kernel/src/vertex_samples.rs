@@ -34,6 +34,10 @@ pub const CAMERA_DIMENSIONS: u32 = 2;
 /// material draw exactly the numbers they drew before it existed. (Both samplers hash the
 /// dimension into an independent stream: any dimension is as good as the next.)
 pub const LOBE_DIMENSION: u32 = 1 << 31;
+/// The thin lens's pair (the point on the lens), drawn only by cameras with a lens: outside every
+/// vertex's block and below the lobe choices, so pinhole renders draw exactly what they drew
+/// before lenses existed.
+pub const LENS_DIMENSION: u32 = LOBE_DIMENSION - 2;
 /// In [`VertexQuery::dimensions`]: a number the vertex does not read.
 pub const NO_DIMENSION: u32 = u32::MAX;
 

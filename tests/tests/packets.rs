@@ -32,6 +32,9 @@ fn scenes() -> Vec<(&'static str, Scene)> {
     independent.render.sampler = Sampler::Independent;
     let mut adaptive = small("cornell.toml");
     adaptive.render.adaptive_target = 0.05;
+    let mut lens = small("cornell.toml");
+    lens.camera.aperture = 0.2;
+    lens.camera.focus_distance = 3.5;
     let mut sky = small("many_lights.toml");
     sky.background = glam::Vec3::new(0.2, 0.3, 0.5);
     vec![

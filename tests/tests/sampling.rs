@@ -16,7 +16,7 @@ use twinpath_tests::chi_square;
 
 /// Family-wise significance of all chi-square tests in this file (Sidak-style split below).
 const ALPHA: f64 = 0.01;
-const TESTS: f64 = 10.0;
+const TESTS: f64 = 11.0;
 const SAMPLES: u32 = 1_000_000;
 
 fn assert_fits(name: &str, observed: &[f64], expected: &[f64]) {
@@ -371,4 +371,24 @@ fn atan2_turns_matches_f64() {
         worst.0, worst.1, worst.2
     );
     assert!(worst.0 <= 1.0, "atan2_turns beyond its bound at {worst:?}");
+}
+
+/// The thin lens's concentric disk map is uniform on the unit disk: bins equal in r^2 and in the
+/// angle hold equal areas, so equal expected counts; no point leaves the disk.
+#[test]
+fn sample_concentric_disk_is_uniform_on_the_disk() {
+    use kernel::sampling::sample_concentric_disk;
+    let mut observed = vec![0.0; THETA_BINS * PHI_BINS];
+    let mut r = rng(41);
+    for _ in 0..SAMPLES {
+        let (x, y) = sample_concentric_disk(r.next_f32(), r.next_f32());
+        let r2 = (x as f64).powi(2) + (y as f64).powi(2);
+        assert!(r2 <= 1.0 + 1e-6, "({x}, {y}) outside the disk");
+        let phi = (y as f64).atan2(x as f64).rem_euclid(2.0 * PI);
+        let i = ((r2 * THETA_BINS as f64) as usize).min(THETA_BINS - 1);
+        let j = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
+        observed[i * PHI_BINS + j] += 1.0;
+    }
+    let expected = vec![SAMPLES as f64 / (THETA_BINS * PHI_BINS) as f64; THETA_BINS * PHI_BINS];
+    assert_fits("sample_concentric_disk", &observed, &expected);
 }

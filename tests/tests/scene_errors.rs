@@ -642,3 +642,31 @@ fn dielectric_needs_a_closed_outward_surface() {
     )
     .unwrap();
 }
+
+#[test]
+fn thin_lens_settings() {
+    let s = parse_scene(
+        &with(
+            "height = 24",
+            "height = 24\naperture = 0.1\nfocus_distance = 2.5",
+        ),
+        &scene_path(),
+    )
+    .unwrap();
+    assert_eq!((s.camera.aperture, s.camera.focus_distance), (0.1, 2.5));
+    // The default focus is the look-at point's distance; the default aperture a pinhole.
+    let s = parse_scene(GOOD, &scene_path()).unwrap();
+    assert_eq!((s.camera.aperture, s.camera.focus_distance), (0.0, 4.0));
+    assert_error(
+        &with("height = 24", "height = 24\naperture = -0.1"),
+        "aperture",
+        "camera.aperture",
+        "not a lens diameter",
+    );
+    assert_error(
+        &with("height = 24", "height = 24\nfocus_distance = 0"),
+        "focus_distance",
+        "camera.focus_distance",
+        "not a distance",
+    );
+}

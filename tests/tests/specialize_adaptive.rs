@@ -48,6 +48,13 @@ fn cornell_panel() -> Scene {
     small(Scene::load(&repo_root().join("scenes/cornell_panel.toml")).unwrap())
 }
 
+/// `scene` through a lens of diameter 0.2 focused on its spheres (3.5 from the eye).
+fn thin_lens(mut scene: Scene) -> Scene {
+    scene.camera.aperture = 0.2;
+    scene.camera.focus_distance = 3.5;
+    scene
+}
+
 fn scenes() -> Vec<(&'static str, Scene)> {
     let mut half = cornell();
     half.render.mis = Mis::Half;
@@ -63,6 +70,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("materials", materials()),
         ("cornell with gold and glass", cornell_materials()),
         ("cornell lit by a panel (triangle lights)", cornell_panel()),
+        ("cornell through a thin lens", thin_lens(cornell())),
     ]
 }
 
@@ -97,6 +105,11 @@ fn scene_analysis_finds_the_features_present() {
         features::TRIANGLE_LIGHTS
     );
     assert_eq!(cornell().features() & features::TRIANGLE_LIGHTS, 0);
+    assert_eq!(cornell().features() & features::THIN_LENS, 0);
+    assert_eq!(
+        thin_lens(cornell()).features() & features::THIN_LENS,
+        features::THIN_LENS
+    );
     let mut generic = cornell();
     generic.render.specialize = false;
     assert_eq!(generic.features(), 0);

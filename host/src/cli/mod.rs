@@ -78,7 +78,8 @@ pub struct SettingFlags {
     /// How light sampling and BRDF sampling are weighted.
     #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(Mis::NAMES))]
     mis: Option<String>,
-    /// How next-event estimation picks a point on a sphere light.
+    /// How next-event estimation picks a point on a light: by the solid angle it subtends (a
+    /// sphere's cone, a triangle's spherical triangle) or uniformly on its surface.
     #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(LightSampling::NAMES))]
     light_sampling: Option<String>,
     /// How next-event estimation picks one of several lights.

@@ -105,13 +105,14 @@ macro_rules! with_features {
     }};
 }
 
-/// The feature bits beyond the diffuse renderer's: other materials than the Lambertian and
-/// triangle lights.
-const EXTENDED: u32 = features::MATERIALS | features::TRIANGLE_LIGHTS;
+/// The feature bits beyond the diffuse renderer's: other materials than the Lambertian,
+/// triangle lights and a thin lens.
+const EXTENDED: u32 = features::MATERIALS | features::TRIANGLE_LIGHTS | features::THIN_LENS;
 
 /// `bits` with every [`EXTENDED`] bit set if any is: the CPU compiles one path for scenes with
-/// other materials or triangle lights (such a bit only keeps code, which the material's `kind`
-/// and the light's `kind` then skip where absent), not one per combination of them.
+/// other materials, triangle lights or a lens (such a bit only keeps code, which the material's
+/// `kind`, the light's `kind` and the lens radius then skip where absent), not one per
+/// combination of them.
 fn with_all_extended(bits: u32) -> u32 {
     if bits & EXTENDED != 0 {
         bits | EXTENDED

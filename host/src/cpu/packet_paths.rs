@@ -94,7 +94,7 @@ impl CpuRenderer {
                     .expect("the batch holds sample next");
                 let (px, py) = pixel_of(next);
                 let uv = batch_camera[next % LANES];
-                *slot = Some((next, start_path_at(params, px, py, rng, uv)));
+                *slot = Some((next, start_path_at(features, params, px, py, rng, uv)));
                 next += 1;
             }
             if slots.iter().all(Option::is_none) {

@@ -58,6 +58,10 @@ struct CameraFile {
     vfov: Spanned<f32>,
     width: Spanned<i64>,
     height: Spanned<i64>,
+    /// Thin-lens diameter (default 0: a pinhole).
+    aperture: Option<Spanned<f32>>,
+    /// Distance of the plane in focus along the view axis (default: |look_at - eye|).
+    focus_distance: Option<Spanned<f32>>,
 }
 
 #[derive(Deserialize)]
@@ -215,6 +219,34 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             "is zero or parallel to the viewing direction",
         ));
     }
+    let aperture = match &cam.aperture {
+        Some(a) => {
+            let x = *a.get_ref();
+            if !(0.0..=MAX_COORDINATE).contains(&x) {
+                return Err(ck.err(
+                    a.span(),
+                    "camera.aperture",
+                    format!("{x} is not a lens diameter in 0..={MAX_COORDINATE:e}"),
+                ));
+            }
+            x
+        }
+        None => 0.0,
+    };
+    let focus_distance = match &cam.focus_distance {
+        Some(f) => {
+            let x = *f.get_ref();
+            if !(x > 0.0 && x <= MAX_COORDINATE) {
+                return Err(ck.err(
+                    f.span(),
+                    "camera.focus_distance",
+                    format!("{x} is not a distance in (0, {MAX_COORDINATE:e}]"),
+                ));
+            }
+            x
+        }
+        None => forward.length(),
+    };
     let camera = CameraDesc {
         eye,
         look_at,
@@ -222,6 +254,8 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         vfov_degrees: vfov,
         width,
         height,
+        aperture,
+        focus_distance,
     };
 
     // Render settings: each through the one vocabulary, in the file's order.

@@ -27,10 +27,15 @@ pub struct CameraDesc {
     pub vfov_degrees: f32,
     pub width: u32,
     pub height: u32,
+    /// Diameter of the thin lens (0: a pinhole).
+    pub aperture: f32,
+    /// Distance along the view axis of the plane in focus.
+    pub focus_distance: f32,
 }
 
 impl CameraDesc {
-    /// The kernel's camera: forward, and right/up scaled by the image plane's half-extents.
+    /// The kernel's camera: forward, and right/up scaled by the image plane's half-extents; the
+    /// lens radius and the focus distance in the spare fourth components (`kernel::scene::Camera`).
     pub fn to_kernel(&self) -> Camera {
         let forward = (self.look_at - self.eye).normalize();
         let right = forward.cross(self.up).normalize();
@@ -39,8 +44,8 @@ impl CameraDesc {
         let half_w = half_h * self.width as f32 / self.height as f32;
         let v4 = |v: Vec3| [v.x, v.y, v.z, 0.0];
         Camera {
-            eye: v4(self.eye),
-            forward: v4(forward),
+            eye: [self.eye.x, self.eye.y, self.eye.z, 0.5 * self.aperture],
+            forward: [forward.x, forward.y, forward.z, self.focus_distance],
             right: v4(right * half_w),
             up: v4(up * half_h),
         }
