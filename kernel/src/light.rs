@@ -9,7 +9,7 @@ use crate::sampling::{
     sample_triangle_barycentrics, ConeSample, SurfacePoint,
 };
 use crate::scene::{light_kind, light_sampling, Light};
-use crate::spherical_triangle::{self, barycentrics_along};
+use crate::spherical_triangle::{barycentrics_along, SphericalTriangle};
 use spirv_std::glam::Vec3;
 
 /// A point chosen on a light, and the density of having chosen it.
@@ -189,21 +189,43 @@ pub fn pdf_light_from(
     }
 }
 
-/// The solid angle triangle light `l` subtends at `x` where `mode` samples it so (then the
-/// density of a direction is select_pmf / that), else 0 (sampled by area): see
-/// `spherical_triangle::sampled_solid_angle`.
+/// Triangle light `l` as seen from `x`, if `mode` samples it as a spherical triangle there;
+/// else it is sampled by area. Two tests decide, both functions of `x` and the light alone (so
+/// the sampler and the density MIS uses decide alike): the small-triangle estimate of its solid
+/// angle, area |cos theta| / d^2 from the centroid, must reach
+/// [`SPHERICAL_SAMPLING_MIN_ESTIMATE`] (below it the spherical sampler's cost buys less than
+/// it costs, and this estimate is cheap where the exact solid angle is not), then the exact
+/// solid angle must satisfy `spherical_triangle::SphericalTriangle::sampled` (pbrt-v4's
+/// numerical limits and the edge-on guard).
 #[inline]
-fn triangle_solid_angle_used(l: &Light, mode: u32, x: Vec3) -> f32 {
+pub fn spherical_triangle_used(l: &Light, mode: u32, x: Vec3) -> Option<SphericalTriangle> {
     if mode != light_sampling::SOLID_ANGLE {
-        return 0.0;
+        return None;
     }
-    spherical_triangle::sampled_solid_angle(
-        x,
+    let (p0, e1, e2) = (
         Vec3::from(l.position),
         Vec3::from(l.edge1),
         Vec3::from(l.edge2),
-    )
+    );
+    let to_x = x - (p0 + (e1 + e2) * (1.0 / 3.0));
+    let d = to_x.length();
+    let twice_area_cos = e1.cross(e2).dot(to_x).abs() / d;
+    if !(0.5 * twice_area_cos >= SPHERICAL_SAMPLING_MIN_ESTIMATE * (d * d)) {
+        return None;
+    }
+    let t = SphericalTriangle::of(x, p0, e1, e2);
+    if t.sampled() {
+        Some(t)
+    } else {
+        None
+    }
 }
+
+/// The smallest estimated solid angle (sr; area |cos| / d^2) at which a triangle light is
+/// sampled as a spherical triangle: measured (docs/performance.md, "Triangle lights"), the
+/// spherical sampler costs about twice the area sampler and pays for it only where the light
+/// is large in the receiver's view.
+pub const SPHERICAL_SAMPLING_MIN_ESTIMATE: f32 = 0.1;
 
 /// The normal a triangle light's point shows receiver `x`: the geometric one
 /// (`geometry::triangle_normal`, as a hit's), turned toward `x` if the light is two-sided.
@@ -219,7 +241,7 @@ fn triangle_light_normal(l: &Light, point: Vec3, x: Vec3) -> Vec3 {
 
 /// A point on triangle light `l` (index `light`) for receiver `x`: uniform in the solid angle
 /// it subtends (`spherical_triangle::sample`, then the point that direction meets) where `mode`
-/// is [`light_sampling::SOLID_ANGLE`] and `spherical_triangle::sampled_solid_angle` allows,
+/// is [`light_sampling::SOLID_ANGLE`] and `spherical_triangle::SphericalTriangle::sampled` allows,
 /// else uniform in area (density 1 / area,
 /// converted to solid angle). Either way the point is placed by barycentrics on the triangle
 /// (`geometry::triangle_point`, as hits are), so its error bound is `Light::point_error`.
@@ -236,10 +258,8 @@ pub fn sample_triangle_light(
 ) -> DirectionalLightSample {
     let p0 = Vec3::from(l.position);
     let (e1, e2) = (Vec3::from(l.edge1), Vec3::from(l.edge2));
-    let omega = triangle_solid_angle_used(l, mode, x);
-    if omega > 0.0 {
-        let s = spherical_triangle::sample(x, p0, e1, e2, u1, u2);
-        let (u, v) = barycentrics_along(x, s.direction, p0, e1, e2);
+    if let Some(t) = spherical_triangle_used(l, mode, x) {
+        let (u, v) = barycentrics_along(x, t.sample(u1, u2), p0, e1, e2);
         let position = triangle_point(p0, e1, e2, u, v);
         DirectionalLightSample {
             point: SurfacePoint {
@@ -247,7 +267,7 @@ pub fn sample_triangle_light(
                 normal: triangle_light_normal(l, position, x),
             },
             light,
-            pdf_solid_angle: l.select_pmf / omega,
+            pdf_solid_angle: l.select_pmf / t.solid_angle(),
         }
     } else {
         let (u, v) = sample_triangle_barycentrics(u1, u2);
@@ -265,9 +285,8 @@ pub fn sample_triangle_light(
 /// of triangle light `l` for receiver `x`.
 #[inline]
 pub fn pdf_triangle_light(l: &Light, mode: u32, x: Vec3, y: Vec3, n_y: Vec3) -> f32 {
-    let omega = triangle_solid_angle_used(l, mode, x);
-    if omega > 0.0 {
-        l.select_pmf / omega
+    if let Some(t) = spherical_triangle_used(l, mode, x) {
+        l.select_pmf / t.solid_angle()
     } else {
         area_to_solid_angle_pdf(l.select_pmf / l.area, x, y, n_y)
     }

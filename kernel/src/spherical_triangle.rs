@@ -19,10 +19,11 @@ pub const MIN_SOLID_ANGLE: f32 = 3e-4;
 /// construction is ill-conditioned. pbrt-v4's threshold (`MaxSphericalSampleArea`).
 pub const MAX_SOLID_ANGLE: f32 = 6.22;
 
-/// A triangle as seen from a receiver: the unit directions toward its vertices and their
-/// triple product.
-#[derive(Clone, Copy)]
-struct View {
+/// A triangle as seen from a receiver: the unit directions toward its vertices, their triple
+/// product and the solid angle they span, computed once for the sampler's decision, the sample
+/// and its density.
+#[derive(Clone, Copy, Debug)]
+pub struct SphericalTriangle {
     /// Unit directions from the receiver to p0, p1, p2.
     dir: [Vec3; 3],
     /// The triple product of the unit directions, A . (B x C) = (p0 - x) . ((p1 - x) x (p2 - x))
@@ -32,32 +33,47 @@ struct View {
     /// dividing before the dot product keeps every intermediate below f32's range at the
     /// scene's largest coordinates (1e15: a product of three lengths would overflow).
     volume: f32,
+    /// The solid angle divided by 2 pi (an angle in turns, as `atan2_turns` gives), by Van
+    /// Oosterom and Strackee's formula (1983, "The Solid Angle of a Plane Triangle", IEEE Trans.
+    /// Biomed. Eng. 30(2)): with a, b, c the vectors to the vertices,
+    /// tan(omega / 2) = |a . (b x c)| / (|a||b||c| + (a . b)|c| + (a . c)|b| + (b . c)|a|), here
+    /// divided through by |a||b||c|. It keeps its relative precision for small and distant
+    /// triangles, where Girard's alpha + beta + gamma - pi cancels.
+    omega_turns: f32,
 }
 
-impl View {
+impl SphericalTriangle {
+    /// The triangle p0, p0 + `edge1`, p0 + `edge2` seen from `x`.
     #[inline]
-    fn of(x: Vec3, p0: Vec3, edge1: Vec3, edge2: Vec3) -> Self {
+    pub fn of(x: Vec3, p0: Vec3, edge1: Vec3, edge2: Vec3) -> Self {
         let a = p0 - x;
         let b = a + edge1;
         let c = a + edge2;
         let len = [a.length(), b.length(), c.length()];
         let dir = [a / len[0], b / len[1], c / len[2]];
+        let volume = dir[0].dot(edge1.cross(edge2) / (len[1] * len[2]));
+        let [a, b, c] = dir;
         Self {
             dir,
-            volume: dir[0].dot(edge1.cross(edge2) / (len[1] * len[2])),
+            volume,
+            omega_turns: 2.0 * atan2_turns(volume.abs(), 1.0 + a.dot(b) + b.dot(c) + c.dot(a)),
         }
     }
 
-    /// The solid angle divided by 2 pi (so that it is an angle in turns, as `atan2_turns`
-    /// gives), by Van Oosterom and Strackee's formula (1983, "The Solid Angle of a Plane
-    /// Triangle", IEEE Trans. Biomed. Eng. 30(2)): with a, b, c the vectors to the vertices,
-    /// tan(omega / 2) = |a . (b x c)| / (|a||b||c| + (a . b)|c| + (a . c)|b| + (b . c)|a|), here
-    /// divided through by |a||b||c|. It keeps its relative precision for small and distant triangles,
-    /// where Girard's alpha + beta + gamma - pi cancels.
+    /// The solid angle (steradians): 0 if the receiver lies in the triangle's plane or the
+    /// triangle is degenerate.
     #[inline]
-    fn solid_angle_turns(&self) -> f32 {
-        let [a, b, c] = self.dir;
-        2.0 * atan2_turns(self.volume.abs(), 1.0 + a.dot(b) + b.dot(c) + c.dot(a))
+    pub fn solid_angle(&self) -> f32 {
+        2.0 * PI * self.omega_turns
+    }
+
+    /// Whether the triangle is sampled as a spherical triangle ([`Self::sample`], density
+    /// 1 / [`Self::solid_angle`]): a solid angle within [`MIN_SOLID_ANGLE`] and
+    /// [`MAX_SOLID_ANGLE`], and not seen edge-on ([`MIN_VOLUME_PER_SOLID_ANGLE`]).
+    #[inline]
+    pub fn sampled(&self) -> bool {
+        let omega = self.solid_angle();
+        uses_solid_angle(omega) && self.volume.abs() >= MIN_VOLUME_PER_SOLID_ANGLE * omega
     }
 }
 
@@ -65,7 +81,7 @@ impl View {
 /// (0 if `x` lies in its plane or the triangle is degenerate).
 #[inline]
 pub fn solid_angle(x: Vec3, p0: Vec3, edge1: Vec3, edge2: Vec3) -> f32 {
-    2.0 * PI * View::of(x, p0, edge1, edge2).solid_angle_turns()
+    SphericalTriangle::of(x, p0, edge1, edge2).solid_angle()
 }
 
 /// The smallest triple product of the unit directions to the vertices, relative to the solid
@@ -78,14 +94,12 @@ pub fn solid_angle(x: Vec3, p0: Vec3, edge1: Vec3, edge2: Vec3) -> f32 {
 pub const MIN_VOLUME_PER_SOLID_ANGLE: f32 = 1e-3;
 
 /// The solid angle (steradians) the triangle p0, p0 + `edge1`, p0 + `edge2` subtends at `x` if
-/// it is to be sampled as a spherical triangle (within [`MIN_SOLID_ANGLE`] and
-/// [`MAX_SOLID_ANGLE`], and not seen edge-on: [`MIN_VOLUME_PER_SOLID_ANGLE`]), else 0.
+/// it is to be sampled as a spherical triangle ([`SphericalTriangle::sampled`]), else 0.
 #[inline]
 pub fn sampled_solid_angle(x: Vec3, p0: Vec3, edge1: Vec3, edge2: Vec3) -> f32 {
-    let view = View::of(x, p0, edge1, edge2);
-    let omega = 2.0 * PI * view.solid_angle_turns();
-    if uses_solid_angle(omega) && view.volume.abs() >= MIN_VOLUME_PER_SOLID_ANGLE * omega {
-        omega
+    let t = SphericalTriangle::of(x, p0, edge1, edge2);
+    if t.sampled() {
+        t.solid_angle()
     } else {
         0.0
     }
@@ -100,20 +114,12 @@ pub fn uses_solid_angle(omega: f32) -> bool {
     omega >= MIN_SOLID_ANGLE && omega <= MAX_SOLID_ANGLE
 }
 
-/// A direction sampled in a triangle's spherical triangle, and the triangle's solid angle.
-#[derive(Clone, Copy, Debug)]
-pub struct SphericalTriangleSample {
-    /// Unit direction from the receiver.
-    pub direction: Vec3,
-    /// Solid angle (sr): the density is 1 / `solid_angle`.
-    pub solid_angle: f32,
-}
-
 /// A direction uniformly distributed over the solid angle the triangle p0, p0 + `edge1`,
 /// p0 + `edge2` subtends at `x`, from two uniform numbers (Arvo 1995, "Stratified Sampling of
 /// Spherical Triangles", SIGGRAPH; pbrt-v4 `SampleSphericalTriangle` implements Arvo's
-/// formula as he states it). The density is 1 / [`solid_angle`] of the same arguments;
-/// `solid_angle` is 0 (and the direction meaningless) when the triangle subtends none.
+/// formula as he states it). The density is 1 / [`solid_angle`] of the same arguments; for a
+/// triangle that subtends none (or that [`SphericalTriangle::sampled`] refuses) the direction is
+/// meaningless, but finite or caught by [`barycentrics_along`].
 ///
 /// # Derivation
 /// Let A, B, C be the unit directions to the vertices, alpha the spherical triangle's angle at
@@ -141,47 +147,43 @@ pub struct SphericalTriangleSample {
 /// cos theta = 1 - u2 (1 - B . C') measured from B: Arvo shows this conditional choice makes
 /// the joint density uniform (his section 3); 1 - B . C' is computed as |B - C'|^2 / 2.
 #[inline]
-pub fn sample(
-    x: Vec3,
-    p0: Vec3,
-    edge1: Vec3,
-    edge2: Vec3,
-    u1: f32,
-    u2: f32,
-) -> SphericalTriangleSample {
-    let view = View::of(x, p0, edge1, edge2);
-    let omega_turns = view.solid_angle_turns();
-    let [a, b, c] = view.dir;
-    // The angle at A, between the planes of (A, B) and (A, C): the cross products' dot is
-    // cos alpha |A x B| |A x C|, and the length of their cross product, |A . (B x C)|, the
-    // sine's (the triple product of the unit directions).
-    let cos_part = a.cross(b).dot(a.cross(c));
-    let sin_part = view.volume.abs();
-    let alpha_turns = atan2_turns(sin_part, cos_part);
-    let sin_alpha = sin_part / (cos_part * cos_part + sin_part * sin_part).sqrt();
+pub fn sample(x: Vec3, p0: Vec3, edge1: Vec3, edge2: Vec3, u1: f32, u2: f32) -> Vec3 {
+    SphericalTriangle::of(x, p0, edge1, edge2).sample(u1, u2)
+}
 
-    let sub_area_turns = u1 * omega_turns;
-    let (_, s) = cos_sin_turns(0.5 * sub_area_turns);
-    let (_, sin_phi) = cos_sin_turns(sub_area_turns - alpha_turns);
-    let m = 0.5 * (a - b).length_squared();
-    let two_s2 = 2.0 * s * s;
-    let one_minus_q = two_s2 * (2.0 - m) / (two_s2 - m * sin_alpha * sin_phi);
-    // q in [-1, 1]; a degenerate 0 / 0 reads as C' = A.
-    let one_minus_q = if one_minus_q > 0.0 {
-        one_minus_q.min(2.0)
-    } else {
-        0.0
-    };
-    let sin_b = (one_minus_q * (2.0 - one_minus_q)).sqrt();
-    let c_prime = (1.0 - one_minus_q) * a + sin_b * (c - c.dot(a) * a).normalize();
+impl SphericalTriangle {
+    /// [`sample`] of the triangle this view holds: the unit direction of (u1, u2).
+    #[inline]
+    pub fn sample(&self, u1: f32, u2: f32) -> Vec3 {
+        let omega_turns = self.omega_turns;
+        let [a, b, c] = self.dir;
+        // The angle at A, between the planes of (A, B) and (A, C): the cross products' dot is
+        // cos alpha |A x B| |A x C|, and the length of their cross product, |A . (B x C)|, the
+        // sine's (the triple product of the unit directions).
+        let cos_part = a.cross(b).dot(a.cross(c));
+        let sin_part = self.volume.abs();
+        let alpha_turns = atan2_turns(sin_part, cos_part);
+        let sin_alpha = sin_part / (cos_part * cos_part + sin_part * sin_part).sqrt();
 
-    let one_minus_cos = u2 * (0.5 * (b - c_prime).length_squared());
-    let cos_theta = 1.0 - one_minus_cos;
-    let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
-    let direction = cos_theta * b + sin_theta * (c_prime - c_prime.dot(b) * b).normalize();
-    SphericalTriangleSample {
-        direction: direction.normalize(),
-        solid_angle: 2.0 * PI * omega_turns,
+        let sub_area_turns = u1 * omega_turns;
+        let (_, s) = cos_sin_turns(0.5 * sub_area_turns);
+        let (_, sin_phi) = cos_sin_turns(sub_area_turns - alpha_turns);
+        let m = 0.5 * (a - b).length_squared();
+        let two_s2 = 2.0 * s * s;
+        let one_minus_q = two_s2 * (2.0 - m) / (two_s2 - m * sin_alpha * sin_phi);
+        // q in [-1, 1]; a degenerate 0 / 0 reads as C' = A.
+        let one_minus_q = if one_minus_q > 0.0 {
+            one_minus_q.min(2.0)
+        } else {
+            0.0
+        };
+        let sin_b = (one_minus_q * (2.0 - one_minus_q)).sqrt();
+        let c_prime = (1.0 - one_minus_q) * a + sin_b * (c - c.dot(a) * a).normalize();
+
+        let one_minus_cos = u2 * (0.5 * (b - c_prime).length_squared());
+        let cos_theta = 1.0 - one_minus_cos;
+        let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+        (cos_theta * b + sin_theta * (c_prime - c_prime.dot(b) * b).normalize()).normalize()
     }
 }
 
