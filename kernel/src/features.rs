@@ -36,6 +36,8 @@ pub const MATERIALS: u32 = GLOSSY | CONDUCTOR | DIELECTRIC;
 /// The light table may hold triangles (emissive quads and meshes): without it every light is
 /// a sphere.
 pub const TRIANGLE_LIGHTS: u32 = 1 << 10;
+/// The scene has an environment map: a light, and the background of escaping paths.
+pub const ENVIRONMENT: u32 = 1 << 12;
 /// The camera may have a thin lens (a lens radius above 0; with the bit, a pinhole camera still
 /// runs as one).
 pub const THIN_LENS: u32 = 1 << 11;
@@ -91,6 +93,9 @@ pub fn scene_features(params: &RenderParams) -> u32 {
     }
     if params.camera.eye[3] > 0.0 {
         f |= THIN_LENS;
+    }
+    if params.env_width > 0 {
+        f |= ENVIRONMENT | BACKGROUND;
     }
     f
 }
@@ -155,6 +160,11 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn dielectric(self) -> bool {
         self.answer(DIELECTRIC, true)
+    }
+    /// Whether the render may have an environment map (see [`ENVIRONMENT`]).
+    #[inline]
+    fn environment(self, p: &RenderParams) -> bool {
+        self.answer(ENVIRONMENT, p.env_width > 0)
     }
     /// Whether the camera may have a lens (see [`THIN_LENS`]).
     #[inline]

@@ -12,6 +12,7 @@ pub mod adaptive;
 pub mod brdf;
 pub mod bsdf;
 pub mod camera;
+pub mod environment;
 pub mod features;
 pub mod frame;
 pub mod fresnel;

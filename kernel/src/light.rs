@@ -1,6 +1,7 @@
 //! Area lights (spheres and triangles): choosing one, a point on it, and the densities of
 //! those choices.
 
+use crate::environment;
 use crate::geometry::{
     area_to_solid_angle_pdf, sphere_point_error, triangle_normal, triangle_point,
 };
@@ -8,7 +9,7 @@ use crate::sampling::{
     pdf_sphere_area, pdf_sphere_cone, sample_sphere, sample_sphere_cone,
     sample_triangle_barycentrics, ConeSample, SurfacePoint,
 };
-use crate::scene::{light_kind, light_sampling, Light};
+use crate::scene::{light_kind, light_sampling, Light, RenderParams};
 use crate::spherical_triangle::{barycentrics_along, SphericalTriangle};
 use spirv_std::glam::Vec3;
 
@@ -108,6 +109,71 @@ pub fn is_triangle(triangles: bool, l: &Light) -> bool {
     triangles && l.kind == light_kind::TRIANGLE
 }
 
+/// Whether light `l` is the environment map, where the light table may hold one
+/// (`environment`: `features::ENVIRONMENT`).
+#[inline]
+pub fn is_environment(environment: bool, l: &Light) -> bool {
+    environment && l.kind == light_kind::ENVIRONMENT
+}
+
+/// A direction toward the environment map (light `l`, index `light`) for receiver `x`, by
+/// `environment::sample` under `mode`, as a light point: beyond the sphere bounding the scene
+/// (`l.position`, `l.radius`) along the direction, facing back along it, so the shadow ray to
+/// it crosses the whole scene. Density: the map's, times the selection probability.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn sample_environment_light(
+    l: &Light,
+    light: u32,
+    mode: u32,
+    params: &RenderParams,
+    table: &[f32],
+    x: Vec3,
+    u1: f32,
+    u2: f32,
+) -> DirectionalLightSample {
+    let dir = environment::sample(params, table, mode, u1, u2);
+    let far = 2.0 * (l.radius + (x - Vec3::from(l.position)).length());
+    DirectionalLightSample {
+        point: SurfacePoint {
+            position: x + dir * far,
+            normal: -dir,
+        },
+        light,
+        pdf_solid_angle: l.select_pmf * environment::pdf(params, table, mode, dir),
+    }
+}
+
+/// The solid-angle density with which [`sample_light_from`] chooses the environment map (light
+/// `l`) and direction `dir`: what MIS needs when a path escapes along `dir`.
+#[inline]
+pub fn pdf_environment_light(
+    l: &Light,
+    mode: u32,
+    params: &RenderParams,
+    table: &[f32],
+    dir: Vec3,
+) -> f32 {
+    l.select_pmf * environment::pdf(params, table, mode, dir)
+}
+
+/// The radiance light sample `ls` of light `l` sends toward its receiver: the light's constant
+/// radiance, or the environment map's along the sample's direction (-normal).
+#[inline]
+pub fn sample_radiance(
+    environment: bool,
+    params: &RenderParams,
+    table: &[f32],
+    l: &Light,
+    ls: &DirectionalLightSample,
+) -> Vec3 {
+    if is_environment(environment, l) {
+        environment::eval(params, table, -ls.point.normal)
+    } else {
+        Vec3::from(l.radiance)
+    }
+}
+
 /// Whether `mode` samples light `l` by its cone from receiver `x`: a sphere (the caller knows it
 /// is one) with `x` strictly outside.
 #[inline]
@@ -120,7 +186,8 @@ pub fn uses_cone(mode: u32, l: &Light, x: Vec3) -> bool {
 /// sampling ([`sample_light`], density converted to solid angle), or by the cone the sphere
 /// subtends ([`sample_sphere_cone`]) when `mode` is [`light_sampling::SOLID_ANGLE`] and `x` is
 /// outside it. A triangle (only where `triangles`, see [`is_triangle`]): by
-/// [`sample_triangle_light`].
+/// [`sample_triangle_light`]. The environment map (only where `environment`, see
+/// [`is_environment`]; `params` and `table` describe it): by [`sample_environment_light`].
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn sample_light_from(
@@ -128,6 +195,9 @@ pub fn sample_light_from(
     light_count: u32,
     mode: u32,
     triangles: bool,
+    environment: bool,
+    params: &RenderParams,
+    table: &[f32],
     x: Vec3,
     u_select: f32,
     u1: f32,
@@ -137,6 +207,9 @@ pub fn sample_light_from(
     let l = lights[light as usize];
     if is_triangle(triangles, &l) {
         return sample_triangle_light(&l, light, mode, x, u1, u2);
+    }
+    if is_environment(environment, &l) {
+        return sample_environment_light(&l, light, mode, params, table, x, u1, u2);
     }
     let center = Vec3::from(l.position);
     if uses_cone(mode, &l, x) {

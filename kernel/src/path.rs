@@ -5,12 +5,16 @@ use crate::adaptive::sample_stream;
 use crate::brdf::{eval_scattering, pdf_brdf, sampled_brdf_weight};
 use crate::bsdf::{self, DELTA_PDF};
 use crate::camera::{camera_origin, camera_ray_direction, lens_radius, thin_lens_ray};
+use crate::environment;
 use crate::features::FeatureSet;
 use crate::geometry::{
     offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error, triangle_point,
     triangle_point_error_conditioned, TriangleShape,
 };
-use crate::light::{eval_radiance, light_point_error, pdf_light_from, DirectionalLightSample};
+use crate::light::{
+    eval_radiance, light_point_error, pdf_environment_light, pdf_light_from, sample_radiance,
+    DirectionalLightSample,
+};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{
@@ -203,11 +207,19 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
     params: &RenderParams,
     materials: &[Material],
     lights: &[Light],
+    environment: &[f32],
     origin: Vec3,
     dir: Vec3,
     rng: &mut SampleRng,
 ) -> Vec3 {
-    let path = PathState::new(origin, dir, *rng).run(tracer, features, params, materials, lights);
+    let path = PathState::new(origin, dir, *rng).run(
+        tracer,
+        features,
+        params,
+        materials,
+        lights,
+        environment,
+    );
     *rng = path.rng;
     path.radiance
 }
@@ -291,6 +303,7 @@ impl PathState {
         params: &RenderParams,
         materials: &[Material],
         lights: &[Light],
+        environment: &[f32],
     ) -> Self {
         loop {
             let hit = if self.extend {
@@ -299,11 +312,28 @@ impl PathState {
                 SurfaceHit::miss()
             };
             let occluded = self.shadow && tracer.occluded(self.shadow_from, self.shadow_to);
-            if self.advance(features, params, materials, lights, &hit, occluded) {
+            if self.advance(
+                features,
+                params,
+                materials,
+                lights,
+                environment,
+                &hit,
+                occluded,
+            ) {
                 let material = materials[hit.material as usize];
                 let query = self.vertex_query(features, params, &hit, &material);
                 let samples = VertexSamples::draw(&query, &mut self.rng);
-                self.vertex(features, params, lights, &hit, &material, &query, &samples);
+                self.vertex(
+                    features,
+                    params,
+                    lights,
+                    environment,
+                    &hit,
+                    &material,
+                    &query,
+                    &samples,
+                );
             }
             if self.finished() {
                 return self;
@@ -318,12 +348,14 @@ impl PathState {
     /// states its query ([`PathState::vertex_query`]), fills its samples and hands them to
     /// [`PathState::vertex`], which prepares the next rays.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn advance<F: FeatureSet>(
         &mut self,
         features: F,
         params: &RenderParams,
         materials: &[Material],
         lights: &[Light],
+        environment: &[f32],
         hit: &SurfaceHit,
         occluded: bool,
     ) -> bool {
@@ -336,6 +368,32 @@ impl PathState {
         }
         self.extend = false;
         if !hit.is_hit() {
+            if features.environment(params) && environment::has_map(params) {
+                // 1: the camera ray sees the environment map; 2(b): an extension found it,
+                // weighted against light sampling's choice of the same direction as any light.
+                let emitted = environment::eval(params, environment, self.ray_dir);
+                if self.depth == 0 {
+                    self.radiance = emitted;
+                } else {
+                    let mode = features.mis_mode(params);
+                    let weight = if mode == mis::POWER {
+                        let pdf_l = pdf_environment_light(
+                            &lights[params.env_light as usize],
+                            light_sampling_of(features, params),
+                            params,
+                            environment,
+                            self.ray_dir,
+                        );
+                        power_heuristic(self.previous_pdf, pdf_l)
+                    } else if features.materials() && self.previous_pdf == DELTA_PDF {
+                        1.0
+                    } else {
+                        bsdf_strategy_weight(mode)
+                    };
+                    self.radiance += self.throughput * emitted * weight;
+                }
+                return false;
+            }
             // 1: the camera ray sees the background; an extension adds it with weight 1.
             if self.depth == 0 {
                 self.radiance = background(params);
@@ -426,6 +484,7 @@ impl PathState {
             light_count,
             mode: light_sampling_of(features, params),
             triangle_lights: features.triangle_lights(),
+            environment_light: features.environment(params),
             extend: self.depth < params.max_depth,
             roulette: self.depth >= params.rr_start_depth,
             survival,
@@ -446,15 +505,34 @@ impl PathState {
         features: F,
         params: &RenderParams,
         lights: &[Light],
+        environment: &[f32],
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
         samples: &VertexSamples,
     ) {
         if query.lambertian {
-            self.lambertian_vertex(features, params, lights, hit, material, query, samples);
+            self.lambertian_vertex(
+                features,
+                params,
+                lights,
+                environment,
+                hit,
+                material,
+                query,
+                samples,
+            );
         } else {
-            self.bsdf_vertex(features, params, lights, hit, material, query, samples);
+            self.bsdf_vertex(
+                features,
+                params,
+                lights,
+                environment,
+                hit,
+                material,
+                query,
+                samples,
+            );
         }
     }
 
@@ -466,6 +544,7 @@ impl PathState {
         features: F,
         params: &RenderParams,
         lights: &[Light],
+        environment: &[f32],
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
@@ -477,14 +556,20 @@ impl PathState {
 
         // 2(a): next-event estimation.
         if query.samples_light() {
-            let ls = samples.light_sample(query, lights);
+            let ls = samples.light_sample(query, params, lights, environment);
             let y = ls.point.position;
             let wi = (y - x).normalize();
             let cos_x = n.dot(wi);
             let cos_y = -ls.point.normal.dot(wi);
             let pdf_w = ls.pdf_solid_angle;
             if cos_x > 0.0 && cos_y > 0.0 && pdf_w > 0.0 {
-                let emitted = Vec3::from(lights[ls.light as usize].radiance);
+                let emitted = sample_radiance(
+                    query.environment_light,
+                    params,
+                    environment,
+                    &lights[ls.light as usize],
+                    &ls,
+                );
                 let weight = light_strategy_weight(features, params, pdf_w, pdf_brdf(n, wi));
                 let radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
@@ -523,6 +608,7 @@ impl PathState {
         features: F,
         params: &RenderParams,
         lights: &[Light],
+        environment: &[f32],
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
@@ -540,14 +626,20 @@ impl PathState {
 
         // 2(a): next-event estimation.
         if query.samples_light() {
-            let ls = samples.light_sample(query, lights);
+            let ls = samples.light_sample(query, params, lights, environment);
             let y = ls.point.position;
             let wi = (y - x).normalize();
             let cos_y = -ls.point.normal.dot(wi);
             let pdf_w = ls.pdf_solid_angle;
             let (f_cos, pdf_b) = bsdf::eval(features, material, n, wo, wi, eta);
             if cos_y > 0.0 && pdf_w > 0.0 && f_cos.max_element() > 0.0 {
-                let emitted = Vec3::from(lights[ls.light as usize].radiance);
+                let emitted = sample_radiance(
+                    query.environment_light,
+                    params,
+                    environment,
+                    &lights[ls.light as usize],
+                    &ls,
+                );
                 let weight = light_strategy_weight(features, params, pdf_w, pdf_b);
                 let from = offset_ray_origin(x, side(n, n.dot(wi) > 0.0), hit.error);
                 let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
@@ -701,12 +793,13 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
     params: &RenderParams,
     materials: &[Material],
     lights: &[Light],
+    environment: &[f32],
     px: u32,
     py: u32,
     sample: u32,
 ) -> Vec3 {
     start_sample(features, params, px, py, sample)
-        .run(tracer, features, params, materials, lights)
+        .run(tracer, features, params, materials, lights, environment)
         .radiance
 }
 

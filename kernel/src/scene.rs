@@ -110,6 +110,10 @@ pub mod light_kind {
     /// An emissive triangle (of a quad or a mesh): emits from its front face, the side
     /// edge1 x edge2 points to, or from both faces when `Light::two_sided`.
     pub const TRIANGLE: u32 = 1;
+    /// The environment map: radiance arriving from infinitely far in every direction
+    /// (`environment`). `position` and `radius` hold a sphere bounding the scene, which shadow
+    /// rays toward it leave; `radiance` its mean (for the selection by power).
+    pub const ENVIRONMENT: u32 = 2;
 }
 
 /// An area light: the light table lists every emissive sphere and every emissive triangle.
@@ -211,7 +215,7 @@ pub mod sampler {
     pub const SOBOL: u32 = 1;
 }
 
-/// Everything a path needs besides the scene geometry and tables. 144 bytes.
+/// Everything a path needs besides the scene geometry and tables. 176 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
@@ -248,4 +252,16 @@ pub struct RenderParams {
     pub min_pilot_samples: u32,
     /// One of [`sampler`].
     pub sampler: u32,
+    /// The environment map's width and height in texels (0 x 0: none; the constant
+    /// `background` then lights the scene). Its texels and sampling tables are the
+    /// environment table (`environment`).
+    pub env_width: u32,
+    pub env_height: u32,
+    /// Index of the environment map in the light table, or [`NONE`].
+    pub env_light: u32,
+    /// Factor on every texel.
+    pub env_scale: f32,
+    /// Cosine and sine of the map's rotation about +y.
+    pub env_rotation: [f32; 2],
+    pub _pad: [u32; 2],
 }

@@ -5,7 +5,8 @@
 //! Bindings (descriptor set 0): 0 TLAS, 1 running mean (rgba32f: rgb mean, a sample count),
 //! 2 params ([`RenderParams`]), 3 materials, 4 lights, 5 triangles, 6 spheres,
 //! 7 running M2 (rgba32f: rgb sum of squared deviations from the mean, a discarded samples),
-//! 8 adaptive-sampling pilots (rgba32f: luminance mean, luminance M2, count, unused).
+//! 8 adaptive-sampling pilots (rgba32f: luminance mean, luminance M2, count, unused),
+//! 9 the environment table (`crate::environment`; one number when there is no map).
 //! Specialization constant 0: the feature bits of `crate::features` (0: generic path).
 //! Hit groups: 0 triangles (closest hit), 1 spheres (intersection + closest hit).
 //! Miss shader 0 serves both kinds of ray.
@@ -132,6 +133,7 @@ pub fn raygen(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] params: &RenderParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] materials: &[Material],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] lights: &[Light],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] environment: &[f32],
     #[spirv(descriptor_set = 0, binding = 7)] accum_m2: &Image!(
         2D,
         format = rgba32f,
@@ -170,6 +172,7 @@ pub fn raygen(
             params,
             materials,
             lights,
+            environment,
             px,
             py,
             index,

@@ -13,7 +13,7 @@ use crate::brdf::sample_brdf;
 use crate::light::{sample_light_from, DirectionalLightSample};
 use crate::rng::SampleRng;
 use crate::sampling::SurfacePoint;
-use crate::scene::{Light, NONE};
+use crate::scene::{Light, RenderParams, NONE};
 use spirv_std::glam::Vec3;
 
 /// Random dimensions per path vertex: light choice (1) and point (2), roulette (1), BRDF (2).
@@ -56,6 +56,8 @@ pub struct VertexQuery {
     pub mode: u32,
     /// Whether a light may be a triangle (`features::TRIANGLE_LIGHTS`).
     pub triangle_lights: bool,
+    /// Whether a light may be the environment map (`features::ENVIRONMENT`).
+    pub environment_light: bool,
     /// Whether the vertex may extend the path (its depth is below `max_depth`).
     pub extend: bool,
     /// The roulette's survival probability: a number is drawn only where `roulette` and not
@@ -147,8 +149,8 @@ pub struct VertexSamples {
     /// The lobe choice, where [`VertexQuery::lobe_dimension`] names one and the path survives
     /// roulette.
     pub u_lobe: f32,
-    /// `sample_light_from(lights, light_count, mode, triangle_lights, x, u_select, u_light)`,
-    /// if `has_light`.
+    /// `sample_light_from(lights, light_count, mode, ..., x, u_select, u_light)`, if
+    /// `has_light`.
     pub light: DirectionalLightSample,
     pub has_light: bool,
     /// `sample_brdf(n, u_brdf)`, if `has_brdf_dir`.
@@ -233,9 +235,16 @@ impl VertexSamples {
         s
     }
 
-    /// The light sample for `query`: the one given, or computed now.
+    /// The light sample for `query`: the one given, or computed now (`params` and `table`
+    /// describe the environment map, if any).
     #[inline]
-    pub fn light_sample(&self, query: &VertexQuery, lights: &[Light]) -> DirectionalLightSample {
+    pub fn light_sample(
+        &self,
+        query: &VertexQuery,
+        params: &RenderParams,
+        lights: &[Light],
+        table: &[f32],
+    ) -> DirectionalLightSample {
         if self.has_light {
             return self.light;
         }
@@ -245,6 +254,9 @@ impl VertexSamples {
             query.light_count,
             query.mode,
             query.triangle_lights,
+            query.environment_light,
+            params,
+            table,
             query.x,
             self.u_select,
             u1,

@@ -74,6 +74,7 @@ fn estimate_at(scene: &Scene, x: Vec3, view_dir: Vec3, stream: u32, batch: u32) 
                 &params,
                 &cpu.materials,
                 &cpu.lights,
+                &cpu.environment,
                 origin,
                 view_dir,
                 &mut rng,

@@ -189,6 +189,8 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
     let many = small("many_lights.toml").lights;
     let one = small("cornell.toml").lights;
     let panel = small("cornell_panel.toml").lights;
+    // No environment map in these light tables: its parameters stay unread.
+    let params = small("cornell.toml").params(0, 1);
     assert!(many.len() > 1 && one.len() == 1 && panel.len() == 2);
     let bits = |v: Vec3| v.to_array().map(f32::to_bits);
     let mut checked = [0usize; 5];
@@ -252,6 +254,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 },
                 // A table with triangles needs the bit; a table of spheres runs either way.
                 triangle_lights: round % 3 == 2 || h(lane, 23) % 2 == 0,
+                environment_light: false,
                 extend: h(lane, 19) % 5 != 0,
                 roulette: h(lane, 20) % 3 != 0,
                 survival,
@@ -272,7 +275,10 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
             if q.samples_light() {
                 assert_eq!(pair_bits(got.u_light), pair_bits(want.u_light));
                 // What the vertex uses: the sample given, or the one it computes itself.
-                let (g, w) = (got.light_sample(q, lights), want.light_sample(q, lights));
+                let (g, w) = (
+                    got.light_sample(q, &params, lights, &[0.0]),
+                    want.light_sample(q, &params, lights, &[0.0]),
+                );
                 assert_eq!(
                     (
                         bits(g.point.position),

@@ -670,3 +670,60 @@ fn thin_lens_settings() {
         "not a distance",
     );
 }
+
+#[test]
+fn environment_map_settings() {
+    let bg = |body: &str| format!("{GOOD}\n[background]\n{body}\n");
+    let sky = twinpath_tests::repo_root().join("scenes/sky.hdr");
+    let s = parse_scene(
+        &bg(&format!(
+            "map = \"{}\"\nscale = 0.5\nrotation = 90",
+            sky.display()
+        )),
+        &scene_path(),
+    )
+    .unwrap();
+    let map = s.environment.as_ref().unwrap();
+    assert_eq!(
+        (map.width, map.height, map.scale, map.rotation_degrees),
+        (512, 256, 0.5, 90.0)
+    );
+    // The map is a light: the last entry of the light table.
+    assert_eq!(
+        s.lights.last().unwrap().kind,
+        kernel::scene::light_kind::ENVIRONMENT
+    );
+    assert_error(
+        &bg("map = \"nowhere.exr\""),
+        "nowhere",
+        "background.map",
+        "does not exist",
+    );
+    assert_error(
+        &bg(&format!(
+            "radiance = [1, 1, 1]\nmap = \"{}\"",
+            sky.display()
+        )),
+        "map =",
+        "background",
+        "choose one",
+    );
+    assert_error(
+        &bg("radiance = [1, 1, 1]\nscale = 2"),
+        "scale",
+        "background",
+        "belong to a map",
+    );
+    assert_error(
+        &bg(&format!("map = \"{}\"\nscale = -1", sky.display())),
+        "scale",
+        "background.scale",
+        "non-negative",
+    );
+    // A file that is not an image: named, with the reason.
+    let e = error_of(&bg("map = \"../scenes/cornell.toml\""));
+    assert!(
+        e.file.ends_with("cornell.toml") && e.field == "background.map",
+        "{e}"
+    );
+}

@@ -71,6 +71,10 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("cornell with gold and glass", cornell_materials()),
         ("cornell lit by a panel (triangle lights)", cornell_panel()),
         ("cornell through a thin lens", thin_lens(cornell())),
+        (
+            "an environment map",
+            small(Scene::load(&repo_root().join("scenes/sky.toml")).unwrap()),
+        ),
     ]
 }
 
@@ -106,6 +110,12 @@ fn scene_analysis_finds_the_features_present() {
     );
     assert_eq!(cornell().features() & features::TRIANGLE_LIGHTS, 0);
     assert_eq!(cornell().features() & features::THIN_LENS, 0);
+    assert_eq!(cornell().features() & features::ENVIRONMENT, 0);
+    let sky = small(Scene::load(&repo_root().join("scenes/sky.toml")).unwrap());
+    assert_eq!(
+        sky.features() & (features::ENVIRONMENT | features::BACKGROUND | features::LIGHTS),
+        features::ENVIRONMENT | features::BACKGROUND | features::LIGHTS
+    );
     assert_eq!(
         thin_lens(cornell()).features() & features::THIN_LENS,
         features::THIN_LENS

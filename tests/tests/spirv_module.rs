@@ -128,7 +128,13 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     adaptive_target,
                     pilot_period,
                     min_pilot_samples,
-                    sampler
+                    sampler,
+                    env_width,
+                    env_height,
+                    env_light,
+                    env_scale,
+                    env_rotation,
+                    _pad
                 ],
                 false
             ),

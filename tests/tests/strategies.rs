@@ -1,7 +1,8 @@
 //! Light sampling alone, BSDF sampling alone, and their MIS combination estimate the same
 //! image: a glossy scene (a Kd + Ks floor, a rough gold sphere, a sharp Kd + Ks sphere, a
 //! sphere light) and a scene lit by triangle lights (a two-sided tilted panel, a one-sided
-//! panel, an emissive mesh; sampled by solid angle, and by area as a fifth variant) rendered in
+//! panel, an emissive mesh; sampled by solid angle, and by area as a fifth variant) and a scene
+//! lit by an environment map (by luminance, and uniformly as a fifth variant) rendered in
 //! each mode (`mis = light | bsdf | half` against `power`) agree
 //! block by block of 2 x 2 pixels and in the image mean: Welch t-tests on the means of 16
 //! independent renders (batch means), since light sampling of a sharp lobe and BSDF sampling
@@ -13,6 +14,7 @@
 use statrs::distribution::{ContinuousCDF, StudentsT};
 use twinpath::film::Film;
 use twinpath::render::Backend;
+use twinpath::scene::environment::EnvironmentMap;
 use twinpath::scene::Scene;
 use twinpath::settings::{LightSampling, Mis};
 use twinpath_tests::{render_film, scene_from_toml};
@@ -127,8 +129,11 @@ struct Variant {
     area: bool,
 }
 
-fn render(text: &str, v: Variant, batch: u32) -> Film {
+fn render(text: &str, map: Option<&EnvironmentMap>, v: Variant, batch: u32) -> Film {
     let mut scene: Scene = scene_from_toml(text);
+    if let Some(m) = map {
+        scene.set_environment(Some(m.clone()));
+    }
     scene.render.mis = v.mis;
     if v.area {
         scene.render.light_sampling = LightSampling::Area;
@@ -184,14 +189,14 @@ fn welch(a: &[f64], b: &[f64]) -> (f64, f64) {
 
 /// Every variant of `text` agrees with power-heuristic MIS (by solid angle), block by block and
 /// in the image mean.
-fn variants_agree(label: &str, text: &str, variants: &[Variant]) {
+fn variants_agree(label: &str, text: &str, map: Option<&EnvironmentMap>, variants: &[Variant]) {
     let power = Variant {
         mis: Mis::Power,
         area: false,
     };
     let batches = |v: Variant| -> Vec<Vec<[f64; 3]>> {
         (0..BATCHES)
-            .map(|b| block_means(&render(text, v, b)))
+            .map(|b| block_means(&render(text, map, v, b)))
             .collect()
     };
     let reference = batches(power);
@@ -249,7 +254,7 @@ const MODES: [Variant; 3] = [
 
 #[test]
 fn light_only_bsdf_only_and_mis_agree() {
-    variants_agree("sphere light", SPHERE_LIGHT_SCENE, &MODES);
+    variants_agree("sphere light", SPHERE_LIGHT_SCENE, None, &MODES);
 }
 
 #[test]
@@ -259,5 +264,33 @@ fn light_only_bsdf_only_and_mis_agree_under_triangle_lights() {
         mis: Mis::Power,
         area: true,
     });
-    variants_agree("triangle lights", TRIANGLE_LIGHT_SCENE, &variants);
+    variants_agree("triangle lights", TRIANGLE_LIGHT_SCENE, None, &variants);
+}
+
+/// The glossy scene without its sphere light, under an environment map with a bright patch (a
+/// "sun" of 2 x 1 texels) over a smooth sky: importance sampling by luminance (power MIS)
+/// against light-only, BSDF-only, half weights and uniform directions.
+#[test]
+fn light_only_bsdf_only_and_mis_agree_under_an_environment_map() {
+    let (w, h) = (32u32, 16u32);
+    let mut map = EnvironmentMap::constant(w, h, [0.0; 3]);
+    for j in 0..h {
+        for i in 0..w {
+            let v = (j as f32 + 0.5) / h as f32;
+            let sky = if v < 0.5 { 0.6 - 0.5 * v } else { 0.15 };
+            let sun = if (i == 5 || i == 6) && j == 4 {
+                60.0
+            } else {
+                0.0
+            };
+            map.texels[(j * w + i) as usize] = [sky + sun, sky + 0.9 * sun, 1.2 * sky + 0.7 * sun];
+        }
+    }
+    let text = SPHERE_LIGHT_SCENE.replace("material = \"light\"", "material = \"floor\"");
+    let mut variants = MODES.to_vec();
+    variants.push(Variant {
+        mis: Mis::Power,
+        area: true,
+    });
+    variants_agree("environment map", &text, Some(&map), &variants);
 }

@@ -49,6 +49,8 @@ pub struct CpuRenderer {
     pub bvh: Bvh,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
+    /// The environment table (`kernel::environment`; one number without a map).
+    pub environment: Vec<f32>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path).
     pub features: u32,
     /// How a tile's samples are computed, chosen once when the renderer is built.
@@ -106,13 +108,14 @@ macro_rules! with_features {
 }
 
 /// The feature bits beyond the diffuse renderer's: other materials than the Lambertian,
-/// triangle lights and a thin lens.
-const EXTENDED: u32 = features::MATERIALS | features::TRIANGLE_LIGHTS | features::THIN_LENS;
+/// triangle lights, a thin lens and an environment map.
+const EXTENDED: u32 =
+    features::MATERIALS | features::TRIANGLE_LIGHTS | features::THIN_LENS | features::ENVIRONMENT;
 
 /// `bits` with every [`EXTENDED`] bit set if any is: the CPU compiles one path for scenes with
-/// other materials, triangle lights or a lens (such a bit only keeps code, which the material's
-/// `kind`, the light's `kind` and the lens radius then skip where absent), not one per
-/// combination of them.
+/// other materials, triangle lights, a lens or an environment map (such a bit only keeps code,
+/// which the material's `kind`, the light's `kind`, the lens radius and the map's size then skip
+/// where absent), not one per combination of them.
 fn with_all_extended(bits: u32) -> u32 {
     if bits & EXTENDED != 0 {
         bits | EXTENDED
@@ -136,6 +139,7 @@ impl CpuRenderer {
             bvh,
             materials: scene.materials.clone(),
             lights: scene.light_table(),
+            environment: scene.environment_table(),
             features: with_all_extended(scene.features()),
             tiles: small.map_or(TileStrategy::OnePath, TileStrategy::Packets),
         }
@@ -162,6 +166,7 @@ impl CpuRenderer {
             params,
             &self.materials,
             &self.lights,
+            &self.environment,
             px,
             py,
             sample,

@@ -136,6 +136,7 @@ impl CpuRenderer {
                     params,
                     &self.materials,
                     &self.lights,
+                    &self.environment,
                     hit,
                     occluded[lane],
                 ) {
@@ -154,6 +155,7 @@ impl CpuRenderer {
                         features,
                         params,
                         &self.lights,
+                        &self.environment,
                         hit,
                         material,
                         query,

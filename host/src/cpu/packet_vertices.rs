@@ -13,11 +13,11 @@ use super::packet_numbers::NumberRequests;
 use super::simd::widest_simd;
 use glam::Vec3;
 use kernel::brdf::sample_brdf_v3;
-use kernel::light::{choose_light, cone_light_sample, is_triangle, uses_cone};
+use kernel::light::{choose_light, cone_light_sample, uses_cone};
 use kernel::real::V3;
 use kernel::rng::SampleRng;
 use kernel::sampling::{sample_sphere_cone_v3, ConeSample, SurfacePoint};
-use kernel::scene::Light;
+use kernel::scene::{light_kind, Light};
 use kernel::vertex_samples::{VertexQuery, VertexSamples, NO_DIMENSION};
 use std::simd::Simd;
 
@@ -138,7 +138,7 @@ pub fn fill_vertex_samples(
         if q.samples_light() {
             let light = choose_light(lights, q.light_count, s.u_select);
             let l = &lights[light as usize];
-            if !is_triangle(q.triangle_lights, l) && uses_cone(q.mode, l, q.x) {
+            if l.kind == light_kind::SPHERE && uses_cone(q.mode, l, q.x) {
                 set_lane3(&mut args.center, lane, Vec3::from(l.position));
                 args.radius[lane] = l.radius;
                 set_lane3(&mut args.receiver, lane, q.x);

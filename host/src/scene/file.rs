@@ -2,6 +2,7 @@
 //! field; every error carries the file, the line of the offending value and the field's path.
 
 use super::closed_surface::check_closed_outward;
+use super::environment::EnvironmentMap;
 use super::error::{line_of, SceneError};
 use super::light_table::{sphere_light, triangle_light};
 use super::mesh::load_mesh;
@@ -114,7 +115,14 @@ struct MeshFile {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct BackgroundFile {
-    radiance: V3,
+    /// A uniform environment.
+    radiance: Option<V3>,
+    /// An equirectangular environment map (EXR or HDR), relative to the scene file.
+    map: Option<Spanned<String>>,
+    /// Factor on the map's texels (default 1).
+    scale: Option<Spanned<f32>>,
+    /// The map's rotation about the up axis (+y), degrees (default 0).
+    rotation: Option<Spanned<f32>>,
 }
 
 /// Checks values and reports errors at their line.
@@ -486,10 +494,14 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
 
     super::light_table::assign_light_selection(&mut lights, render.light_selection.code());
 
-    let background = match &file.background {
-        Some(b) => ck.color(&b.radiance, "background.radiance", None)?,
-        None => Vec3::ZERO,
+    let (background, environment) = match &file.background {
+        Some(b) => background(&ck, b, base_dir)?,
+        None => (Vec3::ZERO, None),
     };
+    if let Some(map) = &environment {
+        lights.push(map.light(&spheres, &triangles));
+    }
+    super::light_table::assign_light_selection(&mut lights, render.light_selection.code());
 
     Ok(Scene {
         name: path.display().to_string(),
@@ -502,5 +514,68 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         triangles,
         triangle_groups,
         lights,
+        environment,
     })
+}
+
+/// The `[background]` table: a uniform radiance, or an environment map with its scale and
+/// rotation (exactly one of the two).
+fn background(
+    ck: &Checker,
+    b: &BackgroundFile,
+    base_dir: &Path,
+) -> Result<(Vec3, Option<EnvironmentMap>), SceneError> {
+    match (&b.radiance, &b.map) {
+        (Some(r), None) => {
+            if let Some(s) = b.scale.as_ref().or(b.rotation.as_ref()) {
+                return Err(ck.err(
+                    s.span(),
+                    "background",
+                    "scale and rotation belong to a map, not to a uniform radiance",
+                ));
+            }
+            Ok((ck.color(r, "background.radiance", None)?, None))
+        }
+        (None, Some(m)) => {
+            let map_path = base_dir.join(m.get_ref());
+            if !map_path.is_file() {
+                return Err(ck.err(
+                    m.span(),
+                    "background.map",
+                    format!("map file {} does not exist", map_path.display()),
+                ));
+            }
+            let mut map = EnvironmentMap::load(&map_path, "background.map")?;
+            if let Some(s) = &b.scale {
+                let k = *s.get_ref();
+                if !(k >= 0.0 && k.is_finite()) {
+                    return Err(ck.err(
+                        s.span(),
+                        "background.scale",
+                        format!("{k} must be a non-negative finite number"),
+                    ));
+                }
+                map.scale = k;
+            }
+            if let Some(r) = &b.rotation {
+                let deg = *r.get_ref();
+                if !deg.is_finite() {
+                    return Err(ck.err(r.span(), "background.rotation", "is not finite"));
+                }
+                map.rotation_degrees = deg;
+            }
+            Ok((Vec3::ZERO, Some(map)))
+        }
+        (Some(_), Some(m)) => Err(ck.err(
+            m.span(),
+            "background",
+            "gives both radiance and map: choose one",
+        )),
+        (None, None) => Err(SceneError::new(
+            ck.path,
+            None,
+            "background",
+            "needs radiance or map",
+        )),
+    }
 }

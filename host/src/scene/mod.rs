@@ -2,6 +2,7 @@
 //! `#[repr(C)]` tables. Neither backend knows the file format.
 
 mod closed_surface;
+pub mod environment;
 mod error;
 mod file;
 pub mod light_table;
@@ -93,6 +94,9 @@ pub struct Scene {
     pub triangles: Vec<Triangle>,
     pub triangle_groups: Vec<TriangleGroup>,
     pub lights: Vec<Light>,
+    /// The environment map, if `[background] map` names one (its light is the last entry of
+    /// `lights`).
+    pub environment: Option<environment::EnvironmentMap>,
 }
 
 impl Scene {
@@ -143,7 +147,45 @@ impl Scene {
             },
             min_pilot_samples: MIN_PILOT_SAMPLES,
             sampler: r.sampler.code(),
+            env_width: self.environment.as_ref().map_or(0, |m| m.width),
+            env_height: self.environment.as_ref().map_or(0, |m| m.height),
+            env_light: if self.environment.is_some() {
+                self.lights.len() as u32 - 1
+            } else {
+                kernel::scene::NONE
+            },
+            env_scale: self.environment.as_ref().map_or(1.0, |m| m.scale),
+            env_rotation: {
+                let a = self
+                    .environment
+                    .as_ref()
+                    .map_or(0.0, |m| m.rotation_degrees)
+                    .to_radians();
+                [a.cos(), a.sin()]
+            },
+            _pad: [0; 2],
         }
+    }
+
+    /// Replaces the environment map (and its light, the last entry of `lights`), keeping the
+    /// light selection up to date: scenes built in code (tests) give maps this way.
+    pub fn set_environment(&mut self, map: Option<environment::EnvironmentMap>) {
+        if self.environment.take().is_some() {
+            self.lights.pop();
+        }
+        if let Some(m) = &map {
+            self.lights.push(m.light(&self.spheres, &self.triangles));
+        }
+        self.environment = map;
+        light_table::assign_light_selection(&mut self.lights, self.render.light_selection.code());
+    }
+
+    /// The environment table (`kernel::environment`): the map's texels and CDFs, or one zero
+    /// (a storage buffer needs a number behind it) without a map.
+    pub fn environment_table(&self) -> Vec<f32> {
+        self.environment
+            .as_ref()
+            .map_or_else(|| vec![0.0], |m| m.table())
     }
 
     /// The kernel's feature bits for this scene and its settings (`kernel::features`; 0 with

@@ -91,6 +91,11 @@ impl GpuRenderer {
             )?,
             ctx.upload_buffer("triangles", bytemuck::cast_slice(&scene.triangles), STORAGE)?,
             ctx.upload_buffer("spheres", bytemuck::cast_slice(&scene.spheres), STORAGE)?,
+            ctx.upload_buffer(
+                "environment",
+                bytemuck::cast_slice(&scene.environment_table()),
+                STORAGE,
+            )?,
         ];
         let accum = ctx.create_storage_image("accum", w, h)?;
         let accum_sq = ctx.create_storage_image("accum_sq", w, h)?;
@@ -107,7 +112,7 @@ impl GpuRenderer {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 5,
+                descriptor_count: 6,
             },
         ];
         let (pool, set) = ctx.create_descriptor_set(pipeline.set_layout, &sizes)?;
@@ -134,6 +139,7 @@ impl GpuRenderer {
             buffer_info(&tables[1]),
             buffer_info(&tables[2]),
             buffer_info(&tables[3]),
+            buffer_info(&tables[4]),
         ];
         let buffer_bindings = [
             binding::PARAMS,
@@ -141,6 +147,7 @@ impl GpuRenderer {
             binding::LIGHTS,
             binding::TRIANGLES,
             binding::SPHERES,
+            binding::ENVIRONMENT,
         ];
         let mut writes = vec![
             vk::WriteDescriptorSet::default()

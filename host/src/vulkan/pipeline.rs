@@ -26,6 +26,7 @@ pub mod binding {
     pub const SPHERES: u32 = 6;
     pub const ACCUM_SQ: u32 = 7;
     pub const PILOTS: u32 = 8;
+    pub const ENVIRONMENT: u32 = 9;
 }
 
 /// Which hit groups a pipeline has: a scene without triangles (or spheres) gets no triangle
@@ -117,6 +118,7 @@ impl RtPipeline {
             b(binding::SPHERES, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::ACCUM_SQ, vk::DescriptorType::STORAGE_IMAGE),
             b(binding::PILOTS, vk::DescriptorType::STORAGE_IMAGE),
+            b(binding::ENVIRONMENT, vk::DescriptorType::STORAGE_BUFFER),
         ];
         let set_layout = unsafe {
             ctx.device.create_descriptor_set_layout(
