@@ -200,3 +200,52 @@ fn shadow_rays_never_hit_the_light_they_sample() {
     );
     assert_eq!(fails, 0);
 }
+
+/// The same for triangle lights: a shadow ray toward a point sampled on a triangle light (by
+/// area or as a spherical triangle, one- and two-sided, with the light's own error bound as the
+/// renderer builds it) never hits that triangle, for receivers 1e-3 to 1e4 sizes away on the
+/// side the light faces (the renderer casts no shadow ray where cos theta_light <= 0).
+#[test]
+fn shadow_rays_never_hit_the_triangle_light_they_sample() {
+    use kernel::light::sample_triangle_light;
+    use kernel::scene::{light_sampling, Triangle, NONE};
+    let mut g = Gen(twinpath_tests::SplitMix(4));
+    let (mut fails, mut tested) = (0, 0);
+    for k in 0..cases() {
+        let (s, t) = g.placement();
+        let (p0, e1, e2) = (t, g.dir() * s, g.dir() * s);
+        if e1.cross(e2).length() < 1e-3 * s * s {
+            continue;
+        }
+        let tri = Triangle {
+            p0: p0.to_array(),
+            material: 0,
+            edge1: e1.to_array(),
+            light: NONE,
+            edge2: e2.to_array(),
+            _pad: 0,
+        };
+        let mut l = twinpath::scene::light_table::triangle_light(&tri, [1.0; 3], k % 2 == 0);
+        l.select_pmf = 1.0;
+        let centroid = p0 + (e1 + e2) / 3.0;
+        let x = centroid + g.dir() * s * g.pow10(-3.0, 4.0);
+        let mode = if k % 3 == 0 {
+            light_sampling::AREA
+        } else {
+            light_sampling::SOLID_ANGLE
+        };
+        let ls = sample_triangle_light(&l, 0, mode, x, g.unit(), g.unit());
+        let y = ls.point.position;
+        if !(ls.pdf_solid_angle > 0.0) || ls.point.normal.dot(x - y) <= 0.0 {
+            continue;
+        }
+        tested += 1;
+        let end = shadow_ray_end(x, y, ls.point.normal, l.point_error);
+        if intersect_triangle(x, end - x, p0, e1, e2, 0.0, 1.0) >= 0.0 {
+            fails += 1;
+        }
+    }
+    println!("triangle light samples: {fails} of {tested} shadow rays hit their own light");
+    assert!(tested > cases() / 3);
+    assert_eq!(fails, 0);
+}
