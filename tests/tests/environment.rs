@@ -213,3 +213,29 @@ fn plane_under_one_bright_texel_matches_its_closed_form_on_both_backends() {
     }
     assert_validation_clean();
 }
+
+/// A constant map lights the plane as the constant background does: radiance kd L (the plane
+/// sees the whole upper hemisphere), every sample exactly that under the uniform background (an
+/// escaping path adds it with weight 1), and in the mean under the map (light samples and
+/// escaping paths weighted by MIS), per pixel on both backends.
+#[test]
+fn a_constant_map_lights_like_the_constant_background_on_both_backends() {
+    let want = KD as f64 * 0.5;
+    let mut uniform = scene_from_toml(PLANE);
+    uniform.background = Vec3::splat(0.5);
+    let film = render_film(&uniform, Backend::Cpu, 16);
+    assert!(
+        film.mean()
+            .iter()
+            .all(|p| (p[0] as f64 - want).abs() < 1e-6),
+        "the uniform background is not exactly kd L"
+    );
+    let map = plane_under(&EnvironmentMap::constant(32, 16, [0.5; 3]));
+    let exact = vec![Some(want); map.pixel_count()];
+    for backend in [Backend::Cpu, Backend::Gpu] {
+        let film = render_film(&map, backend, 64);
+        assert_eq!(film.discarded, 0);
+        assert_film_matches(&film, &exact, &format!("{backend:?}, constant map"));
+    }
+    assert_validation_clean();
+}
