@@ -375,21 +375,14 @@ impl PathState {
                 if self.depth == 0 {
                     self.radiance = emitted;
                 } else {
-                    let mode = features.mis_mode(params);
-                    let weight = if mode == mis::POWER {
-                        let pdf_l = pdf_environment_light(
-                            &lights[params.env_light as usize],
-                            light_sampling_of(features, params),
-                            params,
-                            environment,
-                            self.ray_dir,
-                        );
-                        power_heuristic(self.previous_pdf, pdf_l)
-                    } else if features.materials() && self.previous_pdf == DELTA_PDF {
-                        1.0
-                    } else {
-                        bsdf_strategy_weight(mode)
-                    };
+                    let pdf_l = pdf_environment_light(
+                        &lights[params.env_light as usize],
+                        light_sampling_of(features, params),
+                        params,
+                        environment,
+                        self.ray_dir,
+                    );
+                    let weight = self.found_light_weight(features, params, pdf_l);
                     self.radiance += self.throughput * emitted * weight;
                 }
                 return false;
@@ -411,28 +404,17 @@ impl PathState {
                 // 1: a light seen directly (it reflects nothing, so the path ends).
                 self.radiance = emitted;
             } else {
-                // 2(b): the extension found a light. After a delta lobe (pdf `DELTA_PDF`) light
-                // sampling could not have found it: the power heuristic's ratio pdf_l / inf is
-                // 0, weight 1; the other modes test for it.
-                let mode = features.mis_mode(params);
-                let weight = if mode == mis::POWER {
-                    let sampling = light_sampling_of(features, params);
-                    let x = self.previous_vertex;
-                    let pdf_l = pdf_light_from(
-                        lights,
-                        sampling,
-                        features.triangle_lights(),
-                        hit.light,
-                        x,
-                        hit.position,
-                        hit.normal,
-                    );
-                    power_heuristic(self.previous_pdf, pdf_l)
-                } else if features.materials() && self.previous_pdf == DELTA_PDF {
-                    1.0
-                } else {
-                    bsdf_strategy_weight(mode)
-                };
+                // 2(b): the extension found a light.
+                let pdf_l = pdf_light_from(
+                    lights,
+                    light_sampling_of(features, params),
+                    features.triangle_lights(),
+                    hit.light,
+                    self.previous_vertex,
+                    hit.position,
+                    hit.normal,
+                );
+                let weight = self.found_light_weight(features, params, pdf_l);
                 self.radiance += self.throughput * emitted * weight;
             }
             return false;
@@ -714,6 +696,31 @@ impl PathState {
         self.ray_dir = dir;
         self.previous_vertex = x;
         self.previous_pdf = pdf;
+    }
+}
+
+impl PathState {
+    /// The MIS weight of a light (area light or environment map) that the extension from
+    /// `previous_vertex` found, where light sampling has density `pdf_light` (read only under
+    /// the power heuristic; the other modes' unused density is pure code, which inlining
+    /// drops). After a delta lobe (pdf `DELTA_PDF`) light sampling
+    /// could not have found it: the power heuristic's ratio pdf_l / inf is 0, weight 1; the
+    /// other modes test for it.
+    #[inline]
+    fn found_light_weight<F: FeatureSet>(
+        &self,
+        features: F,
+        params: &RenderParams,
+        pdf_light: f32,
+    ) -> f32 {
+        let mode = features.mis_mode(params);
+        if mode == mis::POWER {
+            power_heuristic(self.previous_pdf, pdf_light)
+        } else if features.materials() && self.previous_pdf == DELTA_PDF {
+            1.0
+        } else {
+            bsdf_strategy_weight(mode)
+        }
     }
 }
 
