@@ -9,6 +9,7 @@
 
 use crate::scene::{
     light_kind, light_sampling, material_kind, mis, roulette, Light, Material, RenderParams,
+    ShadingTriangle, NONE,
 };
 
 /// The bits are answers fixed before the render; without it, they are ignored.
@@ -41,6 +42,10 @@ pub const ENVIRONMENT: u32 = 1 << 12;
 /// The camera may have a thin lens (a lens radius above 0; with the bit, a pinhole camera still
 /// runs as one).
 pub const THIN_LENS: u32 = 1 << 11;
+/// Some triangle may have vertex normals: hits may shade with an interpolated normal.
+pub const SHADING_NORMALS: u32 = 1 << 13;
+/// Some material may have a texture: hits may look one up.
+pub const TEXTURES: u32 = 1 << 14;
 
 /// The material bits of a scene with these materials: one per kind present besides the
 /// Lambertian. (A bit may also be set for a kind that is absent: it only keeps that kind's
@@ -67,6 +72,23 @@ pub fn light_features(lights: &[Light]) -> u32 {
     } else {
         0
     }
+}
+
+/// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
+/// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals.
+#[inline]
+pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> u32 {
+    let mut f = 0;
+    if materials
+        .iter()
+        .any(|m| m.textures.iter().any(|&t| t != NONE))
+    {
+        f |= TEXTURES;
+    }
+    if shading.iter().any(|s| s.has_normals != 0) {
+        f |= SHADING_NORMALS;
+    }
+    f
 }
 
 /// The feature bits of a render with these parameters.
@@ -170,6 +192,16 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn thin_lens(self) -> bool {
         self.answer(THIN_LENS, true)
+    }
+    /// Whether a hit may have a shading normal (see [`SHADING_NORMALS`]).
+    #[inline]
+    fn shading_normals(self) -> bool {
+        self.answer(SHADING_NORMALS, true)
+    }
+    /// Whether a material may have a texture (see [`TEXTURES`]).
+    #[inline]
+    fn textures(self) -> bool {
+        self.answer(TEXTURES, true)
     }
     /// Whether a light may be a triangle (see [`TRIANGLE_LIGHTS`]).
     #[inline]

@@ -3,7 +3,7 @@
 use crate::intersect;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
-use spirv_std::glam::Vec3;
+use spirv_std::glam::{Vec2, Vec3};
 
 /// Seed: `GeometryFactor(A, B)`. |(n_a . d)(n_b . d)| / (d . d)^2 with d = p_a - p_b: the
 /// cosines at both ends over the squared distance, i.e. the Jacobian between the product of the
@@ -138,6 +138,20 @@ pub fn intersect_triangle(
 #[inline]
 pub fn triangle_point(p0: Vec3, edge1: Vec3, edge2: Vec3, u: f32, v: f32) -> Vec3 {
     p0 + (u * edge1 + v * edge2)
+}
+
+/// The barycentrics (u, v) of point `p` of the triangle's plane, p = p0 + u edge1 + v edge2,
+/// by least squares on the edges' Gram matrix (0 for a degenerate triangle).
+#[inline]
+pub fn triangle_barycentrics(p0: Vec3, edge1: Vec3, edge2: Vec3, p: Vec3) -> Vec2 {
+    let d = p - p0;
+    let (a, b, c) = (edge1.dot(edge1), edge1.dot(edge2), edge2.dot(edge2));
+    let (e, f) = (d.dot(edge1), d.dot(edge2));
+    let det = a * c - b * b;
+    if !(det > 0.0) {
+        return Vec2::ZERO;
+    }
+    Vec2::new((c * e - b * f) / det, (a * f - b * e) / det)
 }
 
 /// Unit geometric normal of a triangle, (edge1 x edge2) normalised.

@@ -31,6 +31,8 @@ pub mod scene;
 pub mod shaders;
 pub mod sobol;
 pub mod spherical_triangle;
+pub mod surface;
+pub mod texture;
 pub mod turns;
 pub mod vertex_samples;
 pub mod word;

@@ -3,15 +3,18 @@
 
 use crate::environment;
 use crate::geometry::{
-    area_to_solid_angle_pdf, sphere_point_error, triangle_normal, triangle_point,
+    area_to_solid_angle_pdf, sphere_point_error, triangle_barycentrics, triangle_normal,
+    triangle_point,
 };
 use crate::sampling::{
     pdf_sphere_area, pdf_sphere_cone, sample_sphere, sample_sphere_cone,
     sample_triangle_barycentrics, ConeSample, SurfacePoint,
 };
-use crate::scene::{light_kind, light_sampling, Light, RenderParams};
+use crate::scene::{light_kind, light_sampling, Light, RenderParams, NONE};
 use crate::spherical_triangle::{barycentrics_along, SphericalTriangle};
-use spirv_std::glam::Vec3;
+use crate::surface::blend2;
+use crate::texture;
+use spirv_std::glam::{Vec2, Vec3};
 
 /// A point chosen on a light, and the density of having chosen it.
 #[derive(Clone, Copy, Debug)]
@@ -158,17 +161,36 @@ pub fn pdf_environment_light(
 }
 
 /// The radiance light sample `ls` of light `l` sends toward its receiver: the light's constant
-/// radiance, or the environment map's along the sample's direction (-normal).
+/// radiance (times its emission texture at the point, where `textured` and it has one), or the
+/// environment map's along the sample's direction (-normal).
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub fn sample_radiance(
     environment: bool,
+    textured: bool,
     params: &RenderParams,
     table: &[f32],
+    textures: &[u32],
     l: &Light,
     ls: &DirectionalLightSample,
 ) -> Vec3 {
     if is_environment(environment, l) {
         environment::eval(params, table, -ls.point.normal)
+    } else if textured && l.emission_texture != NONE {
+        // A triangle with an emission texture: its value at the point's texture coordinates.
+        let bary = triangle_barycentrics(
+            Vec3::from(l.position),
+            Vec3::from(l.edge1),
+            Vec3::from(l.edge2),
+            ls.point.position,
+        );
+        let uv = blend2(
+            Vec2::new(l.uv[0], l.uv[1]),
+            Vec2::new(l.uv[2], l.uv[3]),
+            Vec2::new(l.uv[4], l.uv[5]),
+            bary,
+        );
+        Vec3::from(l.radiance) * texture::lookup(textures, l.emission_texture, uv)
     } else {
         Vec3::from(l.radiance)
     }

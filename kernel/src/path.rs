@@ -18,10 +18,12 @@ use crate::light::{
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{
-    light_sampling, material_kind, mis, Light, Material, RenderParams, Sphere, Triangle, NONE,
+    light_sampling, material_kind, mis, Light, Material, RenderParams, ShadingTriangle, Sphere,
+    Triangle, NONE,
 };
+use crate::surface::shade;
 use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION, LENS_DIMENSION};
-use spirv_std::glam::Vec3;
+use spirv_std::glam::{Vec2, Vec3};
 
 /// Where a ray meets the scene first. `t < 0` means it met nothing.
 #[derive(Clone, Copy, Debug)]
@@ -44,6 +46,17 @@ pub struct SurfaceHit {
     /// rounding flips at grazing hits (a grazing ray would otherwise leave inward and be
     /// trapped inside the sphere).
     pub arrived_behind: bool,
+    /// A triangle's index into the shading table (`Triangle::shading`), else [`NONE`].
+    pub shading: u32,
+    /// A triangle's barycentrics (u, v) of p1 and p2 at the hit.
+    pub barycentrics: Vec2,
+    /// The unit shading normal, either orientation; meaningful where `smooth`
+    /// (`surface::shade` fills it, and `uv`).
+    pub shading_normal: Vec3,
+    /// Whether the hit shades with `shading_normal` (vertex normals) instead of `normal`.
+    pub smooth: bool,
+    /// Texture coordinates at the hit (where the scene has textures).
+    pub uv: Vec2,
 }
 
 impl SurfaceHit {
@@ -58,6 +71,11 @@ impl SurfaceHit {
             light: NONE,
             error: 0.0,
             arrived_behind: false,
+            shading: NONE,
+            barycentrics: Vec2::ZERO,
+            shading_normal: Vec3::ZERO,
+            smooth: false,
+            uv: Vec2::ZERO,
         }
     }
 
@@ -78,6 +96,11 @@ impl SurfaceHit {
             light: sphere.light,
             error: sphere_point_error(center, radius),
             arrived_behind: from_center.dot(from_center) < radius * radius,
+            shading: NONE,
+            barycentrics: Vec2::ZERO,
+            shading_normal: Vec3::ZERO,
+            smooth: false,
+            uv: Vec2::ZERO,
         }
     }
 
@@ -108,6 +131,11 @@ impl SurfaceHit {
             light: tri.light,
             error: triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition),
             arrived_behind: Self::behind_plane(shape.normal, dir),
+            shading: tri.shading,
+            barycentrics: Vec2::new(u, v),
+            shading_normal: Vec3::ZERO,
+            smooth: false,
+            uv: Vec2::ZERO,
         }
     }
 
@@ -208,6 +236,8 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
     materials: &[Material],
     lights: &[Light],
     environment: &[f32],
+    shading: &[ShadingTriangle],
+    textures: &[u32],
     origin: Vec3,
     dir: Vec3,
     rng: &mut SampleRng,
@@ -219,6 +249,8 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
         materials,
         lights,
         environment,
+        shading,
+        textures,
     );
     *rng = path.rng;
     path.radiance
@@ -296,6 +328,7 @@ impl PathState {
     /// Runs the path to its end, one ray cast at a time through `tracer`; the result is in
     /// `radiance` of the returned (finished) state.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn run<T: Tracer, F: FeatureSet>(
         mut self,
         tracer: &mut T,
@@ -304,24 +337,26 @@ impl PathState {
         materials: &[Material],
         lights: &[Light],
         environment: &[f32],
+        shading: &[ShadingTriangle],
+        textures: &[u32],
     ) -> Self {
         loop {
-            let hit = if self.extend {
+            let mut hit = if self.extend {
                 tracer.closest_hit(self.ray_origin, self.ray_dir)
             } else {
                 SurfaceHit::miss()
             };
             let occluded = self.shadow && tracer.occluded(self.shadow_from, self.shadow_to);
+            let material = shade(features, &mut hit, materials, shading, textures);
             if self.advance(
                 features,
                 params,
-                materials,
+                &material,
                 lights,
                 environment,
                 &hit,
                 occluded,
             ) {
-                let material = materials[hit.material as usize];
                 let query = self.vertex_query(features, params, &hit, &material);
                 let samples = VertexSamples::draw(&query, &mut self.rng);
                 self.vertex(
@@ -329,6 +364,7 @@ impl PathState {
                     params,
                     lights,
                     environment,
+                    textures,
                     &hit,
                     &material,
                     &query,
@@ -342,7 +378,8 @@ impl PathState {
     }
 
     /// Takes the answers to this round's rays: `hit`, the closest hit of the extension ray
-    /// (ignored unless `extend`), and whether the shadow segment is `occluded` (ignored unless
+    /// (ignored unless `extend`) with `material`, its material there (`surface::shade`), and
+    /// whether the shadow segment is `occluded` (ignored unless
     /// `shadow`); then runs the estimator up to its next ray casts (steps 1-5 above) or up to
     /// the vertex at `hit`. Returns whether the path reached that vertex: then the caller
     /// states its query ([`PathState::vertex_query`]), fills its samples and hands them to
@@ -353,7 +390,7 @@ impl PathState {
         &mut self,
         features: F,
         params: &RenderParams,
-        materials: &[Material],
+        material: &Material,
         lights: &[Light],
         environment: &[f32],
         hit: &SurfaceHit,
@@ -395,7 +432,6 @@ impl PathState {
             }
             return false;
         }
-        let material = materials[hit.material as usize];
         if hit.light != NONE {
             let two_sided = features.triangle_lights() && lights[hit.light as usize].two_sided != 0;
             let emitted =
@@ -459,10 +495,22 @@ impl PathState {
         } else {
             params.rr_probability
         };
+        let ng = hit.facing_normal();
+        let n = if features.shading_normals() && hit.smooth {
+            // The shading normal on wo's side (pbrt-v4's two-sided BxDFs mirror wo's
+            // hemisphere of the shading frame; `crate::surface`).
+            side(
+                hit.shading_normal,
+                hit.shading_normal.dot(self.ray_dir) < 0.0,
+            )
+        } else {
+            ng
+        };
         VertexQuery {
             depth: self.depth,
             x: hit.position,
-            n: hit.facing_normal(),
+            n,
+            ng,
             light_count,
             mode: light_sampling_of(features, params),
             triangle_lights: features.triangle_lights(),
@@ -488,6 +536,7 @@ impl PathState {
         params: &RenderParams,
         lights: &[Light],
         environment: &[f32],
+        textures: &[u32],
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
@@ -499,6 +548,7 @@ impl PathState {
                 params,
                 lights,
                 environment,
+                textures,
                 hit,
                 material,
                 query,
@@ -510,6 +560,7 @@ impl PathState {
                 params,
                 lights,
                 environment,
+                textures,
                 hit,
                 material,
                 query,
@@ -527,14 +578,18 @@ impl PathState {
         params: &RenderParams,
         lights: &[Light],
         environment: &[f32],
+        textures: &[u32],
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
         samples: &VertexSamples,
     ) {
-        let (x, n) = (query.x, query.n);
+        let (x, n, ng) = (query.x, query.n, query.ng);
         let albedo = Vec3::from(material.albedo);
-        let ray_origin = offset_ray_origin(x, n, hit.error);
+        let ray_origin = offset_ray_origin(x, ng, hit.error);
+        // With a shading normal, a direction below the geometric surface carries nothing
+        // (`crate::surface`): it would leave through the surface.
+        let smooth = features.shading_normals() && hit.smooth;
 
         // 2(a): next-event estimation.
         if query.samples_light() {
@@ -544,11 +599,14 @@ impl PathState {
             let cos_x = n.dot(wi);
             let cos_y = -ls.point.normal.dot(wi);
             let pdf_w = ls.pdf_solid_angle;
-            if cos_x > 0.0 && cos_y > 0.0 && pdf_w > 0.0 {
+            let above = !smooth || ng.dot(wi) > 0.0;
+            if cos_x > 0.0 && cos_y > 0.0 && pdf_w > 0.0 && above {
                 let emitted = sample_radiance(
                     query.environment_light,
+                    features.textures(),
                     params,
                     environment,
+                    textures,
                     &lights[ls.light as usize],
                     &ls,
                 );
@@ -570,6 +628,9 @@ impl PathState {
         // 3: extension by BRDF sampling. Every direction the sampler returns continues the
         // path (none is tangent; step 3 of `trace_path`).
         let wi = samples.brdf_direction(query);
+        if smooth && ng.dot(wi) <= 0.0 {
+            return;
+        }
         let pdf_b = pdf_brdf(n, wi);
         // = eval_scattering(n, wi, albedo) / pdf_b, exactly (see `sampled_brdf_weight`).
         self.throughput *= sampled_brdf_weight(albedo);
@@ -591,12 +652,14 @@ impl PathState {
         params: &RenderParams,
         lights: &[Light],
         environment: &[f32],
+        textures: &[u32],
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
         samples: &VertexSamples,
     ) {
-        let (x, n) = (query.x, query.n);
+        let (x, n, ng) = (query.x, query.n, query.ng);
+        let smooth = features.shading_normals() && hit.smooth;
         let wo = -self.ray_dir;
         // The index beyond the surface over the index on wo's side (dielectrics only): the
         // outside is the side the normal points to (`SurfaceHit::normal`).
@@ -614,16 +677,21 @@ impl PathState {
             let cos_y = -ls.point.normal.dot(wi);
             let pdf_w = ls.pdf_solid_angle;
             let (f_cos, pdf_b) = bsdf::eval(features, material, n, wo, wi, eta);
-            if cos_y > 0.0 && pdf_w > 0.0 && f_cos.max_element() > 0.0 {
+            // With a shading normal, the BSDF's reflection must be one geometrically too, and
+            // its transmission cross the surface (`crate::surface`).
+            let consistent = !smooth || (n.dot(wi) > 0.0) == (ng.dot(wi) > 0.0);
+            if cos_y > 0.0 && pdf_w > 0.0 && f_cos.max_element() > 0.0 && consistent {
                 let emitted = sample_radiance(
                     query.environment_light,
+                    features.textures(),
                     params,
                     environment,
+                    textures,
                     &lights[ls.light as usize],
                     &ls,
                 );
                 let weight = light_strategy_weight(features, params, pdf_w, pdf_b);
-                let from = offset_ray_origin(x, side(n, n.dot(wi) > 0.0), hit.error);
+                let from = offset_ray_origin(x, side(ng, ng.dot(wi) > 0.0), hit.error);
                 let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
                 self.await_shadow(features, lights, from, &ls, radiance);
             }
@@ -640,6 +708,9 @@ impl PathState {
         // 3: extension by BSDF sampling.
         let (u1, u2) = samples.u_brdf;
         let s = bsdf::sample(features, material, n, wo, eta, samples.u_lobe, u1, u2);
+        if smooth && (ng.dot(s.wi) > 0.0) == s.transmitted {
+            return;
+        }
         self.throughput *= s.weight;
         if features.dielectric() {
             self.eta_scale *= s.eta2;
@@ -647,7 +718,7 @@ impl PathState {
         if !(self.throughput.max_element() > 0.0) {
             return;
         }
-        let origin = offset_ray_origin(x, side(n, !s.transmitted), hit.error);
+        let origin = offset_ray_origin(x, side(ng, !s.transmitted), hit.error);
         self.await_extension(origin, s.wi, x, s.pdf);
     }
 
@@ -801,12 +872,23 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
     materials: &[Material],
     lights: &[Light],
     environment: &[f32],
+    shading: &[ShadingTriangle],
+    textures: &[u32],
     px: u32,
     py: u32,
     sample: u32,
 ) -> Vec3 {
     start_sample(features, params, px, py, sample)
-        .run(tracer, features, params, materials, lights, environment)
+        .run(
+            tracer,
+            features,
+            params,
+            materials,
+            lights,
+            environment,
+            shading,
+            textures,
+        )
         .radiance
 }
 

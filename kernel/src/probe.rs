@@ -20,7 +20,8 @@ use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
 use crate::scene::{light_kind, Camera, Light, Material};
 use crate::sobol::{sobol_pair, sobol_single};
 use crate::spherical_triangle;
-use spirv_std::glam::{UVec4, Vec3, Vec4};
+use crate::texture::{bilerp, footprint};
+use spirv_std::glam::{UVec4, Vec2, Vec3, Vec4};
 
 /// Which function a probe record evaluates (input layout -> output layout).
 pub mod function {
@@ -73,7 +74,11 @@ pub mod function {
     /// out0 = light::sample_triangle_light's (position, pdf) for [`probe_triangle_light`],
     /// out1 = (its normal, spherical_triangle::solid_angle(x, vertices))
     pub const TRIANGLE_LIGHT: u32 = 15;
-    pub const COUNT: u32 = 16;
+    /// uv = in0.xy, (width, height) = in0.zw as u32, clamp = in1.x as u32, four RGBA8 texels
+    /// (x0 y0, x1 y0, x0 y1, x1 y1) = in2 as u32, read as byte / 256 -> out0 = texture::footprint's
+    /// (x0, x1, y0, y1) as u32, out1 = (texture::bilerp of the texels, fx)
+    pub const TEXTURE: u32 = 16;
+    pub const COUNT: u32 = 17;
 }
 
 #[inline]
@@ -133,7 +138,18 @@ pub fn probe_triangle_light(p0: Vec3, e1: Vec3, e2: Vec3, two_sided: u32) -> Lig
         alias: 0,
         area: 0.5 * e1.cross(e2).length(),
         point_error: 0.0,
+        uv: [0.0; 6],
+        emission_texture: crate::scene::NONE,
+        _pad: 0,
     }
+}
+
+/// An RGBA8 word's red, green and blue as byte / 256 (exact in f32), the texture probe's
+/// stand-in for the decoding tables.
+#[inline]
+fn probe_texel(word: u32) -> Vec3 {
+    let c = |shift: u32| ((word >> shift) & 0xff) as f32 * (1.0 / 256.0);
+    Vec3::new(c(0), c(8), c(16))
 }
 
 /// Evaluates `function` on one input record; see [`function`] for the layouts.
@@ -260,6 +276,22 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
                 .normal
                 .extend(spherical_triangle::solid_angle(x, p0, e1, e2)),
         )
+    } else if function == function::TEXTURE {
+        let i = input[0];
+        let fp = footprint(Vec2::new(i0.x, i0.y), i.z, i.w, input[1].x != 0);
+        let t = input[2];
+        let c = bilerp(
+            probe_texel(t.x),
+            probe_texel(t.y),
+            probe_texel(t.z),
+            probe_texel(t.w),
+            fp.fx,
+            fp.fy,
+        );
+        return [
+            UVec4::new(fp.x0, fp.x1, fp.y0, fp.y1),
+            bits(c.extend(fp.fx)),
+        ];
     } else {
         (Vec4::ZERO, Vec4::ZERO)
     };

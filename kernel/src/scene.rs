@@ -31,7 +31,41 @@ pub struct Triangle {
     /// Index into the light table when the triangle emits, else [`NONE`].
     pub light: u32,
     pub edge2: [f32; 3],
-    pub _pad: u32,
+    /// Index into the shading table ([`ShadingTriangle`]) when the triangle has vertex normals
+    /// or texture coordinates, else [`NONE`].
+    pub shading: u32,
+}
+
+/// A triangle's vertex attributes (`Triangle::shading`): normals interpolated into the shading
+/// normal, texture coordinates interpolated into the point's (u, v), both by the hit's
+/// barycentrics (`crate::surface`). Vertex k is p0, p1 = p0 + edge1, p2 = p0 + edge2. 64 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct ShadingTriangle {
+    /// Vertex normals (any length; ignored unless `has_normals`).
+    pub normal0: [f32; 3],
+    pub normal1: [f32; 3],
+    pub normal2: [f32; 3],
+    /// Texture coordinates of the three vertices (u right, v up in the image).
+    pub uv0: [f32; 2],
+    pub uv1: [f32; 2],
+    pub uv2: [f32; 2],
+    /// 1 if the normals shade the triangle, 0 if its geometric normal does.
+    pub has_normals: u32,
+}
+
+/// The material parameters a texture can give (`Material::textures[slot]`).
+pub mod texture_slot {
+    /// Kd, the diffuse reflectance (a colour map: sRGB-decoded).
+    pub const KD: usize = 0;
+    /// Ks, the specular reflectance (a colour map).
+    pub const KS: usize = 1;
+    /// The GGX roughness alpha (linear; the red channel).
+    pub const ALPHA: usize = 2;
+    /// The emitted radiance (a colour map).
+    pub const EMISSION: usize = 3;
+    pub const COUNT: usize = 4;
 }
 
 /// The kinds of surface a [`Material`] describes (`Material::kind`); `crate::bsdf` derives each.
@@ -48,7 +82,7 @@ pub mod material_kind {
 }
 
 /// A two-sided surface's scattering (one of [`material_kind`]), or a light (emission > 0 and
-/// no reflection). 80 bytes.
+/// no reflection). 96 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
@@ -76,6 +110,9 @@ pub struct Material {
     /// A light on triangles: 1 if both faces emit, 0 for the front face alone (copied into
     /// each of its triangles' `Light::two_sided`).
     pub two_sided: u32,
+    /// Per [`texture_slot`]: the texture (an index into the texture table, `crate::texture`)
+    /// whose value at the point multiplies that parameter, or [`NONE`].
+    pub textures: [u32; texture_slot::COUNT],
 }
 
 impl Material {
@@ -92,6 +129,7 @@ impl Material {
             complex: 0,
             k: [0.0; 3],
             two_sided: 0,
+            textures: [NONE; texture_slot::COUNT],
         }
     }
 
@@ -117,7 +155,7 @@ pub mod light_kind {
 }
 
 /// An area light: the light table lists every emissive sphere and every emissive triangle.
-/// 80 bytes.
+/// 112 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
@@ -147,6 +185,12 @@ pub struct Light {
     /// TRIANGLE: a bound on the rounding error of any point sampled on it
     /// (`geometry::triangle_point_error` at u = v = 1, which bounds every point of it).
     pub point_error: f32,
+    /// TRIANGLE with `emission_texture`: the texture coordinates of p0, p1 and p2.
+    pub uv: [f32; 6],
+    /// TRIANGLE: the texture multiplying `radiance` (`Material::textures[EMISSION]`), or
+    /// [`NONE`].
+    pub emission_texture: u32,
+    pub _pad: u32,
 }
 
 /// Pinhole or thin-lens camera: a ray through image-plane point (x, y) in [-1, 1]^2 (y up) has

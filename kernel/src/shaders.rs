@@ -6,7 +6,9 @@
 //! 2 params ([`RenderParams`]), 3 materials, 4 lights, 5 triangles, 6 spheres,
 //! 7 running M2 (rgba32f: rgb sum of squared deviations from the mean, a discarded samples),
 //! 8 adaptive-sampling pilots (rgba32f: luminance mean, luminance M2, count, unused),
-//! 9 the environment table (`crate::environment`; one number when there is no map).
+//! 9 the environment table (`crate::environment`; one number when there is no map),
+//! 10 the shading table (`ShadingTriangle`s; one zero record when there is none),
+//! 11 the texture table (`crate::texture`).
 //! Specialization constant 0: the feature bits of `crate::features` (0: generic path).
 //! Hit groups: 0 triangles (closest hit), 1 spheres (intersection + closest hit).
 //! Miss shader 0 serves both kinds of ray.
@@ -15,7 +17,7 @@ use crate::adaptive::{is_pilot_sample, luminance, pixel_converged};
 use crate::features::Dynamic;
 use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::path::{render_sample, SurfaceHit, Tracer};
-use crate::scene::{Light, Material, RenderParams, Sphere, Triangle};
+use crate::scene::{Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
 use spirv_std::glam::{UVec2, UVec3, UVec4, Vec2, Vec3, Vec4};
 use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
@@ -35,6 +37,9 @@ pub struct HitPayload {
     pub hit: u32,
     /// 1 if the ray arrived from behind the normal (`SurfaceHit::arrived_behind`).
     pub behind: u32,
+    /// A triangle's barycentrics and shading-table index (`SurfaceHit::shading`).
+    pub barycentrics: Vec2,
+    pub shading: u32,
 }
 
 impl HitPayload {
@@ -46,6 +51,8 @@ impl HitPayload {
         self.light = h.light;
         self.hit = 1;
         self.behind = h.arrived_behind as u32;
+        self.barycentrics = h.barycentrics;
+        self.shading = h.shading;
     }
 
     /// The record a closest-hit shader stored, or a miss.
@@ -61,6 +68,11 @@ impl HitPayload {
             light: self.light,
             error: self.normal.w,
             arrived_behind: self.behind != 0,
+            shading: self.shading,
+            barycentrics: self.barycentrics,
+            shading_normal: Vec3::ZERO,
+            smooth: false,
+            uv: Vec2::ZERO,
         }
     }
 }
@@ -134,6 +146,8 @@ pub fn raygen(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] materials: &[Material],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] lights: &[Light],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] environment: &[f32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] shading: &[ShadingTriangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] textures: &[u32],
     #[spirv(descriptor_set = 0, binding = 7)] accum_m2: &Image!(
         2D,
         format = rgba32f,
@@ -173,6 +187,8 @@ pub fn raygen(
             materials,
             lights,
             environment,
+            shading,
+            textures,
             px,
             py,
             index,

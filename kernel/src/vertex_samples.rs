@@ -46,9 +46,12 @@ pub const NO_DIMENSION: u32 = u32::MAX;
 pub struct VertexQuery {
     /// The vertex's depth (1 for the camera ray's hit): its block of dimensions.
     pub depth: u32,
-    /// The receiver point and the normal on the side the ray arrived from.
+    /// The receiver point and the normal on the side the ray arrived from: the shading
+    /// normal, or the geometric one (`ng`) on surfaces without vertex normals.
     pub x: Vec3,
     pub n: Vec3,
+    /// The geometric normal on the side the ray arrived from (rays leave offset along it).
+    pub ng: Vec3,
     /// Lights next-event estimation chooses among; 0: no light sample (no lights, or a black
     /// surface).
     pub light_count: u32,

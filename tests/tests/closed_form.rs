@@ -75,6 +75,8 @@ fn estimate_at(scene: &Scene, x: Vec3, view_dir: Vec3, stream: u32, batch: u32) 
                 &cpu.materials,
                 &cpu.lights,
                 &cpu.environment,
+                &cpu.shading,
+                &cpu.textures,
                 origin,
                 view_dir,
                 &mut rng,

@@ -263,6 +263,27 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                 r[3][3] = (g.u64() % 2) as u32;
                 r
             }
+            function::TEXTURE => {
+                // Coordinates inside, on the edges, far outside and between texel centres;
+                // sizes from one texel to 4096.
+                let size = |g: &mut Gen| g.pick(&[1.0, 2.0, 3.0, 7.0, 64.0, 1000.0, 4096.0]) as u32;
+                let coordinate = |g: &mut Gen| {
+                    let (x, u) = (g.range(-3.0, 4.0), g.unit());
+                    g.pick(&[x, u, 0.0, 1.0, -1.0, 0.5, 1e-7, 1.0 - 1e-7, 1e6 * x])
+                };
+                let (width, height) = (size(g), size(g));
+                let mut r = rec([
+                    [coordinate(g), coordinate(g), 0.0, 0.0],
+                    [0.0; 4],
+                    [0.0; 4],
+                    [0.0; 4],
+                ]);
+                r[0][2] = width;
+                r[0][3] = height;
+                r[1][0] = (g.u64() % 2) as u32;
+                r[2] = [0; 4].map(|_| g.u64() as u32);
+                r
+            }
             _ => unreachable!(),
         })
         .collect()
@@ -333,6 +354,7 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "bsdf::eval", func: function::BSDF_EVAL, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "D, G1, Fresnel and the refraction Jacobian (FMA contraction): 64 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: 1% relative" },
     Bound { name: "bsdf::sample", func: function::BSDF_SAMPLE, max_ulps: 2048, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "the visible-normal sampler, Fresnel choice and pdf (FMA contraction); weights of grazing directions carry G1 ~ n . wi, whose rounding moves them relatively (measured 648 ULP): 2048 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: 1% relative" },
     Bound { name: "sample_triangle_light / solid_angle", func: function::TRIANGLE_LIGHT, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "atan2_turns, normalisations and the ray/plane step (FMA contraction): 64 eps relative to the solid angle, density and geometry size, divided by h, the receiver's elevation above the light's plane (all are 0 / 0 in it); normals 64 eps" },
+    Bound { name: "texture footprint and bilerp", func: function::TEXTURE, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, why: "the same texels and weights bit for bit: wrapping, clamping and the blend" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
 

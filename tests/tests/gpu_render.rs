@@ -16,6 +16,12 @@ use twinpath_tests::{
 /// with Moller-Trumbore).
 fn assert_backends_agree(path: &str, spp: u32, tolerance: f32) {
     let scene = Scene::load(&repo_root().join(path)).unwrap();
+    assert_scene_backends_agree(&scene, path, spp, tolerance);
+}
+
+/// [`assert_backends_agree`] on a scene already loaded (`path` labels it).
+fn assert_scene_backends_agree(scene: &Scene, path: &str, spp: u32, tolerance: f32) {
+    let scene = scene.clone();
     let cpu = render_film(&scene, Backend::Cpu, spp);
     let gpu = render_film(&scene, Backend::Gpu, spp);
     assert_eq!((cpu.discarded, gpu.discarded), (0, 0));
@@ -101,6 +107,19 @@ fn environment_map_same_image_on_cpu_and_gpu() {
 #[test]
 fn mesh_scene_same_image_on_cpu_and_gpu() {
     assert_backends_agree("scenes/meshes.toml", 16, 1e-4);
+}
+
+/// Textures (kd, alpha and emission maps, repeated and clamped) and shading normals (an OBJ
+/// sphere, a PLY torus) at half the scene's resolution: the lookup is bit-exact between the
+/// backends (`gpu_functions.rs`) and the interpolated normals and coordinates are the same
+/// multiply-adds as the BSDFs', so pixels are compared to 1e-3 as for materials.
+#[test]
+fn textures_and_smooth_normals_same_image_on_cpu_and_gpu() {
+    let path = "scenes/textures.toml";
+    let mut scene = Scene::load(&repo_root().join(path)).unwrap();
+    scene.camera.width /= 2;
+    scene.camera.height /= 2;
+    assert_scene_backends_agree(&scene, path, 8, 1e-3);
 }
 
 const KD: f32 = 0.6;

@@ -246,6 +246,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 depth: 1 + h(lane, 6) % 40,
                 x,
                 n,
+                ng: n,
                 light_count,
                 mode: if h(lane, 18) % 4 == 0 {
                     light_sampling::AREA

@@ -223,7 +223,7 @@ fn shadow_rays_never_hit_the_triangle_light_they_sample() {
             edge1: e1.to_array(),
             light: NONE,
             edge2: e2.to_array(),
-            _pad: 0,
+            shading: kernel::scene::NONE,
         };
         let mut l = twinpath::scene::light_table::triangle_light(&tri, [1.0; 3], k % 2 == 0);
         l.select_pmf = 1.0;

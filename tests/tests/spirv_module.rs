@@ -2,7 +2,7 @@
 //! exactly the entry points the Vulkan backend binds (rust-gpu can silently drop one), and laying
 //! out every shared struct exactly as the host does.
 
-use kernel::scene::{Light, Material, RenderParams, Sphere, Triangle};
+use kernel::scene::{Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
 use std::collections::BTreeSet;
 use std::mem::{offset_of, size_of};
 use std::process::Command;
@@ -144,7 +144,10 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
             binding::MATERIALS,
             host_layout!(
                 Material,
-                [albedo, kind, emission, alpha, specular, ior, eta, complex, k, two_sided],
+                [
+                    albedo, kind, emission, alpha, specular, ior, eta, complex, k, two_sided,
+                    textures
+                ],
                 true
             ),
         ),
@@ -165,7 +168,10 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     alias_threshold,
                     alias,
                     area,
-                    point_error
+                    point_error,
+                    uv,
+                    emission_texture,
+                    _pad
                 ],
                 true
             ),
@@ -173,7 +179,16 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
         (
             "Triangle",
             binding::TRIANGLES,
-            host_layout!(Triangle, [p0, material, edge1, light, edge2, _pad], true),
+            host_layout!(Triangle, [p0, material, edge1, light, edge2, shading], true),
+        ),
+        (
+            "ShadingTriangle",
+            binding::SHADING,
+            host_layout!(
+                ShadingTriangle,
+                [normal0, normal1, normal2, uv0, uv1, uv2, has_normals],
+                true
+            ),
         ),
         (
             "Sphere",

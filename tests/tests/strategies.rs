@@ -294,3 +294,23 @@ fn light_only_bsdf_only_and_mis_agree_under_an_environment_map() {
     });
     variants_agree("environment map", &text, Some(&map), &variants);
 }
+
+/// scenes/textures.toml at 32 x 32: a checkered floor (kd map), a glossy wall whose roughness
+/// is a texture, a panel whose emission is a texture (next-event estimation reads it at the
+/// sampled point, BSDF sampling where the ray meets the panel), smooth meshes (shading
+/// normals). The strategies agree only if both read the same texture values at the same points.
+#[test]
+fn light_only_bsdf_only_and_mis_agree_with_textures_and_shading_normals() {
+    let text = std::fs::read_to_string(twinpath_tests::repo_root().join("scenes/textures.toml"))
+        .unwrap()
+        .replace("width = 320", "width = 32")
+        .replace("height = 240", "height = 32")
+        .replace("sampler = ", "# sampler = ")
+        .replace("[render]", "[render]\nsampler = \"independent\"");
+    let mut variants = MODES.to_vec();
+    variants.push(Variant {
+        mis: Mis::Power,
+        area: true,
+    });
+    variants_agree("textures and shading normals", &text, None, &variants);
+}

@@ -45,7 +45,7 @@ fn light_of(p: [Vec3; 3], two_sided: bool) -> kernel::scene::Light {
         edge1: (p[1] - p[0]).to_array(),
         light: NONE,
         edge2: (p[2] - p[0]).to_array(),
-        _pad: 0,
+        shading: kernel::scene::NONE,
     };
     let mut l = triangle_light(&tri, [1.0; 3], two_sided);
     l.select_pmf = 1.0;

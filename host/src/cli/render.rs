@@ -79,6 +79,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         scene.render.spp,
         scene.render.seed
     );
+    eprintln!("twinpath: scene memory: {}", scene.memory_report());
     let opts = RenderOptions {
         backend: a.backend,
         device: a.device,

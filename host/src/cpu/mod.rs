@@ -19,7 +19,7 @@ use glam::Vec3;
 use indicatif::ProgressBar;
 use kernel::features::{self, Dynamic, FeatureSet, Static};
 use kernel::path::render_sample;
-use kernel::scene::{Light, Material, RenderParams};
+use kernel::scene::{Light, Material, RenderParams, ShadingTriangle};
 use kernel::{SurfaceHit, Tracer};
 use packet::SmallScene;
 use rayon::prelude::*;
@@ -51,6 +51,10 @@ pub struct CpuRenderer {
     pub lights: Vec<Light>,
     /// The environment table (`kernel::environment`; one number without a map).
     pub environment: Vec<f32>,
+    /// The shading table (`kernel::scene::ShadingTriangle`) and the texture table
+    /// (`kernel::texture`).
+    pub shading: Vec<ShadingTriangle>,
+    pub textures: Vec<u32>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path).
     pub features: u32,
     /// How a tile's samples are computed, chosen once when the renderer is built.
@@ -108,9 +112,13 @@ macro_rules! with_features {
 }
 
 /// The feature bits beyond the diffuse renderer's: other materials than the Lambertian,
-/// triangle lights, a thin lens and an environment map.
-const EXTENDED: u32 =
-    features::MATERIALS | features::TRIANGLE_LIGHTS | features::THIN_LENS | features::ENVIRONMENT;
+/// triangle lights, a thin lens, an environment map, shading normals and textures.
+const EXTENDED: u32 = features::MATERIALS
+    | features::TRIANGLE_LIGHTS
+    | features::THIN_LENS
+    | features::ENVIRONMENT
+    | features::SHADING_NORMALS
+    | features::TEXTURES;
 
 /// `bits` with every [`EXTENDED`] bit set if any is: the CPU compiles one path for scenes with
 /// other materials, triangle lights, a lens or an environment map (such a bit only keeps code,
@@ -140,6 +148,8 @@ impl CpuRenderer {
             materials: scene.materials.clone(),
             lights: scene.light_table(),
             environment: scene.environment_table(),
+            shading: scene.shading_table(),
+            textures: scene.textures.words.clone(),
             features: with_all_extended(scene.features()),
             tiles: small.map_or(TileStrategy::OnePath, TileStrategy::Packets),
         }
@@ -167,6 +177,8 @@ impl CpuRenderer {
             &self.materials,
             &self.lights,
             &self.environment,
+            &self.shading,
+            &self.textures,
             px,
             py,
             sample,

@@ -13,7 +13,8 @@ use crate::film::PixelSums;
 use glam::Vec3;
 use kernel::features::FeatureSet;
 use kernel::path::{sample_rng, start_path_at, PathState};
-use kernel::scene::{RenderParams, NONE};
+use kernel::scene::{Material, RenderParams, NONE};
+use kernel::surface::shade;
 use kernel::SurfaceHit;
 use std::simd::Simd;
 
@@ -74,6 +75,7 @@ impl CpuRenderer {
         let mut batch = [None; LANES];
         let mut batch_camera = [(0.0, 0.0); LANES];
         let mut hits = [SurfaceHit::miss(); LANES];
+        let mut materials = [Material::diffuse([0.0; 3]); LANES];
         loop {
             for slot in slots.iter_mut().filter(|s| s.is_none()) {
                 if next == n {
@@ -130,18 +132,25 @@ impl CpuRenderer {
             let mut queries = [None; LANES];
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((_, path)) = slot else { continue };
-                let hit = &hits[lane];
+                let hit = &mut hits[lane];
+                let material = shade(
+                    features,
+                    hit,
+                    &self.materials,
+                    &self.shading,
+                    &self.textures,
+                );
                 if path.advance(
                     features,
                     params,
-                    &self.materials,
+                    &material,
                     &self.lights,
                     &self.environment,
                     hit,
                     occluded[lane],
                 ) {
-                    let material = &self.materials[hit.material as usize];
-                    let query = path.vertex_query(features, params, hit, material);
+                    let query = path.vertex_query(features, params, hit, &material);
+                    materials[lane] = material;
                     queries[lane] = Some((path.rng, query));
                 }
             }
@@ -149,15 +158,14 @@ impl CpuRenderer {
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((k, path)) = slot else { continue };
                 if let Some((_, query)) = &queries[lane] {
-                    let hit = &hits[lane];
-                    let material = &self.materials[hit.material as usize];
                     path.vertex(
                         features,
                         params,
                         &self.lights,
                         &self.environment,
-                        hit,
-                        material,
+                        &self.textures,
+                        &hits[lane],
+                        &materials[lane],
                         query,
                         &samples[lane],
                     );

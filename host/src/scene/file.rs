@@ -6,10 +6,11 @@ use super::environment::EnvironmentMap;
 use super::error::{line_of, SceneError};
 use super::light_table::{sphere_light, triangle_light};
 use super::mesh::load_mesh;
+use super::textures::TextureTable;
 use super::{CameraDesc, Scene, TriangleGroup};
 use crate::settings::RenderSettings;
 use glam::Vec3;
-use kernel::scene::{material_kind, Light, Sphere, Triangle, NONE};
+use kernel::scene::{material_kind, texture_slot, Light, ShadingTriangle, Sphere, Triangle, NONE};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -76,6 +77,14 @@ pub(super) struct MaterialFile {
     pub emission: Option<V3>,
     /// With `emission`, on quads and meshes: both faces emit (default: the front face).
     pub two_sided: Option<Spanned<bool>>,
+    /// Image textures multiplying kd, ks, alpha (its red channel) and emission (each factor
+    /// defaults to 1 where its map is given), relative to the scene file.
+    pub kd_map: Option<Spanned<String>>,
+    pub ks_map: Option<Spanned<String>>,
+    pub alpha_map: Option<Spanned<String>>,
+    pub emission_map: Option<Spanned<String>>,
+    /// How the maps continue outside [0, 1]: "repeat" (default) or "clamp".
+    pub wrap: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -292,9 +301,12 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     // Materials, in name order.
     let mut materials = Vec::new();
     let mut material_names = Vec::new();
+    let base_dir = path.parent().unwrap_or(Path::new("."));
+    let mut textures = TextureTable::new();
     for (name, m) in &file.materials {
         let field = format!("materials.{name}");
-        let material = super::materials::material(&ck, &field, m)?;
+        let mut material = super::materials::material(&ck, &field, m)?;
+        super::materials::attach_textures(&ck, &field, m, base_dir, &mut textures, &mut material)?;
         materials.push(material);
         material_names.push(name.clone());
     }
@@ -317,6 +329,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     };
     let is_emissive = |m: u32| materials[m as usize].emission.iter().any(|&c| c > 0.0);
     let is_dielectric = |m: u32| materials[m as usize].kind == material_kind::DIELECTRIC;
+    let is_textured = |m: u32| materials[m as usize].textures.iter().any(|&t| t != NONE);
 
     // Spheres; emissive ones become lights.
     let mut spheres = Vec::new();
@@ -340,6 +353,17 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             ));
         }
         let material = find_material(&sf.material, &format!("sphere[{i}].material"))?;
+        if is_textured(material) {
+            return Err(ck.err(
+                sf.material.span(),
+                &format!("sphere[{i}].material"),
+                format!(
+                    "'{}' has textures: spheres have no texture coordinates (textures are for \
+                     quads and meshes)",
+                    sf.material.get_ref()
+                ),
+            ));
+        }
         if materials[material as usize].two_sided != 0 {
             return Err(ck.err(
                 sf.material.span(),
@@ -373,16 +397,43 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     // Quads (two triangles each) and meshes; each triangle of an emissive one is a light.
     let mut triangles = Vec::new();
     let mut triangle_groups = Vec::new();
-    let push_triangle =
-        |triangles: &mut Vec<Triangle>, lights: &mut Vec<Light>, p: [Vec3; 3], material: u32| {
-            let mut tri = super::triangle(p, material);
-            let m = &materials[material as usize];
-            if is_emissive(material) {
-                tri.light = lights.len() as u32;
-                lights.push(triangle_light(&tri, m.emission, m.two_sided != 0));
+    let mut shading = Vec::new();
+    let push_triangle = |triangles: &mut Vec<Triangle>,
+                         lights: &mut Vec<Light>,
+                         shading: &mut Vec<ShadingTriangle>,
+                         p: [Vec3; 3],
+                         material: u32,
+                         attributes: Option<ShadingTriangle>| {
+        let mut tri = super::triangle(p, material);
+        let m = &materials[material as usize];
+        if let Some(a) = attributes {
+            tri.shading = shading.len() as u32;
+            shading.push(a);
+        }
+        if is_emissive(material) {
+            tri.light = lights.len() as u32;
+            let mut light = triangle_light(&tri, m.emission, m.two_sided != 0);
+            if let Some(a) = attributes {
+                light.uv = [a.uv0, a.uv1, a.uv2]
+                    .concat()
+                    .try_into()
+                    .expect("six numbers");
+                light.emission_texture = m.textures[texture_slot::EMISSION];
             }
-            triangles.push(tri);
-        };
+            lights.push(light);
+        }
+        triangles.push(tri);
+    };
+    // A quad's texture coordinates: (0, 0) at its corner, (1, 0) along edge1, (0, 1) along edge2.
+    let quad_uv = |corners: [[f32; 2]; 3]| ShadingTriangle {
+        normal0: [0.0; 3],
+        normal1: [0.0; 3],
+        normal2: [0.0; 3],
+        uv0: corners[0],
+        uv1: corners[1],
+        uv2: corners[2],
+        has_normals: 0,
+    };
     let quads_start = triangles.len();
     for (i, q) in file.quad.iter().enumerate() {
         let qf = q.get_ref();
@@ -410,17 +461,22 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 ),
             ));
         }
+        let textured = is_textured(material);
         push_triangle(
             &mut triangles,
             &mut lights,
+            &mut shading,
             [corner, corner + e1, corner + e1 + e2],
             material,
+            textured.then(|| quad_uv([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])),
         );
         push_triangle(
             &mut triangles,
             &mut lights,
+            &mut shading,
             [corner, corner + e1 + e2, corner + e2],
             material,
+            textured.then(|| quad_uv([[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]])),
         );
     }
     if triangles.len() > quads_start {
@@ -429,7 +485,6 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             range: quads_start..triangles.len(),
         });
     }
-    let base_dir = path.parent().unwrap_or(Path::new("."));
     for (i, m) in file.mesh.iter().enumerate() {
         let mf = m.get_ref();
         let field = format!("mesh[{i}]");
@@ -471,6 +526,18 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 )
             })?;
         }
+        let textured = is_textured(material);
+        if textured && soup.uvs.is_empty() {
+            return Err(ck.err(
+                mf.material.span(),
+                &format!("{field}.material"),
+                format!(
+                    "'{}' has textures but {} has no texture coordinates (OBJ vt, PLY u v)",
+                    mf.material.get_ref(),
+                    mf.file.get_ref()
+                ),
+            ));
+        }
         let start = triangles.len();
         for (k, t) in soup.triangles.iter().enumerate() {
             let p = t.map(|v| Vec3::from(v) * scale + translate);
@@ -483,7 +550,29 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             }
             // Degenerate (zero-area) triangles cannot be hit; they are dropped.
             if (p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0 {
-                push_triangle(&mut triangles, &mut lights, p, material);
+                let normals = soup.normals.get(k);
+                let uvs = soup.uvs.get(k).filter(|_| textured);
+                let attributes = (normals.is_some() || uvs.is_some()).then(|| {
+                    let n = normals.copied().unwrap_or([[0.0; 3]; 3]);
+                    let t = uvs.copied().unwrap_or([[0.0; 2]; 3]);
+                    ShadingTriangle {
+                        normal0: n[0],
+                        normal1: n[1],
+                        normal2: n[2],
+                        uv0: t[0],
+                        uv1: t[1],
+                        uv2: t[2],
+                        has_normals: normals.is_some() as u32,
+                    }
+                });
+                push_triangle(
+                    &mut triangles,
+                    &mut lights,
+                    &mut shading,
+                    p,
+                    material,
+                    attributes,
+                );
             }
         }
         triangle_groups.push(TriangleGroup {
@@ -515,6 +604,8 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         triangle_groups,
         lights,
         environment,
+        shading,
+        textures,
     })
 }
 

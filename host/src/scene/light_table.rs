@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use kernel::geometry::triangle_point_error;
-use kernel::scene::{light_kind, light_selection, Light, Triangle};
+use kernel::scene::{light_kind, light_selection, Light, Triangle, NONE};
 
 /// The light of an emissive sphere (selection filled later by [`assign_light_selection`]).
 pub fn sphere_light(center: Vec3, radius: f32, radiance: [f32; 3]) -> Light {
@@ -21,6 +21,9 @@ pub fn sphere_light(center: Vec3, radius: f32, radiance: [f32; 3]) -> Light {
         alias: 0,
         area: 0.0,
         point_error: 0.0,
+        uv: [0.0; 6],
+        emission_texture: NONE,
+        _pad: 0,
     }
 }
 
@@ -46,6 +49,9 @@ pub fn triangle_light(tri: &Triangle, radiance: [f32; 3], two_sided: bool) -> Li
         alias: 0,
         area: area as f32,
         point_error: triangle_point_error(p0, e1, e2, 1.0, 1.0),
+        uv: [0.0; 6],
+        emission_texture: NONE,
+        _pad: 0,
     }
 }
 

@@ -3,8 +3,10 @@
 
 use super::error::SceneError;
 use super::file::{Checker, MaterialFile};
+use super::textures::{TextureTable, TextureUse};
 use glam::Vec3;
-use kernel::scene::{material_kind, Material};
+use kernel::scene::{material_kind, texture_slot, Material, NONE};
+use std::path::Path;
 use toml::Spanned;
 
 /// Named conductors: RGB (eta, k) as Mitsuba 3 reduces its measured spectra (the `eta` and `k`
@@ -58,6 +60,7 @@ pub(super) fn material(
         ));
     }
     let alpha = match &mf.alpha {
+        None if mf.alpha_map.is_some() => Some(1.0),
         Some(a) => {
             let x = *a.get_ref();
             if !(0.0..=MAX_ALPHA).contains(&x) {
@@ -71,14 +74,17 @@ pub(super) fn material(
         }
         None => None,
     };
-    if let Some(e) = &mf.emission {
-        if mf.kd.is_some() || alpha.is_some() {
+    if mf.emission.is_some() || mf.emission_map.is_some() {
+        if mf.kd.is_some() || alpha.is_some() || mf.kd_map.is_some() || mf.ks_map.is_some() {
             return Err(whole(
                 "has emission and reflection: a light reflects nothing, give emission alone",
             ));
         }
-        let mut out =
-            Material::emitter(ck.color(e, &format!("{field}.emission"), None)?.to_array());
+        let radiance = match &mf.emission {
+            Some(e) => ck.color(e, &format!("{field}.emission"), None)?,
+            None => Vec3::ONE,
+        };
+        let mut out = Material::emitter(radiance.to_array());
         out.two_sided = mf.two_sided.as_ref().is_some_and(|t| *t.get_ref()) as u32;
         return Ok(out);
     }
@@ -117,8 +123,12 @@ pub(super) fn material(
     }
     let kd = match &mf.kd {
         Some(kd) => Some(ck.color(kd, &format!("{field}.kd"), Some(1.0))?),
+        None if mf.kd_map.is_some() => Some(Vec3::ONE),
         None => None,
     };
+    if mf.ks.is_none() && mf.ks_map.is_some() {
+        return Err(whole("has ks_map but no ks: give the specular factor"));
+    }
     match (&mf.ks, kd, alpha) {
         (None, Some(kd), None) => Ok(Material::diffuse(kd.to_array())),
         (None, Some(_), Some(_)) => Err(whole(
@@ -236,4 +246,87 @@ fn conductor(
             names.join(", ")
         ))),
     }
+}
+
+/// The textures of entry `m` (`kd_map`, `ks_map`, `alpha_map`, `emission_map`, `wrap`), added
+/// to `table` and recorded in `out.textures`. A colour map for kd or ks must not reflect more
+/// than it receives: its largest value times the factor stays within 1 (and kd + ks within 1).
+pub(super) fn attach_textures(
+    ck: &Checker,
+    field: &str,
+    m: &Spanned<MaterialFile>,
+    base_dir: &Path,
+    table: &mut TextureTable,
+    out: &mut Material,
+) -> Result<(), SceneError> {
+    let mf = m.get_ref();
+    let clamp = match &mf.wrap {
+        None => false,
+        Some(w) => match w.get_ref().as_str() {
+            "repeat" => false,
+            "clamp" => true,
+            other => {
+                return Err(ck.err(
+                    w.span(),
+                    &format!("{field}.wrap"),
+                    format!("unknown wrap '{other}' (expected repeat or clamp)"),
+                ))
+            }
+        },
+    };
+    let maps = [
+        (&mf.kd_map, "kd_map", texture_slot::KD, true),
+        (&mf.ks_map, "ks_map", texture_slot::KS, true),
+        (&mf.alpha_map, "alpha_map", texture_slot::ALPHA, false),
+        (
+            &mf.emission_map,
+            "emission_map",
+            texture_slot::EMISSION,
+            true,
+        ),
+    ];
+    let mut peak = [Vec3::ONE; texture_slot::COUNT];
+    for (map, name, slot, colour) in maps {
+        let Some(map) = map else { continue };
+        let map_field = format!("{field}.{name}");
+        if out.kind != material_kind::DIFFUSE && out.kind != material_kind::GLOSSY {
+            return Err(ck.err(
+                map.span(),
+                &map_field,
+                "textures apply to diffuse, kd + ks and emitting materials",
+            ));
+        }
+        let file = base_dir.join(map.get_ref());
+        if !file.is_file() {
+            return Err(ck.err(
+                map.span(),
+                &map_field,
+                format!("texture file {} does not exist", file.display()),
+            ));
+        }
+        let index = table.add(&file, TextureUse { colour, clamp }, &map_field)?;
+        peak[slot] = table.peak(index);
+        out.textures[slot] = index;
+    }
+    if mf.wrap.is_some() && out.textures.iter().all(|&t| t == NONE) {
+        return Err(ck.err(
+            mf.wrap.as_ref().map_or(m.span(), |w| w.span()),
+            &format!("{field}.wrap"),
+            "belongs to textures: the material has no map",
+        ));
+    }
+    let reflected = Vec3::from(out.albedo) * peak[texture_slot::KD]
+        + Vec3::from(out.specular) * peak[texture_slot::KS];
+    if out.emission == [0.0; 3] && reflected.max_element() > 1.0 {
+        return Err(ck.err(
+            m.span(),
+            field,
+            format!(
+                "kd and ks with their maps reach {:?} in a channel: the surface would reflect \
+                 more than it receives",
+                reflected.to_array()
+            ),
+        ));
+    }
+    Ok(())
 }

@@ -7,10 +7,27 @@ use std::path::Path;
 /// allocation (a hostile header must not reserve unbounded memory).
 pub const MAX_PLY_ELEMENTS: usize = 1 << 28;
 
-/// Triangles as vertex positions, three per triangle.
+/// Triangles as vertex positions, three per triangle, with their vertex normals and texture
+/// coordinates where the file gives them (each list empty, or one entry per triangle).
 #[derive(Debug, Default, Clone)]
 pub struct TriangleSoup {
     pub triangles: Vec<[[f32; 3]; 3]>,
+    pub normals: Vec<[[f32; 3]; 3]>,
+    pub uvs: Vec<[[f32; 2]; 3]>,
+}
+
+impl TriangleSoup {
+    /// Keeps the attribute lists only if every triangle has the attribute (a file that gives
+    /// normals to some faces only is shaded flat).
+    fn settle(mut self) -> Self {
+        if self.normals.len() != self.triangles.len() {
+            self.normals.clear();
+        }
+        if self.uvs.len() != self.triangles.len() {
+            self.uvs.clear();
+        }
+        self
+    }
 }
 
 /// Loads an OBJ or PLY file by its extension.
@@ -64,18 +81,39 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
             })?;
             Ok([p[0], p[1], p[2]])
         };
+        let has_normals = !m.normals.is_empty() && m.normals.len() == m.positions.len();
+        let has_uvs = !m.texcoords.is_empty() && m.texcoords.len() / 2 == m.positions.len() / 3;
         for (k, f) in m.indices.as_chunks::<3>().0.iter().enumerate() {
+            let face = format!("object '{}' face {}", model.name, k + 1);
             let tri = [vertex(f[0])?, vertex(f[1])?, vertex(f[2])?];
-            check_finite(
-                path,
-                None,
-                &format!("object '{}' face {}", model.name, k + 1),
-                &tri,
-            )?;
+            check_finite(path, None, &face, &tri)?;
             soup.triangles.push(tri);
+            if has_normals {
+                let n = f.map(|i| {
+                    let i = 3 * i as usize;
+                    [m.normals[i], m.normals[i + 1], m.normals[i + 2]]
+                });
+                check_finite(path, None, &format!("{face} normal"), &n)?;
+                soup.normals.push(n);
+            }
+            if has_uvs {
+                let t = f.map(|i| {
+                    let i = 2 * i as usize;
+                    [m.texcoords[i], m.texcoords[i + 1]]
+                });
+                if !t.iter().flatten().all(|c| c.is_finite()) {
+                    return Err(SceneError::new(
+                        path,
+                        None,
+                        format!("{face} texture coordinate"),
+                        "not a finite number",
+                    ));
+                }
+                soup.uvs.push(t);
+            }
         }
     }
-    Ok(soup)
+    Ok(soup.settle())
 }
 
 fn check_finite(
@@ -317,6 +355,8 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
     let min_value_bytes = if format == PlyFormat::Ascii { 2 } else { 1 };
 
     let mut vertices: Vec<[f32; 3]> = Vec::new();
+    let mut vertex_normals: Vec<[f32; 3]> = Vec::new();
+    let mut vertex_uvs: Vec<[f32; 2]> = Vec::new();
     let mut soup = TriangleSoup::default();
     for element in &elements {
         let min_bytes = element
@@ -348,12 +388,25 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
                         ))
                     }
                 };
+                // Optional attributes: a normal, texture coordinates under any of their usual
+                // names.
+                let normal_at = match (idx("nx"), idx("ny"), idx("nz")) {
+                    (Some(x), Some(y), Some(z)) => Some([x, y, z]),
+                    _ => None,
+                };
+                let uv_at = [("u", "v"), ("s", "t"), ("texture_u", "texture_v")]
+                    .iter()
+                    .find_map(|(a, b)| Some([idx(a)?, idx(b)?]));
                 vertices.reserve(element.count);
                 for v in 0..element.count {
+                    let mut values = [0.0f64; 16];
                     let mut p = [0.0f32; 3];
                     let field = format!("vertex {v}");
                     for (k, prop) in element.properties.iter().enumerate() {
                         let value = read_property(&mut reader, prop, &field)?;
+                        if k < values.len() {
+                            values[k] = value;
+                        }
                         if k == ix {
                             p[0] = value as f32;
                         } else if k == iy {
@@ -366,6 +419,25 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
                         return Err(reader.err(&field, "vertex coordinate is not a finite number"));
                     }
                     vertices.push(p);
+                    let attribute = |at: &[usize]| -> Option<Vec<f32>> {
+                        at.iter()
+                            .map(|&k| values.get(k).map(|&x| x as f32))
+                            .collect()
+                    };
+                    if let Some(n) = normal_at.and_then(|at| attribute(&at)) {
+                        if !n.iter().all(|c| c.is_finite()) {
+                            return Err(reader.err(&field, "normal is not a finite number"));
+                        }
+                        vertex_normals.push([n[0], n[1], n[2]]);
+                    }
+                    if let Some(t) = uv_at.and_then(|at| attribute(&at)) {
+                        if !t.iter().all(|c| c.is_finite()) {
+                            return Err(
+                                reader.err(&field, "texture coordinate is not a finite number")
+                            );
+                        }
+                        vertex_uvs.push([t[0], t[1]]);
+                    }
                 }
             }
             "face" => {
@@ -405,11 +477,14 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
                                     ));
                                 }
                                 for k in 1..n - 1 {
-                                    soup.triangles.push([
-                                        vertices[polygon[0]],
-                                        vertices[polygon[k]],
-                                        vertices[polygon[k + 1]],
-                                    ]);
+                                    let corners = [polygon[0], polygon[k], polygon[k + 1]];
+                                    soup.triangles.push(corners.map(|i| vertices[i]));
+                                    if vertex_normals.len() == vertices.len() {
+                                        soup.normals.push(corners.map(|i| vertex_normals[i]));
+                                    }
+                                    if vertex_uvs.len() == vertices.len() {
+                                        soup.uvs.push(corners.map(|i| vertex_uvs[i]));
+                                    }
                                 }
                             }
                             other => {
@@ -432,7 +507,7 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
             }
         }
     }
-    Ok(soup)
+    Ok(soup.settle())
 }
 
 /// Reads one property, returning its value (lists: their length, items skipped).

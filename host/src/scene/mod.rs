@@ -8,13 +8,14 @@ mod file;
 pub mod light_table;
 mod materials;
 pub mod mesh;
+pub mod textures;
 
 pub use error::SceneError;
 pub use file::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
 
 use crate::settings::RenderSettings;
 use glam::Vec3;
-use kernel::scene::{Camera, Light, Material, RenderParams, Sphere, Triangle};
+use kernel::scene::{Camera, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
 use std::ops::Range;
 use std::path::Path;
 
@@ -69,7 +70,7 @@ pub fn triangle(p: [Vec3; 3], material: u32) -> Triangle {
         edge1: (p[1] - p[0]).to_array(),
         light: kernel::scene::NONE,
         edge2: (p[2] - p[0]).to_array(),
-        _pad: 0,
+        shading: kernel::scene::NONE,
     }
 }
 
@@ -97,6 +98,11 @@ pub struct Scene {
     /// The environment map, if `[background] map` names one (its light is the last entry of
     /// `lights`).
     pub environment: Option<environment::EnvironmentMap>,
+    /// Vertex normals and texture coordinates of the triangles that have them
+    /// (`Triangle::shading` indexes it).
+    pub shading: Vec<ShadingTriangle>,
+    /// The materials' textures (`Material::textures` indexes it).
+    pub textures: textures::TextureTable,
 }
 
 impl Scene {
@@ -188,6 +194,69 @@ impl Scene {
             .map_or_else(|| vec![0.0], |m| m.table())
     }
 
+    /// The shading table as the kernel binds it: one zero record when empty (a storage buffer
+    /// needs something behind it).
+    pub fn shading_table(&self) -> Vec<ShadingTriangle> {
+        if self.shading.is_empty() {
+            vec![bytemuck::Zeroable::zeroed()]
+        } else {
+            self.shading.clone()
+        }
+    }
+
+    /// Bytes of the scene's tables on either backend: triangles, spheres, shading records,
+    /// materials, lights, textures and the environment map (what `twinpath info` reports).
+    pub fn table_bytes(&self) -> [(&'static str, usize); 7] {
+        use std::mem::size_of;
+        [
+            ("triangles", self.triangles.len() * size_of::<Triangle>()),
+            ("spheres", self.spheres.len() * size_of::<Sphere>()),
+            ("shading", self.shading.len() * size_of::<ShadingTriangle>()),
+            ("materials", self.materials.len() * size_of::<Material>()),
+            ("lights", self.lights.len() * size_of::<Light>()),
+            ("textures", self.textures.bytes()),
+            (
+                "environment",
+                self.environment
+                    .as_ref()
+                    .map_or(0, |_| 4 * self.environment_table().len()),
+            ),
+        ]
+    }
+
+    /// One line on the memory the scene's tables take on either backend: each non-empty table
+    /// and the total, and the textures' count and sizes.
+    pub fn memory_report(&self) -> String {
+        let size = |b: usize| {
+            if b < 1 << 20 {
+                format!("{:.1} KiB", b as f64 / 1024.0)
+            } else {
+                format!("{:.1} MiB", b as f64 / (1024.0 * 1024.0))
+            }
+        };
+        let tables = self.table_bytes();
+        let total: usize = tables.iter().map(|t| t.1).sum();
+        let mut parts: Vec<String> = tables
+            .iter()
+            .filter(|t| t.1 > 0 && (t.0 != "textures" || !self.textures.textures.is_empty()))
+            .map(|(name, b)| format!("{name} {}", size(*b)))
+            .collect();
+        if !self.textures.textures.is_empty() {
+            let sizes: Vec<String> = self
+                .textures
+                .textures
+                .iter()
+                .map(|t| format!("{}x{}", t.width, t.height))
+                .collect();
+            parts.push(format!(
+                "{} textures ({})",
+                sizes.len(),
+                sizes.join(", ")
+            ));
+        }
+        format!("{} in all: {}", size(total), parts.join(", "))
+    }
+
     /// The kernel's feature bits for this scene and its settings (`kernel::features`; 0 with
     /// `specialize` off, the generic path).
     pub fn features(&self) -> u32 {
@@ -195,6 +264,7 @@ impl Scene {
             kernel::features::scene_features(&self.params(0, 1))
                 | kernel::features::material_features(&self.materials)
                 | kernel::features::light_features(&self.lights)
+                | kernel::features::surface_features(&self.materials, &self.shading)
         } else {
             0
         }

@@ -96,6 +96,16 @@ impl GpuRenderer {
                 bytemuck::cast_slice(&scene.environment_table()),
                 STORAGE,
             )?,
+            ctx.upload_buffer(
+                "shading",
+                bytemuck::cast_slice(&scene.shading_table()),
+                STORAGE,
+            )?,
+            ctx.upload_buffer(
+                "textures",
+                bytemuck::cast_slice(&scene.textures.words),
+                STORAGE,
+            )?,
         ];
         let accum = ctx.create_storage_image("accum", w, h)?;
         let accum_sq = ctx.create_storage_image("accum_sq", w, h)?;
@@ -112,7 +122,7 @@ impl GpuRenderer {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 6,
+                descriptor_count: 8,
             },
         ];
         let (pool, set) = ctx.create_descriptor_set(pipeline.set_layout, &sizes)?;
@@ -140,6 +150,8 @@ impl GpuRenderer {
             buffer_info(&tables[2]),
             buffer_info(&tables[3]),
             buffer_info(&tables[4]),
+            buffer_info(&tables[5]),
+            buffer_info(&tables[6]),
         ];
         let buffer_bindings = [
             binding::PARAMS,
@@ -148,6 +160,8 @@ impl GpuRenderer {
             binding::TRIANGLES,
             binding::SPHERES,
             binding::ENVIRONMENT,
+            binding::SHADING,
+            binding::TEXTURES,
         ];
         let mut writes = vec![
             vk::WriteDescriptorSet::default()

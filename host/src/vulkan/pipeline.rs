@@ -27,6 +27,8 @@ pub mod binding {
     pub const ACCUM_SQ: u32 = 7;
     pub const PILOTS: u32 = 8;
     pub const ENVIRONMENT: u32 = 9;
+    pub const SHADING: u32 = 10;
+    pub const TEXTURES: u32 = 11;
 }
 
 /// Which hit groups a pipeline has: a scene without triangles (or spheres) gets no triangle
@@ -119,6 +121,8 @@ impl RtPipeline {
             b(binding::ACCUM_SQ, vk::DescriptorType::STORAGE_IMAGE),
             b(binding::PILOTS, vk::DescriptorType::STORAGE_IMAGE),
             b(binding::ENVIRONMENT, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::SHADING, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::TEXTURES, vk::DescriptorType::STORAGE_BUFFER),
         ];
         let set_layout = unsafe {
             ctx.device.create_descriptor_set_layout(

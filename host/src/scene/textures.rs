@@ -1,0 +1,191 @@
+//! Image textures of a scene (`kd_map`, `ks_map`, `alpha_map`, `emission_map`): PNG, JPEG, EXR
+//! or HDR images loaded with `image` into the one texture table the kernel reads
+//! (`kernel::texture` describes its layout). 8-bit images keep one word per texel (decoded by
+//! the table's sRGB or linear byte tables), float images three.
+
+use super::error::SceneError;
+use kernel::texture::{flags, LINEAR_TABLE, RECORDS, RECORD_WORDS, SRGB_TABLE};
+use std::path::{Path, PathBuf};
+
+/// Largest texture side accepted.
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+
+/// The texture table and what went into it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureTable {
+    /// The kernel's table: header, decoding tables, records, texels.
+    pub words: Vec<u32>,
+    /// Each texture: its file, its flags, its size.
+    pub textures: Vec<TextureInfo>,
+}
+
+/// One texture of the table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureInfo {
+    pub path: PathBuf,
+    pub flags: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// How a texture is read: as colour (sRGB-encoded 8-bit images) or as linear data, and how
+/// coordinates outside [0, 1] wrap.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TextureUse {
+    pub colour: bool,
+    pub clamp: bool,
+}
+
+/// The sRGB decoding of byte `b` (IEC 61966-2-1), in f64.
+pub fn srgb_to_linear(b: u8) -> f64 {
+    let c = b as f64 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+impl Default for TextureTable {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl TextureTable {
+    /// An empty table: no textures, the decoding tables in place.
+    pub fn new() -> Self {
+        let mut words = vec![0u32; RECORDS];
+        for b in 0..=255u8 {
+            words[SRGB_TABLE + b as usize] = (srgb_to_linear(b) as f32).to_bits();
+            words[LINEAR_TABLE + b as usize] = ((b as f64 / 255.0) as f32).to_bits();
+        }
+        Self {
+            words,
+            textures: Vec::new(),
+        }
+    }
+
+    /// Bytes the kernel's table takes.
+    pub fn bytes(&self) -> usize {
+        4 * self.words.len()
+    }
+
+    /// The index of the texture of `path` used as `usage`, loading it on first use (`field`
+    /// names the scene's field in errors). The table is rebuilt with the new record, since
+    /// records precede texels.
+    pub fn add(&mut self, path: &Path, usage: TextureUse, field: &str) -> Result<u32, SceneError> {
+        let err = |msg: String| SceneError::new(path, None, field, msg);
+        let image = image::ImageReader::open(path)
+            .map_err(|e| err(format!("cannot read: {e}")))?
+            .with_guessed_format()
+            .map_err(|e| err(format!("cannot read: {e}")))?
+            .decode()
+            .map_err(|e| err(format!("not a readable PNG, JPEG, EXR or HDR image: {e}")))?;
+        let (width, height) = (image.width(), image.height());
+        if width == 0 || height == 0 || width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
+            return Err(err(format!(
+                "{width} x {height} texels: each side must be within 1..={MAX_TEXTURE_SIDE}"
+            )));
+        }
+        let float = matches!(
+            image.color(),
+            image::ColorType::Rgb32F | image::ColorType::Rgba32F
+        );
+        let mut tex_flags = 0;
+        if usage.clamp {
+            tex_flags |= flags::CLAMP;
+        }
+        let texels: Vec<u32> = if float {
+            tex_flags |= flags::FLOAT;
+            let rgb = image.into_rgb32f();
+            if let Some((k, p)) = rgb
+                .pixels()
+                .enumerate()
+                .find(|(_, p)| !p.0.iter().all(|c| c.is_finite() && *c >= 0.0))
+            {
+                return Err(err(format!(
+                    "texel ({}, {}) is {:?}: values must be finite and non-negative",
+                    k as u32 % width,
+                    k as u32 / width,
+                    p.0
+                )));
+            }
+            rgb.pixels().flat_map(|p| p.0.map(f32::to_bits)).collect()
+        } else {
+            if usage.colour {
+                tex_flags |= flags::SRGB;
+            }
+            image
+                .into_rgba8()
+                .pixels()
+                .map(|p| u32::from_le_bytes(p.0))
+                .collect()
+        };
+        if let Some(k) = self
+            .textures
+            .iter()
+            .position(|t| t.path == path && t.flags == tex_flags)
+        {
+            return Ok(k as u32);
+        }
+        self.push(path, tex_flags, width, height, &texels);
+        Ok(self.textures.len() as u32 - 1)
+    }
+
+    /// The largest value of texture `index` in each channel (decoded as the kernel decodes it).
+    pub fn peak(&self, index: u32) -> glam::Vec3 {
+        let r = RECORDS + RECORD_WORDS * index as usize;
+        let (first, w, h, tex_flags) = (
+            self.words[r] as usize,
+            self.words[r + 1] as usize,
+            self.words[r + 2] as usize,
+            self.words[r + 3],
+        );
+        let mut peak = glam::Vec3::ZERO;
+        if tex_flags & flags::FLOAT != 0 {
+            for t in self.words[first..first + 3 * w * h].chunks(3) {
+                peak = peak.max(glam::Vec3::from_array(
+                    [0, 1, 2].map(|k| f32::from_bits(t[k])),
+                ));
+            }
+        } else {
+            let base = if tex_flags & flags::SRGB != 0 {
+                SRGB_TABLE
+            } else {
+                LINEAR_TABLE
+            };
+            for &word in &self.words[first..first + w * h] {
+                let c = [0, 8, 16]
+                    .map(|s| f32::from_bits(self.words[base + ((word >> s) & 0xff) as usize]));
+                peak = peak.max(glam::Vec3::from_array(c));
+            }
+        }
+        peak
+    }
+
+    /// Appends a texture of `width` x `height` texels (`texels` in the kernel's encoding for
+    /// `tex_flags`) and rebuilds the table.
+    pub fn push(&mut self, path: &Path, tex_flags: u32, width: u32, height: u32, texels: &[u32]) {
+        // The texels of the textures so far, after their records.
+        let old_records = RECORDS + RECORD_WORDS * self.textures.len();
+        let old_texels = self.words.split_off(old_records);
+        self.textures.push(TextureInfo {
+            path: path.to_path_buf(),
+            flags: tex_flags,
+            width,
+            height,
+        });
+        let n = self.textures.len();
+        let shift = RECORD_WORDS as u32;
+        self.words[0] = n as u32;
+        for k in 0..n - 1 {
+            self.words[RECORDS + RECORD_WORDS * k] += shift;
+        }
+        let first = (RECORDS + RECORD_WORDS * n + old_texels.len()) as u32;
+        self.words
+            .extend_from_slice(&[first, width, height, tex_flags]);
+        self.words.extend_from_slice(&old_texels);
+        self.words.extend_from_slice(texels);
+    }
+}

@@ -1,0 +1,207 @@
+//! Image textures: every texel of a scene in one `u32` buffer (the texture table), looked up and
+//! bilinearly filtered by this shared code, so the CPU and the GPU compute the same value bit
+//! for bit (no sampler objects, no descriptor indexing, no driver filtering).
+//!
+//! Layout of the table (`TextureTable` on the host builds it):
+//! - word 0: the number of textures T;
+//! - words [`SRGB_TABLE`]..+256: the sRGB-decoded value of each byte (f32 bits; the host
+//!   computes the IEC 61966-2-1 curve in f64), words [`LINEAR_TABLE`]..+256: byte / 255;
+//! - words [`RECORDS`] + 4k..+4: texture k's record: first texel word, width, height, flags
+//!   ([`flags`]);
+//! - the texels: an 8-bit texture one word per texel (r | g << 8 | b << 16 | a << 24), a float
+//!   texture three words (f32 bits of r, g, b); rows from the image's top, texels left to right.
+//!
+//! Texture coordinates: u from the image's left edge (0) to its right edge (1), v from its
+//! bottom (0) to its top (1) (the OBJ and PLY convention); texel (i, j)'s centre is at
+//! ((i + 1/2) / w, 1 - (j + 1/2) / h). Bilinear filtering between the four texel centres around
+//! the point (pbrt-v4 `Image::Bilerp`, the same weights).
+
+use crate::scene::{texture_slot, Material, NONE};
+#[cfg(target_arch = "spirv")]
+use crate::Float;
+use spirv_std::glam::{Vec2, Vec3};
+
+/// Word of the sRGB decoding table.
+pub const SRGB_TABLE: usize = 1;
+/// Word of the linear decoding table (byte / 255).
+pub const LINEAR_TABLE: usize = SRGB_TABLE + 256;
+/// Word of texture 0's record.
+pub const RECORDS: usize = LINEAR_TABLE + 256;
+/// Words per texture record.
+pub const RECORD_WORDS: usize = 4;
+
+/// Bits of a texture record's flags word.
+pub mod flags {
+    /// Texels are three f32 words (an EXR or HDR image), else one RGBA8 word.
+    pub const FLOAT: u32 = 1 << 0;
+    /// 8-bit texels are sRGB-encoded (colour maps), else linear.
+    pub const SRGB: u32 = 1 << 1;
+    /// Coordinates outside [0, 1] clamp to the edge, else the image repeats.
+    pub const CLAMP: u32 = 1 << 2;
+}
+
+/// The four texels around a point and the point's position between them: texel columns `x0`,
+/// `x1` (x1 is x0's right neighbour, wrapped or clamped), rows `y0`, `y1` (y1 below y0), and the
+/// weights `fx`, `fy` of x1 and y1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    pub x0: u32,
+    pub x1: u32,
+    pub y0: u32,
+    pub y1: u32,
+    pub fx: f32,
+    pub fy: f32,
+}
+
+/// The bilinear footprint of texture coordinates `uv` on a `width` x `height` image: repeated
+/// (the fractional part of each coordinate) or clamped to [0, 1] first, so texel indices are
+/// always in range whatever `uv` is (a non-finite coordinate reads as 0).
+#[inline]
+pub fn footprint(uv: Vec2, width: u32, height: u32, clamp: bool) -> Footprint {
+    let (u, v) = (unit_coordinate(uv.x, clamp), unit_coordinate(uv.y, clamp));
+    let (x0, x1, fx) = axis(u * width as f32 - 0.5, width, clamp);
+    let (y0, y1, fy) = axis((1.0 - v) * height as f32 - 0.5, height, clamp);
+    Footprint {
+        x0,
+        x1,
+        y0,
+        y1,
+        fx,
+        fy,
+    }
+}
+
+/// `t` in [0, 1]: clamped, or its fractional part (which rounding may leave at 1, handled by
+/// [`axis`]); 0 for a non-finite `t`.
+#[inline]
+fn unit_coordinate(t: f32, clamp: bool) -> f32 {
+    if !t.is_finite() {
+        return 0.0;
+    }
+    if clamp {
+        t.clamp(0.0, 1.0)
+    } else {
+        t - t.floor()
+    }
+}
+
+/// Along one axis of `n` texels, at continuous texel coordinate `x` in [-1/2, n - 1/2]: the two
+/// texels whose centres enclose it and the second one's weight. Repeating, texel -1 is n - 1
+/// and texel n is 0; clamping, both are the edge texel.
+#[inline]
+fn axis(x: f32, n: u32, clamp: bool) -> (u32, u32, f32) {
+    let floor = x.floor();
+    let f = x - floor;
+    let last = n as i32 - 1;
+    let i0 = floor as i32;
+    let i1 = i0 + 1;
+    if clamp {
+        (clamp_index(i0, last), clamp_index(i1, last), f)
+    } else {
+        (wrap_index(i0, last), wrap_index(i1, last), f)
+    }
+}
+
+/// Texel index `i` in -1..=last + 1 clamped to 0..=last.
+#[inline]
+fn clamp_index(i: i32, last: i32) -> u32 {
+    if i < 0 {
+        0
+    } else if i > last {
+        last as u32
+    } else {
+        i as u32
+    }
+}
+
+/// Texel index `i` in -1..=last + 1 wrapped into 0..=last (the image repeats).
+#[inline]
+fn wrap_index(i: i32, last: i32) -> u32 {
+    if i < 0 {
+        last as u32
+    } else if i > last {
+        (i - last - 1) as u32
+    } else {
+        i as u32
+    }
+}
+
+/// Bilinear blend of the texel values `c00` (x0, y0), `c10` (x1, y0), `c01` (x0, y1) and `c11`
+/// (x1, y1) at weights (fx, fy).
+#[inline]
+pub fn bilerp(c00: Vec3, c10: Vec3, c01: Vec3, c11: Vec3, fx: f32, fy: f32) -> Vec3 {
+    let top = c00 * (1.0 - fx) + c10 * fx;
+    let bottom = c01 * (1.0 - fx) + c11 * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
+/// The value of texel (x, y) of texture `record` (its first word `offset`, its `width` and
+/// `flags`): decoded through the table's sRGB or linear byte table, or read as f32.
+#[inline]
+fn texel(table: &[u32], offset: u32, width: u32, tex_flags: u32, x: u32, y: u32) -> Vec3 {
+    let index = y as usize * width as usize + x as usize;
+    if tex_flags & flags::FLOAT != 0 {
+        let w = offset as usize + 3 * index;
+        Vec3::new(
+            f32::from_bits(table[w]),
+            f32::from_bits(table[w + 1]),
+            f32::from_bits(table[w + 2]),
+        )
+    } else {
+        let word = table[offset as usize + index];
+        let base = if tex_flags & flags::SRGB != 0 {
+            SRGB_TABLE
+        } else {
+            LINEAR_TABLE
+        };
+        Vec3::new(
+            decoded(table, base, word),
+            decoded(table, base, word >> 8),
+            decoded(table, base, word >> 16),
+        )
+    }
+}
+
+/// The decoding table at `base`'s entry for the low byte of `word`.
+#[inline]
+fn decoded(table: &[u32], base: usize, word: u32) -> f32 {
+    f32::from_bits(table[base + (word & 0xff) as usize])
+}
+
+/// Texture `texture` of `table` at coordinates `uv`, bilinearly filtered (RGB; linear values).
+#[inline]
+pub fn lookup(table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
+    let r = RECORDS + RECORD_WORDS * texture as usize;
+    let (offset, width, height, tex_flags) = (table[r], table[r + 1], table[r + 2], table[r + 3]);
+    let f = footprint(uv, width, height, tex_flags & flags::CLAMP != 0);
+    bilerp(
+        texel(table, offset, width, tex_flags, f.x0, f.y0),
+        texel(table, offset, width, tex_flags, f.x1, f.y0),
+        texel(table, offset, width, tex_flags, f.x0, f.y1),
+        texel(table, offset, width, tex_flags, f.x1, f.y1),
+        f.fx,
+        f.fy,
+    )
+}
+
+/// `material` at a point of texture coordinates `uv`: each parameter with a texture multiplied
+/// by the texture's value there (alpha by its red channel).
+#[inline]
+pub fn textured_material(material: &Material, table: &[u32], uv: Vec2) -> Material {
+    let mut m = *material;
+    let t = material.textures;
+    if t[texture_slot::KD] != NONE {
+        m.albedo = (Vec3::from(m.albedo) * lookup(table, t[texture_slot::KD], uv)).to_array();
+    }
+    if t[texture_slot::KS] != NONE {
+        m.specular = (Vec3::from(m.specular) * lookup(table, t[texture_slot::KS], uv)).to_array();
+    }
+    if t[texture_slot::ALPHA] != NONE {
+        m.alpha *= lookup(table, t[texture_slot::ALPHA], uv).x;
+    }
+    if t[texture_slot::EMISSION] != NONE {
+        m.emission =
+            (Vec3::from(m.emission) * lookup(table, t[texture_slot::EMISSION], uv)).to_array();
+    }
+    m
+}
