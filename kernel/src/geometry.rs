@@ -154,6 +154,19 @@ pub fn triangle_barycentrics(p0: Vec3, edge1: Vec3, edge2: Vec3, p: Vec3) -> Vec
     Vec2::new((c * e - b * f) / det, (a * f - b * e) / det)
 }
 
+/// Barycentric blend of the values `a`, `b`, `c` at p0, p1, p2, at barycentrics (u, v) of p1
+/// and p2.
+#[inline]
+pub fn blend3(a: Vec3, b: Vec3, c: Vec3, bary: Vec2) -> Vec3 {
+    a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y
+}
+
+/// [`blend3`] of two-component values (texture coordinates).
+#[inline]
+pub fn blend2(a: Vec2, b: Vec2, c: Vec2, bary: Vec2) -> Vec2 {
+    a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y
+}
+
 /// Unit geometric normal of a triangle, (edge1 x edge2) normalised.
 #[inline]
 pub fn triangle_normal(edge1: Vec3, edge2: Vec3) -> Vec3 {

@@ -3,7 +3,7 @@
 
 use crate::environment;
 use crate::geometry::{
-    area_to_solid_angle_pdf, sphere_point_error, triangle_barycentrics, triangle_normal,
+    area_to_solid_angle_pdf, blend2, sphere_point_error, triangle_barycentrics, triangle_normal,
     triangle_point,
 };
 use crate::sampling::{
@@ -12,7 +12,6 @@ use crate::sampling::{
 };
 use crate::scene::{light_kind, light_sampling, Light, RenderParams, NONE};
 use crate::spherical_triangle::{barycentrics_along, SphericalTriangle};
-use crate::surface::blend2;
 use crate::texture;
 use spirv_std::glam::{Vec2, Vec3};
 
@@ -161,39 +160,44 @@ pub fn pdf_environment_light(
 }
 
 /// The radiance light sample `ls` of light `l` sends toward its receiver: the light's constant
-/// radiance (times its emission texture at the point, where `textured` and it has one), or the
-/// environment map's along the sample's direction (-normal).
+/// radiance, or the environment map's along the sample's direction (-normal). (A triangle with
+/// an emission texture scales it by [`emission_texture_at`].)
 #[inline]
-#[allow(clippy::too_many_arguments)]
 pub fn sample_radiance(
     environment: bool,
-    textured: bool,
     params: &RenderParams,
     table: &[f32],
-    textures: &[u32],
     l: &Light,
     ls: &DirectionalLightSample,
 ) -> Vec3 {
     if is_environment(environment, l) {
         environment::eval(params, table, -ls.point.normal)
-    } else if textured && l.emission_texture != NONE {
-        // A triangle with an emission texture: its value at the point's texture coordinates.
-        let bary = triangle_barycentrics(
-            Vec3::from(l.position),
-            Vec3::from(l.edge1),
-            Vec3::from(l.edge2),
-            ls.point.position,
-        );
-        let uv = blend2(
-            Vec2::new(l.uv[0], l.uv[1]),
-            Vec2::new(l.uv[2], l.uv[3]),
-            Vec2::new(l.uv[4], l.uv[5]),
-            bary,
-        );
-        Vec3::from(l.radiance) * texture::lookup(textures, l.emission_texture, uv)
     } else {
         Vec3::from(l.radiance)
     }
+}
+
+/// The emission texture's value at the point of light sample `ls` on triangle light `l`
+/// (1 where the light has no texture): the point's barycentrics on the triangle, its texture
+/// coordinates from the light's `uv`, the texture there.
+#[inline]
+pub fn emission_texture_at(textures: &[u32], l: &Light, ls: &DirectionalLightSample) -> Vec3 {
+    if l.emission_texture == NONE {
+        return Vec3::ONE;
+    }
+    let bary = triangle_barycentrics(
+        Vec3::from(l.position),
+        Vec3::from(l.edge1),
+        Vec3::from(l.edge2),
+        ls.point.position,
+    );
+    let uv = blend2(
+        Vec2::new(l.uv[0], l.uv[1]),
+        Vec2::new(l.uv[2], l.uv[3]),
+        Vec2::new(l.uv[4], l.uv[5]),
+        bary,
+    );
+    texture::lookup(textures, l.emission_texture, uv)
 }
 
 /// Whether `mode` samples light `l` by its cone from receiver `x`: a sphere (the caller knows it

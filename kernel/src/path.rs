@@ -12,8 +12,8 @@ use crate::geometry::{
     triangle_point_error_conditioned, TriangleShape,
 };
 use crate::light::{
-    eval_radiance, light_point_error, pdf_environment_light, pdf_light_from, sample_radiance,
-    DirectionalLightSample,
+    emission_texture_at, eval_radiance, light_point_error, pdf_environment_light, pdf_light_from,
+    sample_radiance, DirectionalLightSample,
 };
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
@@ -21,7 +21,7 @@ use crate::scene::{
     light_sampling, material_kind, mis, Light, Material, RenderParams, ShadingTriangle, Sphere,
     Triangle, NONE,
 };
-use crate::surface::shade;
+use crate::surface::{emission_at, shade};
 use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION, LENS_DIMENSION};
 use spirv_std::glam::{Vec2, Vec3};
 
@@ -50,13 +50,6 @@ pub struct SurfaceHit {
     pub shading: u32,
     /// A triangle's barycentrics (u, v) of p1 and p2 at the hit.
     pub barycentrics: Vec2,
-    /// The unit shading normal, either orientation; meaningful where `smooth`
-    /// (`surface::shade` fills it, and `uv`).
-    pub shading_normal: Vec3,
-    /// Whether the hit shades with `shading_normal` (vertex normals) instead of `normal`.
-    pub smooth: bool,
-    /// Texture coordinates at the hit (where the scene has textures).
-    pub uv: Vec2,
 }
 
 impl SurfaceHit {
@@ -73,9 +66,6 @@ impl SurfaceHit {
             arrived_behind: false,
             shading: NONE,
             barycentrics: Vec2::ZERO,
-            shading_normal: Vec3::ZERO,
-            smooth: false,
-            uv: Vec2::ZERO,
         }
     }
 
@@ -98,9 +88,6 @@ impl SurfaceHit {
             arrived_behind: from_center.dot(from_center) < radius * radius,
             shading: NONE,
             barycentrics: Vec2::ZERO,
-            shading_normal: Vec3::ZERO,
-            smooth: false,
-            uv: Vec2::ZERO,
         }
     }
 
@@ -133,9 +120,6 @@ impl SurfaceHit {
             arrived_behind: Self::behind_plane(shape.normal, dir),
             shading: tri.shading,
             barycentrics: Vec2::new(u, v),
-            shading_normal: Vec3::ZERO,
-            smooth: false,
-            uv: Vec2::ZERO,
         }
     }
 
@@ -341,23 +325,33 @@ impl PathState {
         textures: &[u32],
     ) -> Self {
         loop {
-            let mut hit = if self.extend {
+            let hit = if self.extend {
                 tracer.closest_hit(self.ray_origin, self.ray_dir)
             } else {
                 SurfaceHit::miss()
             };
             let occluded = self.shadow && tracer.occluded(self.shadow_from, self.shadow_to);
-            let material = shade(features, &mut hit, materials, shading, textures);
             if self.advance(
                 features,
                 params,
-                &material,
+                materials,
                 lights,
                 environment,
+                shading,
+                textures,
                 &hit,
                 occluded,
             ) {
-                let query = self.vertex_query(features, params, &hit, &material);
+                let (material, shading_normal) = shade(
+                    features,
+                    hit.material,
+                    hit.shading,
+                    hit.barycentrics,
+                    materials,
+                    shading,
+                    textures,
+                );
+                let query = self.vertex_query(features, params, &hit, &material, shading_normal);
                 let samples = VertexSamples::draw(&query, &mut self.rng);
                 self.vertex(
                     features,
@@ -378,8 +372,7 @@ impl PathState {
     }
 
     /// Takes the answers to this round's rays: `hit`, the closest hit of the extension ray
-    /// (ignored unless `extend`) with `material`, its material there (`surface::shade`), and
-    /// whether the shadow segment is `occluded` (ignored unless
+    /// (ignored unless `extend`), and whether the shadow segment is `occluded` (ignored unless
     /// `shadow`); then runs the estimator up to its next ray casts (steps 1-5 above) or up to
     /// the vertex at `hit`. Returns whether the path reached that vertex: then the caller
     /// states its query ([`PathState::vertex_query`]), fills its samples and hands them to
@@ -390,9 +383,11 @@ impl PathState {
         &mut self,
         features: F,
         params: &RenderParams,
-        material: &Material,
+        materials: &[Material],
         lights: &[Light],
         environment: &[f32],
+        shading: &[ShadingTriangle],
+        textures: &[u32],
         hit: &SurfaceHit,
         occluded: bool,
     ) -> bool {
@@ -433,9 +428,17 @@ impl PathState {
             return false;
         }
         if hit.light != NONE {
+            let material = &materials[hit.material as usize];
             let two_sided = features.triangle_lights() && lights[hit.light as usize].two_sided != 0;
-            let emitted =
-                eval_radiance(Vec3::from(material.emission), hit.arrived_behind, two_sided);
+            let emission = emission_at(
+                features,
+                material,
+                hit.shading,
+                hit.barycentrics,
+                shading,
+                textures,
+            );
+            let emitted = eval_radiance(emission, hit.arrived_behind, two_sided);
             if self.depth == 0 {
                 // 1: a light seen directly (it reflects nothing, so the path ends).
                 self.radiance = emitted;
@@ -470,6 +473,7 @@ impl PathState {
         params: &RenderParams,
         hit: &SurfaceHit,
         material: &Material,
+        shading_normal: Vec3,
     ) -> VertexQuery {
         let lambertian = !features.materials() || material.kind == material_kind::DIFFUSE;
         let reflects = if lambertian {
@@ -496,13 +500,11 @@ impl PathState {
             params.rr_probability
         };
         let ng = hit.facing_normal();
-        let n = if features.shading_normals() && hit.smooth {
+        let smooth = features.shading_normals() && shading_normal != Vec3::ZERO;
+        let n = if smooth {
             // The shading normal on wo's side (pbrt-v4's two-sided BxDFs mirror wo's
             // hemisphere of the shading frame; `crate::surface`).
-            side(
-                hit.shading_normal,
-                hit.shading_normal.dot(self.ray_dir) < 0.0,
-            )
+            side(shading_normal, shading_normal.dot(self.ray_dir) < 0.0)
         } else {
             ng
         };
@@ -511,6 +513,7 @@ impl PathState {
             x: hit.position,
             n,
             ng,
+            smooth,
             light_count,
             mode: light_sampling_of(features, params),
             triangle_lights: features.triangle_lights(),
@@ -589,7 +592,7 @@ impl PathState {
         let ray_origin = offset_ray_origin(x, ng, hit.error);
         // With a shading normal, a direction below the geometric surface carries nothing
         // (`crate::surface`): it would leave through the surface.
-        let smooth = features.shading_normals() && hit.smooth;
+        let smooth = features.shading_normals() && query.smooth;
 
         // 2(a): next-event estimation.
         if query.samples_light() {
@@ -601,15 +604,12 @@ impl PathState {
             let pdf_w = ls.pdf_solid_angle;
             let above = !smooth || ng.dot(wi) > 0.0;
             if cos_x > 0.0 && cos_y > 0.0 && pdf_w > 0.0 && above {
-                let emitted = sample_radiance(
-                    query.environment_light,
-                    features.textures(),
-                    params,
-                    environment,
-                    textures,
-                    &lights[ls.light as usize],
-                    &ls,
-                );
+                let light = &lights[ls.light as usize];
+                let mut emitted =
+                    sample_radiance(query.environment_light, params, environment, light, &ls);
+                if features.textures() {
+                    emitted *= emission_texture_at(textures, light, &ls);
+                }
                 let weight = light_strategy_weight(features, params, pdf_w, pdf_brdf(n, wi));
                 let radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
@@ -659,7 +659,7 @@ impl PathState {
         samples: &VertexSamples,
     ) {
         let (x, n, ng) = (query.x, query.n, query.ng);
-        let smooth = features.shading_normals() && hit.smooth;
+        let smooth = features.shading_normals() && query.smooth;
         let wo = -self.ray_dir;
         // The index beyond the surface over the index on wo's side (dielectrics only): the
         // outside is the side the normal points to (`SurfaceHit::normal`).
@@ -681,15 +681,12 @@ impl PathState {
             // its transmission cross the surface (`crate::surface`).
             let consistent = !smooth || (n.dot(wi) > 0.0) == (ng.dot(wi) > 0.0);
             if cos_y > 0.0 && pdf_w > 0.0 && f_cos.max_element() > 0.0 && consistent {
-                let emitted = sample_radiance(
-                    query.environment_light,
-                    features.textures(),
-                    params,
-                    environment,
-                    textures,
-                    &lights[ls.light as usize],
-                    &ls,
-                );
+                let light = &lights[ls.light as usize];
+                let mut emitted =
+                    sample_radiance(query.environment_light, params, environment, light, &ls);
+                if features.textures() {
+                    emitted *= emission_texture_at(textures, light, &ls);
+                }
                 let weight = light_strategy_weight(features, params, pdf_w, pdf_b);
                 let from = offset_ray_origin(x, side(ng, ng.dot(wi) > 0.0), hit.error);
                 let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);

@@ -70,9 +70,6 @@ impl HitPayload {
             arrived_behind: self.behind != 0,
             shading: self.shading,
             barycentrics: self.barycentrics,
-            shading_normal: Vec3::ZERO,
-            smooth: false,
-            uv: Vec2::ZERO,
         }
     }
 }

@@ -17,27 +17,15 @@
 //! which is near silhouettes of coarse meshes (docs/materials.md, "Shading normals").
 
 use crate::features::FeatureSet;
-use crate::path::SurfaceHit;
-use crate::scene::{Material, ShadingTriangle, NONE};
-use crate::texture::textured_material;
+use crate::geometry::{blend2, blend3};
+use crate::scene::{texture_slot, Material, ShadingTriangle, NONE};
+use crate::texture::{lookup, textured_material};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
 
-/// Barycentric blend of `a`, `b`, `c` at barycentrics (b1, b2) of the second and third.
-#[inline]
-pub fn blend3(a: Vec3, b: Vec3, c: Vec3, bary: Vec2) -> Vec3 {
-    a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y
-}
-
-/// Barycentric blend of texture coordinates.
-#[inline]
-pub fn blend2(a: Vec2, b: Vec2, c: Vec2, bary: Vec2) -> Vec2 {
-    a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y
-}
-
-/// The shading normal of `tri` at barycentrics `bary` (unit; `None`-like: the zero vector where
-/// the blend has no direction, as opposite vertex normals can give).
+/// The shading normal of `tri` at barycentrics `bary`: unit, or the zero vector where the blend
+/// has no direction (as opposite vertex normals can give), which leaves the hit flat.
 #[inline]
 pub fn interpolated_normal(tri: &ShadingTriangle, bary: Vec2) -> Vec3 {
     let n = blend3(
@@ -65,35 +53,55 @@ pub fn interpolated_uv(tri: &ShadingTriangle, bary: Vec2) -> Vec2 {
     )
 }
 
-/// The material at `hit` (a copy of its table entry; textures applied where the scene has
-/// any), after filling `hit`'s shading normal (`smooth` where its triangle has vertex normals
-/// that give one) and texture coordinates. A miss gets a black placeholder, never read.
+/// The material at a vertex on material `material` and shading record `record` (a hit's
+/// `SurfaceHit::material` and `shading`) at barycentrics `bary`: a copy of its table entry, with
+/// its textures applied where the scene has any; and the unit shading normal (either
+/// orientation) where the record's vertex normals give one, else zero (the hit shades with its
+/// geometric normal).
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub fn shade<F: FeatureSet>(
     features: F,
-    hit: &mut SurfaceHit,
+    material: u32,
+    record: u32,
+    bary: Vec2,
     materials: &[Material],
     shading: &[ShadingTriangle],
     textures: &[u32],
-) -> Material {
-    if !hit.is_hit() {
-        return Material::diffuse([0.0; 3]);
+) -> (Material, Vec3) {
+    let m = materials[material as usize];
+    if !(features.shading_normals() || features.textures()) || record == NONE {
+        return (m, Vec3::ZERO);
     }
-    let material = materials[hit.material as usize];
-    if !(features.shading_normals() || features.textures()) || hit.shading == NONE {
-        return material;
-    }
-    let tri = shading[hit.shading as usize];
+    let tri = shading[record as usize];
+    let mut normal = Vec3::ZERO;
     if features.shading_normals() && tri.has_normals != 0 {
-        let n = interpolated_normal(&tri, hit.barycentrics);
-        if n != Vec3::ZERO {
-            hit.shading_normal = n;
-            hit.smooth = true;
-        }
+        normal = interpolated_normal(&tri, bary);
     }
     if features.textures() {
-        hit.uv = interpolated_uv(&tri, hit.barycentrics);
-        return textured_material(&material, textures, hit.uv);
+        let uv = interpolated_uv(&tri, bary);
+        return (textured_material(&m, textures, uv), normal);
     }
-    material
+    (m, normal)
+}
+
+/// The radiance `material` emits at a light hit on shading record `record` at barycentrics
+/// `bary`: its emission, times its emission texture there where it has one.
+#[inline]
+pub fn emission_at<F: FeatureSet>(
+    features: F,
+    material: &Material,
+    record: u32,
+    bary: Vec2,
+    shading: &[ShadingTriangle],
+    textures: &[u32],
+) -> Vec3 {
+    let emission = Vec3::from(material.emission);
+    let texture = material.textures[texture_slot::EMISSION];
+    if features.textures() && texture != NONE && record != NONE {
+        let uv = interpolated_uv(&shading[record as usize], bary);
+        emission * lookup(textures, texture, uv)
+    } else {
+        emission
+    }
 }

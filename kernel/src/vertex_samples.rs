@@ -52,6 +52,8 @@ pub struct VertexQuery {
     pub n: Vec3,
     /// The geometric normal on the side the ray arrived from (rays leave offset along it).
     pub ng: Vec3,
+    /// Whether `n` is an interpolated shading normal (`crate::surface`).
+    pub smooth: bool,
     /// Lights next-event estimation chooses among; 0: no light sample (no lights, or a black
     /// surface).
     pub light_count: u32,

@@ -56,6 +56,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
             "cornell lit by a panel (triangle lights)",
             small("cornell_panel.toml"),
         ),
+        ("textures and smooth meshes", small("textures.toml")),
     ]
 }
 
@@ -247,6 +248,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 x,
                 n,
                 ng: n,
+                smooth: false,
                 light_count,
                 mode: if h(lane, 18) % 4 == 0 {
                     light_sampling::AREA

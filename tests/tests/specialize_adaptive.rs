@@ -48,6 +48,11 @@ fn cornell_panel() -> Scene {
     small(Scene::load(&repo_root().join("scenes/cornell_panel.toml")).unwrap())
 }
 
+/// Textured floor, wall and light; smooth meshes (shading normals).
+fn textures() -> Scene {
+    small(Scene::load(&repo_root().join("scenes/textures.toml")).unwrap())
+}
+
 /// `scene` through a lens of diameter 0.2 focused on its spheres (3.5 from the eye).
 fn thin_lens(mut scene: Scene) -> Scene {
     scene.camera.aperture = 0.2;
@@ -75,6 +80,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
             "an environment map",
             small(Scene::load(&repo_root().join("scenes/sky.toml")).unwrap()),
         ),
+        ("textures and smooth meshes", textures()),
     ]
 }
 
@@ -111,6 +117,15 @@ fn scene_analysis_finds_the_features_present() {
     assert_eq!(cornell().features() & features::TRIANGLE_LIGHTS, 0);
     assert_eq!(cornell().features() & features::THIN_LENS, 0);
     assert_eq!(cornell().features() & features::ENVIRONMENT, 0);
+    // Textures and shading normals: their own bits, which every other shipped scene lacks.
+    assert_eq!(
+        textures().features() & (features::TEXTURES | features::SHADING_NORMALS),
+        features::TEXTURES | features::SHADING_NORMALS
+    );
+    assert_eq!(
+        materials().features() & (features::TEXTURES | features::SHADING_NORMALS),
+        0
+    );
     let sky = small(Scene::load(&repo_root().join("scenes/sky.toml")).unwrap());
     assert_eq!(
         sky.features() & (features::ENVIRONMENT | features::BACKGROUND | features::LIGHTS),

@@ -8,8 +8,9 @@
 //! 3. A checkered plane under a sphere light matches the closed form kd(square) L (r/D)^2 cos in
 //!    every pixel inside a square, on both backends; the same images against the squares'
 //!    colours swapped fail by far (the test's power).
-//! 4. Scene errors: a texture on a sphere, on a mesh without texture coordinates, a missing file,
-//!    an unknown wrap, maps that would reflect more than they receive.
+//! 4. PNG, JPEG and EXR maps load; scene errors: a texture on a sphere, on a mesh without
+//!    texture coordinates, on metal, a missing file, an unknown wrap, maps that would reflect more
+//!    than they receive.
 
 use glam::{Vec2, Vec3};
 use kernel::texture::{flags, lookup, LINEAR_TABLE, SRGB_TABLE};
@@ -365,6 +366,11 @@ fn scene_error(materials: &str, shapes: &str) -> String {
     image::Rgb32FImage::from_pixel(2, 2, image::Rgb([2.0, 2.0, 2.0]))
         .save(dir.join("bright.exr"))
         .unwrap();
+    image::open(dir.join("checker.png"))
+        .unwrap()
+        .to_rgb8()
+        .save(dir.join("checker.jpg"))
+        .unwrap();
     let text = format!(
         "[camera]\neye = [0, 1, 3]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 8\nheight = 8\n[materials]\n{materials}\n{shapes}"
     );
@@ -385,8 +391,18 @@ fn texture_errors_name_the_field_and_the_reason() {
             .join("scenes/meshes/icosphere.obj")
             .display()
     );
-    let cases: [(&str, &str, &str); 7] = [
+    let cases: [(&str, &str, &str); 9] = [
         ("m = { kd_map = \"checker.png\" }", quad, ""),
+        (
+            "m = { kd_map = \"checker.jpg\", wrap = \"clamp\" }",
+            quad,
+            "",
+        ),
+        (
+            "m = { emission_map = \"bright.exr\", two_sided = true }",
+            quad,
+            "",
+        ),
         (
             "m = { kd_map = \"checker.png\" }",
             sphere,
@@ -442,7 +458,10 @@ fn memory_report_lists_tables_and_textures() {
     assert_eq!(bytes["shading"], 64 * scene.shading.len());
     let report = scene.memory_report();
     println!("{report}");
-    assert!(report.contains("3 textures (64x64, 32x16, 64x64)"), "{report}");
+    assert!(
+        report.contains("3 textures (64x64, 32x16, 64x64)"),
+        "{report}"
+    );
 
     let dir = temp_dir("texture-sharing");
     let png = checker_png(&dir);

@@ -75,6 +75,9 @@ impl CpuRenderer {
         let mut batch = [None; LANES];
         let mut batch_camera = [(0.0, 0.0); LANES];
         let mut hits = [SurfaceHit::miss(); LANES];
+        // The materials of this round's vertices, with textures applied, where the scene has
+        // textures or shading normals (else the table's entries are read in place).
+        let surfaces = features.textures() || features.shading_normals();
         let mut materials = [Material::diffuse([0.0; 3]); LANES];
         loop {
             for slot in slots.iter_mut().filter(|s| s.is_none()) {
@@ -132,25 +135,34 @@ impl CpuRenderer {
             let mut queries = [None; LANES];
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((_, path)) = slot else { continue };
-                let hit = &mut hits[lane];
-                let material = shade(
-                    features,
-                    hit,
-                    &self.materials,
-                    &self.shading,
-                    &self.textures,
-                );
+                let hit = &hits[lane];
                 if path.advance(
                     features,
                     params,
-                    &material,
+                    &self.materials,
                     &self.lights,
                     &self.environment,
+                    &self.shading,
+                    &self.textures,
                     hit,
                     occluded[lane],
                 ) {
-                    let query = path.vertex_query(features, params, hit, &material);
-                    materials[lane] = material;
+                    let query = if surfaces {
+                        let (material, shading_normal) = shade(
+                            features,
+                            hit.material,
+                            hit.shading,
+                            hit.barycentrics,
+                            &self.materials,
+                            &self.shading,
+                            &self.textures,
+                        );
+                        materials[lane] = material;
+                        path.vertex_query(features, params, hit, &material, shading_normal)
+                    } else {
+                        let material = &self.materials[hit.material as usize];
+                        path.vertex_query(features, params, hit, material, Vec3::ZERO)
+                    };
                     queries[lane] = Some((path.rng, query));
                 }
             }
@@ -158,14 +170,20 @@ impl CpuRenderer {
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((k, path)) = slot else { continue };
                 if let Some((_, query)) = &queries[lane] {
+                    let hit = &hits[lane];
+                    let material = if surfaces {
+                        &materials[lane]
+                    } else {
+                        &self.materials[hit.material as usize]
+                    };
                     path.vertex(
                         features,
                         params,
                         &self.lights,
                         &self.environment,
                         &self.textures,
-                        &hits[lane],
-                        &materials[lane],
+                        hit,
+                        material,
                         query,
                         &samples[lane],
                     );

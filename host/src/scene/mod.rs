@@ -248,11 +248,12 @@ impl Scene {
                 .iter()
                 .map(|t| format!("{}x{}", t.width, t.height))
                 .collect();
-            parts.push(format!(
-                "{} textures ({})",
-                sizes.len(),
-                sizes.join(", ")
-            ));
+            let noun = if sizes.len() == 1 {
+                "texture"
+            } else {
+                "textures"
+            };
+            parts.push(format!("{} {noun} ({})", sizes.len(), sizes.join(", ")));
         }
         format!("{} in all: {}", size(total), parts.join(", "))
     }
