@@ -56,8 +56,73 @@ fn scenes() -> Vec<(&'static str, Scene)> {
             "cornell lit by a panel (triangle lights)",
             small("cornell_panel.toml"),
         ),
-        ("textures and smooth meshes", small("textures.toml")),
+        ("textures and a smooth mesh", small_textured()),
     ]
+}
+
+/// A scene small enough for packets with every texture slot and a smooth mesh: a checkered
+/// floor, a wall of textured roughness, a panel of textured emission, an octahedron with vertex
+/// normals (written to a temporary file).
+fn small_textured() -> Scene {
+    let dir = std::env::temp_dir().join(format!("twinpath-packets-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = dir.join("octahedron.obj");
+    let mut text = String::new();
+    for v in ["1 0 0", "-1 0 0", "0 1 0", "0 -1 0", "0 0 1", "0 0 -1"] {
+        text += &format!("v {v}\nvn {v}\n");
+    }
+    for f in [
+        [1, 3, 5],
+        [3, 2, 5],
+        [2, 4, 5],
+        [4, 1, 5],
+        [3, 1, 6],
+        [2, 3, 6],
+        [4, 2, 6],
+        [1, 4, 6],
+    ] {
+        text += &format!("f {0}//{0} {1}//{1} {2}//{2}\n", f[0], f[1], f[2]);
+    }
+    std::fs::write(&obj, text).unwrap();
+    let mut s = twinpath_tests::scene_from_toml(&format!(
+        r#"
+        [camera]
+        eye = [0.0, 1.2, 3.0]
+        look_at = [0.0, 0.4, 0.0]
+        up = [0.0, 1.0, 0.0]
+        vfov = 45.0
+        width = 48
+        height = 48
+        [materials]
+        floor = {{ kd_map = "textures/checker.png" }}
+        wall = {{ kd = [0.3, 0.3, 0.3], ks = [0.5, 0.5, 0.5], alpha_map = "textures/roughness.png" }}
+        panel = {{ emission = [4.0, 4.0, 4.0], emission_map = "textures/emission.png" }}
+        ball = {{ kd = [0.6, 0.5, 0.4], ks = [0.3, 0.3, 0.3], alpha = 0.2 }}
+        [[quad]]
+        corner = [-2.0, 0.0, 2.0]
+        edge1 = [4.0, 0.0, 0.0]
+        edge2 = [0.0, 0.0, -4.0]
+        material = "floor"
+        [[quad]]
+        corner = [-2.0, 0.0, -1.0]
+        edge1 = [4.0, 0.0, 0.0]
+        edge2 = [0.0, 2.0, 0.0]
+        material = "wall"
+        [[quad]]
+        corner = [-0.6, 1.8, -0.3]
+        edge1 = [1.2, 0.0, 0.0]
+        edge2 = [0.0, 0.0, 0.6]
+        material = "panel"
+        [[mesh]]
+        file = "{}"
+        scale = 0.4
+        translate = [0.0, 0.4, 0.0]
+        material = "ball"
+        "#,
+        obj.display()
+    ));
+    s.background = glam::Vec3::splat(0.1);
+    s
 }
 
 #[test]
