@@ -7,6 +7,7 @@ use super::error::{line_of, SceneError};
 use super::light_table::{sphere_light, triangle_light};
 use super::mesh::load_mesh;
 use super::textures::TextureTable;
+use super::transform::{parse_transform, TransformFields};
 use super::{CameraDesc, Scene, TriangleGroup};
 use crate::settings::RenderSettings;
 use glam::Vec3;
@@ -99,6 +100,12 @@ struct SphereFile {
     center: V3,
     radius: Spanned<f32>,
     material: Spanned<String>,
+    /// Optional transform (`transform::parse_transform`): scale (a number or [x, y, z]), then
+    /// rotate ([degrees, axis x, y, z]), then translate; or a row-major 4 x 4 affine matrix.
+    scale: Option<Spanned<toml::Value>>,
+    rotate: Option<Spanned<[f32; 4]>>,
+    translate: Option<V3>,
+    matrix: Option<Spanned<[[f32; 4]; 4]>>,
 }
 
 #[derive(Deserialize)]
@@ -108,6 +115,12 @@ struct QuadFile {
     edge1: V3,
     edge2: V3,
     material: Spanned<String>,
+    /// Optional transform (`transform::parse_transform`): scale (a number or [x, y, z]), then
+    /// rotate ([degrees, axis x, y, z]), then translate; or a row-major 4 x 4 affine matrix.
+    scale: Option<Spanned<toml::Value>>,
+    rotate: Option<Spanned<[f32; 4]>>,
+    translate: Option<V3>,
+    matrix: Option<Spanned<[[f32; 4]; 4]>>,
 }
 
 #[derive(Deserialize)]
@@ -115,10 +128,42 @@ struct QuadFile {
 struct MeshFile {
     file: Spanned<String>,
     material: Spanned<String>,
-    /// Uniform scale applied to the vertices first (default 1).
-    scale: Option<Spanned<f32>>,
-    /// Translation applied after the scale (default 0).
+    /// Optional transform (`transform::parse_transform`): scale (a number or [x, y, z]), then
+    /// rotate ([degrees, axis x, y, z]), then translate; or a row-major 4 x 4 affine matrix.
+    scale: Option<Spanned<toml::Value>>,
+    rotate: Option<Spanned<[f32; 4]>>,
     translate: Option<V3>,
+    matrix: Option<Spanned<[[f32; 4]; 4]>>,
+}
+
+/// Whether a shape's table gives any transform field.
+macro_rules! any_transform {
+    ($f:expr) => {
+        $f.scale.is_some() || $f.rotate.is_some() || $f.translate.is_some() || $f.matrix.is_some()
+    };
+}
+
+/// `corners` in reverse winding (the second and third swapped) where `mirror`: a mirroring
+/// transform flips a triangle's front face, and reversing the winding flips it back (glTF 2.0,
+/// "Transformations").
+fn wound<T: Copy>(corners: [T; 3], mirror: bool) -> [T; 3] {
+    if mirror {
+        [corners[0], corners[2], corners[1]]
+    } else {
+        corners
+    }
+}
+
+/// The transform fields of a shape's table (`transform::TransformFields`).
+macro_rules! transform_fields {
+    ($f:expr) => {
+        TransformFields {
+            scale: $f.scale.as_ref(),
+            rotate: $f.rotate.as_ref(),
+            translate: $f.translate.as_ref(),
+            matrix: $f.matrix.as_ref(),
+        }
+    };
 }
 
 #[derive(Deserialize)]
@@ -352,6 +397,30 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 format!("{radius:e} is outside {MIN_RADIUS:e}..={MAX_COORDINATE:e} (the range the renderer supports)"),
             ));
         }
+        let (center, radius) = if any_transform!(sf) {
+            let field = format!("sphere[{i}]");
+            let t = parse_transform(&ck, &field, &transform_fields!(sf))?;
+            let Some(k) = t.uniform_scale() else {
+                return Err(ck.err(
+                    s.span(),
+                    &field,
+                    "a sphere takes a uniform scale and rotations only (it would become an \
+                     ellipsoid)",
+                ));
+            };
+            let (c, r) = (t.point(center), radius * k);
+            if !(MIN_RADIUS..=MAX_COORDINATE).contains(&r) || c.abs().max_element() > MAX_COORDINATE
+            {
+                return Err(ck.err(
+                    s.span(),
+                    &field,
+                    format!("transformed, centre {c} and radius {r:e} leave the range the renderer supports"),
+                ));
+            }
+            (c, r)
+        } else {
+            (center, radius)
+        };
         let material = find_material(&sf.material, &format!("sphere[{i}].material"))?;
         if is_textured(material) {
             return Err(ck.err(
@@ -438,9 +507,27 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     for (i, q) in file.quad.iter().enumerate() {
         let qf = q.get_ref();
         let field = format!("quad[{i}]");
-        let corner = ck.vec3(&qf.corner, &format!("{field}.corner"))?;
-        let e1 = ck.vec3(&qf.edge1, &format!("{field}.edge1"))?;
-        let e2 = ck.vec3(&qf.edge2, &format!("{field}.edge2"))?;
+        let mut corner = ck.vec3(&qf.corner, &format!("{field}.corner"))?;
+        let mut e1 = ck.vec3(&qf.edge1, &format!("{field}.edge1"))?;
+        let mut e2 = ck.vec3(&qf.edge2, &format!("{field}.edge2"))?;
+        let mut mirror = false;
+        if any_transform!(qf) {
+            let t = parse_transform(&ck, &field, &transform_fields!(qf))?;
+            corner = t.point(corner);
+            e1 = t.vector(e1);
+            e2 = t.vector(e2);
+            mirror = t.mirrors();
+            if [corner, corner + e1 + e2]
+                .iter()
+                .any(|p| p.abs().max_element() > MAX_COORDINATE)
+            {
+                return Err(ck.err(
+                    q.span(),
+                    &field,
+                    format!("a corner lies beyond {MAX_COORDINATE:e} after the transform"),
+                ));
+            }
+        }
         let area = e1.cross(e2).length();
         if !(area > 0.0) || !area.is_finite() {
             return Err(ck.err(
@@ -462,21 +549,23 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             ));
         }
         let textured = is_textured(material);
+        // A mirroring transform reverses the winding, which keeps the front face the side the
+        // untransformed quad's front maps to.
         push_triangle(
             &mut triangles,
             &mut lights,
             &mut shading,
-            [corner, corner + e1, corner + e1 + e2],
+            wound([corner, corner + e1, corner + e1 + e2], mirror),
             material,
-            textured.then(|| quad_uv([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])),
+            textured.then(|| quad_uv(wound([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], mirror))),
         );
         push_triangle(
             &mut triangles,
             &mut lights,
             &mut shading,
-            [corner, corner + e1 + e2, corner + e2],
+            wound([corner, corner + e1 + e2, corner + e2], mirror),
             material,
-            textured.then(|| quad_uv([[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]])),
+            textured.then(|| quad_uv(wound([[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]], mirror))),
         );
     }
     if triangles.len() > quads_start {
@@ -497,24 +586,12 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 format!("mesh file {} does not exist", mesh_path.display()),
             ));
         }
-        let scale = match &mf.scale {
-            Some(s) => {
-                let k = *s.get_ref();
-                if !(k > 0.0 && k.is_finite()) {
-                    return Err(ck.err(
-                        s.span(),
-                        &format!("{field}.scale"),
-                        format!("{k} must be a positive finite number"),
-                    ));
-                }
-                k
-            }
-            None => 1.0,
+        let transform = if any_transform!(mf) {
+            Some(parse_transform(&ck, &field, &transform_fields!(mf))?)
+        } else {
+            None
         };
-        let translate = match &mf.translate {
-            Some(t) => ck.vec3(t, &format!("{field}.translate"))?,
-            None => Vec3::ZERO,
-        };
+        let mirror = transform.is_some_and(|t| t.mirrors());
         let soup = load_mesh(&mesh_path)?;
         if is_dielectric(material) {
             check_closed_outward(&soup.triangles).map_err(|msg| {
@@ -540,21 +617,37 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         }
         let start = triangles.len();
         for (k, t) in soup.triangles.iter().enumerate() {
-            let p = t.map(|v| Vec3::from(v) * scale + translate);
+            let p = t.map(|v| match &transform {
+                Some(m) => m.point(Vec3::from(v)),
+                None => Vec3::from(v),
+            });
             if p.iter().any(|v| v.abs().max_element() > MAX_COORDINATE) {
                 return Err(ck.err(
                     mf.file.span(),
                     &format!("{field} triangle {k}"),
-                    format!("a vertex lies beyond {MAX_COORDINATE:e} after scale and translate"),
+                    format!("a vertex lies beyond {MAX_COORDINATE:e} after the transform"),
                 ));
             }
+            let p = wound(p, mirror);
             // Degenerate (zero-area) triangles cannot be hit; they are dropped.
             if (p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0 {
-                let normals = soup.normals.get(k);
-                let uvs = soup.uvs.get(k).filter(|_| textured);
+                let normals = soup.normals.get(k).map(|n| {
+                    wound(
+                        n.map(|n| match &transform {
+                            Some(m) => m.normal(Vec3::from(n)).to_array(),
+                            None => n,
+                        }),
+                        mirror,
+                    )
+                });
+                let uvs = soup
+                    .uvs
+                    .get(k)
+                    .filter(|_| textured)
+                    .map(|t| wound(*t, mirror));
                 let attributes = (normals.is_some() || uvs.is_some()).then(|| {
-                    let n = normals.copied().unwrap_or([[0.0; 3]; 3]);
-                    let t = uvs.copied().unwrap_or([[0.0; 2]; 3]);
+                    let n = normals.unwrap_or([[0.0; 3]; 3]);
+                    let t = uvs.unwrap_or([[0.0; 2]; 3]);
                     ShadingTriangle {
                         normal0: n[0],
                         normal1: n[1],

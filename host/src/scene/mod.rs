@@ -9,6 +9,7 @@ pub mod light_table;
 mod materials;
 pub mod mesh;
 pub mod textures;
+pub mod transform;
 
 pub use error::SceneError;
 pub use file::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
