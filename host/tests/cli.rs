@@ -79,8 +79,9 @@ fn render_writes_exr_and_png() {
     assert_eq!(out.status.code(), Some(1));
 }
 
-/// Starts a render that would take hours, sends SIGINT, and expects the image so far.
-fn interrupt(backend: &str) {
+/// Starts a render that would take hours, sends SIGINT after `wait`, and returns its log and
+/// the image it wrote.
+fn interrupt_after(backend: &str, wait: Duration) -> (String, image::Rgb32FImage) {
     let dir = temp_dir(backend);
     let scene = small_scene(&dir, 64);
     let exr = dir.join("partial.exr");
@@ -110,7 +111,7 @@ fn interrupt(backend: &str) {
         stderr.read_to_string(&mut rest).unwrap();
         rest
     });
-    std::thread::sleep(Duration::from_secs(2));
+    std::thread::sleep(wait);
     let status = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
@@ -134,11 +135,31 @@ fn interrupt(backend: &str) {
         "{err}"
     );
     assert!(err.contains("of 1000000 samples per pixel"), "{err}");
-    let img = image::open(&exr).unwrap().to_rgb32f();
-    assert!(
-        img.pixels().any(|p| p.0[0] > 0.0),
-        "{backend}: the partial image is black"
-    );
+    (err, image::open(&exr).unwrap().to_rgb32f())
+}
+
+/// Interrupts a render that would take hours and expects the image so far: every sample done
+/// is in it. On a busy machine the first pass may not have finished when SIGINT arrives (then
+/// the log says 0 samples and the image is rightly black), so the wait doubles until it has.
+fn interrupt(backend: &str) {
+    let mut wait = Duration::from_secs(2);
+    loop {
+        let (err, img) = interrupt_after(backend, wait);
+        if err.contains("so far, 0 of") {
+            assert!(img.pixels().all(|p| p.0 == [0.0; 3]), "{backend}: {err}");
+            assert!(
+                wait < Duration::from_secs(128),
+                "{backend}: no pass in {wait:?}"
+            );
+            wait *= 2;
+            continue;
+        }
+        assert!(
+            img.pixels().any(|p| p.0[0] > 0.0),
+            "{backend}: the partial image is black"
+        );
+        return;
+    }
 }
 
 #[test]
