@@ -52,6 +52,11 @@ fn obj_and_ply_vertex_normals_and_texture_coordinates_are_read() {
     let soup = parse_obj(std::path::Path::new("partial.obj"), partial.as_bytes()).unwrap();
     assert_eq!(soup.triangles.len(), 2);
     assert!(soup.normals.is_empty());
+
+    // A file the fuzzer made (mixed relative and missing attribute indices): an error or a
+    // soup, never a panic.
+    let crash = std::fs::read(repo_root().join("tests/fixtures/fuzz_obj_attributes.obj")).unwrap();
+    let _ = parse_obj(std::path::Path::new("fuzz.obj"), &crash);
 }
 
 /// The scene: a unit sphere (`shape`) of albedo 0.6 at the origin under a sphere light and a

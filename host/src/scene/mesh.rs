@@ -81,8 +81,10 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
             })?;
             Ok([p[0], p[1], p[2]])
         };
+        // Attributes are read only where every index has one (exact lengths; `get` below keeps
+        // a malformed file from reading past them: the fuzzer found such a file).
         let has_normals = !m.normals.is_empty() && m.normals.len() == m.positions.len();
-        let has_uvs = !m.texcoords.is_empty() && m.texcoords.len() / 2 == m.positions.len() / 3;
+        let has_uvs = !m.texcoords.is_empty() && 3 * m.texcoords.len() == 2 * m.positions.len();
         for (k, f) in m.indices.as_chunks::<3>().0.iter().enumerate() {
             let face = format!("object '{}' face {}", model.name, k + 1);
             let tri = [vertex(f[0])?, vertex(f[1])?, vertex(f[2])?];
@@ -91,7 +93,9 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
             if has_normals {
                 let n = f.map(|i| {
                     let i = 3 * i as usize;
-                    [m.normals[i], m.normals[i + 1], m.normals[i + 2]]
+                    m.normals
+                        .get(i..i + 3)
+                        .map_or([f32::NAN; 3], |n| [n[0], n[1], n[2]])
                 });
                 check_finite(path, None, &format!("{face} normal"), &n)?;
                 soup.normals.push(n);
@@ -99,7 +103,9 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
             if has_uvs {
                 let t = f.map(|i| {
                     let i = 2 * i as usize;
-                    [m.texcoords[i], m.texcoords[i + 1]]
+                    m.texcoords
+                        .get(i..i + 2)
+                        .map_or([f32::NAN; 2], |t| [t[0], t[1]])
                 });
                 if !t.iter().flatten().all(|c| c.is_finite()) {
                     return Err(SceneError::new(
