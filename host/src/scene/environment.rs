@@ -87,7 +87,7 @@ impl EnvironmentMap {
     /// unreachable (or, for an all-black map, harmless: it sends no light).
     pub fn table(&self) -> Vec<f32> {
         let (w, h) = (self.width as usize, self.height as usize);
-        let mut out = Vec::with_capacity(3 * w * h + (h + 1) + h * (w + 1));
+        let mut out = Vec::with_capacity(self.table_len());
         out.extend(self.texels.iter().flatten());
         let luminance =
             |t: &[f32; 3]| 0.2126 * t[0] as f64 + 0.7152 * t[1] as f64 + 0.0722 * t[2] as f64;
@@ -105,7 +105,15 @@ impl EnvironmentMap {
         for row in &weights {
             out.extend(cdf(row));
         }
+        debug_assert_eq!(out.len(), self.table_len());
         out
+    }
+
+    /// The number of entries of [`EnvironmentMap::table`]: the texels (3 w h), the marginal CDF
+    /// (h + 1) and each row's conditional CDF (w + 1 each).
+    pub fn table_len(&self) -> usize {
+        let (w, h) = (self.width as usize, self.height as usize);
+        3 * w * h + (h + 1) + h * (w + 1)
     }
 
     /// The environment map's entry in the light table: the sphere bounding the scene's geometry

@@ -218,9 +218,7 @@ impl Scene {
             ("textures", self.textures.bytes()),
             (
                 "environment",
-                self.environment
-                    .as_ref()
-                    .map_or(0, |_| 4 * self.environment_table().len()),
+                self.environment.as_ref().map_or(0, |m| 4 * m.table_len()),
             ),
         ]
     }
