@@ -16,11 +16,12 @@ use glam::{Vec2, Vec3};
 use kernel::texture::{flags, lookup, LINEAR_TABLE, SRGB_TABLE};
 use std::path::{Path, PathBuf};
 use twinpath::render::Backend;
-use twinpath::scene::textures::{srgb_to_linear, TextureTable};
+use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse};
 use twinpath::scene::{parse_scene, Scene};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches, render_film, scene_from_toml, with_independent_samples, SplitMix,
+    assert_film_matches, pixel_quadrature, render_film, scene_from_toml, with_independent_samples,
+    SplitMix,
 };
 
 /// A fresh folder for this test's files.
@@ -145,7 +146,18 @@ fn lookup_is_bilinear_between_texel_centres_repeated_or_clamped() {
         if clamp {
             tex_flags |= flags::CLAMP;
         }
-        table.push(Path::new("generated"), tex_flags, width, height, &words);
+        let usage = TextureUse {
+            colour: srgb,
+            clamp,
+        };
+        table.push(
+            Path::new("generated"),
+            usage,
+            tex_flags,
+            width,
+            height,
+            &words,
+        );
         refs.push(Reference {
             width,
             height,
@@ -270,63 +282,41 @@ fn checker_scene(png: &Path) -> Scene {
 /// texel of a square's edge (where bilinear filtering blends the two colours). `swap` exchanges
 /// the squares' colours.
 fn checker_exact(scene: &Scene, swap: bool) -> Vec<Option<f64>> {
-    let cam = scene.camera.to_kernel();
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let eye = Vec3::new(cam.eye[0], cam.eye[1], cam.eye[2]);
     let lamp = Vec3::new(0.0, LAMP_H, 0.0);
     let kd = |b: u8| KD_FACTOR * srgb_to_linear(b) as f32 as f64;
-    let q = 16;
-    (0..w * h)
-        .map(|i| {
-            let (px, py) = (i % w, i / w);
-            let mut sum = 0.0;
-            for sy in 0..q {
-                for sx in 0..q {
-                    let (u, v) = ((sx as f32 + 0.5) / q as f32, (sy as f32 + 0.5) / q as f32);
-                    let d = kernel::camera::camera_ray_direction(&cam, w, h, px, py, u, v);
-                    if d.y >= 0.0
-                        || kernel::geometry::intersect_sphere(
-                            eye,
-                            d,
-                            lamp,
-                            LAMP_R,
-                            0.0,
-                            f32::INFINITY,
-                        ) >= 0.0
-                    {
-                        return None;
-                    }
-                    let x = (eye + d * (-eye.y / d.y)).as_dvec3();
-                    // Texture coordinates of the quad: u along +x, v along -z.
-                    let (tu, tv) = (
-                        (x.x + HALF as f64) / (2.0 * HALF as f64),
-                        (HALF as f64 - x.z) / (2.0 * HALF as f64),
-                    );
-                    if !(0.0..1.0).contains(&tu) || !(0.0..1.0).contains(&tv) {
-                        return None;
-                    }
-                    let (tx, ty) = (tu * TEXELS as f64, (1.0 - tv) * TEXELS as f64);
-                    let margin = |t: f64| {
-                        let r = t.rem_euclid(SQUARE as f64);
-                        (0.6..SQUARE as f64 - 0.6).contains(&r)
-                    };
-                    if !margin(tx) || !margin(ty) {
-                        return None;
-                    }
-                    let square = (tx as u32 / SQUARE + ty as u32 / SQUARE).is_multiple_of(2);
-                    let k = if square != swap {
-                        kd(LIGHT_BYTE)
-                    } else {
-                        kd(DARK_BYTE)
-                    };
-                    let to = lamp.as_dvec3() - x;
-                    let dist = to.length();
-                    sum += k * LAMP_L as f64 * (LAMP_R as f64 / dist).powi(2) * (to.y / dist);
-                }
-            }
-            Some(sum / (q * q) as f64)
-        })
-        .collect()
+    pixel_quadrature(scene, 16, |eye, d| {
+        if d.y >= 0.0
+            || kernel::geometry::intersect_sphere(eye, d, lamp, LAMP_R, 0.0, f32::INFINITY) >= 0.0
+        {
+            return None;
+        }
+        let x = (eye + d * (-eye.y / d.y)).as_dvec3();
+        // Texture coordinates of the quad: u along +x, v along -z.
+        let (tu, tv) = (
+            (x.x + HALF as f64) / (2.0 * HALF as f64),
+            (HALF as f64 - x.z) / (2.0 * HALF as f64),
+        );
+        if !(0.0..1.0).contains(&tu) || !(0.0..1.0).contains(&tv) {
+            return None;
+        }
+        let (tx, ty) = (tu * TEXELS as f64, (1.0 - tv) * TEXELS as f64);
+        let margin = |t: f64| {
+            let r = t.rem_euclid(SQUARE as f64);
+            (0.6..SQUARE as f64 - 0.6).contains(&r)
+        };
+        if !margin(tx) || !margin(ty) {
+            return None;
+        }
+        let square = (tx as u32 / SQUARE + ty as u32 / SQUARE).is_multiple_of(2);
+        let k = if square != swap {
+            kd(LIGHT_BYTE)
+        } else {
+            kd(DARK_BYTE)
+        };
+        let to = lamp.as_dvec3() - x;
+        let dist = to.length();
+        Some(k * LAMP_L as f64 * (LAMP_R as f64 / dist).powi(2) * (to.y / dist))
+    })
 }
 
 #[test]

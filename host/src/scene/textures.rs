@@ -23,6 +23,8 @@ pub struct TextureTable {
 #[derive(Clone, Debug, PartialEq)]
 pub struct TextureInfo {
     pub path: PathBuf,
+    /// How the scene uses it (a file used twice the same way is one texture).
+    pub usage: TextureUse,
     pub flags: u32,
     pub width: u32,
     pub height: u32,
@@ -75,6 +77,14 @@ impl TextureTable {
     /// names the scene's field in errors). The table is rebuilt with the new record, since
     /// records precede texels.
     pub fn add(&mut self, path: &Path, usage: TextureUse, field: &str) -> Result<u32, SceneError> {
+        // The same file used the same way: no need to read it again.
+        if let Some(k) = self
+            .textures
+            .iter()
+            .position(|t| t.path == path && t.usage == usage)
+        {
+            return Ok(k as u32);
+        }
         let err = |msg: String| SceneError::new(path, None, field, msg);
         let image = image::ImageReader::open(path)
             .map_err(|e| err(format!("cannot read: {e}")))?
@@ -122,6 +132,7 @@ impl TextureTable {
                 .map(|p| u32::from_le_bytes(p.0))
                 .collect()
         };
+        // Used another way that reads the same (a float image as colour and as linear data).
         if let Some(k) = self
             .textures
             .iter()
@@ -129,7 +140,7 @@ impl TextureTable {
         {
             return Ok(k as u32);
         }
-        self.push(path, tex_flags, width, height, &texels);
+        self.push(path, usage, tex_flags, width, height, &texels);
         Ok(self.textures.len() as u32 - 1)
     }
 
@@ -166,12 +177,21 @@ impl TextureTable {
 
     /// Appends a texture of `width` x `height` texels (`texels` in the kernel's encoding for
     /// `tex_flags`) and rebuilds the table.
-    pub fn push(&mut self, path: &Path, tex_flags: u32, width: u32, height: u32, texels: &[u32]) {
+    pub fn push(
+        &mut self,
+        path: &Path,
+        usage: TextureUse,
+        tex_flags: u32,
+        width: u32,
+        height: u32,
+        texels: &[u32],
+    ) {
         // The texels of the textures so far, after their records.
         let old_records = RECORDS + RECORD_WORDS * self.textures.len();
         let old_texels = self.words.split_off(old_records);
         self.textures.push(TextureInfo {
             path: path.to_path_buf(),
+            usage,
             flags: tex_flags,
             width,
             height,
