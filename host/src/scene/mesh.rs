@@ -81,40 +81,29 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
             })?;
             Ok([p[0], p[1], p[2]])
         };
-        // Attributes are read only where every index has one (exact lengths; `get` below keeps
-        // a malformed file from reading past them: the fuzzer found such a file).
+        // Attributes are read only where every vertex has one: with these exact lengths, an
+        // index `vertex` accepted is in range for them too.
         let has_normals = !m.normals.is_empty() && m.normals.len() == m.positions.len();
         let has_uvs = !m.texcoords.is_empty() && 3 * m.texcoords.len() == 2 * m.positions.len();
         for (k, f) in m.indices.as_chunks::<3>().0.iter().enumerate() {
             let face = format!("object '{}' face {}", model.name, k + 1);
             let tri = [vertex(f[0])?, vertex(f[1])?, vertex(f[2])?];
-            check_finite(path, None, &face, &tri)?;
+            check_finite(path, None, &face, &tri, "vertex coordinate")?;
             soup.triangles.push(tri);
             if has_normals {
                 let n = f.map(|i| {
                     let i = 3 * i as usize;
-                    m.normals
-                        .get(i..i + 3)
-                        .map_or([f32::NAN; 3], |n| [n[0], n[1], n[2]])
+                    [m.normals[i], m.normals[i + 1], m.normals[i + 2]]
                 });
-                check_finite(path, None, &format!("{face} normal"), &n)?;
+                check_finite(path, None, &face, &n, "normal")?;
                 soup.normals.push(n);
             }
             if has_uvs {
                 let t = f.map(|i| {
                     let i = 2 * i as usize;
-                    m.texcoords
-                        .get(i..i + 2)
-                        .map_or([f32::NAN; 2], |t| [t[0], t[1]])
+                    [m.texcoords[i], m.texcoords[i + 1]]
                 });
-                if !t.iter().flatten().all(|c| c.is_finite()) {
-                    return Err(SceneError::new(
-                        path,
-                        None,
-                        format!("{face} texture coordinate"),
-                        "not a finite number",
-                    ));
-                }
+                check_finite(path, None, &face, &t, "texture coordinate")?;
                 soup.uvs.push(t);
             }
         }
@@ -122,20 +111,23 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
     Ok(soup.settle())
 }
 
-fn check_finite(
+/// An error naming `field` unless every component of a triangle's three `what`s (positions,
+/// normals, texture coordinates) is finite.
+fn check_finite<const N: usize>(
     path: &Path,
     line: Option<usize>,
     field: &str,
-    tri: &[[f32; 3]; 3],
+    corners: &[[f32; N]; 3],
+    what: &str,
 ) -> Result<(), SceneError> {
-    if tri.iter().flatten().all(|c| c.is_finite()) {
+    if corners.iter().flatten().all(|c| c.is_finite()) {
         Ok(())
     } else {
         Err(SceneError::new(
             path,
             line,
             field,
-            "vertex coordinate is not a finite number",
+            format!("{what} is not a finite number"),
         ))
     }
 }
