@@ -136,13 +136,6 @@ struct MeshFile {
     matrix: Option<Spanned<[[f32; 4]; 4]>>,
 }
 
-/// Whether a shape's table gives any transform field.
-macro_rules! any_transform {
-    ($f:expr) => {
-        $f.scale.is_some() || $f.rotate.is_some() || $f.translate.is_some() || $f.matrix.is_some()
-    };
-}
-
 /// `corners` in reverse winding (the second and third swapped) where `mirror`: a mirroring
 /// transform flips a triangle's front face, and reversing the winding flips it back (glTF 2.0,
 /// "Transformations").
@@ -397,7 +390,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 format!("{radius:e} is outside {MIN_RADIUS:e}..={MAX_COORDINATE:e} (the range the renderer supports)"),
             ));
         }
-        let (center, radius) = if any_transform!(sf) {
+        let (center, radius) = if transform_fields!(sf).is_given() {
             let field = format!("sphere[{i}]");
             let t = parse_transform(&ck, &field, &transform_fields!(sf))?;
             let Some(k) = t.uniform_scale() else {
@@ -511,7 +504,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         let mut e1 = ck.vec3(&qf.edge1, &format!("{field}.edge1"))?;
         let mut e2 = ck.vec3(&qf.edge2, &format!("{field}.edge2"))?;
         let mut mirror = false;
-        if any_transform!(qf) {
+        if transform_fields!(qf).is_given() {
             let t = parse_transform(&ck, &field, &transform_fields!(qf))?;
             corner = t.point(corner);
             e1 = t.vector(e1);
@@ -586,7 +579,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 format!("mesh file {} does not exist", mesh_path.display()),
             ));
         }
-        let transform = if any_transform!(mf) {
+        let transform = if transform_fields!(mf).is_given() {
             Some(parse_transform(&ck, &field, &transform_fields!(mf))?)
         } else {
             None

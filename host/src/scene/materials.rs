@@ -308,12 +308,14 @@ pub(super) fn attach_textures(
         peak[slot] = table.peak(index);
         out.textures[slot] = index;
     }
-    if mf.wrap.is_some() && out.textures.iter().all(|&t| t == NONE) {
-        return Err(ck.err(
-            mf.wrap.as_ref().map_or(m.span(), |w| w.span()),
-            &format!("{field}.wrap"),
-            "belongs to textures: the material has no map",
-        ));
+    if let Some(w) = &mf.wrap {
+        if out.textures.iter().all(|&t| t == NONE) {
+            return Err(ck.err(
+                w.span(),
+                &format!("{field}.wrap"),
+                "belongs to textures: the material has no map",
+            ));
+        }
     }
     let reflected = Vec3::from(out.albedo) * peak[texture_slot::KD]
         + Vec3::from(out.specular) * peak[texture_slot::KS];

@@ -84,6 +84,16 @@ pub(super) struct TransformFields<'a> {
     pub matrix: Option<&'a Spanned<[[f32; 4]; 4]>>,
 }
 
+impl TransformFields<'_> {
+    /// Whether any transform field is given (without one, a shape is used as written).
+    pub fn is_given(&self) -> bool {
+        self.scale.is_some()
+            || self.rotate.is_some()
+            || self.translate.is_some()
+            || self.matrix.is_some()
+    }
+}
+
 /// The transform of shape `field` (e.g. `mesh[2]`) from its fields, checked: finite numbers,
 /// no zero scale, a rotation axis of non-zero length, `matrix` alone and affine and invertible.
 pub(super) fn parse_transform(
