@@ -279,10 +279,55 @@ pub fn plane_under_lamps(camera: &str, render: &str, kd: f32, lamps: &[Lamp]) ->
 /// any of whose quadrature rays sees a lamp or misses the plane, or where one lamp could hide
 /// part of another (their cones of directions overlap).
 pub fn plane_exact(scene: &Scene, kd: f32, lamps: &[Lamp]) -> Vec<Option<f64>> {
+    pixel_quadrature(scene, 24, |eye, d| {
+        if d.y >= 0.0 {
+            return None;
+        }
+        for l in lamps {
+            let t =
+                kernel::geometry::intersect_sphere(eye, d, l.center, l.radius, 0.0, f32::INFINITY);
+            if t >= 0.0 {
+                return None;
+            }
+        }
+        let x = (eye + d * (-eye.y / d.y)).as_dvec3();
+        let cones: Vec<(glam::DVec3, f64)> = lamps
+            .iter()
+            .map(|l| {
+                let to = l.center.as_dvec3() - x;
+                (to.normalize(), (l.radius as f64 / to.length()).asin())
+            })
+            .collect();
+        for (a, ca) in cones.iter().enumerate() {
+            for cb in &cones[a + 1..] {
+                let sep = ca.0.dot(cb.0).clamp(-1.0, 1.0).acos();
+                if sep < 1.01 * (ca.1 + cb.1) {
+                    return None;
+                }
+            }
+        }
+        let mut sum = 0.0;
+        for l in lamps {
+            let dist = (l.center.as_dvec3() - x).length();
+            let cos = l.center.y as f64 / dist;
+            sum += kd as f64 * l.radiance as f64 * (l.radius as f64 / dist).powi(2) * cos;
+        }
+        Some(sum)
+    })
+}
+
+/// Each pixel's mean of `value(eye, direction)` over the camera rays through a q x q midpoint
+/// quadrature of the pixel (the box filter: a pixel's samples are uniform over it), in row
+/// order; `None` for a pixel where `value` is `None` at any point. The closed-form tests'
+/// exact images are built on it.
+pub fn pixel_quadrature(
+    scene: &Scene,
+    q: u32,
+    value: impl Fn(glam::Vec3, glam::Vec3) -> Option<f64>,
+) -> Vec<Option<f64>> {
     let cam = scene.camera.to_kernel();
     let (w, h) = (scene.camera.width, scene.camera.height);
     let eye = glam::Vec3::new(cam.eye[0], cam.eye[1], cam.eye[2]);
-    let q = 24;
     (0..w * h)
         .map(|i| {
             let (px, py) = (i % w, i / w);
@@ -291,44 +336,7 @@ pub fn plane_exact(scene: &Scene, kd: f32, lamps: &[Lamp]) -> Vec<Option<f64>> {
                 for sx in 0..q {
                     let (u, v) = ((sx as f32 + 0.5) / q as f32, (sy as f32 + 0.5) / q as f32);
                     let d = kernel::camera::camera_ray_direction(&cam, w, h, px, py, u, v);
-                    if d.y >= 0.0 {
-                        return None;
-                    }
-                    for l in lamps {
-                        let t = kernel::geometry::intersect_sphere(
-                            eye,
-                            d,
-                            l.center,
-                            l.radius,
-                            0.0,
-                            f32::INFINITY,
-                        );
-                        if t >= 0.0 {
-                            return None;
-                        }
-                    }
-                    let x = (eye + d * (-eye.y / d.y)).as_dvec3();
-                    let cones: Vec<(glam::DVec3, f64)> = lamps
-                        .iter()
-                        .map(|l| {
-                            let to = l.center.as_dvec3() - x;
-                            (to.normalize(), (l.radius as f64 / to.length()).asin())
-                        })
-                        .collect();
-                    for (a, ca) in cones.iter().enumerate() {
-                        for cb in &cones[a + 1..] {
-                            let sep = ca.0.dot(cb.0).clamp(-1.0, 1.0).acos();
-                            if sep < 1.01 * (ca.1 + cb.1) {
-                                return None;
-                            }
-                        }
-                    }
-                    for l in lamps {
-                        let dist = (l.center.as_dvec3() - x).length();
-                        let cos = l.center.y as f64 / dist;
-                        sum +=
-                            kd as f64 * l.radiance as f64 * (l.radius as f64 / dist).powi(2) * cos;
-                    }
+                    sum += value(eye, d)?;
                 }
             }
             Some(sum / (q * q) as f64)

@@ -101,25 +101,18 @@ fn mesh(path: &std::path::Path) -> String {
 /// (|n . d| > 0.3) at points the lamp lights at more than 0.3 cosine: away from the silhouette
 /// (where polygon and circle differ) and the terminator (where shadow rays graze the facets).
 fn interior_pixels(scene: &Scene) -> Vec<bool> {
-    let cam = scene.camera.to_kernel();
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let eye = Vec3::new(cam.eye[0], cam.eye[1], cam.eye[2]);
     let lamp = Vec3::new(1.5, 2.5, 4.0);
-    (0..w * h)
-        .map(|i| {
-            (0..16).all(|s| {
-                let (u, v) = ((s % 4) as f32 / 4.0 + 0.125, (s / 4) as f32 / 4.0 + 0.125);
-                let d = kernel::camera::camera_ray_direction(&cam, w, h, i % w, i / w, u, v);
-                let t =
-                    kernel::geometry::intersect_sphere(eye, d, Vec3::ZERO, 1.0, 0.0, f32::INFINITY);
-                if t < 0.0 {
-                    return false;
-                }
-                let n = (eye + t * d).normalize();
-                -n.dot(d) > 0.3 && n.dot((lamp - n).normalize()) > 0.3
-            })
-        })
-        .collect()
+    twinpath_tests::pixel_quadrature(scene, 4, |eye, d| {
+        let t = kernel::geometry::intersect_sphere(eye, d, Vec3::ZERO, 1.0, 0.0, f32::INFINITY);
+        if t < 0.0 {
+            return None;
+        }
+        let n = (eye + t * d).normalize();
+        (-n.dot(d) > 0.3 && n.dot((lamp - n).normalize()) > 0.3).then_some(0.0)
+    })
+    .iter()
+    .map(Option::is_some)
+    .collect()
 }
 
 /// Relative difference allowed between a pixel of the mesh and of the analytic sphere beyond

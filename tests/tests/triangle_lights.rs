@@ -521,39 +521,24 @@ fn polygon_irradiance(x: DVec3, v: &[DVec3]) -> f64 {
 /// point each camera ray meets, averaged over the pixel by a 16 x 16 midpoint quadrature (the
 /// box filter); `None` where a quadrature ray meets the panel or misses the plane.
 fn panel_exact(scene: &Scene) -> Vec<Option<f64>> {
-    let cam = scene.camera.to_kernel();
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let eye = DVec3::new(cam.eye[0] as f64, cam.eye[1] as f64, cam.eye[2] as f64);
     let panel = [
         DVec3::new(-A, H, -B),
         DVec3::new(A, H, -B),
         DVec3::new(A, H, B),
         DVec3::new(-A, H, B),
     ];
-    let q = 16;
-    (0..w * h)
-        .map(|i| {
-            let (px, py) = (i % w, i / w);
-            let mut sum = 0.0;
-            for sy in 0..q {
-                for sx in 0..q {
-                    let (u, v) = ((sx as f32 + 0.5) / q as f32, (sy as f32 + 0.5) / q as f32);
-                    let d =
-                        kernel::camera::camera_ray_direction(&cam, w, h, px, py, u, v).as_dvec3();
-                    if d.y >= 0.0 {
-                        return None;
-                    }
-                    let at_panel = eye + d * ((H - eye.y) / d.y);
-                    if at_panel.x.abs() <= A * 1.01 && at_panel.z.abs() <= B * 1.01 {
-                        return None;
-                    }
-                    let x = eye + d * (-eye.y / d.y);
-                    sum += KD as f64 / PI * polygon_irradiance(x, &panel);
-                }
-            }
-            Some(sum / (q * q) as f64)
-        })
-        .collect()
+    twinpath_tests::pixel_quadrature(scene, 16, |eye, d| {
+        let (eye, d) = (eye.as_dvec3(), d.as_dvec3());
+        if d.y >= 0.0 {
+            return None;
+        }
+        let at_panel = eye + d * ((H - eye.y) / d.y);
+        if at_panel.x.abs() <= A * 1.01 && at_panel.z.abs() <= B * 1.01 {
+            return None;
+        }
+        let x = eye + d * (-eye.y / d.y);
+        Some(KD as f64 / PI * polygon_irradiance(x, &panel))
+    })
 }
 
 #[test]
