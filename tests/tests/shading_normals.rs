@@ -53,8 +53,9 @@ fn obj_and_ply_vertex_normals_and_texture_coordinates_are_read() {
     assert_eq!(soup.triangles.len(), 2);
     assert!(soup.normals.is_empty());
 
-    // A file the fuzzer made (mixed relative and missing attribute indices): an error or a
-    // soup, never a panic.
+    // A file the fuzzer made (a relative vt index that wraps around in tobj's usize arithmetic):
+    // an error or a soup, never a panic, in the build twinpath ships (overflow checks off; the
+    // fuzz build's overflow checks make tobj panic on it, see docs/robustness.md).
     let crash = std::fs::read(repo_root().join("tests/fixtures/fuzz_obj_attributes.obj")).unwrap();
     let _ = parse_obj(std::path::Path::new("fuzz.obj"), &crash);
 }
