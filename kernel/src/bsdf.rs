@@ -60,14 +60,73 @@ impl BsdfSample {
 /// refraction): no light sample can meet it, so its vertex takes none.
 #[inline]
 pub fn is_delta(m: &Material) -> bool {
-    m.kind != material_kind::DIFFUSE && m.kind != material_kind::GLOSSY && m.alpha < DELTA_ALPHA
+    !has_diffuse_lobe(m) && m.alpha < DELTA_ALPHA
+}
+
+/// Whether the material has a Lambertian lobe (the Lambertian surface, the Kd + Ks mixture and
+/// glTF's metallic-roughness material), which no roughness makes a delta distribution.
+#[inline]
+fn has_diffuse_lobe(m: &Material) -> bool {
+    m.kind == material_kind::DIFFUSE
+        || m.kind == material_kind::GLOSSY
+        || m.kind == material_kind::METALLIC_ROUGHNESS
+}
+
+/// Whether the Kd + Ks code evaluates and samples `m`: the seed's mixture, and glTF's
+/// metallic-roughness material once resolved ([`resolve_metallic_roughness`]).
+#[inline]
+fn is_glossy<F: FeatureSet>(features: F, m: &Material) -> bool {
+    features.glossy()
+        && (m.kind == material_kind::GLOSSY
+            || (features.metallic_roughness() && m.kind == material_kind::METALLIC_ROUGHNESS))
+}
+
+/// glTF's dielectric reflectance at normal incidence, ((1 - 1.5) / (1 + 1.5))^2 (glTF 2.0,
+/// Appendix B, "dielectric_brdf", index 1.5).
+pub const GLTF_DIELECTRIC_F0: f32 = 0.04;
+
+/// glTF 2.0's metallic-roughness material (Appendix B) in the Kd + Ks form [`eval`] reads,
+/// from its base colour (`albedo`), `metallic` and `roughness` as textures left them:
+///
+/// `mix(dielectric_brdf, metal_brdf, metallic)` with
+/// `dielectric_brdf = fresnel_mix(0.04; diffuse(base), specular)` and
+/// `metal_brdf = specular * F_Schlick(F0 = base)`. The specular lobes share D and G, and
+/// Schlick's F is affine in F0, so their sum is one GGX lobe with
+/// F_Schlick(F0 = lerp(0.04, base, metallic)) (`specular`), and the diffuse part is
+/// `(1 - metallic) base / pi` (`albedo`) weighed by 1 - F_Schlick(0.04, |wo . h|)
+/// ([`diffuse_share`]); alpha = roughness^2. The kind stays METALLIC_ROUGHNESS, which is what
+/// selects that weight.
+#[inline]
+pub fn resolve_metallic_roughness(m: &Material) -> Material {
+    let mut r = *m;
+    let base = Vec3::from(m.albedo);
+    let metallic = m.metallic;
+    r.albedo = (base * (1.0 - metallic)).to_array();
+    r.specular = (Vec3::splat(GLTF_DIELECTRIC_F0) * (1.0 - metallic) + base * metallic).to_array();
+    r.alpha = m.roughness * m.roughness;
+    r
+}
+
+/// The factor on the Kd lobe for light from `wi` toward `wo`: 1 for the seed's mixture, and
+/// for glTF's material the share its dielectric layer lets through, 1 - F_Schlick(0.04,
+/// |wo . h|) at the half vector h of `wo` and `wi` (Appendix B's `fresnel_mix`).
+#[inline]
+fn diffuse_share<F: FeatureSet>(features: F, m: &Material, wo: Vec3, wi: Vec3) -> f32 {
+    if features.metallic_roughness() && m.kind == material_kind::METALLIC_ROUGHNESS {
+        let h = (wo + wi).normalize();
+        1.0 - schlick(Vec3::splat(GLTF_DIELECTRIC_F0), wo.dot(h).abs()).x
+    } else {
+        1.0
+    }
 }
 
 /// Whether [`sample`] reads the lobe-choice number `u_lobe`: the Kd + Ks mixture chooses its
 /// lobe, the dielectric reflection or refraction.
 #[inline]
 pub fn chooses_lobe(m: &Material) -> bool {
-    m.kind == material_kind::GLOSSY || m.kind == material_kind::DIELECTRIC
+    m.kind == material_kind::GLOSSY
+        || m.kind == material_kind::DIELECTRIC
+        || m.kind == material_kind::METALLIC_ROUGHNESS
 }
 
 /// The probability that the Kd + Ks mixture samples its glossy lobe from `wo` at cosine
@@ -125,8 +184,8 @@ pub fn eval<F: FeatureSet>(
     if !(cos_o > 0.0) {
         return (Vec3::ZERO, 0.0);
     }
-    if features.glossy() && m.kind == material_kind::GLOSSY {
-        eval_glossy(m, n, wo, wi, cos_o, cos_i)
+    if is_glossy(features, m) {
+        eval_glossy(features, m, n, wo, wi, cos_o, cos_i)
     } else if m.alpha < DELTA_ALPHA {
         (Vec3::ZERO, 0.0)
     } else if features.conductor() && m.kind == material_kind::CONDUCTOR {
@@ -138,16 +197,24 @@ pub fn eval<F: FeatureSet>(
     }
 }
 
-/// [`eval`] of the Kd + Ks mixture: Kd/pi cos + D G F_Schlick(wi . h) / (4 cos_o), density the
-/// mixture of the cosine lobe and the visible-normal reflection.
+/// [`eval`] of the Kd + Ks mixture: Kd/pi cos (times [`diffuse_share`]) + D G F_Schlick(wi . h)
+/// / (4 cos_o), density the mixture of the cosine lobe and the visible-normal reflection.
 #[inline]
-fn eval_glossy(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32) -> (Vec3, f32) {
+fn eval_glossy<F: FeatureSet>(
+    features: F,
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+    cos_o: f32,
+    cos_i: f32,
+) -> (Vec3, f32) {
     if !(cos_i > 0.0) {
         return (Vec3::ZERO, 0.0);
     }
     let p_glossy = glossy_lobe_probability(m, cos_o);
     let c = cos_i * (1.0 / PI);
-    let mut f = Vec3::from(m.albedo) * c;
+    let mut f = Vec3::from(m.albedo) * (c * diffuse_share(features, m, wo, wi));
     let mut pdf = (1.0 - p_glossy) * c;
     if !(m.alpha < DELTA_ALPHA) {
         let r = reflection(n, wo, wi, cos_o, cos_i, m.alpha);
@@ -251,7 +318,7 @@ pub fn sample<F: FeatureSet>(
     if !(cos_o > 0.0) {
         return BsdfSample::NONE;
     }
-    if features.glossy() && m.kind == material_kind::GLOSSY {
+    if is_glossy(features, m) {
         sample_glossy(features, m, n, wo, cos_o, u_lobe, u1, u2)
     } else if features.conductor() && m.kind == material_kind::CONDUCTOR {
         sample_conductor(m, n, wo, cos_o, u1, u2)
@@ -292,7 +359,7 @@ fn sample_glossy<F: FeatureSet>(
     };
     if smooth {
         // The diffuse lobe beside a delta one: (Kd/pi cos) / ((1 - p) cos/pi), exactly.
-        let weight = Vec3::from(m.albedo) / (1.0 - p_glossy);
+        let weight = Vec3::from(m.albedo) * (diffuse_share(features, m, wo, wi) / (1.0 - p_glossy));
         return reflected(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
     }
     let (f, pdf) = eval(features, m, n, wo, wi, 1.0);

@@ -33,7 +33,7 @@ pub const CONDUCTOR: u32 = 1 << 8;
 /// The scene may have dielectrics (refraction, and roulette's eta^2 bookkeeping).
 pub const DIELECTRIC: u32 = 1 << 9;
 /// Every material bit: a scene with none of them is Lambertian only and runs the diffuse path.
-pub const MATERIALS: u32 = GLOSSY | CONDUCTOR | DIELECTRIC;
+pub const MATERIALS: u32 = GLOSSY | CONDUCTOR | DIELECTRIC | METALLIC_ROUGHNESS;
 /// The light table may hold triangles (emissive quads and meshes): without it every light is
 /// a sphere.
 pub const TRIANGLE_LIGHTS: u32 = 1 << 10;
@@ -46,6 +46,10 @@ pub const THIN_LENS: u32 = 1 << 11;
 pub const SHADING_NORMALS: u32 = 1 << 13;
 /// Some material may have a texture: hits may look one up.
 pub const TEXTURES: u32 = 1 << 14;
+/// The scene may have glTF metallic-roughness surfaces (`material_kind::METALLIC_ROUGHNESS`),
+/// resolved at each hit into the Kd + Ks form; it comes with [`GLOSSY`], whose code evaluates
+/// them.
+pub const METALLIC_ROUGHNESS: u32 = 1 << 15;
 
 /// The material bits of a scene with these materials: one per kind present besides the
 /// Lambertian. (A bit may also be set for a kind that is absent: it only keeps that kind's
@@ -58,6 +62,7 @@ pub fn material_features(materials: &[Material]) -> u32 {
             material_kind::GLOSSY => GLOSSY,
             material_kind::CONDUCTOR => CONDUCTOR,
             material_kind::DIELECTRIC => DIELECTRIC,
+            material_kind::METALLIC_ROUGHNESS => GLOSSY | METALLIC_ROUGHNESS,
             _ => 0,
         };
     }
@@ -182,6 +187,10 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn dielectric(self) -> bool {
         self.answer(DIELECTRIC, true)
+    }
+    #[inline]
+    fn metallic_roughness(self) -> bool {
+        self.answer(METALLIC_ROUGHNESS, true)
     }
     /// Whether the render may have an environment map (see [`ENVIRONMENT`]).
     #[inline]

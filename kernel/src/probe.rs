@@ -21,6 +21,8 @@ use crate::scene::{light_kind, Camera, Light, Material};
 use crate::sobol::{sobol_pair, sobol_single};
 use crate::spherical_triangle;
 use crate::texture::{bilerp, footprint};
+#[cfg(target_arch = "spirv")]
+use crate::Float;
 use spirv_std::glam::{UVec4, Vec2, Vec3, Vec4};
 
 /// Which function a probe record evaluates (input layout -> output layout).
@@ -103,7 +105,9 @@ fn v3(v: Vec3) -> Vec4 {
 
 /// The material of the BSDF probes: kind `kind` with roughness `alpha` and, for a dielectric,
 /// index `eta`; Kd (0.5, 0.4, 0.3) and Ks (0.2, 0.3, 0.4) for the Kd + Ks mixture; gold's RGB
-/// index (`complex` 1) or reflectance (0.9, 0.8, 0.7) for a conductor.
+/// index (`complex` 1) or reflectance (0.9, 0.8, 0.7) for a conductor; for glTF's
+/// metallic-roughness material base colour (0.5, 0.4, 0.3), metallic 0.3 (`complex` 0) or 0.9,
+/// roughness sqrt(alpha), resolved as `surface::shade` resolves it.
 #[inline]
 pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material {
     let mut m = Material::diffuse([0.5, 0.4, 0.3]);
@@ -118,6 +122,12 @@ pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material
     } else {
         [0.9, 0.8, 0.7]
     };
+    if kind == crate::scene::material_kind::METALLIC_ROUGHNESS {
+        m.specular = [0.0; 3];
+        m.metallic = if complex != 0 { 0.9 } else { 0.3 };
+        m.roughness = alpha.sqrt();
+        m = crate::bsdf::resolve_metallic_roughness(&m);
+    }
     m
 }
 

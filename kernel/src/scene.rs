@@ -57,9 +57,11 @@ pub struct ShadingTriangle {
 
 /// The material parameters a texture can give (`Material::textures[slot]`).
 pub mod texture_slot {
-    /// Kd, the diffuse reflectance (a colour map: sRGB-decoded).
+    /// Kd, the diffuse reflectance (a colour map: sRGB-decoded); METALLIC_ROUGHNESS: the base
+    /// colour.
     pub const KD: usize = 0;
-    /// Ks, the specular reflectance (a colour map).
+    /// Ks, the specular reflectance (a colour map); METALLIC_ROUGHNESS: glTF's
+    /// metallic-roughness map (linear; blue multiplies metallic, green roughness).
     pub const KS: usize = 1;
     /// The GGX roughness alpha (linear; the red channel).
     pub const ALPHA: usize = 2;
@@ -79,10 +81,17 @@ pub mod material_kind {
     /// Glass: GGX (or smooth) reflection and refraction between the outside (index 1) and the
     /// inside (index `ior`) of a closed surface.
     pub const DIELECTRIC: u32 = 3;
+    /// glTF 2.0's metallic-roughness material (the specification's Appendix B): a mix, by
+    /// `metallic`, of a GGX metal whose Schlick Fresnel has F0 = base colour and a dielectric
+    /// (index 1.5, F0 = 0.04) whose Schlick Fresnel weighs a GGX layer over the diffuse base
+    /// colour; GGX alpha = roughness^2. Stored as `albedo` = base colour, `metallic`,
+    /// `roughness`; `crate::surface::shade` resolves it at the point into the Kd + Ks form
+    /// (`bsdf::resolve_metallic_roughness`) that `crate::bsdf` evaluates.
+    pub const METALLIC_ROUGHNESS: u32 = 4;
 }
 
 /// A two-sided surface's scattering (one of [`material_kind`]), or a light (emission > 0 and
-/// no reflection). 96 bytes.
+/// no reflection). 112 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
@@ -113,6 +122,13 @@ pub struct Material {
     /// Per [`texture_slot`]: the texture (an index into the texture table, `crate::texture`)
     /// whose value at the point multiplies that parameter, or [`NONE`].
     pub textures: [u32; texture_slot::COUNT],
+    /// METALLIC_ROUGHNESS: glTF's metalness in [0, 1] (the `KS` texture's blue channel
+    /// multiplies it).
+    pub metallic: f32,
+    /// METALLIC_ROUGHNESS: glTF's perceptual roughness in [0, 1] (GGX alpha = roughness^2; the
+    /// `KS` texture's green channel multiplies it).
+    pub roughness: f32,
+    pub _pad: [u32; 2],
 }
 
 impl Material {
@@ -130,6 +146,9 @@ impl Material {
             k: [0.0; 3],
             two_sided: 0,
             textures: [NONE; texture_slot::COUNT],
+            metallic: 0.0,
+            roughness: 0.0,
+            _pad: [0; 2],
         }
     }
 

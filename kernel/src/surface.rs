@@ -16,9 +16,10 @@
 //! the same way): no leaks, at the price of a little energy lost where the normals disagree,
 //! which is near silhouettes of coarse meshes (docs/materials.md, "Shading normals").
 
+use crate::bsdf::resolve_metallic_roughness;
 use crate::features::FeatureSet;
 use crate::geometry::{blend2, blend3};
-use crate::scene::{texture_slot, Material, ShadingTriangle, NONE};
+use crate::scene::{material_kind, texture_slot, Material, ShadingTriangle, NONE};
 use crate::texture::{lookup, textured_material};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -55,7 +56,8 @@ pub fn interpolated_uv(tri: &ShadingTriangle, bary: Vec2) -> Vec2 {
 
 /// The material at a vertex on material `material` and shading record `record` (a hit's
 /// `SurfaceHit::material` and `shading`) at barycentrics `bary`: a copy of its table entry, with
-/// its textures applied where the scene has any; and the unit shading normal (either
+/// its textures applied where the scene has any and, for glTF's metallic-roughness material,
+/// resolved into the form `crate::bsdf` evaluates (`bsdf::resolve_metallic_roughness`); and the unit shading normal (either
 /// orientation) where the record's vertex normals give one, else zero (the hit shades with its
 /// geometric normal).
 #[inline]
@@ -69,18 +71,19 @@ pub fn shade<F: FeatureSet>(
     shading: &[ShadingTriangle],
     textures: &[u32],
 ) -> (Material, Vec3) {
-    let m = materials[material as usize];
-    if !(features.shading_normals() || features.textures()) || record == NONE {
-        return (m, Vec3::ZERO);
-    }
-    let tri = shading[record as usize];
+    let mut m = materials[material as usize];
     let mut normal = Vec3::ZERO;
-    if features.shading_normals() && tri.has_normals != 0 {
-        normal = interpolated_normal(&tri, bary);
+    if (features.shading_normals() || features.textures()) && record != NONE {
+        let tri = shading[record as usize];
+        if features.shading_normals() && tri.has_normals != 0 {
+            normal = interpolated_normal(&tri, bary);
+        }
+        if features.textures() {
+            m = textured_material(&m, textures, interpolated_uv(&tri, bary));
+        }
     }
-    if features.textures() {
-        let uv = interpolated_uv(&tri, bary);
-        return (textured_material(&m, textures, uv), normal);
+    if features.metallic_roughness() && m.kind == material_kind::METALLIC_ROUGHNESS {
+        m = resolve_metallic_roughness(&m);
     }
     (m, normal)
 }

@@ -16,7 +16,7 @@
 //! ((i + 1/2) / w, 1 - (j + 1/2) / h). Bilinear filtering between the four texel centres around
 //! the point (pbrt-v4 `Image::Bilerp`, the same weights).
 
-use crate::scene::{texture_slot, Material, NONE};
+use crate::scene::{material_kind, texture_slot, Material, NONE};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
@@ -185,7 +185,8 @@ pub fn lookup(table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
 }
 
 /// `material` at a point of texture coordinates `uv`: each parameter with a texture multiplied
-/// by the texture's value there (alpha by its red channel).
+/// by the texture's value there (alpha by its red channel; for glTF's metallic-roughness
+/// material the `KS` map's blue channel multiplies metallic and its green roughness).
 #[inline]
 pub fn textured_material(material: &Material, table: &[u32], uv: Vec2) -> Material {
     let mut m = *material;
@@ -194,7 +195,14 @@ pub fn textured_material(material: &Material, table: &[u32], uv: Vec2) -> Materi
         m.albedo = (Vec3::from(m.albedo) * lookup(table, t[texture_slot::KD], uv)).to_array();
     }
     if t[texture_slot::KS] != NONE {
-        m.specular = (Vec3::from(m.specular) * lookup(table, t[texture_slot::KS], uv)).to_array();
+        let value = lookup(table, t[texture_slot::KS], uv);
+        if m.kind == material_kind::METALLIC_ROUGHNESS {
+            // glTF's metallic-roughness map: blue is metalness, green roughness.
+            m.metallic *= value.z;
+            m.roughness *= value.y;
+        } else {
+            m.specular = (Vec3::from(m.specular) * value).to_array();
+        }
     }
     if t[texture_slot::ALPHA] != NONE {
         m.alpha *= lookup(table, t[texture_slot::ALPHA], uv).x;

@@ -89,6 +89,15 @@ pub enum RefMaterial {
     },
     /// GGX reflection and refraction; `eta` = index beyond / index on wo's side.
     Dielectric { eta: f64, alpha: f64 },
+    /// glTF 2.0's metallic-roughness material, written from the specification's Appendix B
+    /// as it stands: mix(dielectric_brdf, metal_brdf, metallic) with
+    /// dielectric_brdf = fresnel_mix(ior 1.5, diffuse(base), specular) and
+    /// metal_brdf = specular * conductor_fresnel(f0 = base); alpha = roughness^2.
+    MetallicRoughness {
+        base: DVec3,
+        metallic: f64,
+        roughness: f64,
+    },
 }
 
 impl RefMaterial {
@@ -130,6 +139,28 @@ impl RefMaterial {
                 m.ior = eta as f32;
                 m
             }
+            RefMaterial::MetallicRoughness {
+                base,
+                metallic,
+                roughness,
+            } => {
+                let mut m = Material::diffuse(f(base));
+                m.kind = material_kind::METALLIC_ROUGHNESS;
+                m.metallic = metallic as f32;
+                m.roughness = roughness as f32;
+                m
+            }
+        }
+    }
+
+    /// The material as `kernel::bsdf` receives it: [`RefMaterial::kernel`], with glTF's
+    /// material resolved as `kernel::surface::shade` resolves it at a hit.
+    pub fn kernel_at_hit(&self) -> kernel::scene::Material {
+        let m = self.kernel();
+        if m.kind == kernel::scene::material_kind::METALLIC_ROUGHNESS {
+            kernel::bsdf::resolve_metallic_roughness(&m)
+        } else {
+            m
         }
     }
 
@@ -148,6 +179,27 @@ impl RefMaterial {
             return DVec3::ZERO;
         }
         match *self {
+            RefMaterial::MetallicRoughness {
+                base,
+                metallic,
+                roughness,
+            } => {
+                if ci < 0.0 {
+                    return DVec3::ZERO;
+                }
+                let alpha = roughness * roughness;
+                let h = (wo + wi).normalize();
+                let voh = wo.dot(h).abs();
+                let specular = ggx_d(n.dot(h), alpha) * ggx_g1(co, alpha) * ggx_g1(ci, alpha)
+                    / (4.0 * co * ci);
+                let diffuse = base / PI;
+                // fresnel_mix(ior 1.5, base, layer) = mix(base, layer, F0 + (1 - F0)(1 - |VdotH|)^5).
+                let f0 = ((1.0f64 - 1.5) / (1.0 + 1.5)).powi(2);
+                let fr = f0 + (1.0 - f0) * (1.0 - voh).powi(5);
+                let dielectric_brdf = diffuse * (1.0 - fr) + DVec3::splat(specular * fr);
+                let metal_brdf = specular * (base + (DVec3::ONE - base) * (1.0 - voh).powi(5));
+                dielectric_brdf * (1.0 - metallic) + metal_brdf * metallic
+            }
             RefMaterial::Glossy { kd, ks, alpha } => {
                 if ci < 0.0 {
                     return DVec3::ZERO;
@@ -233,6 +285,22 @@ impl RefMaterial {
             vndf(h, alpha) / (4.0 * wo.dot(h).abs())
         };
         match *self {
+            RefMaterial::MetallicRoughness {
+                base,
+                metallic,
+                roughness,
+            } => {
+                if ci <= 0.0 {
+                    return 0.0;
+                }
+                // The kernel samples it as the Kd + Ks mixture of Kd = (1 - metallic) base and
+                // F0 = lerp(0.04, base, metallic).
+                let kd = base * (1.0 - metallic);
+                let ks = DVec3::splat(0.04 * (1.0 - metallic)) + base * metallic;
+                let fs = schlick(ks, co).element_sum();
+                let p = fs / (fs + kd.element_sum());
+                (1.0 - p) * ci / PI + p * reflected(roughness * roughness)
+            }
             RefMaterial::Glossy { kd, ks, alpha } => {
                 if ci <= 0.0 {
                     return 0.0;

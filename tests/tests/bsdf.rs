@@ -37,6 +37,14 @@ fn dielectric(eta: f64, alpha: f64) -> RefMaterial {
     RefMaterial::Dielectric { eta, alpha }
 }
 
+fn metallic_roughness(metallic: f64, roughness: f64) -> RefMaterial {
+    RefMaterial::MetallicRoughness {
+        base: DVec3::new(0.8, 0.5, 0.2),
+        metallic,
+        roughness,
+    }
+}
+
 /// The rough materials the sampler tests cover.
 fn rough_materials() -> Vec<(String, RefMaterial)> {
     let mut v = Vec::new();
@@ -45,6 +53,12 @@ fn rough_materials() -> Vec<(String, RefMaterial)> {
     }
     for alpha in [0.05, 0.3] {
         v.push((format!("Kd + Ks alpha {alpha}"), glossy(alpha)));
+    }
+    for (metallic, roughness) in [(0.0, 0.3), (0.5, 0.5), (1.0, 0.8)] {
+        v.push((
+            format!("glTF metallic {metallic} roughness {roughness}"),
+            metallic_roughness(metallic, roughness),
+        ));
     }
     for eta in [1.5, 1.0 / 1.5] {
         for alpha in [0.1, 0.5] {
@@ -134,7 +148,7 @@ fn rough_samplers_follow_their_pdfs() {
         .enumerate()
         .filter_map(|(k, (name, m, n, degrees))| {
             let (n, wo) = (*n, at_angle(*n, *degrees));
-            let km = m.kernel();
+            let km = m.kernel_at_hit();
             let eta = m.eta() as f32;
             let mut observed = vec![0.0; THETA_BINS * PHI_BINS + 1];
             let mut rng = SampleRng::new(777, k as u32, 0);
@@ -189,8 +203,9 @@ fn unit(g: &mut SplitMix) -> Vec3 {
 /// (where f32 keeps the lobes' shape; `properties.rs` covers the edges for finiteness).
 fn random_material(g: &mut SplitMix) -> RefMaterial {
     let alpha = 10f64.powf(-2.0 + 2.0 * g.unit() as f64);
-    match g.u64() % 4 {
+    match g.u64() % 5 {
         0 => glossy(alpha),
+        4 => metallic_roughness(g.unit() as f64, alpha.sqrt()),
         1 => conductor(alpha),
         2 => RefMaterial::Conductor {
             eta: DVec3::ZERO,
@@ -231,7 +246,7 @@ fn values_and_densities_match_the_f64_reference() {
                 continue;
             }
         }
-        let (f_cos, pdf) = eval(Dynamic(0), &m.kernel(), n, wo, wi, m.eta() as f32);
+        let (f_cos, pdf) = eval(Dynamic(0), &m.kernel_at_hit(), n, wo, wi, m.eta() as f32);
         let f_ref = m.f(nd, wod, wid) * wid.dot(nd).abs();
         let pdf_ref = m.pdf(nd, wod, wid);
         // Values below 1e-4 (the lobes' peaks reach 1e4) are compared absolutely: there, near
@@ -278,7 +293,7 @@ fn evaluation_is_reciprocal() {
         if wo.dot(n) < 1e-2 || wi.dot(n).abs() < 1e-2 {
             continue;
         }
-        let km = m.kernel();
+        let km = m.kernel_at_hit();
         let eta = m.eta() as f32;
         let forward = eval(Dynamic(0), &km, n, wo, wi, eta).0 / wi.dot(n).abs();
         let through = wi.dot(n) < 0.0;
@@ -323,7 +338,7 @@ fn sampled_weight_is_value_over_density() {
         if wo.dot(n) < 1e-2 {
             continue;
         }
-        let km = m.kernel();
+        let km = m.kernel_at_hit();
         let eta = m.eta() as f32;
         let s = sample(Dynamic(0), &km, n, wo, eta, g.unit(), g.unit(), g.unit());
         if !(s.weight.max_element() > 0.0) || s.wi.dot(n).abs() < 1e-2 {
@@ -434,7 +449,7 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
             };
             let fs = schlick(ks, cos_o);
             let p = fs.element_sum() / (fs.element_sum() + kd.element_sum());
-            let km = m.kernel();
+            let km = m.kernel_at_hit();
             let mut g = SplitMix(0x9105 + degrees as u64);
             let mut mirrored = 0;
             for _ in 0..TRIALS {
@@ -453,6 +468,38 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
             }
             assert_binomial(
                 &format!("Kd + Ks mirror at {degrees} deg"),
+                mirrored,
+                TRIALS,
+                p,
+            );
+            // glTF's material at roughness 0: the mirror with F0 = lerp(0.04, base, metallic),
+            // and the diffuse lobe's weight (1 - metallic) base (1 - F(0.04, wo . h)) / (1 - p).
+            let (base, metallic) = (DVec3::new(0.8, 0.5, 0.2), 0.25);
+            let km = metallic_roughness(metallic, 0.0).kernel_at_hit();
+            let kd = base * (1.0 - metallic);
+            let f0 = DVec3::splat(0.04 * (1.0 - metallic)) + base * metallic;
+            let fs = schlick(f0, cos_o);
+            let p = fs.element_sum() / (fs.element_sum() + kd.element_sum());
+            let mut mirrored = 0;
+            for _ in 0..TRIALS {
+                let s = sample(Dynamic(0), &km, n, wo, 1.0, g.unit(), g.unit(), g.unit());
+                if s.pdf == DELTA_PDF {
+                    assert!((s.wi - mirror).length() < 1e-6);
+                    for c in 0..3 {
+                        assert!(rel(s.weight[c] as f64, fs[c] / p) < 1e-5);
+                    }
+                    mirrored += 1;
+                } else {
+                    let (wo64, wi64) = (wo.as_dvec3(), s.wi.as_dvec3());
+                    let voh = wo64.dot((wo64 + wi64).normalize()).abs();
+                    let share = 1.0 - (0.04 + 0.96 * (1.0 - voh).powi(5));
+                    for c in 0..3 {
+                        assert!(rel(s.weight[c] as f64, kd[c] * share / (1.0 - p)) < 1e-5);
+                    }
+                }
+            }
+            assert_binomial(
+                &format!("glTF mirror at {degrees} deg"),
                 mirrored,
                 TRIALS,
                 p,

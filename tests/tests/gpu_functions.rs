@@ -236,7 +236,7 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                     [g.unit(), g.unit(), g.unit(), 0.0]
                 };
                 let mut x = rec([w(n, alpha), w(wo, eta), third, [0.0; 4]]);
-                x[3][0] = (g.u64() % 4) as u32;
+                x[3][0] = (g.u64() % 5) as u32;
                 x[3][1] = (g.u64() % 2) as u32;
                 x
             }
@@ -352,7 +352,7 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "fresnel (conductor, dielectric, schlick)", func: function::FRESNEL, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "reflectances <= 1 with cancelling terms (FMA contraction): 8 ULP, or 8 eps absolute" },
     Bound { name: "microfacet (visible normal, D, G1, pdf)", func: function::MICROFACET, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "square roots and normalisations (FMA contraction): 64 ULP or 64 eps; alpha < 0.01: 1% relative" },
     Bound { name: "bsdf::eval", func: function::BSDF_EVAL, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "D, G1, Fresnel and the refraction Jacobian (FMA contraction): 64 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: 1% relative" },
-    Bound { name: "bsdf::sample", func: function::BSDF_SAMPLE, max_ulps: 2048, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "the visible-normal sampler, Fresnel choice and pdf (FMA contraction); weights of grazing directions carry G1 ~ n . wi, whose rounding moves them relatively (measured 648 ULP): 2048 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: 1% relative" },
+    Bound { name: "bsdf::sample", func: function::BSDF_SAMPLE, max_ulps: 2048, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 5e-2)), why: "the visible-normal sampler, Fresnel choice and pdf (FMA contraction); weights of grazing directions carry G1 ~ n . wi, whose rounding moves them relatively (measured 648 ULP): 2048 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: the sampler's stretch by alpha magnifies the rounding of wo by up to 1/alpha, and the density is read at the sampled wi on a lobe a thousandth of a radian wide (measured 2.6% where a 0.9-metallic glTF material picks the sharp lobe 9 times in 10): 5% relative" },
     Bound { name: "sample_triangle_light / solid_angle", func: function::TRIANGLE_LIGHT, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "atan2_turns, normalisations and the ray/plane step (FMA contraction): 64 eps relative to the solid angle, density and geometry size, divided by h, the receiver's elevation above the light's plane (all are 0 / 0 in it); normals 64 eps" },
     Bound { name: "texture footprint and bilerp", func: function::TEXTURE, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, why: "the same texels and weights bit for bit: wrapping, clamping and the blend" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },

@@ -146,7 +146,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                 Material,
                 [
                     albedo, kind, emission, alpha, specular, ior, eta, complex, k, two_sided,
-                    textures
+                    textures, metallic, roughness, _pad
                 ],
                 true
             ),
