@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fuzzes the scene parser and the PLY and OBJ loaders with libFuzzer (cargo-fuzz), each for
+# Fuzzes the scene parser, the PLY and OBJ loaders and the glTF loader with libFuzzer (cargo-fuzz), each for
 # SECONDS (first argument, default 60), from the seed corpora in fuzz/corpus (copied, so new
 # inputs the fuzzer finds do not land in the repository), with a 2 GiB memory limit and a 10 s
 # limit per input: a panic, a crash, a hang or unbounded memory fails the run, and libFuzzer
@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
 command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
-for target in scene ply obj; do
+for target in scene ply obj gltf; do
   work=$(mktemp -d)
   cp fuzz/corpus/"$target"/* "$work"/
   echo "fuzz: $target for ${seconds}s" >&2

@@ -11,7 +11,7 @@ cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
 mkdir -p target
 cargo test --workspace -- --nocapture "$@" 2>&1 | tee target/test.log
-# libFuzzer on the scene parser and the mesh loaders, 60 s each (cargo-fuzz; see scripts/fuzz.sh).
+# libFuzzer on the scene parser, the mesh loaders and the glTF loader, 60 s each (cargo-fuzz; see scripts/fuzz.sh).
 bash scripts/fuzz.sh 60
 # One closing line with the totals of every cargo test binary above.
 awk '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p, f }' target/test.log

@@ -90,6 +90,7 @@ pub fn repo_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 pub mod cubature;
+pub mod gltf_writer;
 pub mod gpu;
 pub mod reference_bsdf;
 pub mod spirv;

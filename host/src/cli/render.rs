@@ -11,8 +11,11 @@ use twinpath::scene::Scene;
 /// Render a scene (default: the built-in Cornell scene) to EXR and/or PNG.
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file (TOML). Without it, the built-in Cornell scene.
+    /// Scene file: TOML, or glTF 2.0 (.gltf, .glb). Without it, the built-in Cornell scene.
     scene: Option<PathBuf>,
+    /// glTF: the perspective camera to render through, by name (default: the first).
+    #[arg(long)]
+    camera: Option<String>,
     #[arg(long, value_enum, default_value_t = Backend::Auto)]
     backend: Backend,
     /// Vulkan device index for the GPU backend (see `twinpath info`).
@@ -44,7 +47,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
             .build_global()
             .context("cannot set the thread count")?;
     }
-    let mut scene = load_scene(a.scene.as_deref())?;
+    let mut scene = match (&a.scene, &a.camera) {
+        (Some(path), Some(name)) => Scene::load_with_camera(path, Some(name))?,
+        (None, Some(_)) => bail!("--camera selects a glTF file's camera: give the file"),
+        (path, None) => load_scene(path.as_deref())?,
+    };
     a.settings.apply(&mut scene.render)?;
     if let Some(m) = &a.spp_map {
         if extension(m).as_deref() != Some("exr") {
@@ -80,6 +87,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
         scene.render.seed
     );
     eprintln!("twinpath: scene memory: {}", scene.memory_report());
+    for note in &scene.notes {
+        eprintln!("twinpath: note: {note}");
+    }
     let opts = RenderOptions {
         backend: a.backend,
         device: a.device,

@@ -1,17 +1,17 @@
 //! The TOML scene format (see README "Scene format"), parsed with serde and checked field by
 //! field; every error carries the file, the line of the offending value and the field's path.
 
+use super::builder::{wound, SceneTables};
 use super::closed_surface::check_closed_outward;
 use super::environment::EnvironmentMap;
 use super::error::{line_of, SceneError};
-use super::light_table::{sphere_light, triangle_light};
+use super::light_table::sphere_light;
 use super::mesh::load_mesh;
-use super::textures::TextureTable;
 use super::transform::{parse_transform, TransformFields};
 use super::{CameraDesc, Scene, TriangleGroup};
 use crate::settings::RenderSettings;
 use glam::Vec3;
-use kernel::scene::{material_kind, texture_slot, Light, ShadingTriangle, Sphere, Triangle, NONE};
+use kernel::scene::{ShadingTriangle, Sphere, NONE};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -48,6 +48,8 @@ struct SceneFile {
     quad: Vec<Spanned<QuadFile>>,
     #[serde(default)]
     mesh: Vec<Spanned<MeshFile>>,
+    #[serde(default)]
+    gltf: Vec<Spanned<GltfFile>>,
     #[serde(default)]
     background: Option<BackgroundFile>,
 }
@@ -86,6 +88,26 @@ pub(super) struct MaterialFile {
     pub emission_map: Option<Spanned<String>>,
     /// How the maps continue outside [0, 1]: "repeat" (default) or "clamp".
     pub wrap: Option<Spanned<String>>,
+    /// glTF's metallic-roughness material (`material_kind::METALLIC_ROUGHNESS`): base colour,
+    /// metalness and perceptual roughness (alpha = roughness^2), each optional (defaults 1, as
+    /// in glTF), with glTF's maps: the base colour (sRGB) and the metallic-roughness map (linear;
+    /// blue metalness, green roughness).
+    pub base_color: Option<V3>,
+    pub metallic: Option<Spanned<f32>>,
+    pub roughness: Option<Spanned<f32>>,
+    pub base_color_map: Option<Spanned<String>>,
+    pub metallic_roughness_map: Option<Spanned<String>>,
+}
+
+impl MaterialFile {
+    /// Whether the entry describes glTF's metallic-roughness material.
+    pub fn is_metallic_roughness(&self) -> bool {
+        self.base_color.is_some()
+            || self.metallic.is_some()
+            || self.roughness.is_some()
+            || self.base_color_map.is_some()
+            || self.metallic_roughness_map.is_some()
+    }
 }
 
 #[derive(Deserialize)]
@@ -136,17 +158,6 @@ struct MeshFile {
     matrix: Option<Spanned<[[f32; 4]; 4]>>,
 }
 
-/// `corners` in reverse winding (the second and third swapped) where `mirror`: a mirroring
-/// transform flips a triangle's front face, and reversing the winding flips it back (glTF 2.0,
-/// "Transformations").
-fn wound<T: Copy>(corners: [T; 3], mirror: bool) -> [T; 3] {
-    if mirror {
-        [corners[0], corners[2], corners[1]]
-    } else {
-        corners
-    }
-}
-
 /// The transform fields of a shape's table (`transform::TransformFields`).
 macro_rules! transform_fields {
     ($f:expr) => {
@@ -157,6 +168,18 @@ macro_rules! transform_fields {
             matrix: $f.matrix.as_ref(),
         }
     };
+}
+
+/// A glTF file's default scene as part of this one (`gltf_scene::include`): its meshes with
+/// their own materials, under an optional transform; its cameras are not used.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GltfFile {
+    file: Spanned<String>,
+    scale: Option<Spanned<toml::Value>>,
+    rotate: Option<Spanned<[f32; 4]>>,
+    translate: Option<V3>,
+    matrix: Option<Spanned<[[f32; 4]; 4]>>,
 }
 
 #[derive(Deserialize)]
@@ -337,17 +360,22 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     }
 
     // Materials, in name order.
-    let mut materials = Vec::new();
-    let mut material_names = Vec::new();
+    let mut tables = SceneTables::default();
     let base_dir = path.parent().unwrap_or(Path::new("."));
-    let mut textures = TextureTable::new();
     for (name, m) in &file.materials {
         let field = format!("materials.{name}");
         let mut material = super::materials::material(&ck, &field, m)?;
-        super::materials::attach_textures(&ck, &field, m, base_dir, &mut textures, &mut material)?;
-        materials.push(material);
-        material_names.push(name.clone());
+        super::materials::attach_textures(
+            &ck,
+            &field,
+            m,
+            base_dir,
+            &mut tables.textures,
+            &mut material,
+        )?;
+        tables.add_material(name.clone(), material);
     }
+    let material_names = tables.material_names.clone();
     let find_material = |s: &Spanned<String>, field: &str| -> Result<u32, SceneError> {
         material_names
             .iter()
@@ -365,13 +393,8 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 )
             })
     };
-    let is_emissive = |m: u32| materials[m as usize].emission.iter().any(|&c| c > 0.0);
-    let is_dielectric = |m: u32| materials[m as usize].kind == material_kind::DIELECTRIC;
-    let is_textured = |m: u32| materials[m as usize].textures.iter().any(|&t| t != NONE);
 
     // Spheres; emissive ones become lights.
-    let mut spheres = Vec::new();
-    let mut lights = Vec::new();
     for (i, s) in file.sphere.iter().enumerate() {
         let sf = s.get_ref();
         let center = ck.vec3(&sf.center, &format!("sphere[{i}].center"))?;
@@ -415,7 +438,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             (center, radius)
         };
         let material = find_material(&sf.material, &format!("sphere[{i}].material"))?;
-        if is_textured(material) {
+        if tables.is_textured(material) {
             return Err(ck.err(
                 sf.material.span(),
                 &format!("sphere[{i}].material"),
@@ -426,7 +449,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 ),
             ));
         }
-        if materials[material as usize].two_sided != 0 {
+        if tables.materials[material as usize].two_sided != 0 {
             return Err(ck.err(
                 sf.material.span(),
                 &format!("sphere[{i}].material"),
@@ -437,17 +460,17 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 ),
             ));
         }
-        let light = if is_emissive(material) {
-            lights.push(sphere_light(
+        let light = if tables.is_emissive(material) {
+            tables.lights.push(sphere_light(
                 center,
                 radius,
-                materials[material as usize].emission,
+                tables.materials[material as usize].emission,
             ));
-            (lights.len() - 1) as u32
+            (tables.lights.len() - 1) as u32
         } else {
             NONE
         };
-        spheres.push(Sphere {
+        tables.spheres.push(Sphere {
             center: center.to_array(),
             radius,
             material,
@@ -457,35 +480,6 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     }
 
     // Quads (two triangles each) and meshes; each triangle of an emissive one is a light.
-    let mut triangles = Vec::new();
-    let mut triangle_groups = Vec::new();
-    let mut shading = Vec::new();
-    let push_triangle = |triangles: &mut Vec<Triangle>,
-                         lights: &mut Vec<Light>,
-                         shading: &mut Vec<ShadingTriangle>,
-                         p: [Vec3; 3],
-                         material: u32,
-                         attributes: Option<ShadingTriangle>| {
-        let mut tri = super::triangle(p, material);
-        let m = &materials[material as usize];
-        if let Some(a) = attributes {
-            tri.shading = shading.len() as u32;
-            shading.push(a);
-        }
-        if is_emissive(material) {
-            tri.light = lights.len() as u32;
-            let mut light = triangle_light(&tri, m.emission, m.two_sided != 0);
-            if let Some(a) = attributes {
-                light.uv = [a.uv0, a.uv1, a.uv2]
-                    .concat()
-                    .try_into()
-                    .expect("six numbers");
-                light.emission_texture = m.textures[texture_slot::EMISSION];
-            }
-            lights.push(light);
-        }
-        triangles.push(tri);
-    };
     // A quad's texture coordinates: (0, 0) at its corner, (1, 0) along edge1, (0, 1) along edge2.
     let quad_uv = |corners: [[f32; 2]; 3]| ShadingTriangle {
         normal0: [0.0; 3],
@@ -496,7 +490,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         uv2: corners[2],
         has_normals: 0,
     };
-    let quads_start = triangles.len();
+    let quads_start = tables.triangles.len();
     for (i, q) in file.quad.iter().enumerate() {
         let qf = q.get_ref();
         let field = format!("quad[{i}]");
@@ -530,7 +524,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             ));
         }
         let material = find_material(&qf.material, &format!("{field}.material"))?;
-        if is_dielectric(material) {
+        if tables.is_dielectric(material) {
             return Err(ck.err(
                 qf.material.span(),
                 &format!("{field}.material"),
@@ -541,30 +535,24 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 ),
             ));
         }
-        let textured = is_textured(material);
+        let textured = tables.is_textured(material);
         // A mirroring transform reverses the winding, which keeps the front face the side the
         // untransformed quad's front maps to.
-        push_triangle(
-            &mut triangles,
-            &mut lights,
-            &mut shading,
+        tables.push_triangle(
             wound([corner, corner + e1, corner + e1 + e2], mirror),
             material,
             textured.then(|| quad_uv(wound([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], mirror))),
         );
-        push_triangle(
-            &mut triangles,
-            &mut lights,
-            &mut shading,
+        tables.push_triangle(
             wound([corner, corner + e1 + e2, corner + e2], mirror),
             material,
             textured.then(|| quad_uv(wound([[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]], mirror))),
         );
     }
-    if triangles.len() > quads_start {
-        triangle_groups.push(TriangleGroup {
+    if tables.triangles.len() > quads_start {
+        tables.triangle_groups.push(TriangleGroup {
             name: "quads".into(),
-            range: quads_start..triangles.len(),
+            range: quads_start..tables.triangles.len(),
         });
     }
     for (i, m) in file.mesh.iter().enumerate() {
@@ -584,9 +572,8 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         } else {
             None
         };
-        let mirror = transform.is_some_and(|t| t.mirrors());
         let soup = load_mesh(&mesh_path)?;
-        if is_dielectric(material) {
+        if tables.is_dielectric(material) {
             check_closed_outward(&soup.triangles).map_err(|msg| {
                 SceneError::new(
                     &mesh_path,
@@ -596,8 +583,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 )
             })?;
         }
-        let textured = is_textured(material);
-        if textured && soup.uvs.is_empty() {
+        if tables.is_textured(material) && soup.uvs.is_empty() {
             return Err(ck.err(
                 mf.material.span(),
                 &format!("{field}.material"),
@@ -608,91 +594,49 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 ),
             ));
         }
-        let start = triangles.len();
-        for (k, t) in soup.triangles.iter().enumerate() {
-            let p = t.map(|v| match &transform {
-                Some(m) => m.point(Vec3::from(v)),
-                None => Vec3::from(v),
-            });
-            if p.iter().any(|v| v.abs().max_element() > MAX_COORDINATE) {
-                return Err(ck.err(
-                    mf.file.span(),
-                    &format!("{field} triangle {k}"),
-                    format!("a vertex lies beyond {MAX_COORDINATE:e} after the transform"),
-                ));
-            }
-            let p = wound(p, mirror);
-            // Degenerate (zero-area) triangles cannot be hit; they are dropped.
-            if (p[1] - p[0]).cross(p[2] - p[0]).length() > 0.0 {
-                let normals = soup.normals.get(k).map(|n| {
-                    wound(
-                        n.map(|n| match &transform {
-                            Some(m) => m.normal(Vec3::from(n)).to_array(),
-                            None => n,
-                        }),
-                        mirror,
-                    )
-                });
-                let uvs = soup
-                    .uvs
-                    .get(k)
-                    .filter(|_| textured)
-                    .map(|t| wound(*t, mirror));
-                let attributes = (normals.is_some() || uvs.is_some()).then(|| {
-                    let n = normals.unwrap_or([[0.0; 3]; 3]);
-                    let t = uvs.unwrap_or([[0.0; 2]; 3]);
-                    ShadingTriangle {
-                        normal0: n[0],
-                        normal1: n[1],
-                        normal2: n[2],
-                        uv0: t[0],
-                        uv1: t[1],
-                        uv2: t[2],
-                        has_normals: normals.is_some() as u32,
-                    }
-                });
-                push_triangle(
-                    &mut triangles,
-                    &mut lights,
-                    &mut shading,
-                    p,
-                    material,
-                    attributes,
-                );
-            }
-        }
-        triangle_groups.push(TriangleGroup {
-            name: mf.file.get_ref().clone(),
-            range: start..triangles.len(),
-        });
+        tables
+            .push_mesh(
+                mf.file.get_ref().clone(),
+                &soup,
+                transform.as_ref(),
+                material,
+            )
+            .map_err(|(k, msg)| ck.err(mf.file.span(), &format!("{field} triangle {k}"), msg))?;
     }
 
-    super::light_table::assign_light_selection(&mut lights, render.light_selection.code());
+    let mut notes = Vec::new();
+    for (i, g) in file.gltf.iter().enumerate() {
+        let gf = g.get_ref();
+        let field = format!("gltf[{i}]");
+        let gltf_path = base_dir.join(gf.file.get_ref());
+        if !gltf_path.is_file() {
+            return Err(ck.err(
+                gf.file.span(),
+                &format!("{field}.file"),
+                format!("glTF file {} does not exist", gltf_path.display()),
+            ));
+        }
+        let transform = if transform_fields!(gf).is_given() {
+            Some(parse_transform(&ck, &field, &transform_fields!(gf))?)
+        } else {
+            None
+        };
+        super::gltf_scene::include(&mut tables, &gltf_path, transform.as_ref(), &mut notes)?;
+    }
 
     let (background, environment) = match &file.background {
         Some(b) => background(&ck, b, base_dir)?,
         None => (Vec3::ZERO, None),
     };
-    if let Some(map) = &environment {
-        lights.push(map.light(&spheres, &triangles));
-    }
-    super::light_table::assign_light_selection(&mut lights, render.light_selection.code());
-
-    Ok(Scene {
-        name: path.display().to_string(),
+    let mut scene = tables.finish(
+        path.display().to_string(),
         camera,
         render,
         background,
-        materials,
-        material_names,
-        spheres,
-        triangles,
-        triangle_groups,
-        lights,
         environment,
-        shading,
-        textures,
-    })
+    );
+    scene.notes = notes;
+    Ok(scene)
 }
 
 /// The `[background]` table: a uniform radiance, or an environment map with its scale and

@@ -48,6 +48,9 @@ pub(super) fn material(
 ) -> Result<Material, SceneError> {
     let mf = m.get_ref();
     let whole = |msg: &str| ck.err(m.span(), field, msg);
+    if mf.is_metallic_roughness() {
+        return metallic_roughness(ck, field, m);
+    }
     let kinds = [
         mf.ks.is_some(),
         mf.conductor.is_some(),
@@ -167,6 +170,66 @@ pub(super) fn material(
     }
 }
 
+/// glTF's metallic-roughness material: `base_color` (default white), `metallic` and
+/// `roughness` (each in [0, 1], default 1, glTF's defaults) and their maps; nothing of the
+/// other kinds beside them.
+fn metallic_roughness(
+    ck: &Checker,
+    field: &str,
+    m: &Spanned<MaterialFile>,
+) -> Result<Material, SceneError> {
+    let mf = m.get_ref();
+    let others = [
+        ("kd", mf.kd.is_some()),
+        ("ks", mf.ks.is_some()),
+        ("alpha", mf.alpha.is_some()),
+        ("conductor", mf.conductor.is_some()),
+        ("dielectric", mf.dielectric.is_some()),
+        ("emission", mf.emission.is_some()),
+        ("two_sided", mf.two_sided.is_some()),
+        ("kd_map", mf.kd_map.is_some()),
+        ("ks_map", mf.ks_map.is_some()),
+        ("alpha_map", mf.alpha_map.is_some()),
+        ("emission_map", mf.emission_map.is_some()),
+    ];
+    if let Some((name, _)) = others.iter().find(|o| o.1) {
+        return Err(ck.err(
+            m.span(),
+            field,
+            format!(
+                "mixes {name} with glTF's metallic-roughness fields (base_color, metallic, \
+                 roughness and their maps): choose one kind"
+            ),
+        ));
+    }
+    let unit = |v: &Option<Spanned<f32>>, name: &str| -> Result<f32, SceneError> {
+        match v {
+            None => Ok(1.0),
+            Some(x) => {
+                let value = *x.get_ref();
+                if (0.0..=1.0).contains(&value) {
+                    Ok(value)
+                } else {
+                    Err(ck.err(
+                        x.span(),
+                        &format!("{field}.{name}"),
+                        format!("{value} is outside 0..=1"),
+                    ))
+                }
+            }
+        }
+    };
+    let base = match &mf.base_color {
+        Some(b) => ck.color(b, &format!("{field}.base_color"), Some(1.0))?,
+        None => Vec3::ONE,
+    };
+    let mut out = Material::diffuse(base.to_array());
+    out.kind = material_kind::METALLIC_ROUGHNESS;
+    out.metallic = unit(&mf.metallic, "metallic")?;
+    out.roughness = unit(&mf.roughness, "roughness")?;
+    Ok(out)
+}
+
 /// A conductor: a metal's name, `{ eta = [...], k = [...] }` or `{ reflectance = [...] }`.
 fn conductor(
     ck: &Checker,
@@ -276,7 +339,14 @@ pub(super) fn attach_textures(
     };
     let maps = [
         (&mf.kd_map, "kd_map", texture_slot::KD, true),
+        (&mf.base_color_map, "base_color_map", texture_slot::KD, true),
         (&mf.ks_map, "ks_map", texture_slot::KS, true),
+        (
+            &mf.metallic_roughness_map,
+            "metallic_roughness_map",
+            texture_slot::KS,
+            false,
+        ),
         (&mf.alpha_map, "alpha_map", texture_slot::ALPHA, false),
         (
             &mf.emission_map,
@@ -289,11 +359,17 @@ pub(super) fn attach_textures(
     for (map, name, slot, colour) in maps {
         let Some(map) = map else { continue };
         let map_field = format!("{field}.{name}");
-        if out.kind != material_kind::DIFFUSE && out.kind != material_kind::GLOSSY {
+        if ![
+            material_kind::DIFFUSE,
+            material_kind::GLOSSY,
+            material_kind::METALLIC_ROUGHNESS,
+        ]
+        .contains(&out.kind)
+        {
             return Err(ck.err(
                 map.span(),
                 &map_field,
-                "textures apply to diffuse, kd + ks and emitting materials",
+                "textures apply to diffuse, kd + ks, metallic-roughness and emitting materials",
             ));
         }
         let file = base_dir.join(map.get_ref());
@@ -317,8 +393,13 @@ pub(super) fn attach_textures(
             ));
         }
     }
-    let reflected = Vec3::from(out.albedo) * peak[texture_slot::KD]
-        + Vec3::from(out.specular) * peak[texture_slot::KS];
+    // glTF's material reflects at most its base colour (Appendix B), whatever the metalness.
+    let reflected = if out.kind == material_kind::METALLIC_ROUGHNESS {
+        Vec3::from(out.albedo) * peak[texture_slot::KD]
+    } else {
+        Vec3::from(out.albedo) * peak[texture_slot::KD]
+            + Vec3::from(out.specular) * peak[texture_slot::KS]
+    };
     if out.emission == [0.0; 3] && reflected.max_element() > 1.0 {
         return Err(ck.err(
             m.span(),

@@ -1,12 +1,14 @@
 //! Scenes: TOML files (and the meshes they name) validated and flattened into the kernel's
 //! `#[repr(C)]` tables. Neither backend knows the file format.
 
+mod builder;
 mod closed_surface;
 pub mod environment;
 mod error;
 mod file;
+pub mod gltf_scene;
 pub mod light_table;
-mod materials;
+pub mod materials;
 pub mod mesh;
 pub mod textures;
 pub mod transform;
@@ -104,11 +106,35 @@ pub struct Scene {
     pub shading: Vec<ShadingTriangle>,
     /// The materials' textures (`Material::textures` indexes it).
     pub textures: textures::TextureTable,
+    /// What the loader approximated or ignored (glTF features twinpath does not read yet):
+    /// shown to the user before a render.
+    pub notes: Vec<String>,
 }
 
 impl Scene {
-    /// Reads and validates a scene file; meshes are resolved relative to its folder.
+    /// Reads and validates a scene file: TOML, or glTF (`.gltf`, `.glb`: its first
+    /// perspective camera); meshes are resolved relative to its folder.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Self::load_with_camera(path, None)
+    }
+
+    /// [`Scene::load`], a glTF file seen through its perspective camera named `camera`.
+    pub fn load_with_camera(path: &Path, camera: Option<&str>) -> Result<Scene, SceneError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+        if matches!(ext.as_deref(), Some("gltf" | "glb")) {
+            return gltf_scene::load(path, camera);
+        }
+        if let Some(name) = camera {
+            return Err(SceneError::new(
+                path,
+                None,
+                "camera",
+                format!("a camera name ('{name}') selects among a glTF file's cameras; a TOML scene has one"),
+            ));
+        }
         let text = std::fs::read(path)
             .map_err(|e| SceneError::new(path, None, "file", format!("cannot read: {e}")))?;
         let text = String::from_utf8(text).map_err(|e| {

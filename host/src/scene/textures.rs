@@ -92,6 +92,26 @@ impl TextureTable {
             .map_err(|e| err(format!("cannot read: {e}")))?
             .decode()
             .map_err(|e| err(format!("not a readable PNG, JPEG, EXR or HDR image: {e}")))?;
+        self.add_image(path, image, usage, field)
+    }
+
+    /// The index of decoded `image` used as `usage`, named `path` (a file, or a glTF file's
+    /// image as `file#images[k]`): one record per name and use.
+    pub fn add_image(
+        &mut self,
+        path: &Path,
+        image: image::DynamicImage,
+        usage: TextureUse,
+        field: &str,
+    ) -> Result<u32, SceneError> {
+        if let Some(k) = self
+            .textures
+            .iter()
+            .position(|t| t.path == path && t.usage == usage)
+        {
+            return Ok(k as u32);
+        }
+        let err = |msg: String| SceneError::new(path, None, field, msg);
         let (width, height) = (image.width(), image.height());
         if width == 0 || height == 0 || width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
             return Err(err(format!(

@@ -5,7 +5,7 @@
 
 use super::error::SceneError;
 use super::file::Checker;
-use glam::{DMat3, DVec3, Mat3, Vec3};
+use glam::{DMat3, DMat4, DVec3, DVec4, Mat3, Vec3};
 use toml::Spanned;
 
 /// An affine transform x -> linear x + translation, with the normals' matrix.
@@ -60,6 +60,41 @@ impl Transform {
     /// reversed to keep their front face (glTF 2.0, "Transformations").
     pub fn mirrors(&self) -> bool {
         self.linear_f64().determinant() < 0.0
+    }
+
+    /// The 4 x 4 matrix of the transform, in f64.
+    pub fn matrix(&self) -> DMat4 {
+        let l = self.linear_f64();
+        DMat4::from_cols(
+            l.x_axis.extend(0.0),
+            l.y_axis.extend(0.0),
+            l.z_axis.extend(0.0),
+            self.translation.as_dvec3().extend(1.0),
+        )
+    }
+
+    /// The transform of affine matrix `m` (f64, as glTF's node hierarchy composes them):
+    /// `None` for the identity (shapes keep their coordinates bit for bit). Err: a number that
+    /// is not finite, a projective last row, or a singular linear part.
+    pub fn affine(m: DMat4) -> Result<Option<Transform>, &'static str> {
+        if !m.is_finite() {
+            return Err("has a number that is not finite");
+        }
+        if m.row(3) != DVec4::W {
+            return Err("is not affine (its last row is not [0, 0, 0, 1])");
+        }
+        if m == DMat4::IDENTITY {
+            return Ok(None);
+        }
+        let linear = DMat3::from_mat4(m);
+        if !(linear.determinant().abs() > 1e-30) || !linear.as_mat3().is_finite() {
+            return Err("is singular: it flattens the shape");
+        }
+        Ok(Some(Transform {
+            linear: Some(linear.as_mat3()),
+            scale: Vec3::ONE,
+            translation: m.w_axis.truncate().as_vec3(),
+        }))
     }
 
     /// The factor a sphere's radius takes, if the linear part is a uniform scale times a

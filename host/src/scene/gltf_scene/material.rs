@@ -1,0 +1,168 @@
+//! glTF materials onto the kernel's: the metallic-roughness model as the specification's
+//! Appendix B defines it (`material_kind::METALLIC_ROUGHNESS`), emissive materials as lights,
+//! `KHR_materials_transmission` with `KHR_materials_ior` as the dielectric. What is approximated
+//! or ignored is noted (`Scene::notes`); docs/gltf.md lists it.
+
+use super::Import;
+use crate::scene::materials::IOR_RANGE;
+use crate::scene::textures::TextureUse;
+use crate::scene::SceneError;
+use glam::Vec3;
+use gltf::texture::WrappingMode;
+use kernel::scene::{material_kind, texture_slot, Material};
+
+/// The kernel material for glTF material `m` (`None`: the specification's default material,
+/// white, metallic 1, roughness 1), its textures loaded.
+pub(super) fn material(
+    imp: &mut Import,
+    m: Option<gltf::Material>,
+) -> Result<Material, SceneError> {
+    let Some(m) = m else {
+        let mut out = Material::diffuse([1.0; 3]);
+        out.kind = material_kind::METALLIC_ROUGHNESS;
+        out.metallic = 1.0;
+        out.roughness = 1.0;
+        return Ok(out);
+    };
+    let field = format!("materials[{}]", m.index().unwrap_or(0));
+    let label = match m.name() {
+        Some(n) => format!("{field} ('{n}')"),
+        None => field.clone(),
+    };
+    let path = imp.path.clone();
+    let err = |msg: String| SceneError::new(&path, None, field.clone(), msg);
+    let pbr = m.pbr_metallic_roughness();
+    let unit = |x: f32, name: &str| -> Result<f32, SceneError> {
+        if (0.0..=1.0).contains(&x) {
+            Ok(x)
+        } else {
+            Err(err(format!("{name} {x} is outside 0..=1")))
+        }
+    };
+    let base = pbr.base_color_factor();
+    let base_rgb = Vec3::new(base[0], base[1], base[2]);
+    for c in base {
+        unit(c, "baseColorFactor component")?;
+    }
+    let metallic = unit(pbr.metallic_factor(), "metallicFactor")?;
+    let roughness = unit(pbr.roughness_factor(), "roughnessFactor")?;
+    if m.normal_texture().is_some() {
+        imp.note(format!(
+            "{label}: normalTexture ignored (normal maps are not read yet)"
+        ));
+    }
+    if m.occlusion_texture().is_some() {
+        imp.note(format!(
+            "{label}: occlusionTexture ignored (a path tracer computes occlusion)"
+        ));
+    }
+    if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
+        imp.note(format!(
+            "{label}: alphaMode {:?} rendered as OPAQUE",
+            m.alpha_mode()
+        ));
+    }
+
+    let strength = m.emissive_strength().unwrap_or(1.0);
+    if !(strength >= 0.0 && strength.is_finite()) {
+        return Err(err(format!(
+            "KHR_materials_emissive_strength {strength} must be finite and >= 0"
+        )));
+    }
+    let emission = Vec3::from(m.emissive_factor()) * strength;
+    if !(emission.is_finite() && emission.min_element() >= 0.0) {
+        return Err(err(format!(
+            "emissiveFactor x strength {:?} must be finite and >= 0",
+            emission.to_array()
+        )));
+    }
+    if emission.max_element() > 0.0 {
+        imp.note(format!(
+            "{label}: emits, so it is a light, which reflects nothing (its base colour is dropped)"
+        ));
+        let mut out = Material::emitter(emission.to_array());
+        out.two_sided = m.double_sided() as u32;
+        if let Some(info) = m.emissive_texture() {
+            out.textures[texture_slot::EMISSION] = texture(imp, &label, &info, true)?;
+        }
+        return Ok(out);
+    }
+
+    if let Some(t) = m.transmission() {
+        if t.transmission_factor() > 0.0 {
+            let ior = m.ior().unwrap_or(1.5);
+            let (lo, hi) = IOR_RANGE;
+            if !(lo..=hi).contains(&ior) {
+                return Err(err(format!(
+                    "KHR_materials_ior {ior} is outside {lo}..={hi}"
+                )));
+            }
+            if t.transmission_factor() < 1.0 || t.transmission_texture().is_some() {
+                imp.note(format!(
+                    "{label}: transmission {} (and any transmission texture) rendered as fully \
+                     transmissive glass",
+                    t.transmission_factor()
+                ));
+            }
+            if base_rgb != Vec3::ONE || pbr.base_color_texture().is_some() || metallic > 0.0 {
+                imp.note(format!(
+                    "{label}: glass ignores the base colour and metalness (clear glass)"
+                ));
+            }
+            let mut out = Material::diffuse([0.0; 3]);
+            out.kind = material_kind::DIELECTRIC;
+            out.ior = ior;
+            out.alpha = roughness * roughness;
+            return Ok(out);
+        }
+    }
+
+    let mut out = Material::diffuse(base_rgb.to_array());
+    out.kind = material_kind::METALLIC_ROUGHNESS;
+    out.metallic = metallic;
+    out.roughness = roughness;
+    if let Some(info) = pbr.base_color_texture() {
+        out.textures[texture_slot::KD] = texture(imp, &label, &info, true)?;
+    }
+    if let Some(info) = pbr.metallic_roughness_texture() {
+        out.textures[texture_slot::KS] = texture(imp, &label, &info, false)?;
+    }
+    Ok(out)
+}
+
+/// The texture table's index of the image behind `info`, read as colour (sRGB) or linear data,
+/// wrapping as its sampler says (repeat or clamp; mirrored repeat is read as repeat).
+fn texture(
+    imp: &mut Import,
+    label: &str,
+    info: &gltf::texture::Info,
+    colour: bool,
+) -> Result<u32, SceneError> {
+    let tex = info.texture();
+    if info.tex_coord() != 0 {
+        imp.note(format!(
+            "{label}: textures[{}] names TEXCOORD_{}; TEXCOORD_0 is used",
+            tex.index(),
+            info.tex_coord()
+        ));
+    }
+    let sampler = tex.sampler();
+    let (s, t) = (sampler.wrap_s(), sampler.wrap_t());
+    if s == WrappingMode::MirroredRepeat || t == WrappingMode::MirroredRepeat {
+        imp.note(format!(
+            "{label}: textures[{}] mirrored repeat read as repeat",
+            tex.index()
+        ));
+    }
+    if (s == WrappingMode::ClampToEdge) != (t == WrappingMode::ClampToEdge) {
+        imp.note(format!(
+            "{label}: textures[{}] wraps differently in s and t; s's mode is used for both",
+            tex.index()
+        ));
+    }
+    let usage = TextureUse {
+        colour,
+        clamp: s == WrappingMode::ClampToEdge,
+    };
+    imp.image(tex.source().index(), usage)
+}

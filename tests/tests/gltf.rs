@@ -1,0 +1,713 @@
+//! glTF 2.0 import (`twinpath::scene::gltf_scene`), proven on files the tests write
+//! (`twinpath_tests::gltf_writer`):
+//!
+//! 1. Round trip: a mesh with normals, texture coordinates and a textured metallic-roughness
+//!    material, stated once as TOML (a PLY file and `[materials]`) and once as glTF
+//!    (`[[gltf]]`), gives the same kernel tables and the same image, bit for bit, on both
+//!    backends.
+//! 2. A glTF file is a scene by itself: its camera (node transform, yfov, aspect ratio), the
+//!    default material, strips and fans, node transforms composed down the hierarchy.
+//! 3. Appendix B: every mapping rule on a generated file or on the kernel's resolution.
+//! 4. Hostile files are errors naming the file and the JSON path, never panics.
+
+use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
+use kernel::features::Dynamic;
+use kernel::scene::{material_kind, texture_slot, Material, NONE};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use twinpath::render::Backend;
+use twinpath::scene::gltf_scene::MAX_TRIANGLES;
+use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse};
+use twinpath::scene::Scene;
+use twinpath_tests::gltf_writer::GltfWriter;
+use twinpath_tests::gpu::assert_validation_clean;
+use twinpath_tests::{assert_films_identical, render_film};
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("twinpath-gltf-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A 4 x 4 RGB PNG whose texel (i, j) has the given bytes.
+fn png(f: impl Fn(u32, u32) -> [u8; 3]) -> Vec<u8> {
+    let img = image::RgbImage::from_fn(4, 4, |i, j| image::Rgb(f(i, j)));
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    out.into_inner()
+}
+
+/// A small terrain: a 3 x 3 grid of vertices (8 triangles) bent up in the middle, with
+/// normals and texture coordinates that are exact in binary (so 1 - (1 - v) = v).
+struct Terrain {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    uvs: Vec<[f32; 2]>,
+    indices: Vec<u32>,
+}
+
+fn terrain() -> Terrain {
+    let mut t = Terrain {
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        indices: vec![],
+    };
+    for j in 0..3 {
+        for i in 0..3 {
+            let (x, z) = (i as f32 - 1.0, j as f32 - 1.0);
+            let y = if i == 1 && j == 1 { 0.5 } else { 0.0 };
+            t.positions.push([x, y, -z]);
+            t.normals.push([0.25 * x, 1.0, 0.25 * z]);
+            t.uvs.push([0.5 * i as f32, 0.5 * j as f32]);
+        }
+    }
+    for j in 0..2u32 {
+        for i in 0..2u32 {
+            let a = j * 3 + i;
+            t.indices.extend([a, a + 1, a + 4, a, a + 4, a + 3]);
+        }
+    }
+    t
+}
+
+const CAMERA: &str = "[camera]\neye = [0, 2.5, 3]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 45\nwidth = 24\nheight = 16\n";
+const LAMP: &str = "[[quad]]\ncorner = [-0.5, 2, -0.5]\nedge1 = [0, 0, 1]\nedge2 = [1, 0, 0]\nmaterial = \"a_lamp\"\n";
+
+/// The round trip's files: the textures, the PLY mesh and the glTF file of the same surface.
+fn round_trip_files(dir: &Path) {
+    let base = png(|i, j| [40 + 50 * i as u8, 200 - 40 * j as u8, 90]);
+    let mr = png(|i, j| [0, 60 + 60 * j as u8, 255 - 60 * i as u8]);
+    std::fs::write(dir.join("base.png"), &base).unwrap();
+    std::fs::write(dir.join("mr.png"), &mr).unwrap();
+    let t = terrain();
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        t.positions.len(),
+        t.indices.len() / 3
+    );
+    for k in 0..t.positions.len() {
+        let (p, n, uv) = (t.positions[k], t.normals[k], t.uvs[k]);
+        ply += &format!(
+            "{:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?}\n",
+            p[0], p[1], p[2], n[0], n[1], n[2], uv[0], uv[1]
+        );
+    }
+    for f in t.indices.chunks(3) {
+        ply += &format!("3 {} {} {}\n", f[0], f[1], f[2]);
+    }
+    std::fs::write(dir.join("terrain.ply"), ply).unwrap();
+
+    let mut g = GltfWriter::new();
+    let base_tex = g.png_texture(&base);
+    let mr_tex = g.png_texture(&mr);
+    let material = g.push(
+        "materials",
+        json!({ "name": "metal", "pbrMetallicRoughness": {
+            "baseColorFactor": [0.9, 0.6, 0.3, 1.0], "metallicFactor": 0.75, "roughnessFactor": 0.5,
+            "baseColorTexture": { "index": base_tex },
+            "metallicRoughnessTexture": { "index": mr_tex } } }),
+    );
+    let flipped: Vec<[f32; 2]> = t.uvs.iter().map(|uv| [uv[0], 1.0 - uv[1]]).collect();
+    let mesh = g.mesh(
+        &t.positions,
+        Some(&t.normals),
+        Some(&flipped),
+        &t.indices,
+        Some(material),
+    );
+    g.push("nodes", json!({ "mesh": mesh }));
+    g.push("scenes", json!({ "nodes": [0] }));
+    g.json["scene"] = json!(0);
+    std::fs::write(dir.join("terrain.glb"), g.glb()).unwrap();
+}
+
+fn load(dir: &Path, name: &str, text: &str) -> Scene {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn a_scene_as_toml_and_as_gltf_renders_the_same_bits_on_both_backends() {
+    let dir = temp_dir("round-trip");
+    round_trip_files(&dir);
+    let head = format!("{CAMERA}[render]\nspp = 4\n[background]\nradiance = [0.2, 0.2, 0.2]\n");
+    let toml = load(
+        &dir,
+        "as_toml.toml",
+        &format!(
+            "{head}[materials]\na_lamp = {{ emission = [4, 4, 4] }}\nmetal = {{ base_color = [0.9, 0.6, 0.3], metallic = 0.75, roughness = 0.5, base_color_map = \"base.png\", metallic_roughness_map = \"mr.png\" }}\n{LAMP}[[mesh]]\nfile = \"terrain.ply\"\nmaterial = \"metal\"\n"
+        ),
+    );
+    let gltf = load(
+        &dir,
+        "as_gltf.toml",
+        &format!(
+            "{head}[materials]\na_lamp = {{ emission = [4, 4, 4] }}\n{LAMP}[[gltf]]\nfile = \"terrain.glb\"\n"
+        ),
+    );
+    assert_eq!(toml.triangles.len(), 10);
+    assert_eq!(toml.triangles, gltf.triangles, "triangles");
+    assert_eq!(toml.shading, gltf.shading, "shading records");
+    assert!(toml.shading.iter().all(|s| s.has_normals == 1));
+    assert_eq!(toml.materials, gltf.materials, "materials");
+    assert_eq!(toml.materials[1].kind, material_kind::METALLIC_ROUGHNESS);
+    assert_eq!(toml.lights, gltf.lights, "lights");
+    assert_eq!(toml.textures.words, gltf.textures.words, "texture table");
+    assert_eq!(toml.features(), gltf.features());
+    for (backend, spp) in [(Backend::Cpu, 16), (Backend::Gpu, 4)] {
+        let a = render_film(&toml, backend, spp);
+        let b = render_film(&gltf, backend, spp);
+        assert_films_identical(&a, &b, &format!("TOML vs glTF, {backend:?}"));
+        assert!(
+            a.mean().iter().any(|p| p[0] > 0.0),
+            "a black image proves nothing"
+        );
+    }
+    assert_validation_clean();
+}
+
+/// A glb of one triangle soup under a node hierarchy, with a camera.
+fn camera_file(dir: &Path) -> PathBuf {
+    let mut g = GltfWriter::new();
+    // A fan and a strip: the unit square at z = 0 twice, side by side.
+    let square = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
+    let p = g.positions(&square);
+    g.push(
+        "meshes",
+        json!({ "name": "fan", "primitives": [ { "attributes": { "POSITION": p }, "mode": 6 } ] }),
+    );
+    let strip = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+    ];
+    let q = g.positions(&strip);
+    g.push(
+        "meshes",
+        json!({ "name": "strip", "primitives": [ { "attributes": { "POSITION": q }, "mode": 5 } ] }),
+    );
+    g.push(
+        "cameras",
+        json!({ "name": "side", "type": "perspective",
+        "perspective": { "yfov": 0.5, "znear": 0.1 } }),
+    );
+    g.push(
+        "cameras",
+        json!({ "name": "main", "type": "perspective",
+        "perspective": { "yfov": 0.7, "aspectRatio": 1.5, "znear": 0.1 } }),
+    );
+    // Node 0: the parent, translated and scaled; its children: the fan at the origin, the strip
+    // translated by x = 2 (so at x = 2 * 2 + 3 after the parent), the camera rotated 90 degrees
+    // about +y (looking down -x) at z = 5.
+    g.push(
+        "nodes",
+        json!({ "translation": [3.0, 0.0, 0.0], "scale": [2.0, 2.0, 2.0],
+        "children": [1, 2, 3] }),
+    );
+    g.push("nodes", json!({ "mesh": 0 }));
+    g.push(
+        "nodes",
+        json!({ "mesh": 1, "translation": [2.0, 0.0, 0.0] }),
+    );
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    g.push(
+        "nodes",
+        json!({ "camera": 1, "translation": [0.0, 0.0, 2.5],
+        "rotation": [0.0, h, 0.0, h] }),
+    );
+    g.push("nodes", json!({ "camera": 0 }));
+    g.push("scenes", json!({ "nodes": [0, 4] }));
+    let path = dir.join("camera.glb");
+    std::fs::write(&path, g.glb()).unwrap();
+    path
+}
+
+#[test]
+fn a_gltf_file_is_a_scene_with_its_camera_hierarchy_and_default_material() {
+    let dir = temp_dir("camera");
+    let path = camera_file(&dir);
+    let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    // The first camera in the walk: node 3 (camera "main"), under the parent's T S.
+    let c = scene.camera;
+    assert_eq!(
+        (c.width, c.height),
+        (1080, 720),
+        "aspect ratio 1.5 at height 720"
+    );
+    assert!((c.vfov_degrees - 0.7f32.to_degrees()).abs() < 1e-5);
+    assert!(
+        (c.eye - Vec3::new(3.0, 0.0, 5.0)).length() < 1e-6,
+        "eye {}",
+        c.eye
+    );
+    let forward = (c.look_at - c.eye).normalize();
+    assert!(
+        (forward - Vec3::new(-1.0, 0.0, 0.0)).length() < 1e-6,
+        "forward {forward}"
+    );
+    assert!((c.up - Vec3::Y).length() < 1e-6);
+    // Fan and strip: two triangles each, the square scaled by 2 at x = 3 and x = 7.
+    assert_eq!(scene.triangles.len(), 4);
+    let corners = |k: usize| {
+        let t = scene.triangles[k];
+        let p0 = Vec3::from(t.p0);
+        [p0, p0 + Vec3::from(t.edge1), p0 + Vec3::from(t.edge2)]
+    };
+    assert_eq!(
+        corners(0),
+        [
+            Vec3::new(5.0, 0.0, 0.0),
+            Vec3::new(5.0, 2.0, 0.0),
+            Vec3::new(3.0, 0.0, 0.0)
+        ],
+        "fan triangle 0 is (v1, v2, v0)"
+    );
+    assert_eq!(
+        corners(2),
+        [
+            Vec3::new(7.0, 0.0, 0.0),
+            Vec3::new(9.0, 0.0, 0.0),
+            Vec3::new(7.0, 2.0, 0.0)
+        ],
+        "strip triangle 0 is (v0, v1, v2)"
+    );
+    assert_eq!(
+        corners(3),
+        [
+            Vec3::new(9.0, 0.0, 0.0),
+            Vec3::new(9.0, 2.0, 0.0),
+            Vec3::new(7.0, 2.0, 0.0)
+        ],
+        "strip triangle 1 is (v1, v3, v2)"
+    );
+    // Every front face points +z (counter-clockwise seen from +z, as the file winds them).
+    for k in 0..4 {
+        let t = scene.triangles[k];
+        assert!(
+            Vec3::from(t.edge1).cross(Vec3::from(t.edge2)).z > 0.0,
+            "triangle {k} winding"
+        );
+    }
+    // No material: the specification's default, white, metallic 1, roughness 1.
+    assert_eq!(scene.materials.len(), 1);
+    let m = scene.materials[0];
+    assert_eq!(m.kind, material_kind::METALLIC_ROUGHNESS);
+    assert_eq!((m.albedo, m.metallic, m.roughness), ([1.0; 3], 1.0, 1.0));
+    assert_eq!(scene.background, Vec3::ONE, "a white sky");
+    // The other camera by name; an unknown name lists the cameras.
+    let side = Scene::load_with_camera(&path, Some("side")).unwrap();
+    assert_eq!((side.camera.width, side.camera.height), (1280, 720));
+    assert!((side.camera.eye - Vec3::ZERO).length() < 1e-6);
+    let e = Scene::load_with_camera(&path, Some("nope"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("no perspective camera named 'nope'") && e.contains("main, side"),
+        "{e}"
+    );
+    // It renders on both backends (the sky around two grey squares).
+    for backend in [Backend::Cpu, Backend::Gpu] {
+        let mut s = scene.clone();
+        s.camera.width = 24;
+        s.camera.height = 16;
+        let film = render_film(&s, backend, 2);
+        let mean = film.mean();
+        assert!(mean
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)));
+    }
+    assert_validation_clean();
+}
+
+/// A glb with one material `material` on a closed tetrahedron (its faces wound outward).
+fn material_file(dir: &Path, name: &str, material: serde_json::Value, used: &[&str]) -> PathBuf {
+    let mut g = GltfWriter::new();
+    let m = g.push("materials", material);
+    let p = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let mesh = g.mesh(
+        &p,
+        None,
+        None,
+        &[0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3],
+        Some(m),
+    );
+    g.push("nodes", json!({ "mesh": mesh }));
+    if !used.is_empty() {
+        g.json["extensionsUsed"] = json!(used);
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, g.glb()).unwrap();
+    path
+}
+
+#[test]
+fn appendix_b_rules_each_hold() {
+    let dir = temp_dir("appendix-b");
+    let one = |name: &str, material: serde_json::Value, used: &[&str]| -> Scene {
+        let path = material_file(&dir, name, material, used);
+        Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    };
+    // Factors as stored, glTF's defaults for what is absent.
+    let s = one(
+        "factors.glb",
+        json!({ "pbrMetallicRoughness": {
+        "baseColorFactor": [0.5, 0.25, 0.125, 1.0], "metallicFactor": 0.2 } }),
+        &[],
+    );
+    let m = s.materials[0];
+    assert_eq!(m.kind, material_kind::METALLIC_ROUGHNESS);
+    assert_eq!(
+        (m.albedo, m.metallic, m.roughness),
+        ([0.5, 0.25, 0.125], 0.2, 1.0)
+    );
+    // Resolution (what the BSDF sees): Kd = (1 - metallic) base, F0 = lerp(0.04, base,
+    // metallic), alpha = roughness^2.
+    let mut q = m;
+    q.roughness = 0.5;
+    let r = kernel::bsdf::resolve_metallic_roughness(&q);
+    let expect_kd = [0.4, 0.2, 0.1];
+    let expect_f0 = [0.032 + 0.1, 0.032 + 0.05, 0.032 + 0.025];
+    for c in 0..3 {
+        assert!((r.albedo[c] - expect_kd[c]).abs() < 1e-7);
+        assert!((r.specular[c] - expect_f0[c]).abs() < 1e-7);
+    }
+    assert_eq!(r.alpha, 0.25, "alpha = roughness^2");
+    // Emissive colour times KHR_materials_emissive_strength; doubleSided: both faces emit.
+    let s = one(
+        "emissive.glb",
+        json!({ "emissiveFactor": [1.0, 0.5, 0.25], "doubleSided": true,
+        "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4.0 } } }),
+        &["KHR_materials_emissive_strength"],
+    );
+    assert_eq!(s.materials[0].emission, [4.0, 2.0, 1.0]);
+    assert_eq!(s.materials[0].two_sided, 1);
+    assert_eq!(s.lights.len(), 4, "each triangle a light");
+    assert!(
+        s.notes.iter().any(|n| n.contains("reflects nothing")),
+        "{:?}",
+        s.notes
+    );
+    // KHR_materials_transmission + KHR_materials_ior: the dielectric, alpha = roughness^2.
+    let s = one(
+        "glass.glb",
+        json!({ "pbrMetallicRoughness": { "roughnessFactor": 0.5 },
+        "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 },
+                        "KHR_materials_ior": { "ior": 1.33 } } }),
+        &["KHR_materials_transmission", "KHR_materials_ior"],
+    );
+    assert_eq!(s.materials[0].kind, material_kind::DIELECTRIC);
+    assert_eq!((s.materials[0].ior, s.materials[0].alpha), (1.33, 0.25));
+    // An extension that is not read is noted once; one that is required is an error.
+    let s = one("ignored.glb", json!({}), &["KHR_materials_sheen"]);
+    assert!(
+        s.notes
+            .iter()
+            .any(|n| n.contains("extensions ignored: KHR_materials_sheen")),
+        "{:?}",
+        s.notes
+    );
+    // Factors outside [0, 1] name the material.
+    let path = material_file(
+        &dir,
+        "bad.glb",
+        json!({ "pbrMetallicRoughness": { "metallicFactor": 1.5 } }),
+        &[],
+    );
+    let e = Scene::load(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("materials[0]") && e.contains("metallicFactor 1.5"),
+        "{e}"
+    );
+}
+
+#[test]
+fn texture_channels_srgb_and_the_metallic_roughness_map() {
+    // One texel each: base colour bytes (128, 64, 255) read as sRGB; the metallic-roughness
+    // map's bytes (10, 128, 191) read linearly, green multiplying roughness and blue metallic
+    // (red is unused).
+    let dir = temp_dir("channels");
+    let save = |name: &str, rgb: [u8; 3]| {
+        let path = dir.join(name);
+        image::RgbImage::from_pixel(1, 1, image::Rgb(rgb))
+            .save(&path)
+            .unwrap();
+        path
+    };
+    let mut table = TextureTable::new();
+    let base = table
+        .add(
+            &save("base.png", [128, 64, 255]),
+            TextureUse {
+                colour: true,
+                clamp: false,
+            },
+            "b",
+        )
+        .unwrap();
+    let mr = table
+        .add(
+            &save("mr.png", [10, 128, 191]),
+            TextureUse {
+                colour: false,
+                clamp: false,
+            },
+            "m",
+        )
+        .unwrap();
+    let mut m = Material::diffuse([0.5, 1.0, 0.8]);
+    m.kind = material_kind::METALLIC_ROUGHNESS;
+    m.metallic = 0.9;
+    m.roughness = 0.6;
+    m.textures[texture_slot::KD] = base;
+    m.textures[texture_slot::KS] = mr;
+    let record = kernel::scene::ShadingTriangle {
+        normal0: [0.0; 3],
+        normal1: [0.0; 3],
+        normal2: [0.0; 3],
+        uv0: [0.5, 0.5],
+        uv1: [0.5, 0.5],
+        uv2: [0.5, 0.5],
+        has_normals: 0,
+    };
+    let (at, _) = kernel::surface::shade(
+        Dynamic(0),
+        0,
+        0,
+        Vec2::new(0.3, 0.3),
+        &[m],
+        &[record],
+        &table.words,
+    );
+    let base_linear = [128u8, 64, 255].map(srgb_to_linear);
+    let metallic = 0.9 * 191.0 / 255.0;
+    let roughness = 0.6 * 128.0 / 255.0;
+    for c in 0..3 {
+        let b = [0.5, 1.0, 0.8][c] * base_linear[c];
+        let kd = (1.0 - metallic) * b;
+        let f0 = 0.04 * (1.0 - metallic) + metallic * b;
+        assert!(
+            (at.albedo[c] as f64 - kd).abs() < 1e-6,
+            "Kd[{c}] {} vs {kd}",
+            at.albedo[c]
+        );
+        assert!(
+            (at.specular[c] as f64 - f0).abs() < 1e-6,
+            "F0[{c}] {} vs {f0}",
+            at.specular[c]
+        );
+    }
+    assert!(
+        (at.alpha as f64 - roughness * roughness).abs() < 1e-6,
+        "alpha {}",
+        at.alpha
+    );
+    // Without the record (no texture coordinates) the factors alone are resolved.
+    let (plain, _) = kernel::surface::shade(
+        Dynamic(0),
+        0,
+        NONE,
+        Vec2::ZERO,
+        &[m],
+        &[record],
+        &table.words,
+    );
+    assert!((plain.alpha - 0.36).abs() < 1e-7);
+}
+
+/// A change to a test file.
+type Edit = dyn Fn(&mut GltfWriter);
+
+/// A valid glb (one triangle, a node, a scene) whose JSON `edit` then breaks; the error.
+fn hostile(edit: impl Fn(&mut GltfWriter)) -> String {
+    let mut g = GltfWriter::new();
+    g.mesh(
+        &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        None,
+        None,
+        &[0, 1, 2],
+        None,
+    );
+    g.push("nodes", json!({ "mesh": 0 }));
+    g.push("scenes", json!({ "nodes": [0] }));
+    edit(&mut g);
+    let bytes = g.glb();
+    match twinpath::scene::gltf_scene::load_bytes(Path::new("hostile.glb"), &bytes, None, None) {
+        Ok(_) => String::new(),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn hostile_gltf_files_are_errors_naming_the_place() {
+    assert_eq!(hostile(|_| {}), "", "the unbroken file loads");
+    let cases: Vec<(&str, Box<Edit>, &str)> = vec![
+        (
+            "count beyond the buffer",
+            Box::new(|g| g.json["accessors"][0]["count"] = json!(1000)),
+            "accessors[0]: 1000 elements",
+        ),
+        (
+            "offset beyond the view",
+            Box::new(|g| g.json["accessors"][0]["byteOffset"] = json!(4096)),
+            "accessors[0]",
+        ),
+        (
+            "view beyond the buffer",
+            Box::new(|g| g.json["bufferViews"][0]["byteLength"] = json!(1 << 20)),
+            "buffer",
+        ),
+        (
+            "index out of range",
+            Box::new(|g| {
+                let i = g.indices(&[0, 1, 7]);
+                g.json["meshes"][0]["primitives"][0]["indices"] = json!(i);
+            }),
+            "index 2 is 7, beyond the 3 vertices",
+        ),
+        (
+            "a cycle",
+            Box::new(|g| {
+                g.push("nodes", json!({ "children": [2] }));
+                g.push("nodes", json!({ "children": [1] }));
+                g.json["scenes"][0]["nodes"] = json!([0, 1]);
+            }),
+            "is reached twice",
+        ),
+        (
+            "points",
+            Box::new(|g| g.json["meshes"][0]["primitives"][0]["mode"] = json!(0)),
+            "meshes[0].primitives[0]: mode Points",
+        ),
+        (
+            "positions as integers",
+            Box::new(|g| g.json["accessors"][0]["componentType"] = json!(5125)),
+            "expected VEC3 of FLOAT",
+        ),
+        (
+            "a required extension",
+            Box::new(|g| {
+                g.json["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+                g.json["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+            }),
+            "KHR_draco_mesh_compression",
+        ),
+        (
+            "a projective node",
+            Box::new(|g| {
+                g.json["nodes"][0]["matrix"] =
+                    json!([1, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])
+            }),
+            "not affine",
+        ),
+        (
+            "a zero scale",
+            Box::new(|g| g.json["nodes"][0]["scale"] = json!([0.0, 1.0, 1.0])),
+            "singular",
+        ),
+        (
+            "an external buffer without a folder",
+            Box::new(|g| g.json["buffers"][0]["uri"] = json!("data.bin")),
+            "buffers",
+        ),
+        (
+            "a missing mesh",
+            Box::new(|g| g.json["nodes"][0]["mesh"] = json!(5)),
+            "not a valid glTF",
+        ),
+    ];
+    for (label, edit, expected) in cases {
+        let e = hostile(edit);
+        assert!(
+            e.starts_with("hostile.glb: "),
+            "{label}: error '{e}' does not name the file"
+        );
+        assert!(e.contains(expected), "{label}: '{e}' lacks '{expected}'");
+    }
+    // Garbage and truncation.
+    for bytes in [
+        b"glTF\x02\0\0\0".to_vec(),
+        b"{ not json".to_vec(),
+        vec![0u8; 7],
+    ] {
+        let e = twinpath::scene::gltf_scene::load_bytes(Path::new("x.glb"), &bytes, None, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not a valid glTF 2.0 file"), "{e}");
+    }
+}
+
+#[test]
+fn a_million_instances_are_refused_before_they_are_flattened() {
+    // 10^6 nodes instancing a 100-triangle mesh: 10^8 triangles, beyond MAX_TRIANGLES; refused
+    // from the declared counts, without reading or allocating the instances.
+    let e = hostile(|g| {
+        let positions: Vec<[f32; 3]> = (0..300).map(|i| [i as f32, (i % 3) as f32, 0.0]).collect();
+        let indices: Vec<u32> = (0..300).collect();
+        let mesh = g.mesh(&positions, None, None, &indices, None);
+        let first = g.json["nodes"].as_array().unwrap().len();
+        let nodes = g.json["nodes"].as_array_mut().unwrap();
+        for _ in 0..1_000_000 {
+            nodes.push(json!({ "mesh": mesh }));
+        }
+        g.json["scenes"][0]["nodes"] = json!((first..first + 1_000_000).collect::<Vec<_>>());
+    });
+    assert!(
+        e.contains(&format!("more than {MAX_TRIANGLES} triangles")),
+        "{e}"
+    );
+}
+
+#[test]
+fn toml_includes_a_gltf_file_under_a_transform() {
+    let dir = temp_dir("include");
+    let path = camera_file(&dir);
+    let plain = Scene::load(&path).unwrap();
+    let include = |transform: &str| {
+        load(
+            &dir,
+            "include.toml",
+            &format!("{CAMERA}[[gltf]]\nfile = \"camera.glb\"\n{transform}"),
+        )
+    };
+    // The file's own hierarchy, then the include's transform on top: rotate 90 degrees about
+    // +z, then translate.
+    let moved = include("rotate = [90, 0, 0, 1]\ntranslate = [0, 0, -4]\n");
+    let m = DMat4::from_rotation_translation(
+        DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2),
+        DVec3::new(0.0, 0.0, -4.0),
+    );
+    assert_eq!(moved.triangles.len(), plain.triangles.len());
+    for (a, b) in moved.triangles.iter().zip(&plain.triangles) {
+        let want = m.transform_point3(Vec3::from(b.p0).as_dvec3());
+        assert!(
+            (Vec3::from(a.p0).as_dvec3() - want).length() < 1e-5,
+            "{:?} vs {want}",
+            a.p0
+        );
+    }
+    // The TOML camera stays; a missing file names the field.
+    assert_eq!(moved.camera.width, 24);
+    let e = twinpath::scene::parse_scene(
+        &format!("{CAMERA}[[gltf]]\nfile = \"nope.glb\"\n"),
+        &dir.join("x.toml"),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("gltf[0].file") && e.contains("does not exist"),
+        "{e}"
+    );
+}
