@@ -50,6 +50,8 @@ pub const TEXTURES: u32 = 1 << 14;
 /// resolved at each hit into the Kd + Ks form; it comes with [`GLOSSY`], whose code evaluates
 /// them.
 pub const METALLIC_ROUGHNESS: u32 = 1 << 15;
+/// The light table may hold point and spot lights (`light_kind::PUNCTUAL`).
+pub const PUNCTUAL_LIGHTS: u32 = 1 << 16;
 
 /// The material bits of a scene with these materials: one per kind present besides the
 /// Lambertian. (A bit may also be set for a kind that is absent: it only keeps that kind's
@@ -69,14 +71,18 @@ pub fn material_features(materials: &[Material]) -> u32 {
     f
 }
 
-/// The light bits of a scene with these lights: [`TRIANGLE_LIGHTS`] if any is a triangle.
+/// The light bits of a scene with these lights: [`TRIANGLE_LIGHTS`] if any is a triangle,
+/// [`PUNCTUAL_LIGHTS`] if any is a point or spot light.
 #[inline]
 pub fn light_features(lights: &[Light]) -> u32 {
+    let mut f = 0;
     if lights.iter().any(|l| l.kind == light_kind::TRIANGLE) {
-        TRIANGLE_LIGHTS
-    } else {
-        0
+        f |= TRIANGLE_LIGHTS;
     }
+    if lights.iter().any(|l| l.kind == light_kind::PUNCTUAL) {
+        f |= PUNCTUAL_LIGHTS;
+    }
+    f
 }
 
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
@@ -211,6 +217,11 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn textures(self) -> bool {
         self.answer(TEXTURES, true)
+    }
+    /// Whether a light may be a point or spot light (see [`PUNCTUAL_LIGHTS`]).
+    #[inline]
+    fn punctual_lights(self) -> bool {
+        self.answer(PUNCTUAL_LIGHTS, true)
     }
     /// Whether a light may be a triangle (see [`TRIANGLE_LIGHTS`]).
     #[inline]

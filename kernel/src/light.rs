@@ -13,6 +13,8 @@ use crate::sampling::{
 use crate::scene::{light_kind, light_sampling, Light, RenderParams, NONE};
 use crate::spherical_triangle::{barycentrics_along, SphericalTriangle};
 use crate::texture;
+#[cfg(target_arch = "spirv")]
+use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
 
 /// A point chosen on a light, and the density of having chosen it.
@@ -111,6 +113,45 @@ pub fn is_triangle(triangles: bool, l: &Light) -> bool {
     triangles && l.kind == light_kind::TRIANGLE
 }
 
+/// Whether light `l` is a point or spot light, where the light table may hold one
+/// (`punctual`: `features::PUNCTUAL_LIGHTS`).
+#[inline]
+pub fn is_punctual(punctual: bool, l: &Light) -> bool {
+    punctual && l.kind == light_kind::PUNCTUAL
+}
+
+/// glTF's spot falloff of punctual light `l` toward unit direction `out` (from the light):
+/// clamp(cos * scale + offset, 0, 1)^2 with cos the cosine to the axis, scale
+/// 1 / (cos inner - cos outer) and offset -cos outer * scale (`KHR_lights_punctual`, "Spot");
+/// 1 everywhere for a point light (scale 0, offset 1).
+#[inline]
+pub fn spot_attenuation(l: &Light, out: Vec3) -> f32 {
+    let a = (Vec3::from(l.edge1).dot(out) * l.edge2[0] + l.edge2[1]).clamp(0.0, 1.0);
+    a * a
+}
+
+/// The light sample of punctual light `l` (index `light`) for receiver `x`: its position,
+/// "facing" `x` (normal the unit direction from the light to `x`, so the receiver sees it head
+/// on), with `pdf_solid_angle` = selection probability x d^2. A delta light has no density per
+/// solid angle; this one makes the estimator's f cos x radiance / pdf equal f cos x I / d^2 /
+/// p_select, the point light's irradiance (pbrt-v4 `PointLight::SampleLi`), and the vertex
+/// gives it MIS weight 1 (no BSDF sample can meet it). Receiver at the light: density 0.
+#[inline]
+pub fn sample_punctual_light(l: &Light, light: u32, x: Vec3) -> DirectionalLightSample {
+    let p = Vec3::from(l.position);
+    let d = x - p;
+    let d2 = d.dot(d);
+    let ok = d2 > 0.0 && d2.is_finite();
+    DirectionalLightSample {
+        point: SurfacePoint {
+            position: p,
+            normal: if ok { d / d2.sqrt() } else { Vec3::Z },
+        },
+        light,
+        pdf_solid_angle: if ok { l.select_pmf * d2 } else { 0.0 },
+    }
+}
+
 /// Whether light `l` is the environment map, where the light table may hold one
 /// (`environment`: `features::ENVIRONMENT`).
 #[inline]
@@ -160,11 +201,13 @@ pub fn pdf_environment_light(
 }
 
 /// The radiance light sample `ls` of light `l` sends toward its receiver: the light's constant
-/// radiance, or the environment map's along the sample's direction (-normal). (A triangle with
+/// radiance, the environment map's along the sample's direction (-normal), or a punctual
+/// light's intensity times its spot falloff toward the receiver. (A triangle with
 /// an emission texture scales it by [`emission_texture_at`].)
 #[inline]
 pub fn sample_radiance(
     environment: bool,
+    punctual: bool,
     params: &RenderParams,
     table: &[f32],
     l: &Light,
@@ -172,6 +215,8 @@ pub fn sample_radiance(
 ) -> Vec3 {
     if is_environment(environment, l) {
         environment::eval(params, table, -ls.point.normal)
+    } else if is_punctual(punctual, l) {
+        Vec3::from(l.radiance) * spot_attenuation(l, ls.point.normal)
     } else {
         Vec3::from(l.radiance)
     }
@@ -213,7 +258,8 @@ pub fn uses_cone(mode: u32, l: &Light, x: Vec3) -> bool {
 /// subtends ([`sample_sphere_cone`]) when `mode` is [`light_sampling::SOLID_ANGLE`] and `x` is
 /// outside it. A triangle (only where `triangles`, see [`is_triangle`]): by
 /// [`sample_triangle_light`]. The environment map (only where `environment`, see
-/// [`is_environment`]; `params` and `table` describe it): by [`sample_environment_light`].
+/// [`is_environment`]; `params` and `table` describe it): by [`sample_environment_light`]. A
+/// point or spot light (only where `punctual`, see [`is_punctual`]): [`sample_punctual_light`].
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn sample_light_from(
@@ -222,6 +268,7 @@ pub fn sample_light_from(
     mode: u32,
     triangles: bool,
     environment: bool,
+    punctual: bool,
     params: &RenderParams,
     table: &[f32],
     x: Vec3,
@@ -236,6 +283,9 @@ pub fn sample_light_from(
     }
     if is_environment(environment, &l) {
         return sample_environment_light(&l, light, mode, params, table, x, u1, u2);
+    }
+    if is_punctual(punctual, &l) {
+        return sample_punctual_light(&l, light, x);
     }
     let center = Vec3::from(l.position);
     if uses_cone(mode, &l, x) {

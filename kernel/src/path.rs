@@ -12,8 +12,8 @@ use crate::geometry::{
     triangle_point_error_conditioned, TriangleShape,
 };
 use crate::light::{
-    emission_texture_at, eval_radiance, light_point_error, pdf_environment_light, pdf_light_from,
-    sample_radiance, DirectionalLightSample,
+    emission_texture_at, eval_radiance, is_punctual, light_point_error, pdf_environment_light,
+    pdf_light_from, sample_radiance, DirectionalLightSample,
 };
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
@@ -518,6 +518,7 @@ impl PathState {
             mode: light_sampling_of(features, params),
             triangle_lights: features.triangle_lights(),
             environment_light: features.environment(params),
+            punctual_lights: features.punctual_lights(),
             extend: self.depth < params.max_depth,
             roulette: self.depth >= params.rr_start_depth,
             survival,
@@ -613,7 +614,14 @@ impl PathState {
                     textures,
                     &ls,
                 );
-                let weight = light_strategy_weight(features, params, pdf_w, pdf_brdf(n, wi));
+                let weight = light_sample_weight(
+                    features,
+                    params,
+                    query,
+                    &lights[ls.light as usize],
+                    pdf_w,
+                    pdf_brdf(n, wi),
+                );
                 let radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
                 self.await_shadow(features, lights, ray_origin, &ls, radiance);
@@ -693,7 +701,14 @@ impl PathState {
                     textures,
                     &ls,
                 );
-                let weight = light_strategy_weight(features, params, pdf_w, pdf_b);
+                let weight = light_sample_weight(
+                    features,
+                    params,
+                    query,
+                    &lights[ls.light as usize],
+                    pdf_w,
+                    pdf_b,
+                );
                 let from = offset_ray_origin(x, side(ng, ng.dot(wi) > 0.0), hit.error);
                 let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
                 self.await_shadow(features, lights, from, &ls, radiance);
@@ -813,7 +828,14 @@ fn light_sample_radiance<F: FeatureSet>(
     ls: &DirectionalLightSample,
 ) -> Vec3 {
     let light = &lights[ls.light as usize];
-    let emitted = sample_radiance(query.environment_light, params, environment, light, ls);
+    let emitted = sample_radiance(
+        query.environment_light,
+        query.punctual_lights,
+        params,
+        environment,
+        light,
+        ls,
+    );
     if features.textures() {
         emitted * emission_texture_at(textures, light, ls)
     } else {
@@ -828,6 +850,25 @@ fn side(n: Vec3, toward_n: bool) -> Vec3 {
         n
     } else {
         -n
+    }
+}
+
+/// The MIS weight of a sample of light `light` (density `pdf_light`, the BSDF's `pdf_bsdf`):
+/// 1 for a point or spot light, which no BSDF sample can meet (a delta light, as pbrt-v4's
+/// `LightSampleContext` treats them), else [`light_strategy_weight`]'s.
+#[inline]
+fn light_sample_weight<F: FeatureSet>(
+    features: F,
+    params: &RenderParams,
+    query: &VertexQuery,
+    light: &Light,
+    pdf_light: f32,
+    pdf_bsdf: f32,
+) -> f32 {
+    if is_punctual(query.punctual_lights, light) {
+        1.0
+    } else {
+        light_strategy_weight(features, params, pdf_light, pdf_bsdf)
     }
 }
 

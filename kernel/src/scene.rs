@@ -171,6 +171,11 @@ pub mod light_kind {
     /// (`environment`). `position` and `radius` hold a sphere bounding the scene, which shadow
     /// rays toward it leave; `radiance` its mean (for the selection by power).
     pub const ENVIRONMENT: u32 = 2;
+    /// A point or spot light (glTF's `KHR_lights_punctual`): a delta light at `position` of
+    /// radiant intensity `radiance` (per steradian) along its axis `edge1` (unit), attenuated
+    /// off the axis by glTF's spot falloff, clamp(cos * edge2[0] + edge2[1], 0, 1)^2 (a point
+    /// light: edge2 = [0, 1]). Next-event estimation alone finds it (`light::sample_punctual_light`).
+    pub const PUNCTUAL: u32 = 3;
 }
 
 /// An area light: the light table lists every emissive sphere and every emissive triangle.

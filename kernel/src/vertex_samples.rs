@@ -63,6 +63,8 @@ pub struct VertexQuery {
     pub triangle_lights: bool,
     /// Whether a light may be the environment map (`features::ENVIRONMENT`).
     pub environment_light: bool,
+    /// Whether a light may be a point or spot light (`features::PUNCTUAL_LIGHTS`).
+    pub punctual_lights: bool,
     /// Whether the vertex may extend the path (its depth is below `max_depth`).
     pub extend: bool,
     /// The roulette's survival probability: a number is drawn only where `roulette` and not
@@ -260,6 +262,7 @@ impl VertexSamples {
             query.mode,
             query.triangle_lights,
             query.environment_light,
+            query.punctual_lights,
             params,
             table,
             query.x,

@@ -156,6 +156,8 @@ fn a_scene_as_toml_and_as_gltf_renders_the_same_bits_on_both_backends() {
     assert_eq!(toml.lights, gltf.lights, "lights");
     assert_eq!(toml.textures.words, gltf.textures.words, "texture table");
     assert_eq!(toml.features(), gltf.features());
+    let mr = kernel::features::METALLIC_ROUGHNESS | kernel::features::GLOSSY;
+    assert_eq!(toml.features() & mr, mr, "glTF's material keeps its code");
     for (backend, spp) in [(Backend::Cpu, 16), (Backend::Gpu, 4)] {
         let a = render_film(&toml, backend, spp);
         let b = render_film(&gltf, backend, spp);

@@ -323,6 +323,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                 // A table with triangles needs the bit; a table of spheres runs either way.
                 triangle_lights: round % 3 == 2 || h(lane, 23) % 2 == 0,
                 environment_light: false,
+                punctual_lights: false,
                 extend: h(lane, 19) % 5 != 0,
                 roulette: h(lane, 20) % 3 != 0,
                 survival,

@@ -51,6 +51,8 @@ struct SceneFile {
     #[serde(default)]
     gltf: Vec<Spanned<GltfFile>>,
     #[serde(default)]
+    light: Vec<Spanned<LightFile>>,
+    #[serde(default)]
     background: Option<BackgroundFile>,
 }
 
@@ -168,6 +170,19 @@ macro_rules! transform_fields {
             matrix: $f.matrix.as_ref(),
         }
     };
+}
+
+/// A point light, or with `direction` a spot light (glTF's `KHR_lights_punctual`): radiant
+/// `intensity` (per steradian, RGB) at `position`; a spot's falloff runs from `inner_angle` to
+/// `outer_angle` (cone half-angles in degrees, glTF's defaults 0 and 45).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightFile {
+    position: V3,
+    intensity: V3,
+    direction: Option<V3>,
+    inner_angle: Option<Spanned<f32>>,
+    outer_angle: Option<Spanned<f32>>,
 }
 
 /// A glTF file's default scene as part of this one (`gltf_scene::include`): its meshes with
@@ -602,6 +617,61 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 material,
             )
             .map_err(|(k, msg)| ck.err(mf.file.span(), &format!("{field} triangle {k}"), msg))?;
+    }
+
+    for (i, l) in file.light.iter().enumerate() {
+        let lf = l.get_ref();
+        let field = format!("light[{i}]");
+        let position = ck.vec3(&lf.position, &format!("{field}.position"))?;
+        let intensity = ck.color(&lf.intensity, &format!("{field}.intensity"), None)?;
+        let angle = |a: &Option<Spanned<f32>>, name: &str, default: f32| match a {
+            None => Ok(default),
+            Some(x) => {
+                let v = *x.get_ref();
+                if (0.0..=90.0).contains(&v) {
+                    Ok(v)
+                } else {
+                    Err(ck.err(
+                        x.span(),
+                        &format!("{field}.{name}"),
+                        format!("{v} is outside 0..=90 degrees"),
+                    ))
+                }
+            }
+        };
+        let cone = match &lf.direction {
+            None => {
+                if let Some(a) = lf.inner_angle.as_ref().or(lf.outer_angle.as_ref()) {
+                    return Err(ck.err(
+                        a.span(),
+                        &field,
+                        "cone angles belong to a spot light: give its direction",
+                    ));
+                }
+                None
+            }
+            Some(d) => {
+                let axis = ck.vec3(d, &format!("{field}.direction"))?;
+                if !(axis.length() > 0.0) {
+                    return Err(ck.err(d.span(), &format!("{field}.direction"), "is zero"));
+                }
+                let inner = angle(&lf.inner_angle, "inner_angle", 0.0)?;
+                let outer = angle(&lf.outer_angle, "outer_angle", 45.0)?;
+                if !(inner < outer) {
+                    return Err(ck.err(
+                        l.span(),
+                        &field,
+                        format!("inner_angle {inner} must be below outer_angle {outer}"),
+                    ));
+                }
+                Some((axis, inner.to_radians(), outer.to_radians()))
+            }
+        };
+        tables.lights.push(super::light_table::punctual_light(
+            position,
+            intensity.to_array(),
+            cone,
+        ));
     }
 
     let mut notes = Vec::new();

@@ -27,6 +27,33 @@ pub fn sphere_light(center: Vec3, radius: f32, radiance: [f32; 3]) -> Light {
     }
 }
 
+/// A point light (`cone` None) or a spot light (`cone` = (axis, inner and outer cone
+/// half-angles in radians, inner < outer)) at `position` of radiant intensity `intensity`
+/// along its axis, with glTF's `KHR_lights_punctual` falloff, scale
+/// 1 / max(1e-3, cos inner - cos outer) and offset -cos outer x scale (the extension's
+/// reference code).
+pub fn punctual_light(
+    position: Vec3,
+    intensity: [f32; 3],
+    cone: Option<(Vec3, f32, f32)>,
+) -> Light {
+    let mut l = sphere_light(position, 0.0, intensity);
+    l.kind = light_kind::PUNCTUAL;
+    match cone {
+        None => {
+            l.edge1 = [0.0, 0.0, -1.0];
+            l.edge2 = [0.0, 1.0, 0.0];
+        }
+        Some((axis, inner, outer)) => {
+            let (ci, co) = (inner.cos(), outer.cos());
+            let scale = 1.0 / (ci - co).max(1e-3);
+            l.edge1 = axis.normalize().to_array();
+            l.edge2 = [scale, -co * scale, 0.0];
+        }
+    }
+    l
+}
+
 /// The light of an emissive triangle `tri` (its own p0 and edges, so a sample and a hit see
 /// the same triangle): its area (in f64, then rounded) and the error bound of its points.
 pub fn triangle_light(tri: &Triangle, radiance: [f32; 3], two_sided: bool) -> Light {
@@ -61,6 +88,16 @@ pub fn triangle_light(tri: &Triangle, radiance: [f32; 3], two_sided: bool) -> Li
 pub fn light_power(l: &Light) -> f64 {
     let [r, g, b] = l.radiance.map(f64::from);
     let luminance = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+    if l.kind == light_kind::PUNCTUAL {
+        // Intensity over the directions the falloff lets through: 4 pi for a point light, the
+        // cap out to the outer cone (where the falloff reaches 0) for a spot.
+        let (scale, offset) = (l.edge2[0] as f64, l.edge2[1] as f64);
+        let cos_outer = if scale > 0.0 { -offset / scale } else { -1.0 };
+        return luminance.max(0.0)
+            * 2.0
+            * std::f64::consts::PI
+            * (1.0 - cos_outer.clamp(-1.0, 1.0));
+    }
     let area = if l.kind == light_kind::TRIANGLE {
         l.area as f64 * if l.two_sided != 0 { 2.0 } else { 1.0 }
     } else {

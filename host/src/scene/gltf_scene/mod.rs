@@ -283,8 +283,8 @@ impl Import<'_> {
                     cameras.push(c);
                 }
             }
-            if node.light().is_some() {
-                punctual += 1;
+            if let Some(light) = node.light() {
+                punctual += self.add_light(&node, &light, world)?;
             }
             for child in node.children().collect::<Vec<_>>().into_iter().rev() {
                 stack.push((child, world));
@@ -292,7 +292,7 @@ impl Import<'_> {
         }
         if punctual > 0 {
             self.note(format!(
-                "KHR_lights_punctual: {punctual} point/spot light(s) ignored (not supported yet)"
+                "KHR_lights_punctual: {punctual} directional light(s) ignored (not supported yet)"
             ));
         }
         Ok(cameras)
@@ -337,6 +337,74 @@ impl Import<'_> {
             stack.extend(node.children());
         }
         Ok(())
+    }
+
+    /// Adds `KHR_lights_punctual` light `light` of `node` at `world`: a point or spot light at
+    /// the node's origin, a spot pointing down the node's -z; colour x intensity is its radiant
+    /// intensity (the extension's candela taken as RGB watts per steradian); `range` is ignored
+    /// (physical falloff). Returns 1 for a directional light, which is not rendered (yet).
+    fn add_light(
+        &mut self,
+        node: &gltf::Node,
+        light: &gltf::khr_lights_punctual::Light,
+        world: DMat4,
+    ) -> Result<u32, SceneError> {
+        use gltf::khr_lights_punctual::Kind;
+        let field = format!("KHR_lights_punctual.lights[{}]", light.index());
+        let path = self.path.clone();
+        let err = |msg: String| SceneError::new(&path, None, field.clone(), msg);
+        let intensity = Vec3::from(light.color()) * light.intensity();
+        if !(intensity.is_finite() && intensity.min_element() >= 0.0) {
+            return Err(err(format!(
+                "colour x intensity {:?} must be finite and >= 0",
+                intensity.to_array()
+            )));
+        }
+        if light.range().is_some() {
+            self.note(format!(
+                "{field}: range ignored (light falls off as 1/d^2 everywhere)"
+            ));
+        }
+        let position = (world * DVec4::W).truncate();
+        let axis = (world * DVec4::new(0.0, 0.0, -1.0, 0.0)).truncate();
+        if !(position.is_finite()
+            && position.abs().max_element() <= super::file::MAX_COORDINATE as f64)
+        {
+            return Err(err(format!(
+                "nodes[{}] places it at {position}, out of range",
+                node.index()
+            )));
+        }
+        let cone = match light.kind() {
+            Kind::Directional => return Ok(1),
+            Kind::Point => None,
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                if !(0.0 <= inner_cone_angle
+                    && inner_cone_angle < outer_cone_angle
+                    && outer_cone_angle <= std::f32::consts::FRAC_PI_2)
+                    || !(axis.length() > 0.0)
+                {
+                    return Err(err(format!(
+                        "spot cone angles {inner_cone_angle}, {outer_cone_angle} must satisfy \
+                         0 <= inner < outer <= pi/2"
+                    )));
+                }
+                Some((
+                    axis.normalize().as_vec3(),
+                    inner_cone_angle,
+                    outer_cone_angle,
+                ))
+            }
+        };
+        self.tables.lights.push(super::light_table::punctual_light(
+            position.as_vec3(),
+            intensity.to_array(),
+            cone,
+        ));
+        Ok(0)
     }
 
     /// Adds every primitive of `mesh` as placed by `node` at `world`.
