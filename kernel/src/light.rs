@@ -201,13 +201,12 @@ pub fn pdf_environment_light(
 }
 
 /// The radiance light sample `ls` of light `l` sends toward its receiver: the light's constant
-/// radiance, the environment map's along the sample's direction (-normal), or a punctual
-/// light's intensity times its spot falloff toward the receiver. (A triangle with
+/// radiance, or the environment map's along the sample's direction (-normal). (A punctual
+/// light's is [`punctual_radiance`].) (A triangle with
 /// an emission texture scales it by [`emission_texture_at`].)
 #[inline]
 pub fn sample_radiance(
     environment: bool,
-    punctual: bool,
     params: &RenderParams,
     table: &[f32],
     l: &Light,
@@ -215,11 +214,16 @@ pub fn sample_radiance(
 ) -> Vec3 {
     if is_environment(environment, l) {
         environment::eval(params, table, -ls.point.normal)
-    } else if is_punctual(punctual, l) {
-        Vec3::from(l.radiance) * spot_attenuation(l, ls.point.normal)
     } else {
         Vec3::from(l.radiance)
     }
+}
+
+/// The radiance light sample `ls` of punctual light `l` sends toward its receiver: its
+/// intensity times its spot falloff toward the receiver (the sample's "normal").
+#[inline]
+pub fn punctual_radiance(l: &Light, ls: &DirectionalLightSample) -> Vec3 {
+    Vec3::from(l.radiance) * spot_attenuation(l, ls.point.normal)
 }
 
 /// The emission texture's value at the point of light sample `ls` on triangle light `l`
