@@ -713,3 +713,43 @@ fn toml_includes_a_gltf_file_under_a_transform() {
         "{e}"
     );
 }
+
+#[test]
+fn the_shipped_showcase_loads_and_renders_alike_on_both_backends() {
+    let root = twinpath_tests::repo_root();
+    let alone =
+        Scene::load(&root.join("scenes/gltf/showcase.glb")).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        alone.notes.iter().all(|n| !n.contains("ignored")),
+        "{:?}",
+        alone.notes
+    );
+    assert_eq!(
+        (alone.camera.width, alone.camera.height),
+        (960, 720),
+        "its own camera"
+    );
+    let mut scene =
+        Scene::load(&root.join("scenes/gltf_showcase.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let f = scene.features();
+    for (bit, name) in [
+        (kernel::features::METALLIC_ROUGHNESS, "metallic-roughness"),
+        (kernel::features::TEXTURES, "textures"),
+        (kernel::features::SHADING_NORMALS, "smooth normals"),
+        (kernel::features::PUNCTUAL_LIGHTS, "a spot light"),
+        (kernel::features::ENVIRONMENT, "the HDR sky"),
+    ] {
+        assert!(f & bit != 0, "the showcase lacks {name}");
+    }
+    scene.camera.width = 32;
+    scene.camera.height = 24;
+    let cpu = render_film(&scene, Backend::Cpu, 16);
+    let gpu = render_film(&scene, Backend::Gpu, 16);
+    let z = twinpath_tests::image_mean_z(&cpu, &gpu);
+    println!("showcase: CPU vs GPU image mean z = {z:+.2}");
+    assert!(
+        z.abs() < 4.0,
+        "CPU and GPU disagree on the showcase: z = {z}"
+    );
+    assert_validation_clean();
+}

@@ -252,6 +252,11 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
         "{:?}",
         scene.notes
     );
+    assert!(
+        !scene.notes.iter().any(|n| n.contains("extensions ignored")),
+        "KHR_lights_punctual is read: {:?}",
+        scene.notes
+    );
     assert!(scene.features() & kernel::features::PUNCTUAL_LIGHTS != 0);
     // Bad cones and intensities name the light.
     let e = file(json!([{ "type": "spot", "spot": { "innerConeAngle": 0.7, "outerConeAngle": 0.6 } }, { "type": "point" }]), "bad.glb")

@@ -28,10 +28,11 @@ pub const MAX_TRIANGLES: usize = 1 << 26;
 
 /// The extensions read (docs/gltf.md); any other a file uses is noted, and one it requires is
 /// an error.
-pub const SUPPORTED_EXTENSIONS: [&str; 3] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 4] = [
     "KHR_materials_emissive_strength",
     "KHR_materials_transmission",
     "KHR_materials_ior",
+    "KHR_lights_punctual",
 ];
 
 /// Image height of a scene whose glTF camera gives an aspect ratio (width follows from it), and
