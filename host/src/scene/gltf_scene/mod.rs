@@ -54,8 +54,6 @@ pub(super) struct Import<'a> {
     base: Option<PathBuf>,
     document: gltf::Document,
     buffers: Vec<gltf::buffer::Data>,
-    /// The decoded images, read on the first texture.
-    images: Option<Vec<gltf::image::Data>>,
     tables: &'a mut SceneTables,
     notes: &'a mut Vec<String>,
     /// Kernel material of each glTF material index (`None`: the default material).
@@ -71,9 +69,43 @@ fn parse_document(
     notes: &mut Vec<String>,
 ) -> Result<(gltf::Document, Vec<gltf::buffer::Data>), SceneError> {
     let err = |field: &str, msg: String| SceneError::new(path, None, field, msg);
-    let gltf = gltf::Gltf::from_slice(bytes)
-        .map_err(|e| err("file", format!("not a valid glTF 2.0 file: {e}")))?;
-    let document = gltf.document;
+    // A GLB header declaring fewer bytes than the header itself: the gltf crate subtracts the
+    // header's size from it unchecked (a panic under overflow checks, the fuzz build's).
+    if bytes.starts_with(b"glTF") {
+        let declared = bytes
+            .get(8..12)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        if !declared.is_some_and(|n| n >= 12) {
+            return Err(err(
+                "file",
+                format!(
+                    "not a valid glTF 2.0 file: a GLB header declaring {declared:?} bytes (at \
+                     least its own 12)"
+                ),
+            ));
+        }
+    }
+    let invalid = |e: gltf::Error| err("file", format!("not a valid glTF 2.0 file: {e}"));
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+    // The crate's validation indexes the accessor of every POSITION attribute before checking
+    // that it exists (a panic on a dangling index): checked here first.
+    let json = gltf.document.into_json();
+    for (i, mesh) in json.meshes.iter().enumerate() {
+        for (j, p) in mesh.primitives.iter().enumerate() {
+            if let Some(k) = p
+                .attributes
+                .values()
+                .map(|a| a.value())
+                .find(|&k| k >= json.accessors.len())
+            {
+                return Err(err(
+                    &format!("meshes[{i}].primitives[{j}].attributes"),
+                    format!("accessor {k} does not exist"),
+                ));
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(invalid)?;
     if let Some(e) = document
         .extensions_required()
         .find(|e| !SUPPORTED_EXTENSIONS.contains(e))
@@ -196,7 +228,6 @@ fn import(
         base: base.map(Path::to_path_buf),
         document,
         buffers,
-        images: None,
         tables,
         notes,
         materials: HashMap::new(),
@@ -615,62 +646,64 @@ impl Import<'_> {
         }))
     }
 
-    /// The texture table's index of image `k` used as `usage` (decoding the file's images on
-    /// the first call).
+    /// The texture table's index of image `k` used as `usage`: its bytes from a buffer view,
+    /// a data URI or a file beside the glTF file, every index and range checked (the gltf
+    /// crate's image import unwraps a missing mimeType and slices views unchecked), decoded by
+    /// the `image` crate (PNG, JPEG and the formats it guesses).
     fn image(&mut self, k: usize, usage: TextureUse) -> Result<u32, SceneError> {
-        if self.images.is_none() {
-            let images = gltf::import_images(&self.document, self.base.as_deref(), &self.buffers)
-                .map_err(|e| {
-                SceneError::new(&self.path, None, "images", format!("cannot read: {e}"))
-            })?;
-            self.images = Some(images);
-        }
-        let data = &self.images.as_ref().expect("decoded above")[k];
         let field = format!("images[{k}]");
-        let image = dynamic_image(data).ok_or_else(|| {
-            SceneError::new(
-                &self.path,
-                None,
-                field.clone(),
-                format!("{:?} pixels are not a readable image", data.format),
-            )
-        })?;
+        let err = |msg: String| SceneError::new(&self.path, None, field.clone(), msg);
+        let json = self.document.as_json();
+        let image = json
+            .images
+            .get(k)
+            .ok_or_else(|| err("does not exist".into()))?;
+        let bytes: std::borrow::Cow<[u8]> =
+            if let Some(v) = &image.buffer_view {
+                let view = json
+                    .buffer_views
+                    .get(v.value())
+                    .ok_or_else(|| err(format!("its bufferView {} does not exist", v.value())))?;
+                let buffer = self.buffers.get(view.buffer.value()).ok_or_else(|| {
+                    err(format!("its buffer {} does not exist", view.buffer.value()))
+                })?;
+                let offset = view.byte_offset.map_or(0, |o| o.0) as usize;
+                let range = offset..offset.saturating_add(view.byte_length.0 as usize);
+                std::borrow::Cow::Borrowed(buffer.get(range).ok_or_else(|| {
+                    err(format!(
+                        "bufferViews[{}] lies outside its buffer of {} bytes",
+                        v.value(),
+                        buffer.len()
+                    ))
+                })?)
+            } else if let Some(uri) = &image.uri {
+                if let Some(data) = uri.strip_prefix("data:") {
+                    let (_, encoded) = data
+                        .split_once(";base64,")
+                        .ok_or_else(|| err("a data URI that is not base64".into()))?;
+                    std::borrow::Cow::Owned(
+                        base64::decode(encoded).map_err(|e| err(format!("bad base64: {e}")))?,
+                    )
+                } else {
+                    let base = self.base.as_ref().ok_or_else(|| {
+                        err("names an external file, but there is no folder".into())
+                    })?;
+                    let file = base.join(uri);
+                    std::borrow::Cow::Owned(
+                        std::fs::read(&file)
+                            .map_err(|e| err(format!("cannot read {}: {e}", file.display())))?,
+                    )
+                }
+            } else {
+                return Err(err("has neither a bufferView nor a uri".into()));
+            };
+        let decoded = image::load_from_memory(&bytes)
+            .map_err(|e| err(format!("not a readable image: {e}")))?;
         let name = PathBuf::from(format!("{}#{field}", self.path.display()));
-        self.tables.textures.add_image(&name, image, usage, &field)
+        self.tables
+            .textures
+            .add_image(&name, decoded, usage, &field)
     }
-}
-
-/// glTF's decoded pixels as an `image` image.
-fn dynamic_image(d: &gltf::image::Data) -> Option<image::DynamicImage> {
-    use gltf::image::Format;
-    use image::{DynamicImage as D, ImageBuffer};
-    let (w, h, px) = (d.width, d.height, d.pixels.clone());
-    let u16s = || -> Vec<u16> {
-        px.as_chunks::<2>()
-            .0
-            .iter()
-            .map(|c| u16::from_ne_bytes(*c))
-            .collect()
-    };
-    let f32s = || -> Vec<f32> {
-        px.as_chunks::<4>()
-            .0
-            .iter()
-            .map(|c| f32::from_ne_bytes(*c))
-            .collect()
-    };
-    Some(match d.format {
-        Format::R8 => D::ImageLuma8(ImageBuffer::from_raw(w, h, px.clone())?),
-        Format::R8G8 => D::ImageLumaA8(ImageBuffer::from_raw(w, h, px.clone())?),
-        Format::R8G8B8 => D::ImageRgb8(ImageBuffer::from_raw(w, h, px.clone())?),
-        Format::R8G8B8A8 => D::ImageRgba8(ImageBuffer::from_raw(w, h, px.clone())?),
-        Format::R16 => D::ImageLuma16(ImageBuffer::from_raw(w, h, u16s())?),
-        Format::R16G16 => D::ImageLumaA16(ImageBuffer::from_raw(w, h, u16s())?),
-        Format::R16G16B16 => D::ImageRgb16(ImageBuffer::from_raw(w, h, u16s())?),
-        Format::R16G16B16A16 => D::ImageRgba16(ImageBuffer::from_raw(w, h, u16s())?),
-        Format::R32G32B32FLOAT => D::ImageRgb32F(ImageBuffer::from_raw(w, h, f32s())?),
-        Format::R32G32B32A32FLOAT => D::ImageRgba32F(ImageBuffer::from_raw(w, h, f32s())?),
-    })
 }
 
 /// A camera that sees the whole scene from +z (up +y, 40 degrees vertical field of view,
