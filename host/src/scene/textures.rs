@@ -78,12 +78,8 @@ impl TextureTable {
     /// records precede texels.
     pub fn add(&mut self, path: &Path, usage: TextureUse, field: &str) -> Result<u32, SceneError> {
         // The same file used the same way: no need to read it again.
-        if let Some(k) = self
-            .textures
-            .iter()
-            .position(|t| t.path == path && t.usage == usage)
-        {
-            return Ok(k as u32);
+        if let Some(k) = self.find(path, usage) {
+            return Ok(k);
         }
         let err = |msg: String| SceneError::new(path, None, field, msg);
         let image = image::ImageReader::open(path)
@@ -95,6 +91,14 @@ impl TextureTable {
         self.add_image(path, image, usage, field)
     }
 
+    /// The texture already loaded from `path` for `usage`, if any.
+    fn find(&self, path: &Path, usage: TextureUse) -> Option<u32> {
+        self.textures
+            .iter()
+            .position(|t| t.path == path && t.usage == usage)
+            .map(|k| k as u32)
+    }
+
     /// The index of decoded `image` used as `usage`, named `path` (a file, or a glTF file's
     /// image as `file#images[k]`): one record per name and use.
     pub fn add_image(
@@ -104,12 +108,8 @@ impl TextureTable {
         usage: TextureUse,
         field: &str,
     ) -> Result<u32, SceneError> {
-        if let Some(k) = self
-            .textures
-            .iter()
-            .position(|t| t.path == path && t.usage == usage)
-        {
-            return Ok(k as u32);
+        if let Some(k) = self.find(path, usage) {
+            return Ok(k);
         }
         let err = |msg: String| SceneError::new(path, None, field, msg);
         let (width, height) = (image.width(), image.height());

@@ -120,22 +120,7 @@ pub(super) fn read_vec3(
             ),
         ));
     }
-    let e = elements(path, a, buffers)?;
-    (0..e.count)
-        .map(|i| {
-            let b = e.element(i);
-            let v = [f32_at(b, 0), f32_at(b, 1), f32_at(b, 2)];
-            if v.iter().all(|c| c.is_finite()) {
-                Ok(v)
-            } else {
-                Err(accessor_error(
-                    path,
-                    a,
-                    format!("element {i} is {v:?}: not finite"),
-                ))
-            }
-        })
-        .collect()
+    read_finite(path, a, buffers, f32_at)
 }
 
 /// Texture coordinates (TEXCOORD_n): float, or normalised unsigned bytes or shorts.
@@ -160,7 +145,6 @@ pub(super) fn read_uv(
     if a.dimensions() != Dimensions::Vec2 {
         return Err(bad());
     }
-    let e = elements(path, a, buffers)?;
     let read: fn(&[u8], usize) -> f32 = match (a.data_type(), a.normalized()) {
         (DataType::F32, _) => f32_at,
         (DataType::U8, true) => |b, k| b[k] as f32 / 255.0,
@@ -169,10 +153,22 @@ pub(super) fn read_uv(
         }
         _ => return Err(bad()),
     };
+    read_finite(path, a, buffers, read)
+}
+
+/// The N-component elements of accessor `a`, component k of an element's bytes `b` being
+/// `read(b, k)`, each component finite.
+fn read_finite<const N: usize>(
+    path: &Path,
+    a: &Accessor,
+    buffers: &[gltf::buffer::Data],
+    read: fn(&[u8], usize) -> f32,
+) -> Result<Vec<[f32; N]>, SceneError> {
+    let e = elements(path, a, buffers)?;
     (0..e.count)
         .map(|i| {
             let b = e.element(i);
-            let v = [read(b, 0), read(b, 1)];
+            let v: [f32; N] = std::array::from_fn(|k| read(b, k));
             if v.iter().all(|c| c.is_finite()) {
                 Ok(v)
             } else {
