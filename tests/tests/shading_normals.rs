@@ -53,11 +53,12 @@ fn obj_and_ply_vertex_normals_and_texture_coordinates_are_read() {
     assert_eq!(soup.triangles.len(), 2);
     assert!(soup.normals.is_empty());
 
-    // A file the fuzzer made (a relative vt index that wraps around in tobj's usize arithmetic):
-    // an error or a soup, never a panic, in the build twinpath ships (overflow checks off; the
-    // fuzz build's overflow checks make tobj panic on it, see docs/robustness.md).
+    // A file the fuzzer made: a relative vt index reaching before the first vt (which tobj's
+    // usize arithmetic would wrap and then overflow on) is an error naming its line.
     let crash = std::fs::read(repo_root().join("tests/fixtures/fuzz_obj_attributes.obj")).unwrap();
-    let _ = parse_obj(std::path::Path::new("fuzz.obj"), &crash);
+    let e = parse_obj(std::path::Path::new("fuzz.obj"), &crash).unwrap_err();
+    assert_eq!(e.line, Some(3), "{e}");
+    assert!(e.message.contains("texture index -2"), "{e}");
 }
 
 /// The scene: a unit sphere (`shape`) of albedo 0.6 at the origin under a sphere light and a

@@ -1,6 +1,7 @@
 //! Triangle meshes from OBJ (via `tobj`) and PLY (ASCII and binary, read here) files.
 
 use super::error::SceneError;
+use super::obj_indices::check_obj_face_indices;
 use std::path::Path;
 
 /// Largest element count a PLY header may declare; larger headers are rejected before any
@@ -63,6 +64,7 @@ pub fn parse_obj(path: &Path, bytes: &[u8]) -> Result<TriangleSoup, SceneError> 
         single_index: true,
         ..Default::default()
     };
+    check_obj_face_indices(path, bytes)?;
     let mut reader = std::io::BufReader::new(bytes);
     let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default()))
         .map_err(|e| SceneError::new(path, None, "file", format!("malformed OBJ: {e}")))?;

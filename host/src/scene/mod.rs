@@ -10,6 +10,7 @@ pub mod gltf_scene;
 pub mod light_table;
 pub mod materials;
 pub mod mesh;
+mod obj_indices;
 pub mod textures;
 pub mod transform;
 
