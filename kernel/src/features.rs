@@ -8,8 +8,8 @@
 //! answer is the same (`scene_features` derives both from the same parameters).
 
 use crate::scene::{
-    light_kind, light_sampling, material_kind, mis, roulette, Light, Material, RenderParams,
-    ShadingTriangle, NONE,
+    light_kind, light_sampling, material_kind, mis, roulette, texture_slot, Light, Material,
+    RenderParams, ShadingTriangle, NONE,
 };
 
 /// The bits are answers fixed before the render; without it, they are ignored.
@@ -52,6 +52,9 @@ pub const TEXTURES: u32 = 1 << 14;
 pub const METALLIC_ROUGHNESS: u32 = 1 << 15;
 /// The light table may hold point and spot lights (`light_kind::PUNCTUAL`).
 pub const PUNCTUAL_LIGHTS: u32 = 1 << 16;
+/// A material has a normal map (`texture_slot::NORMAL`). Always set with [`SHADING_NORMALS`]:
+/// a mapped normal is a shading normal, which the vertex reads only under that bit.
+pub const NORMAL_MAPS: u32 = 1 << 17;
 
 /// The material bits of a scene with these materials: one per kind present besides the
 /// Lambertian. (A bit may also be set for a kind that is absent: it only keeps that kind's
@@ -86,7 +89,8 @@ pub fn light_features(lights: &[Light]) -> u32 {
 }
 
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
-/// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals.
+/// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals,
+/// [`NORMAL_MAPS`] and [`SHADING_NORMALS`] if a material has a normal map.
 #[inline]
 pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> u32 {
     let mut f = 0;
@@ -95,6 +99,12 @@ pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> 
         .any(|m| m.textures.iter().any(|&t| t != NONE))
     {
         f |= TEXTURES;
+    }
+    if materials
+        .iter()
+        .any(|m| m.textures[texture_slot::NORMAL] != NONE)
+    {
+        f |= NORMAL_MAPS | SHADING_NORMALS;
     }
     if shading.iter().any(|s| s.has_normals != 0) {
         f |= SHADING_NORMALS;
@@ -217,6 +227,11 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn textures(self) -> bool {
         self.answer(TEXTURES, true)
+    }
+    /// Whether a material may have a normal map (see [`NORMAL_MAPS`]).
+    #[inline]
+    fn normal_maps(self) -> bool {
+        self.answer(NORMAL_MAPS, true)
     }
     /// Whether a light may be a point or spot light (see [`PUNCTUAL_LIGHTS`]).
     #[inline]

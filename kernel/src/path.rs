@@ -347,6 +347,7 @@ impl PathState {
                     hit.material,
                     hit.shading,
                     hit.barycentrics,
+                    hit.normal,
                     materials,
                     shading,
                     textures,

@@ -17,9 +17,10 @@ use crate::light::sample_triangle_light;
 use crate::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal};
 use crate::rng::{pcg4d, u32_to_unit_f32};
 use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
-use crate::scene::{light_kind, Camera, Light, Material};
+use crate::scene::{light_kind, Camera, Light, Material, ShadingTriangle};
 use crate::sobol::{sobol_pair, sobol_single};
 use crate::spherical_triangle;
+use crate::surface::mapped_normal;
 use crate::texture::{bilerp, footprint};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -80,7 +81,11 @@ pub mod function {
     /// (x0 y0, x1 y0, x0 y1, x1 y1) = in2 as u32, read as byte / 256 -> out0 = texture::footprint's
     /// (x0, x1, y0, y1) as u32, out1 = (texture::bilerp of the texels, fx)
     pub const TEXTURE: u32 = 16;
-    pub const COUNT: u32 = 17;
+    /// base normal = in0.xyz, scale = in0.w, tangent (at all three vertices) = in1.xyz,
+    /// sign = in1.w, texel = in2.xyz, barycentrics = (in2.w, in3.x) -> out0.xyz =
+    /// surface::mapped_normal
+    pub const MAPPED_NORMAL: u32 = 17;
+    pub const COUNT: u32 = 18;
 }
 
 #[inline]
@@ -302,6 +307,17 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
             UVec4::new(fp.x0, fp.x1, fp.y0, fp.y1),
             bits(c.extend(fp.fx)),
         ];
+    } else if function == function::MAPPED_NORMAL {
+        let t = i1.truncate().to_array();
+        let frame = ShadingTriangle::tangent_frame([t, t, t], i1.w);
+        let n = mapped_normal(
+            i0.truncate(),
+            &frame,
+            Vec2::new(i2.w, i3.x),
+            i2.truncate(),
+            i0.w,
+        );
+        (v3(n), Vec4::ZERO)
     } else {
         (Vec4::ZERO, Vec4::ZERO)
     };

@@ -54,12 +54,52 @@ pub fn interpolated_uv(tri: &ShadingTriangle, bary: Vec2) -> Vec2 {
     )
 }
 
+/// The shading normal a tangent-space normal map gives (glTF 2.0, `material.normalTexture`;
+/// the MikkTSpace convention it names): the texel `texel` (linear RGB in [0, 1]) decodes to
+/// m = (2 texel - 1) x (`scale`, `scale`, 1), and the normal is m's direction in the frame
+/// (T, B, N) at the point: N = `base` (unit: the vertex-normal blend, or the geometric normal),
+/// T = the blend of the tangent record `frame`'s vertex tangents made orthogonal to N
+/// (Gram-Schmidt), B = sign x N x T with the record's sign. Unit; `base` itself where the
+/// tangent or the result has no direction (a degenerate frame leaves the point unmapped).
+#[inline]
+pub fn mapped_normal(
+    base: Vec3,
+    frame: &ShadingTriangle,
+    bary: Vec2,
+    texel: Vec3,
+    scale: f32,
+) -> Vec3 {
+    let t = blend3(
+        Vec3::from(frame.normal0),
+        Vec3::from(frame.normal1),
+        Vec3::from(frame.normal2),
+        bary,
+    );
+    let t = t - base * base.dot(t);
+    let t_len2 = t.dot(t);
+    if !(t_len2 > 0.0 && t_len2.is_finite()) {
+        return base;
+    }
+    let t = t / t_len2.sqrt();
+    let b = base.cross(t) * frame.uv0[0];
+    let m = (texel * 2.0 - Vec3::ONE) * Vec3::new(scale, scale, 1.0);
+    let n = t * m.x + b * m.y + base * m.z;
+    let len2 = n.dot(n);
+    if len2 > 0.0 && len2.is_finite() {
+        n / len2.sqrt()
+    } else {
+        base
+    }
+}
+
 /// The material at a vertex on material `material` and shading record `record` (a hit's
 /// `SurfaceHit::material` and `shading`) at barycentrics `bary`: a copy of its table entry, with
 /// its textures applied where the scene has any and, for glTF's metallic-roughness material,
-/// resolved into the form `crate::bsdf` evaluates (`bsdf::resolve_metallic_roughness`); and the unit shading normal (either
-/// orientation) where the record's vertex normals give one, else zero (the hit shades with its
-/// geometric normal).
+/// resolved into the form `crate::bsdf` evaluates (`bsdf::resolve_metallic_roughness`); and the
+/// unit shading normal (either orientation) where the record's vertex normals or the
+/// material's normal map give one, else zero (the hit shades with its geometric normal).
+/// `geometric` is the hit's unit geometric normal (`SurfaceHit::normal`, edge1 x edge2: the
+/// front a normal map's frame stands on when the triangle has no vertex normals).
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn shade<F: FeatureSet>(
@@ -67,6 +107,7 @@ pub fn shade<F: FeatureSet>(
     material: u32,
     record: u32,
     bary: Vec2,
+    geometric: Vec3,
     materials: &[Material],
     shading: &[ShadingTriangle],
     textures: &[u32],
@@ -79,7 +120,23 @@ pub fn shade<F: FeatureSet>(
             normal = interpolated_normal(&tri, bary);
         }
         if features.textures() {
-            m = textured_material(&m, textures, interpolated_uv(&tri, bary));
+            let uv = interpolated_uv(&tri, bary);
+            m = textured_material(&m, textures, uv);
+            let map = m.textures[texture_slot::NORMAL];
+            if features.normal_maps() && map != NONE {
+                let base = if normal == Vec3::ZERO {
+                    geometric
+                } else {
+                    normal
+                };
+                normal = mapped_normal(
+                    base,
+                    &shading[record as usize + 1],
+                    bary,
+                    lookup(textures, map, uv),
+                    m.normal_scale,
+                );
+            }
         }
     }
     if features.metallic_roughness() && m.kind == material_kind::METALLIC_ROUGHNESS {

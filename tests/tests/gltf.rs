@@ -78,8 +78,10 @@ const LAMP: &str = "[[quad]]\ncorner = [-0.5, 2, -0.5]\nedge1 = [0, 0, 1]\nedge2
 fn round_trip_files(dir: &Path) {
     let base = png(|i, j| [40 + 50 * i as u8, 200 - 40 * j as u8, 90]);
     let mr = png(|i, j| [0, 60 + 60 * j as u8, 255 - 60 * i as u8]);
+    let normal = png(|i, j| [100 + 20 * i as u8, 150 - 15 * j as u8, 230]);
     std::fs::write(dir.join("base.png"), &base).unwrap();
     std::fs::write(dir.join("mr.png"), &mr).unwrap();
+    std::fs::write(dir.join("normal.png"), &normal).unwrap();
     let t = terrain();
     let mut ply = format!(
         "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
@@ -101,12 +103,14 @@ fn round_trip_files(dir: &Path) {
     let mut g = GltfWriter::new();
     let base_tex = g.png_texture(&base);
     let mr_tex = g.png_texture(&mr);
+    let normal_tex = g.png_texture(&normal);
     let material = g.push(
         "materials",
         json!({ "name": "metal", "pbrMetallicRoughness": {
             "baseColorFactor": [0.9, 0.6, 0.3, 1.0], "metallicFactor": 0.75, "roughnessFactor": 0.5,
             "baseColorTexture": { "index": base_tex },
-            "metallicRoughnessTexture": { "index": mr_tex } } }),
+            "metallicRoughnessTexture": { "index": mr_tex } },
+            "normalTexture": { "index": normal_tex, "scale": 0.8 } }),
     );
     let flipped: Vec<[f32; 2]> = t.uvs.iter().map(|uv| [uv[0], 1.0 - uv[1]]).collect();
     let mesh = g.mesh(
@@ -137,7 +141,7 @@ fn a_scene_as_toml_and_as_gltf_renders_the_same_bits_on_both_backends() {
         &dir,
         "as_toml.toml",
         &format!(
-            "{head}[materials]\na_lamp = {{ emission = [4, 4, 4] }}\nmetal = {{ base_color = [0.9, 0.6, 0.3], metallic = 0.75, roughness = 0.5, base_color_map = \"base.png\", metallic_roughness_map = \"mr.png\" }}\n{LAMP}[[mesh]]\nfile = \"terrain.ply\"\nmaterial = \"metal\"\n"
+            "{head}[materials]\na_lamp = {{ emission = [4, 4, 4] }}\nmetal = {{ base_color = [0.9, 0.6, 0.3], metallic = 0.75, roughness = 0.5, base_color_map = \"base.png\", metallic_roughness_map = \"mr.png\", normal_map = \"normal.png\", normal_scale = 0.8 }}\n{LAMP}[[mesh]]\nfile = \"terrain.ply\"\nmaterial = \"metal\"\n"
         ),
     );
     let gltf = load(
@@ -149,14 +153,22 @@ fn a_scene_as_toml_and_as_gltf_renders_the_same_bits_on_both_backends() {
     );
     assert_eq!(toml.triangles.len(), 10);
     assert_eq!(toml.triangles, gltf.triangles, "triangles");
-    assert_eq!(toml.shading, gltf.shading, "shading records");
-    assert!(toml.shading.iter().all(|s| s.has_normals == 1));
+    assert_eq!(
+        toml.shading, gltf.shading,
+        "shading records and tangent frames"
+    );
+    // The mesh's 8 triangles have a record and a tangent frame each.
+    assert_eq!(toml.shading.len(), 16);
+    assert!(toml.shading.iter().step_by(2).all(|s| s.has_normals == 1));
+    assert_eq!(toml.materials[1].normal_scale, 0.8);
     assert_eq!(toml.materials, gltf.materials, "materials");
     assert_eq!(toml.materials[1].kind, material_kind::METALLIC_ROUGHNESS);
     assert_eq!(toml.lights, gltf.lights, "lights");
     assert_eq!(toml.textures.words, gltf.textures.words, "texture table");
     assert_eq!(toml.features(), gltf.features());
-    let mr = kernel::features::METALLIC_ROUGHNESS | kernel::features::GLOSSY;
+    let mr = kernel::features::METALLIC_ROUGHNESS
+        | kernel::features::GLOSSY
+        | kernel::features::NORMAL_MAPS;
     assert_eq!(toml.features() & mr, mr, "glTF's material keeps its code");
     for (backend, spp) in [(Backend::Cpu, 16), (Backend::Gpu, 4)] {
         let a = render_film(&toml, backend, spp);
@@ -489,6 +501,7 @@ fn texture_channels_srgb_and_the_metallic_roughness_map() {
         0,
         0,
         Vec2::new(0.3, 0.3),
+        Vec3::Y,
         &[m],
         &[record],
         &table.words,
@@ -522,6 +535,7 @@ fn texture_channels_srgb_and_the_metallic_roughness_map() {
         0,
         NONE,
         Vec2::ZERO,
+        Vec3::Y,
         &[m],
         &[record],
         &table.words,

@@ -284,6 +284,24 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                 r[2] = [0; 4].map(|_| g.u64() as u32);
                 r
             }
+            function::MAPPED_NORMAL => {
+                // Unit base normals; tangents of any length and angle to it (near-parallel
+                // ones included); texels over the byte range, scales from 0 to 4.
+                let n = g.dir();
+                let length = g.pick(&[1.0, 0.01, 100.0]);
+                let t = (g.dir() + n * g.range(-2.0, 2.0)) * length;
+                let texel = Vec3::new(g.unit(), g.unit(), g.unit());
+                let any = g.range(0.0, 4.0);
+                let scale = g.pick(&[1.0, 0.0, 0.5, 2.0, 4.0, any]);
+                let sign = g.pick(&[1.0, -1.0]);
+                let (u, v) = (g.unit(), g.unit());
+                rec([
+                    w(n, scale),
+                    w(t, sign),
+                    w(texel, u * 0.5),
+                    [v * 0.5, 0.0, 0.0, 0.0],
+                ])
+            }
             _ => unreachable!(),
         })
         .collect()
@@ -355,6 +373,7 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "bsdf::sample", func: function::BSDF_SAMPLE, max_ulps: 2048, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 5e-2)), why: "the visible-normal sampler, Fresnel choice and pdf (FMA contraction); weights of grazing directions carry G1 ~ n . wi, whose rounding moves them relatively (measured 648 ULP): 2048 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: the sampler's stretch by alpha magnifies the rounding of wo by up to 1/alpha, and the density is read at the sampled wi on a lobe a thousandth of a radian wide (measured 2.6% where a 0.9-metallic glTF material picks the sharp lobe 9 times in 10): 5% relative" },
     Bound { name: "sample_triangle_light / solid_angle", func: function::TRIANGLE_LIGHT, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "atan2_turns, normalisations and the ray/plane step (FMA contraction): 64 eps relative to the solid angle, density and geometry size, divided by h, the receiver's elevation above the light's plane (all are 0 / 0 in it); normals 64 eps" },
     Bound { name: "texture footprint and bilerp", func: function::TEXTURE, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, why: "the same texels and weights bit for bit: wrapping, clamping and the blend" },
+    Bound { name: "surface::mapped_normal", func: function::MAPPED_NORMAL, max_ulps: 8, abs: 16.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "a blend, one Gram-Schmidt step, a cross product and two normalisations of unit-scale vectors (FMA contraction, sqrt): 16 eps on a unit vector" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
 
@@ -392,6 +411,14 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let e1 = glam::Vec3::new(f(3, 0), f(3, 1), f(3, 2));
             let e2 = glam::Vec3::new(f(1, 3), f(2, 3), f(3, 3));
             b.abs * (p0.length() + e1.length() + e2.length())
+        }
+        // The mapped normal: Gram-Schmidt leaves t's component across n, whose rounding is
+        // eps |t| absolute, so relative to it b.abs |t| / |t - n (n . t)|.
+        function::MAPPED_NORMAL => {
+            let n = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2)).as_dvec3();
+            let t = glam::Vec3::new(f(1, 0), f(1, 1), f(1, 2)).as_dvec3();
+            let across = (t - n * n.dot(t)).length();
+            (b.abs as f64 * (t.length() / across).max(1.0)) as f32
         }
         function::SAMPLE_SPHERE | function::SAMPLE_SPHERE_CONE if k == 0 && j < 3 => {
             let c = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2));

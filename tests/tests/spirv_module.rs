@@ -145,8 +145,20 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
             host_layout!(
                 Material,
                 [
-                    albedo, kind, emission, alpha, specular, ior, eta, complex, k, two_sided,
-                    textures, metallic, roughness, _pad
+                    albedo,
+                    kind,
+                    emission,
+                    alpha,
+                    specular,
+                    ior,
+                    eta,
+                    complex,
+                    k,
+                    two_sided,
+                    textures,
+                    metallic,
+                    roughness,
+                    normal_scale
                 ],
                 true
             ),

@@ -112,13 +112,14 @@ macro_rules! with_features {
 }
 
 /// The feature bits beyond the diffuse renderer's: other materials than the Lambertian,
-/// triangle lights, a thin lens, an environment map, shading normals and textures.
+/// triangle lights, a thin lens, an environment map, shading normals, textures and normal maps.
 const EXTENDED: u32 = features::MATERIALS
     | features::TRIANGLE_LIGHTS
     | features::THIN_LENS
     | features::ENVIRONMENT
     | features::SHADING_NORMALS
-    | features::TEXTURES;
+    | features::TEXTURES
+    | features::NORMAL_MAPS;
 
 /// `bits` with every [`EXTENDED`] bit set if any is: the CPU compiles one path for scenes with
 /// other materials, triangle lights, a lens or an environment map (such a bit only keeps code,

@@ -153,6 +153,7 @@ impl CpuRenderer {
                             hit.material,
                             hit.shading,
                             hit.barycentrics,
+                            hit.normal,
                             &self.materials,
                             &self.shading,
                             &self.textures,

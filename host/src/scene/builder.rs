@@ -6,10 +6,12 @@ use super::environment::EnvironmentMap;
 use super::file::MAX_COORDINATE;
 use super::light_table::{assign_light_selection, triangle_light};
 use super::mesh::TriangleSoup;
+use super::tangents::face_tangent;
 use super::textures::TextureTable;
 use super::transform::Transform;
 use super::{CameraDesc, Scene, TriangleGroup};
 use crate::settings::RenderSettings;
+use bytemuck::Zeroable;
 use glam::Vec3;
 use kernel::scene::{
     material_kind, texture_slot, Light, Material, ShadingTriangle, Sphere, Triangle, NONE,
@@ -63,7 +65,9 @@ impl SceneTables {
     }
 
     /// Appends the triangle with vertices `p` and `material`, its shading record `attributes`
-    /// if it has one, and its light if the material emits.
+    /// if it has one, and its light if the material emits. A triangle whose material has a
+    /// normal map always gets a record (texture coordinates 0 where it has none), followed by
+    /// its tangent frame (`ShadingTriangle::tangent_frame`, from `tangents::face_tangent`).
     pub fn push_triangle(
         &mut self,
         p: [Vec3; 3],
@@ -72,9 +76,20 @@ impl SceneTables {
     ) {
         let mut tri = super::triangle(p, material);
         let m = self.materials[material as usize];
+        let normal_mapped = m.textures[texture_slot::NORMAL] != NONE;
+        let attributes = match attributes {
+            None if normal_mapped => Some(ShadingTriangle::zeroed()),
+            a => a,
+        };
         if let Some(a) = attributes {
             tri.shading = self.shading.len() as u32;
             self.shading.push(a);
+            if normal_mapped {
+                let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+                let (t, sign) = face_tangent(p, [a.uv0, a.uv1, a.uv2], normal);
+                self.shading
+                    .push(ShadingTriangle::tangent_frame([t; 3], sign));
+            }
         }
         if self.is_emissive(material) {
             tri.light = self.lights.len() as u32;

@@ -99,6 +99,10 @@ pub(super) struct MaterialFile {
     pub roughness: Option<Spanned<f32>>,
     pub base_color_map: Option<Spanned<String>>,
     pub metallic_roughness_map: Option<Spanned<String>>,
+    /// A tangent-space normal map (linear; glTF's `normalTexture`, OpenGL's +y convention) and
+    /// its x/y scale (default 1), for any reflecting material on triangles.
+    pub normal_map: Option<Spanned<String>>,
+    pub normal_scale: Option<Spanned<f32>>,
 }
 
 impl MaterialFile {

@@ -311,7 +311,8 @@ fn conductor(
     }
 }
 
-/// The textures of entry `m` (`kd_map`, `ks_map`, `alpha_map`, `emission_map`, `wrap`), added
+/// The textures of entry `m` (`kd_map`, `ks_map`, `alpha_map`, `emission_map`,
+/// `base_color_map`, `metallic_roughness_map`, `normal_map` with `normal_scale`, `wrap`), added
 /// to `table` and recorded in `out.textures`. A colour map for kd or ks must not reflect more
 /// than it receives: its largest value times the factor stays within 1 (and kd + ks within 1).
 pub(super) fn attach_textures(
@@ -354,12 +355,21 @@ pub(super) fn attach_textures(
             texture_slot::EMISSION,
             true,
         ),
+        (&mf.normal_map, "normal_map", texture_slot::NORMAL, false),
     ];
     let mut peak = [Vec3::ONE; texture_slot::COUNT];
     for (map, name, slot, colour) in maps {
         let Some(map) = map else { continue };
         let map_field = format!("{field}.{name}");
-        if ![
+        if slot == texture_slot::NORMAL {
+            if out.emission != [0.0; 3] {
+                return Err(ck.err(
+                    map.span(),
+                    &map_field,
+                    "belongs to reflecting surfaces: a light has no shading normal",
+                ));
+            }
+        } else if ![
             material_kind::DIFFUSE,
             material_kind::GLOSSY,
             material_kind::METALLIC_ROUGHNESS,
@@ -383,6 +393,21 @@ pub(super) fn attach_textures(
         let index = table.add(&file, TextureUse { colour, clamp }, &map_field)?;
         peak[slot] = table.peak(index);
         out.textures[slot] = index;
+    }
+    if let Some(scale) = &mf.normal_scale {
+        let value = *scale.get_ref();
+        let scale_field = format!("{field}.normal_scale");
+        if mf.normal_map.is_none() {
+            return Err(ck.err(
+                scale.span(),
+                &scale_field,
+                "belongs to normal_map: the material has none",
+            ));
+        }
+        if !value.is_finite() {
+            return Err(ck.err(scale.span(), &scale_field, format!("{value} is not finite")));
+        }
+        out.normal_scale = value;
     }
     if let Some(w) = &mf.wrap {
         if out.textures.iter().all(|&t| t == NONE) {

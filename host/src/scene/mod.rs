@@ -11,6 +11,7 @@ pub mod light_table;
 pub mod materials;
 pub mod mesh;
 mod obj_indices;
+mod tangents;
 pub mod textures;
 pub mod transform;
 

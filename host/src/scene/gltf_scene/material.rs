@@ -46,11 +46,6 @@ pub(super) fn material(
     }
     let metallic = unit(pbr.metallic_factor(), "metallicFactor")?;
     let roughness = unit(pbr.roughness_factor(), "roughnessFactor")?;
-    if m.normal_texture().is_some() {
-        imp.note(format!(
-            "{label}: normalTexture ignored (normal maps are not read yet)"
-        ));
-    }
     if m.occlusion_texture().is_some() {
         imp.note(format!(
             "{label}: occlusionTexture ignored (a path tracer computes occlusion)"
@@ -113,7 +108,7 @@ pub(super) fn material(
             out.kind = material_kind::DIELECTRIC;
             out.ior = ior;
             out.alpha = roughness * roughness;
-            return Ok(out);
+            return normal_map(imp, &label, &m, out);
         }
     }
 
@@ -127,6 +122,29 @@ pub(super) fn material(
     if let Some(info) = pbr.metallic_roughness_texture() {
         out.textures[texture_slot::KS] = texture(imp, &label, &info, false)?;
     }
+    normal_map(imp, &label, &m, out)
+}
+
+/// `out` with glTF material `m`'s `normalTexture` (linear) and its scale, where it has one.
+fn normal_map(
+    imp: &mut Import,
+    label: &str,
+    m: &gltf::Material,
+    mut out: Material,
+) -> Result<Material, SceneError> {
+    let Some(n) = m.normal_texture() else {
+        return Ok(out);
+    };
+    if !n.scale().is_finite() {
+        return Err(SceneError::new(
+            &imp.path,
+            None,
+            format!("materials[{}].normalTexture.scale", m.index().unwrap_or(0)),
+            format!("{} is not finite", n.scale()),
+        ));
+    }
+    out.textures[texture_slot::NORMAL] = texture_of(imp, label, n.texture(), n.tex_coord(), false)?;
+    out.normal_scale = n.scale();
     Ok(out)
 }
 
@@ -138,12 +156,21 @@ fn texture(
     info: &gltf::texture::Info,
     colour: bool,
 ) -> Result<u32, SceneError> {
-    let tex = info.texture();
-    if info.tex_coord() != 0 {
+    texture_of(imp, label, info.texture(), info.tex_coord(), colour)
+}
+
+/// [`texture`] for texture `tex` read with texture coordinates `tex_coord`.
+fn texture_of(
+    imp: &mut Import,
+    label: &str,
+    tex: gltf::Texture,
+    tex_coord: u32,
+    colour: bool,
+) -> Result<u32, SceneError> {
+    if tex_coord != 0 {
         imp.note(format!(
-            "{label}: textures[{}] names TEXCOORD_{}; TEXCOORD_0 is used",
+            "{label}: textures[{}] names TEXCOORD_{tex_coord}; TEXCOORD_0 is used",
             tex.index(),
-            info.tex_coord()
         ));
     }
     let sampler = tex.sampler();
