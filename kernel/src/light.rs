@@ -136,9 +136,27 @@ pub fn spot_attenuation(l: &Light, out: Vec3) -> f32 {
 /// solid angle; this one makes the estimator's f cos x radiance / pdf equal f cos x I / d^2 /
 /// p_select, the point light's irradiance (pbrt-v4 `PointLight::SampleLi`), and the vertex
 /// gives it MIS weight 1 (no BSDF sample can meet it). Receiver at the light: density 0.
+///
+/// A directional light (`radius` > 0): the point beyond the scene's bounding sphere against the
+/// light's direction of travel, 2 (radius + |x - centre|) away, so the shadow ray crosses the
+/// whole scene, facing `x` along that direction; `pdf_solid_angle` = the selection
+/// probability, so the estimator is f cos x E / p_select with E the irradiance (pbrt-v4
+/// `DistantLight::SampleLi`).
 #[inline]
 pub fn sample_punctual_light(l: &Light, light: u32, x: Vec3) -> DirectionalLightSample {
     let p = Vec3::from(l.position);
+    if l.radius > 0.0 {
+        let travel = Vec3::from(l.edge1);
+        let far = 2.0 * (l.radius + (x - p).length());
+        return DirectionalLightSample {
+            point: SurfacePoint {
+                position: x - travel * far,
+                normal: travel,
+            },
+            light,
+            pdf_solid_angle: l.select_pmf,
+        };
+    }
     let d = x - p;
     let d2 = d.dot(d);
     let ok = d2 > 0.0 && d2.is_finite();
@@ -220,7 +238,8 @@ pub fn sample_radiance(
 }
 
 /// The radiance light sample `ls` of punctual light `l` sends toward its receiver: its
-/// intensity times its spot falloff toward the receiver (the sample's "normal").
+/// intensity times its spot falloff toward the receiver (the sample's "normal"); a directional
+/// light's irradiance (its falloff is 1: edge2 = [0, 1]).
 #[inline]
 pub fn punctual_radiance(l: &Light, ls: &DirectionalLightSample) -> Vec3 {
     Vec3::from(l.radiance) * spot_attenuation(l, ls.point.normal)

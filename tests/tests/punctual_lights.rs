@@ -263,18 +263,109 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("KHR_lights_punctual.lights[0]"), "{e}");
-    // A directional light is noted, not rendered.
+    // A directional light shines down its node's -z (here -y), colour x intensity its
+    // irradiance, from beyond the scene's bounding sphere (the triangle's: centre
+    // (0.5, 0, -0.5), radius sqrt(1/2)).
     let s = file(
-        json!([{ "type": "directional" }, { "type": "point" }]),
+        json!([{ "type": "directional", "color": [1.0, 0.5, 0.5], "intensity": 3.0 }, { "type": "point" }]),
         "dir.glb",
     )
     .unwrap();
-    assert_eq!(s.lights.len(), 1);
+    assert_eq!(s.lights.len(), 2);
+    let d = s.lights[0];
+    assert_eq!(d.kind, kernel::scene::light_kind::PUNCTUAL);
+    assert!((Vec3::from(d.edge1) - Vec3::new(0.0, -1.0, 0.0)).length() < 1e-6);
+    assert_eq!(d.radiance, [3.0, 1.5, 1.5]);
+    assert!((Vec3::from(d.position) - Vec3::new(0.5, 0.0, -0.5)).length() < 1e-6);
     assert!(
-        s.notes.iter().any(|n| n.contains("directional")),
+        (d.radius - 0.5f32.sqrt()).abs() < 1e-6,
+        "radius {}",
+        d.radius
+    );
+    assert!(
+        !s.notes.iter().any(|n| n.contains("directional")),
         "{:?}",
         s.notes
     );
+}
+
+/// The plane y = 0 with a sphere of radius `OCCLUDER_R` above it at (0, 1, 0), under a directional
+/// light of irradiance E travelling along `TRAVEL`; direct light only (`max_depth = 1`), black
+/// background: each plane point gets kd E cos / pi, or nothing in the sphere's shadow.
+const TRAVEL: Vec3 = Vec3::new(0.3, -1.0, 0.6);
+const OCCLUDER_R: f32 = 0.7;
+const E: f64 = 2.5;
+
+#[test]
+fn a_directional_light_and_its_shadow_match_the_closed_form_on_both_backends() {
+    let scene = with_independent_samples(scene_from_toml(&format!(
+        "[camera]\n{CAMERA}\n[render]\nmax_depth = 1\n[materials]\nplane = {{ kd = [{KD}, {KD}, {KD}] }}\n[[quad]]\ncorner = [-100, 0, 100]\nedge1 = [200, 0, 0]\nedge2 = [0, 0, -200]\nmaterial = \"plane\"\n[[sphere]]\ncenter = [0, 1, 0]\nradius = {OCCLUDER_R}\nmaterial = \"plane\"\n[[light]]\ndirection = [{}, {}, {}]\nirradiance = [{E}, {E}, {E}]\n",
+        TRAVEL.x, TRAVEL.y, TRAVEL.z
+    )));
+    assert_eq!(scene.lights.len(), 1);
+    assert!(scene.lights[0].radius >= 100.0, "bounds the plane");
+    let toward = -TRAVEL.as_dvec3().normalize();
+    let lit = KD as f64 / std::f64::consts::PI * E * toward.y;
+    // Per quadrature point: the plane point, whether the sphere shadows it, or None where the
+    // ray meets the sphere or misses the plane.
+    let at = |eye: Vec3, d: Vec3| -> Option<bool> {
+        let sphere =
+            kernel::geometry::intersect_sphere(eye, d, Vec3::Y, OCCLUDER_R, 0.0, f32::INFINITY);
+        if d.y >= 0.0 || sphere >= 0.0 {
+            return None;
+        }
+        let x = (eye + d * (-eye.y / d.y)).as_dvec3();
+        // The shadow ray x + s toward meets the sphere where |x + s toward - c|^2 = r^2.
+        let oc = x - glam::DVec3::Y;
+        let b = oc.dot(toward);
+        let disc = b * b - (oc.length_squared() - (OCCLUDER_R as f64).powi(2));
+        Some(disc > 0.0 && -b + disc.sqrt() > 0.0)
+    };
+    let shadowed = pixel_quadrature(&scene, 16, |eye, d| at(eye, d).map(|s| s as u8 as f64));
+    let want: Vec<Option<f64>> = shadowed
+        .iter()
+        .map(|f| f.filter(|&f| f == 0.0).map(|_| lit))
+        .collect();
+    let dark: Vec<usize> = (0..shadowed.len())
+        .filter(|&i| shadowed[i] == Some(1.0))
+        .collect();
+    assert!(
+        dark.len() >= 4 && want.iter().flatten().count() > want.len() / 2,
+        "{} pixels in full shadow",
+        dark.len()
+    );
+    let wrong_cos = KD as f64 / std::f64::consts::PI * E;
+    for backend in [Backend::Cpu, Backend::Gpu] {
+        // A lit pixel's every sample is kd E cos / pi whatever its position: no noise, only
+        // the f32 rounding of the estimator's ~20 operations (each within 2^-24 relative;
+        // the running mean of equal values is exact): 1e-5 relative holds it 8 times over.
+        let film = render_film(&scene, backend, 64);
+        let mean = film.mean();
+        for (i, w) in want.iter().enumerate() {
+            if let Some(w) = w {
+                let m = mean[i][0] as f64;
+                assert!(
+                    (m - w).abs() <= 1e-5 * w,
+                    "{backend:?}: lit pixel {i}: {m} vs {w}"
+                );
+            }
+        }
+        for &i in &dark {
+            assert_eq!(
+                mean[i][0], 0.0,
+                "{backend:?}: pixel {i} lies in full shadow"
+            );
+        }
+        // Irradiance without the receiver's cosine is rejected: every lit pixel is exact up to
+        // its pixel footprint, so its mean is far from kd E / pi.
+        let i = want.iter().position(|w| w.is_some()).unwrap();
+        assert!(
+            (mean[i][0] as f64 - wrong_cos).abs() > 0.05 * wrong_cos,
+            "{backend:?}: {} vs kd E / pi {wrong_cos}",
+            mean[i][0]
+        );
+    }
+    assert_validation_clean();
 }
 
 #[test]
@@ -290,6 +381,11 @@ fn toml_light_errors_name_the_field() {
         ("position = [0, 1, 0]\nintensity = [1, 1, 1]\ndirection = [0, 0, 0]", "light[0].direction"),
         ("position = [0, 1, 0]\nintensity = [1, 1, 1]\ndirection = [0, -1, 0]\ninner_angle = 40\nouter_angle = 30", "below outer_angle"),
         ("position = [0, 1, 0]\nintensity = [1, 1, 1]\ndirection = [0, -1, 0]\nouter_angle = 120", "light[0].outer_angle"),
+        ("direction = [0, -1, 0]\nirradiance = [1, 1, 1]\nposition = [0, 1, 0]", "a direction and an irradiance only"),
+        ("irradiance = [1, 1, 1]", "needs the direction its light travels"),
+        ("direction = [0, 0, 0]\nirradiance = [1, 1, 1]", "light[0].direction"),
+        ("direction = [0, -1, 0]\nirradiance = [1, -1, 1]", "light[0].irradiance"),
+        ("direction = [0, -1, 0]", "needs position and intensity"),
     ] {
         let e = twinpath::scene::parse_scene(&text(light), std::path::Path::new("t.toml"))
             .unwrap_err()

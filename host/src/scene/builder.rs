@@ -4,7 +4,7 @@
 
 use super::environment::EnvironmentMap;
 use super::file::MAX_COORDINATE;
-use super::light_table::{assign_light_selection, triangle_light};
+use super::light_table::{assign_light_selection, place_directional_lights, triangle_light};
 use super::mesh::TriangleSoup;
 use super::tangents::face_tangent;
 use super::textures::TextureTable;
@@ -182,6 +182,7 @@ impl SceneTables {
         background: Vec3,
         environment: Option<EnvironmentMap>,
     ) -> Scene {
+        place_directional_lights(&mut self.lights, &self.spheres, &self.triangles);
         if let Some(map) = &environment {
             self.lights.push(map.light(&self.spheres, &self.triangles));
         }

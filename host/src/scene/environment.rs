@@ -3,8 +3,7 @@
 //! (`kernel::environment`: texels, the marginal CDF over rows, each row's conditional CDF).
 
 use super::error::SceneError;
-use super::light_table::sphere_light;
-use glam::Vec3;
+use super::light_table::{scene_bounds, sphere_light};
 use kernel::scene::{light_kind, Light, Sphere, Triangle};
 use std::path::Path;
 
@@ -120,24 +119,7 @@ impl EnvironmentMap {
     /// (which shadow rays toward the map leave), and its mean radiance, so that selection by power
     /// weighs it as a sphere of that radiance around the scene.
     pub fn light(&self, spheres: &[Sphere], triangles: &[Triangle]) -> Light {
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for s in spheres {
-            let c = Vec3::from(s.center);
-            lo = lo.min(c - s.radius);
-            hi = hi.max(c + s.radius);
-        }
-        for t in triangles {
-            let p0 = Vec3::from(t.p0);
-            for p in [p0, p0 + Vec3::from(t.edge1), p0 + Vec3::from(t.edge2)] {
-                lo = lo.min(p);
-                hi = hi.max(p);
-            }
-        }
-        let (center, radius) = if lo.x <= hi.x {
-            ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-3))
-        } else {
-            (Vec3::ZERO, 1.0)
-        };
+        let (center, radius) = scene_bounds(spheres, triangles);
         let mut l = sphere_light(center, radius, self.mean_radiance());
         l.kind = light_kind::ENVIRONMENT;
         l

@@ -182,8 +182,10 @@ macro_rules! transform_fields {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LightFile {
-    position: V3,
-    intensity: V3,
+    position: Option<V3>,
+    intensity: Option<V3>,
+    /// A directional light's irradiance (with `direction`, without `position`).
+    irradiance: Option<V3>,
     direction: Option<V3>,
     inner_angle: Option<Spanned<f32>>,
     outer_angle: Option<Spanned<f32>>,
@@ -626,8 +628,51 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     for (i, l) in file.light.iter().enumerate() {
         let lf = l.get_ref();
         let field = format!("light[{i}]");
-        let position = ck.vec3(&lf.position, &format!("{field}.position"))?;
-        let intensity = ck.color(&lf.intensity, &format!("{field}.intensity"), None)?;
+        if let Some(irradiance) = &lf.irradiance {
+            // A directional light: a direction and an irradiance, nothing else.
+            let extra = [
+                ("position", lf.position.is_some()),
+                ("intensity", lf.intensity.is_some()),
+                ("inner_angle", lf.inner_angle.is_some()),
+                ("outer_angle", lf.outer_angle.is_some()),
+            ];
+            if let Some((name, _)) = extra.iter().find(|e| e.1) {
+                return Err(ck.err(
+                    l.span(),
+                    &field,
+                    format!(
+                        "gives irradiance (a directional light) and {name}: a directional light \
+                         has a direction and an irradiance only"
+                    ),
+                ));
+            }
+            let Some(d) = &lf.direction else {
+                return Err(ck.err(
+                    l.span(),
+                    &field,
+                    "a directional light (irradiance) needs the direction its light travels",
+                ));
+            };
+            let travel = ck.vec3(d, &format!("{field}.direction"))?;
+            if !(travel.length() > 0.0) {
+                return Err(ck.err(d.span(), &format!("{field}.direction"), "is zero"));
+            }
+            let e = ck.color(irradiance, &format!("{field}.irradiance"), None)?;
+            tables
+                .lights
+                .push(super::light_table::directional_light(travel, e.to_array()));
+            continue;
+        }
+        let (Some(position), Some(intensity)) = (&lf.position, &lf.intensity) else {
+            return Err(ck.err(
+                l.span(),
+                &field,
+                "needs position and intensity (a point or spot light) or direction and \
+                 irradiance (a directional light)",
+            ));
+        };
+        let position = ck.vec3(position, &format!("{field}.position"))?;
+        let intensity = ck.color(intensity, &format!("{field}.intensity"), None)?;
         let angle = |a: &Option<Spanned<f32>>, name: &str, default: f32| match a {
             None => Ok(default),
             Some(x) => {

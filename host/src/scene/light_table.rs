@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use kernel::geometry::triangle_point_error;
-use kernel::scene::{light_kind, light_selection, Light, Triangle, NONE};
+use kernel::scene::{light_kind, light_selection, Light, Sphere, Triangle, NONE};
 
 /// The light of an emissive sphere (selection filled later by [`assign_light_selection`]).
 pub fn sphere_light(center: Vec3, radius: f32, radiance: [f32; 3]) -> Light {
@@ -54,6 +54,58 @@ pub fn punctual_light(
     l
 }
 
+/// A directional light (`light_kind::PUNCTUAL` with `radius` > 0): irradiance `irradiance`
+/// (per unit area perpendicular to the light) arriving along `travel`, the direction the light
+/// travels. Its bounding sphere is a placeholder (unit, at the origin) until
+/// [`place_directional_lights`] sets the scene's.
+pub fn directional_light(travel: Vec3, irradiance: [f32; 3]) -> Light {
+    let mut l = punctual_light(Vec3::ZERO, irradiance, None);
+    l.radius = 1.0;
+    l.edge1 = travel.normalize().to_array();
+    l
+}
+
+/// Whether `l` is a directional light.
+pub fn is_directional(l: &Light) -> bool {
+    l.kind == light_kind::PUNCTUAL && l.radius > 0.0
+}
+
+/// The sphere bounding `spheres` and `triangles` (centre, radius; at least 1e-3), or the unit
+/// sphere at the origin for an empty scene: where the environment map and directional lights
+/// send their light from.
+pub fn scene_bounds(spheres: &[Sphere], triangles: &[Triangle]) -> (Vec3, f32) {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for s in spheres {
+        let c = Vec3::from(s.center);
+        lo = lo.min(c - s.radius);
+        hi = hi.max(c + s.radius);
+    }
+    for t in triangles {
+        let p0 = Vec3::from(t.p0);
+        for p in [p0, p0 + Vec3::from(t.edge1), p0 + Vec3::from(t.edge2)] {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    if lo.x <= hi.x {
+        ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-3))
+    } else {
+        (Vec3::ZERO, 1.0)
+    }
+}
+
+/// Gives every directional light of `lights` the scene's bounding sphere (`scene_bounds`).
+pub fn place_directional_lights(lights: &mut [Light], spheres: &[Sphere], triangles: &[Triangle]) {
+    if !lights.iter().any(is_directional) {
+        return;
+    }
+    let (center, radius) = scene_bounds(spheres, triangles);
+    for l in lights.iter_mut().filter(|l| is_directional(l)) {
+        l.position = center.to_array();
+        l.radius = radius;
+    }
+}
+
 /// The light of an emissive triangle `tri` (its own p0 and edges, so a sample and a hit see
 /// the same triangle): its area (in f64, then rounded) and the error bound of its points.
 pub fn triangle_light(tri: &Triangle, radiance: [f32; 3], two_sided: bool) -> Light {
@@ -88,6 +140,10 @@ pub fn triangle_light(tri: &Triangle, radiance: [f32; 3], two_sided: bool) -> Li
 pub fn light_power(l: &Light) -> f64 {
     let [r, g, b] = l.radiance.map(f64::from);
     let luminance = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+    if is_directional(l) {
+        // Irradiance over the disc the scene presents to it (pbrt-v4 `DistantLight::Phi`).
+        return luminance.max(0.0) * std::f64::consts::PI * (l.radius as f64).powi(2);
+    }
     if l.kind == light_kind::PUNCTUAL {
         // Intensity over the directions the falloff lets through: 4 pi for a point light, the
         // cap out to the outer cone (where the falloff reaches 0) for a spot.

@@ -294,7 +294,6 @@ impl Import<'_> {
         let mut stack: Vec<(gltf::Node, DMat4)> =
             roots.into_iter().rev().map(|n| (n, root)).collect();
         let mut cameras = Vec::new();
-        let mut punctual = 0;
         while let Some((node, parent)) = stack.pop() {
             let k = node.index();
             if std::mem::replace(&mut visited[k], true) {
@@ -316,16 +315,11 @@ impl Import<'_> {
                 }
             }
             if let Some(light) = node.light() {
-                punctual += self.add_light(&node, &light, world)?;
+                self.add_light(&node, &light, world)?;
             }
             for child in node.children().collect::<Vec<_>>().into_iter().rev() {
                 stack.push((child, world));
             }
-        }
-        if punctual > 0 {
-            self.note(format!(
-                "KHR_lights_punctual: {punctual} directional light(s) ignored (not supported yet)"
-            ));
         }
         Ok(cameras)
     }
@@ -374,13 +368,14 @@ impl Import<'_> {
     /// Adds `KHR_lights_punctual` light `light` of `node` at `world`: a point or spot light at
     /// the node's origin, a spot pointing down the node's -z; colour x intensity is its radiant
     /// intensity (the extension's candela taken as RGB watts per steradian); `range` is ignored
-    /// (physical falloff). Returns 1 for a directional light, which is not rendered (yet).
+    /// (physical falloff). A directional light shines down the node's -z with colour x
+    /// intensity as its irradiance (lux taken as RGB watts per square metre).
     fn add_light(
         &mut self,
         node: &gltf::Node,
         light: &gltf::khr_lights_punctual::Light,
         world: DMat4,
-    ) -> Result<u32, SceneError> {
+    ) -> Result<(), SceneError> {
         use gltf::khr_lights_punctual::Kind;
         let field = format!("KHR_lights_punctual.lights[{}]", light.index());
         let path = self.path.clone();
@@ -408,7 +403,21 @@ impl Import<'_> {
             )));
         }
         let cone = match light.kind() {
-            Kind::Directional => return Ok(1),
+            Kind::Directional => {
+                if !(axis.length() > 0.0 && axis.is_finite()) {
+                    return Err(err(format!(
+                        "nodes[{}] gives the directional light no direction",
+                        node.index()
+                    )));
+                }
+                self.tables
+                    .lights
+                    .push(super::light_table::directional_light(
+                        axis.as_vec3(),
+                        intensity.to_array(),
+                    ));
+                return Ok(());
+            }
             Kind::Point => None,
             Kind::Spot {
                 inner_cone_angle,
@@ -436,7 +445,7 @@ impl Import<'_> {
             intensity.to_array(),
             cone,
         ));
-        Ok(0)
+        Ok(())
     }
 
     /// Adds every primitive of `mesh` as placed by `node` at `world`.
