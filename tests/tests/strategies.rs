@@ -314,3 +314,39 @@ fn light_only_bsdf_only_and_mis_agree_with_textures_and_shading_normals() {
     });
     variants_agree("textures and shading normals", &text, None, &variants);
 }
+
+/// The glossy scene with glTF's metallic-roughness material on both spheres (a fractional
+/// metalness on each, so the dielectric and the metal lobes and the (1 - F) diffuse factor are
+/// all sampled) and a bumpy normal map on the floor (a mapped shading normal per point, under
+/// which a direction can lie between the two planes): the strategies agree only if the
+/// resolved material's value, density and sampler agree with each other under the mapped frame.
+#[test]
+fn light_only_bsdf_only_and_mis_agree_with_metallic_roughness_and_a_normal_map() {
+    let dir = std::env::temp_dir().join(format!("twinpath-strategies-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bumps = dir.join("bumps.png");
+    image::RgbImage::from_fn(8, 8, |i, j| {
+        let (x, y) = ((i as f32 * 0.8).sin(), (j as f32 * 1.1).cos());
+        image::Rgb([(128.0 + 90.0 * x) as u8, (128.0 + 90.0 * y) as u8, 200])
+    })
+    .save(&bumps)
+    .unwrap();
+    let text = SPHERE_LIGHT_SCENE
+        .replace(
+            "floor = { kd = [0.4, 0.4, 0.4], ks = [0.3, 0.3, 0.3], alpha = 0.3 }",
+            &format!(
+                "floor = {{ kd = [0.4, 0.4, 0.4], ks = [0.3, 0.3, 0.3], alpha = 0.3, normal_map = \"{}\" }}",
+                bumps.display()
+            ),
+        )
+        .replace(
+            "gold = { conductor = \"gold\", alpha = 0.4 }",
+            "gold = { base_color = [0.9, 0.6, 0.3], metallic = 0.6, roughness = 0.6 }",
+        )
+        .replace(
+            "sharp = { kd = [0.2, 0.3, 0.5], ks = [0.4, 0.4, 0.4], alpha = 0.1 }",
+            "sharp = { base_color = [0.2, 0.3, 0.5], metallic = 0.3, roughness = 0.35 }",
+        );
+    assert!(text.contains("normal_map") && text.contains("metallic = 0.3"));
+    variants_agree("metallic-roughness and a normal map", &text, None, &MODES);
+}
