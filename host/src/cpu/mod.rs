@@ -112,14 +112,15 @@ macro_rules! with_features {
 }
 
 /// The feature bits beyond the diffuse renderer's: other materials than the Lambertian,
-/// triangle lights, a thin lens, an environment map, shading normals, textures and normal maps.
+/// triangle lights, a thin lens, an environment map, shading normals and textures. (Normal maps
+/// and delta lights are not among them: scenes with those run the [`Dynamic`] path, so that
+/// scenes without them do not carry their checks; docs/performance.md measures both.)
 const EXTENDED: u32 = features::MATERIALS
     | features::TRIANGLE_LIGHTS
     | features::THIN_LENS
     | features::ENVIRONMENT
     | features::SHADING_NORMALS
-    | features::TEXTURES
-    | features::NORMAL_MAPS;
+    | features::TEXTURES;
 
 /// `bits` with every [`EXTENDED`] bit set if any is: the CPU compiles one path for scenes with
 /// other materials, triangle lights, a lens or an environment map (such a bit only keeps code,
