@@ -300,3 +300,82 @@ fn normal_map_errors_name_the_field() {
     );
     assert_eq!(plain.features() & kernel::features::NORMAL_MAPS, 0);
 }
+
+/// The tangent frame a glTF file's own `TANGENT` gives, under no transform, a mirroring one and
+/// a rotation; and the per-triangle frame where the file has none or a degenerate one.
+#[test]
+fn gltf_tangents_are_read_and_transformed() {
+    use serde_json::json;
+    use twinpath_tests::gltf_writer::GltfWriter;
+    let dir = temp_dir("tangents");
+    // One triangle in the plane y = 0 (front +y), u along +x, v (ours) along -z: the frame
+    // from the coordinates is T = +x, sign +1. The file says T = (0, 0, 2), w = -1 instead.
+    let load = |tangent: Option<[f32; 4]>, node: serde_json::Value, name: &str| {
+        let mut g = GltfWriter::new();
+        let png = {
+            let img = image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]));
+            let mut out = std::io::Cursor::new(Vec::new());
+            img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+            out.into_inner()
+        };
+        let tex = g.png_texture(&png);
+        let material = g.push("materials", json!({ "normalTexture": { "index": tex } }));
+        let mesh = g.mesh(
+            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
+            Some(&[[0.0, 1.0, 0.0]; 3]),
+            Some(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0]]),
+            &[0, 1, 2],
+            Some(material),
+        );
+        if let Some(t) = tangent {
+            let a = g.floats(&[t, t, t].concat(), "VEC4");
+            g.json["meshes"][mesh]["primitives"][0]["attributes"]["TANGENT"] = json!(a);
+        }
+        let mut node = node;
+        node["mesh"] = json!(mesh);
+        g.push("nodes", node);
+        g.push("scenes", json!({ "nodes": [0] }));
+        let path = dir.join(name);
+        std::fs::write(&path, g.glb()).unwrap();
+        Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let frame = |s: &Scene| {
+        assert_eq!(s.shading.len(), 2, "a record and its tangent frame");
+        (Vec3::from(s.shading[1].normal0), s.shading[1].uv0[0])
+    };
+    let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-6;
+    // No TANGENT: the coordinates' frame.
+    let (t, sign) = frame(&load(None, json!({}), "none.glb"));
+    assert!(close(t, Vec3::X) && sign == 1.0, "{t} {sign}");
+    // The file's tangent as given.
+    let file = Some([0.0, 0.0, 2.0, -1.0]);
+    let (t, sign) = frame(&load(file, json!({}), "given.glb"));
+    assert!(
+        close(t, Vec3::new(0.0, 0.0, 2.0)) && sign == -1.0,
+        "{t} {sign}"
+    );
+    // A mirroring node (x -> -x): T' = M T = T here, and the sign flips.
+    let (t, sign) = frame(&load(
+        file,
+        json!({ "scale": [-1.0, 1.0, 1.0] }),
+        "mirrored.glb",
+    ));
+    assert!(
+        close(t, Vec3::new(0.0, 0.0, 2.0)) && sign == 1.0,
+        "{t} {sign}"
+    );
+    // A rotation of 90 degrees about +y (z -> x): T' = (2, 0, 0), the sign kept.
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    let (t, sign) = frame(&load(
+        file,
+        json!({ "rotation": [0.0, h, 0.0, h] }),
+        "rotated.glb",
+    ));
+    assert!(
+        close(t, Vec3::new(2.0, 0.0, 0.0)) && sign == -1.0,
+        "{t} {sign}"
+    );
+    // A degenerate tangent (zero xyz) falls back to the coordinates' frame.
+    let (t, sign) = frame(&load(Some([0.0, 0.0, 0.0, 1.0]), json!({}), "zero.glb"));
+    assert!(close(t, Vec3::X) && sign == 1.0, "{t} {sign}");
+}

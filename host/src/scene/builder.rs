@@ -67,12 +67,14 @@ impl SceneTables {
     /// Appends the triangle with vertices `p` and `material`, its shading record `attributes`
     /// if it has one, and its light if the material emits. A triangle whose material has a
     /// normal map always gets a record (texture coordinates 0 where it has none), followed by
-    /// its tangent frame (`ShadingTriangle::tangent_frame`, from `tangents::face_tangent`).
+    /// its tangent frame (`ShadingTriangle::tangent_frame`): the file's vertex tangents and sign
+    /// (`tangents`, world space) where it gives usable ones, else `tangents::face_tangent`'s.
     pub fn push_triangle(
         &mut self,
         p: [Vec3; 3],
         material: u32,
         attributes: Option<ShadingTriangle>,
+        tangents: Option<([Vec3; 3], f32)>,
     ) {
         let mut tri = super::triangle(p, material);
         let m = self.materials[material as usize];
@@ -85,10 +87,20 @@ impl SceneTables {
             tri.shading = self.shading.len() as u32;
             self.shading.push(a);
             if normal_mapped {
-                let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
-                let (t, sign) = face_tangent(p, [a.uv0, a.uv1, a.uv2], normal);
-                self.shading
-                    .push(ShadingTriangle::tangent_frame([t; 3], sign));
+                let usable = |t: &([Vec3; 3], f32)| {
+                    t.0.iter().all(|v| v.length() > 0.0 && v.is_finite()) && t.1 != 0.0
+                };
+                let frame = match tangents.filter(usable) {
+                    Some((t, sign)) => {
+                        ShadingTriangle::tangent_frame(t.map(|v| v.to_array()), sign.signum())
+                    }
+                    None => {
+                        let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+                        let (t, sign) = face_tangent(p, [a.uv0, a.uv1, a.uv2], normal);
+                        ShadingTriangle::tangent_frame([t; 3], sign)
+                    }
+                };
+                self.shading.push(frame);
             }
         }
         if self.is_emissive(material) {
@@ -150,6 +162,23 @@ impl SceneTables {
                 .get(k)
                 .filter(|_| textured)
                 .map(|t| wound(*t, mirror));
+            // A file's tangents (glTF TANGENT) map as directions, T' = M T; their sign flips
+            // where M mirrors: (N' x T') . (M B) = det(M) w |M^-T N| for B = w N x T and
+            // N' along M^-T N (docs/materials.md, "Normal maps").
+            let tangents = soup.tangents.get(k).filter(|_| textured).map(|t| {
+                let mapped = wound(
+                    t.map(|c| {
+                        let v = Vec3::new(c[0], c[1], c[2]);
+                        match transform {
+                            Some(m) => m.vector(v),
+                            None => v,
+                        }
+                    }),
+                    mirror,
+                );
+                let sign = if mirror { -t[0][3] } else { t[0][3] };
+                (mapped, sign)
+            });
             let attributes = (normals.is_some() || uvs.is_some()).then(|| {
                 let n = normals.unwrap_or([[0.0; 3]; 3]);
                 let t = uvs.unwrap_or([[0.0; 2]; 3]);
@@ -163,7 +192,7 @@ impl SceneTables {
                     has_normals: normals.is_some() as u32,
                 }
             });
-            self.push_triangle(p, material, attributes);
+            self.push_triangle(p, material, attributes, tangents);
         }
         self.triangle_groups.push(TriangleGroup {
             name,

@@ -563,11 +563,13 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             wound([corner, corner + e1, corner + e1 + e2], mirror),
             material,
             textured.then(|| quad_uv(wound([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], mirror))),
+            None,
         );
         tables.push_triangle(
             wound([corner, corner + e1 + e2, corner + e2], mirror),
             material,
             textured.then(|| quad_uv(wound([[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]], mirror))),
+            None,
         );
     }
     if tables.triangles.len() > quads_start {

@@ -8,13 +8,15 @@ use std::path::Path;
 /// allocation (a hostile header must not reserve unbounded memory).
 pub const MAX_PLY_ELEMENTS: usize = 1 << 28;
 
-/// Triangles as vertex positions, three per triangle, with their vertex normals and texture
-/// coordinates where the file gives them (each list empty, or one entry per triangle).
+/// Triangles as vertex positions, three per triangle, with their vertex normals, texture
+/// coordinates and tangents where the file gives them (each list empty, or one entry per
+/// triangle). A tangent is glTF's `TANGENT`: xyz along increasing u, w the bitangent's sign.
 #[derive(Debug, Default, Clone)]
 pub struct TriangleSoup {
     pub triangles: Vec<[[f32; 3]; 3]>,
     pub normals: Vec<[[f32; 3]; 3]>,
     pub uvs: Vec<[[f32; 2]; 3]>,
+    pub tangents: Vec<[[f32; 4]; 3]>,
 }
 
 impl TriangleSoup {
@@ -26,6 +28,9 @@ impl TriangleSoup {
         }
         if self.uvs.len() != self.triangles.len() {
             self.uvs.clear();
+        }
+        if self.tangents.len() != self.triangles.len() {
+            self.tangents.clear();
         }
         self
     }

@@ -123,6 +123,26 @@ pub(super) fn read_vec3(
     read_finite(path, a, buffers, f32_at)
 }
 
+/// Four-component float vectors (TANGENT: xyz and the bitangent sign w), each finite.
+pub(super) fn read_vec4(
+    path: &Path,
+    a: &Accessor,
+    buffers: &[gltf::buffer::Data],
+) -> Result<Vec<[f32; 4]>, SceneError> {
+    if a.data_type() != DataType::F32 || a.dimensions() != Dimensions::Vec4 {
+        return Err(accessor_error(
+            path,
+            a,
+            format!(
+                "is {:?} {:?}: expected VEC4 of FLOAT",
+                a.dimensions(),
+                a.data_type()
+            ),
+        ));
+    }
+    read_finite(path, a, buffers, f32_at)
+}
+
 /// Texture coordinates (TEXCOORD_n): float, or normalised unsigned bytes or shorts.
 pub(super) fn read_uv(
     path: &Path,

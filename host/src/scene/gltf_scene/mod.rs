@@ -16,7 +16,7 @@ use super::textures::TextureUse;
 use super::transform::Transform;
 use super::{CameraDesc, Scene, SceneError};
 use crate::settings::RenderSettings;
-use accessor::{read_indices, read_uv, read_vec3};
+use accessor::{read_indices, read_uv, read_vec3, read_vec4};
 use glam::{DMat4, DQuat, DVec3, DVec4, Vec3};
 use gltf::mesh::Mode;
 use std::collections::HashMap;
@@ -538,9 +538,14 @@ impl Import<'_> {
             Some(a) => Some(read_uv(&self.path, &a, &self.buffers)?),
             None => None,
         };
+        let tangents = match p.get(&gltf::Semantic::Tangents) {
+            Some(a) => Some(read_vec4(&self.path, &a, &self.buffers)?),
+            None => None,
+        };
         for (name, len) in [
             ("NORMAL", normals.as_ref().map(|v| v.len())),
             ("TEXCOORD_0", uvs.as_ref().map(|v| v.len())),
+            ("TANGENT", tangents.as_ref().map(|v| v.len())),
         ] {
             if let Some(len) = len.filter(|&l| l != n) {
                 return Err(err(format!(
@@ -587,6 +592,9 @@ impl Import<'_> {
                     .iter()
                     .map(|t| t.map(|i| [v[i as usize][0], 1.0 - v[i as usize][1]]))
                     .collect()
+            }),
+            tangents: tangents.map_or_else(Vec::new, |v| {
+                triangles.iter().map(|t| t.map(|i| v[i as usize])).collect()
             }),
         })
     }
