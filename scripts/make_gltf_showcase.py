@@ -2,7 +2,8 @@
 """Writes scenes/gltf/showcase.glb (pure Python, no dependencies; the output is committed): a
 glTF 2.0 binary scene made to show what twinpath reads from glTF files:
   - a floor with a checker base colour texture (metallic 0, roughness 0.7), texture
-    coordinates repeating it 16 x 16 (sampler REPEAT);
+    coordinates repeating it 16 x 16 (sampler REPEAT), and a normal map bevelling each square's
+    edges (tangent space, green up; no TANGENT attribute, so the renderer derives the frame);
   - a UV sphere (64 x 32, smooth normals) whose base colour and metallic-roughness maps run in
     bands: polished gold metal (metallic 1, roughness 0.2) and blue dielectric (metallic 0,
     roughness 0.5), so one object is partly metallic;
@@ -93,8 +94,22 @@ band = lambda j: (j // 8) % 2 == 0
 stripes = texture(png(8, 64, lambda i, j: (255, 200, 90) if band(j) else (40, 90, 200)))
 stripes_mr = texture(png(8, 64, lambda i, j: (0, 51, 255) if band(j) else (0, 128, 0)))
 
+
+
+def bevel(i, j):
+    """The tangent-space normal of texel (i, j) of a square of 8 x 8 texels bevelled at its
+    edges: tilted away from the square's centre on its outer texels (x right, y up the image,
+    so row 0 of the square is its top edge), encoded as glTF's (n + 1) / 2 in bytes."""
+    x = -0.6 if i % 8 == 0 else 0.6 if i % 8 == 7 else 0.0
+    y = 0.6 if j % 8 == 0 else -0.6 if j % 8 == 7 else 0.0
+    n = math.sqrt(x * x + y * y + 1.0)
+    return tuple(round(255 * (c / n + 1) / 2) for c in (x, y, 1.0))
+
+
+bevels = texture(png(64, 64, bevel))
 floor_mat = material("floor", {"baseColorTexture": {"index": checker}, "metallicFactor": 0.0,
                                "roughnessFactor": 0.7})
+doc["materials"][floor_mat]["normalTexture"] = {"index": bevels}
 sphere_mat = material("banded", {"baseColorTexture": {"index": stripes},
                                  "metallicRoughnessTexture": {"index": stripes_mr}})
 box_mat = material("copper", {"baseColorFactor": [0.95, 0.64, 0.54, 1.0], "metallicFactor": 1.0,

@@ -760,6 +760,7 @@ fn the_shipped_showcase_loads_and_renders_alike_on_both_backends() {
         (kernel::features::TEXTURES, "textures"),
         (kernel::features::SHADING_NORMALS, "smooth normals"),
         (kernel::features::PUNCTUAL_LIGHTS, "a spot light"),
+        (kernel::features::NORMAL_MAPS, "a normal map"),
         (kernel::features::ENVIRONMENT, "the HDR sky"),
     ] {
         assert!(f & bit != 0, "the showcase lacks {name}");
