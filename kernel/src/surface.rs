@@ -35,11 +35,18 @@ pub fn interpolated_normal(tri: &ShadingTriangle, bary: Vec2) -> Vec3 {
         Vec3::from(tri.normal2),
         bary,
     );
-    let len2 = n.dot(n);
+    unit_or(n, Vec3::ZERO)
+}
+
+/// `v` scaled to unit length, or `fallback` where `v` has no direction (zero, or a length
+/// that overflows or is not a number).
+#[inline]
+fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
+    let len2 = v.dot(v);
     if len2 > 0.0 && len2.is_finite() {
-        n / len2.sqrt()
+        v / len2.sqrt()
     } else {
-        Vec3::ZERO
+        fallback
     }
 }
 
@@ -75,21 +82,13 @@ pub fn mapped_normal(
         Vec3::from(frame.normal2),
         bary,
     );
-    let t = t - base * base.dot(t);
-    let t_len2 = t.dot(t);
-    if !(t_len2 > 0.0 && t_len2.is_finite()) {
+    let t = unit_or(t - base * base.dot(t), Vec3::ZERO);
+    if t == Vec3::ZERO {
         return base;
     }
-    let t = t / t_len2.sqrt();
     let b = base.cross(t) * frame.uv0[0];
     let m = (texel * 2.0 - Vec3::ONE) * Vec3::new(scale, scale, 1.0);
-    let n = t * m.x + b * m.y + base * m.z;
-    let len2 = n.dot(n);
-    if len2 > 0.0 && len2.is_finite() {
-        n / len2.sqrt()
-    } else {
-        base
-    }
+    unit_or(t * m.x + b * m.y + base * m.z, base)
 }
 
 /// The material at a vertex on material `material` and shading record `record` (a hit's

@@ -345,6 +345,16 @@ pub fn pixel_quadrature(
         .collect()
 }
 
+/// The largest |z| of a film's red channel (means `mean`, variances of the mean `var`) against
+/// the pixel values `wrong` of a hypothesis the test must reject (`None`: pixel not compared).
+pub fn max_abs_z(mean: &[[f32; 3]], var: &[[f32; 3]], wrong: &[Option<f64>]) -> f64 {
+    wrong
+        .iter()
+        .enumerate()
+        .filter_map(|(i, e)| e.map(|e| ((mean[i][0] as f64 - e) / (var[i][0] as f64).sqrt()).abs()))
+        .fold(0.0, f64::max)
+}
+
 /// z-tests a film's red channel against exact pixel values: each pixel (Sidak-corrected for
 /// the number tested) and all pixels together. Returns the overall z.
 pub fn assert_film_matches(film: &twinpath::film::Film, exact: &[Option<f64>], label: &str) -> f64 {

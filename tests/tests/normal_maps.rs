@@ -18,7 +18,8 @@ use twinpath::scene::textures::{TextureTable, TextureUse};
 use twinpath::scene::Scene;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches, pixel_quadrature, render_film, scene_from_toml, with_independent_samples,
+    assert_film_matches, max_abs_z, pixel_quadrature, render_film, scene_from_toml,
+    with_independent_samples,
 };
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -239,13 +240,7 @@ fn a_normal_mapped_plane_under_a_point_light_matches_its_closed_form_on_both_bac
         assert_film_matches(&film, &want, &format!("normal-mapped plane, {backend:?}"));
         let (mean, var) = (film.mean(), film.variance_of_mean());
         for (label, normal) in wrong {
-            let worst = exact(&scene, normal)
-                .iter()
-                .enumerate()
-                .filter_map(|(i, e)| {
-                    e.map(|e| ((mean[i][0] as f64 - e) / (var[i][0] as f64).sqrt()).abs())
-                })
-                .fold(0.0, f64::max);
+            let worst = max_abs_z(&mean, &var, &exact(&scene, normal));
             assert!(
                 worst > 20.0,
                 "{backend:?}: {label} not rejected (max |z| {worst})"

@@ -16,8 +16,8 @@ use twinpath::scene::Scene;
 use twinpath_tests::gltf_writer::GltfWriter;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches, assert_film_matches_with_variance, pixel_quadrature, render_film,
-    scene_from_toml, variance_of_mean_from, with_independent_samples,
+    assert_film_matches, assert_film_matches_with_variance, max_abs_z, pixel_quadrature,
+    render_film, scene_from_toml, variance_of_mean_from, with_independent_samples,
 };
 
 const KD: f32 = 0.6;
@@ -106,13 +106,7 @@ fn a_plane_under_a_point_and_a_sphere_light_matches_its_closed_form_on_both_back
                 &format!("point + sphere, {render}, {backend:?}"),
             );
             let mean = film.mean();
-            let worst = wrong
-                .iter()
-                .enumerate()
-                .filter_map(|(i, e)| {
-                    e.map(|e| ((mean[i][0] as f64 - e) / (var[i][0] as f64).sqrt()).abs())
-                })
-                .fold(0.0, f64::max);
+            let worst = max_abs_z(&mean, &var, &wrong);
             assert!(
                 worst > 20.0,
                 "{render}, {backend:?}: 1/d falloff not rejected (max |z| {worst})"
@@ -171,14 +165,9 @@ fn a_spot_light_follows_gltf_falloff_on_both_backends() {
         }
         assert_film_matches(&film, &lit, &format!("spot, {backend:?}"));
         let var = film.variance_of_mean();
-        let worst = wrong
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| lit[*i].is_some())
-            .filter_map(|(i, e)| {
-                e.map(|e| ((mean[i][0] as f64 - e) / (var[i][0] as f64).sqrt()).abs())
-            })
-            .fold(0.0, f64::max);
+        let wrong_where_lit: Vec<Option<f64>> =
+            wrong.iter().zip(&lit).map(|(w, l)| l.and(*w)).collect();
+        let worst = max_abs_z(&mean, &var, &wrong_where_lit);
         assert!(
             worst > 10.0,
             "{backend:?}: an unsquared falloff not rejected (max |z| {worst})"

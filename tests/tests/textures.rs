@@ -20,8 +20,8 @@ use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse};
 use twinpath::scene::{parse_scene, Scene};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches, pixel_quadrature, render_film, scene_from_toml, with_independent_samples,
-    SplitMix,
+    assert_film_matches, max_abs_z, pixel_quadrature, render_film, scene_from_toml,
+    with_independent_samples, SplitMix,
 };
 
 /// A fresh folder for this test's files.
@@ -333,13 +333,7 @@ fn checkered_plane_matches_the_closed_form_on_both_backends() {
         // Power: the squares' colours swapped are rejected by far.
         let mean = film.mean();
         let var = film.variance_of_mean();
-        let worst = swapped
-            .iter()
-            .enumerate()
-            .filter_map(|(i, e)| {
-                e.map(|e| ((mean[i][0] as f64 - e) / (var[i][0] as f64).sqrt()).abs())
-            })
-            .fold(0.0, f64::max);
+        let worst = max_abs_z(&mean, &var, &swapped);
         println!("checker, {backend:?}: squares swapped: max |z| {worst:.0}");
         assert!(
             worst > 20.0,

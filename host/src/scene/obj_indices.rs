@@ -29,36 +29,37 @@ pub fn check_obj_face_indices(path: &Path, bytes: &[u8]) -> Result<(), SceneErro
             break;
         };
         let mut words = text.split_whitespace();
-        match words.next() {
-            Some(word) if KINDS.iter().any(|(k, _)| *k == word) => {
-                let kind = KINDS.iter().position(|(k, _)| *k == word).unwrap();
-                declared[kind] += 1;
-            }
-            Some("f") | Some("l") => {
-                for corner in words {
-                    for (kind, index) in corner.split('/').enumerate().take(3) {
-                        let Ok(index) = index.parse::<i64>() else {
-                            continue; // empty (`v//vn`) or malformed: tobj reports the latter
-                        };
-                        if index < 0 && index.unsigned_abs() > declared[kind] as u64 {
-                            return Err(SceneError::new(
-                                path,
-                                Some(line),
-                                "face",
-                                format!(
-                                    "{} index {index} reaches before the first {} \
-                                     ({} declared above this line)",
-                                    KINDS[kind].1, KINDS[kind].0, declared[kind]
-                                ),
-                            ));
-                        }
-                        if index > 0 && largest[kind].is_none_or(|(m, _)| index as u64 > m) {
-                            largest[kind] = Some((index as u64, line));
-                        }
-                    }
+        let Some(word) = words.next() else {
+            continue;
+        };
+        if let Some(kind) = KINDS.iter().position(|(k, _)| *k == word) {
+            declared[kind] += 1;
+            continue;
+        }
+        if word != "f" && word != "l" {
+            continue;
+        }
+        for corner in words {
+            for (kind, index) in corner.split('/').enumerate().take(3) {
+                let Ok(index) = index.parse::<i64>() else {
+                    continue; // empty (`v//vn`) or malformed: tobj reports the latter
+                };
+                if index < 0 && index.unsigned_abs() > declared[kind] as u64 {
+                    return Err(SceneError::new(
+                        path,
+                        Some(line),
+                        "face",
+                        format!(
+                            "{} index {index} reaches before the first {} \
+                             ({} declared above this line)",
+                            KINDS[kind].1, KINDS[kind].0, declared[kind]
+                        ),
+                    ));
+                }
+                if index > 0 && largest[kind].is_none_or(|(m, _)| index as u64 > m) {
+                    largest[kind] = Some((index as u64, line));
                 }
             }
-            _ => {}
         }
     }
     for (kind, largest) in largest.into_iter().enumerate() {

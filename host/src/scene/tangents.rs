@@ -16,7 +16,7 @@
 //! surfaces; on curved meshes the per-triangle frame can show the facets in the mapped normal
 //! (docs/gltf.md).
 
-use glam::DVec3;
+use kernel::frame::orthonormal_basis;
 
 /// The unit tangent dp/du of the triangle `p` with texture coordinates `uv`, and the
 /// bitangent sign, for geometric normal `normal` (unit). Where (u, v) does not span the
@@ -47,16 +47,7 @@ pub fn face_tangent(p: [glam::Vec3; 3], uv: [[f32; 2]; 3], normal: glam::Vec3) -
             return (t.normalize().as_vec3().to_array(), sign);
         }
     }
-    (perpendicular(n).as_vec3().to_array(), 1.0)
-}
-
-/// A unit vector perpendicular to unit `n` (Duff et al., "Building an Orthonormal Basis,
-/// Revisited", JCGT 2017: continuous except at the sign switch).
-fn perpendicular(n: DVec3) -> DVec3 {
-    let sign = 1f64.copysign(n.z);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x)
+    (orthonormal_basis(normal).0.to_array(), 1.0)
 }
 
 #[cfg(test)]

@@ -103,38 +103,24 @@ fn f32_at(b: &[u8], k: usize) -> f32 {
     f32::from_le_bytes([b[4 * k], b[4 * k + 1], b[4 * k + 2], b[4 * k + 3]])
 }
 
-/// Three-component float vectors (POSITION, NORMAL), each finite.
-pub(super) fn read_vec3(
+/// N-component float vectors (POSITION and NORMAL: VEC3; TANGENT: VEC4, xyz and the
+/// bitangent sign w), each finite.
+pub(super) fn read_floats<const N: usize>(
     path: &Path,
     a: &Accessor,
     buffers: &[gltf::buffer::Data],
-) -> Result<Vec<[f32; 3]>, SceneError> {
-    if a.data_type() != DataType::F32 || a.dimensions() != Dimensions::Vec3 {
+) -> Result<Vec<[f32; N]>, SceneError> {
+    let (dimensions, name) = match N {
+        3 => (Dimensions::Vec3, "VEC3"),
+        4 => (Dimensions::Vec4, "VEC4"),
+        _ => unreachable!("POSITION, NORMAL and TANGENT are VEC3 or VEC4"),
+    };
+    if a.data_type() != DataType::F32 || a.dimensions() != dimensions {
         return Err(accessor_error(
             path,
             a,
             format!(
-                "is {:?} {:?}: expected VEC3 of FLOAT",
-                a.dimensions(),
-                a.data_type()
-            ),
-        ));
-    }
-    read_finite(path, a, buffers, f32_at)
-}
-
-/// Four-component float vectors (TANGENT: xyz and the bitangent sign w), each finite.
-pub(super) fn read_vec4(
-    path: &Path,
-    a: &Accessor,
-    buffers: &[gltf::buffer::Data],
-) -> Result<Vec<[f32; 4]>, SceneError> {
-    if a.data_type() != DataType::F32 || a.dimensions() != Dimensions::Vec4 {
-        return Err(accessor_error(
-            path,
-            a,
-            format!(
-                "is {:?} {:?}: expected VEC4 of FLOAT",
+                "is {:?} {:?}: expected {name} of FLOAT",
                 a.dimensions(),
                 a.data_type()
             ),

@@ -16,7 +16,7 @@ use super::textures::TextureUse;
 use super::transform::Transform;
 use super::{CameraDesc, Scene, SceneError};
 use crate::settings::RenderSettings;
-use accessor::{read_indices, read_uv, read_vec3, read_vec4};
+use accessor::{read_floats, read_indices, read_uv};
 use glam::{DMat4, DQuat, DVec3, DVec4, Vec3};
 use gltf::mesh::Mode;
 use std::collections::HashMap;
@@ -528,10 +528,10 @@ impl Import<'_> {
         let position = p
             .get(&gltf::Semantic::Positions)
             .ok_or_else(|| err("has no POSITION attribute".into()))?;
-        let positions = read_vec3(&self.path, &position, &self.buffers)?;
+        let positions = read_floats::<3>(&self.path, &position, &self.buffers)?;
         let n = positions.len();
         let normals = match p.get(&gltf::Semantic::Normals) {
-            Some(a) => Some(read_vec3(&self.path, &a, &self.buffers)?),
+            Some(a) => Some(read_floats::<3>(&self.path, &a, &self.buffers)?),
             None => None,
         };
         let uvs = match p.get(&gltf::Semantic::TexCoords(0)) {
@@ -539,7 +539,7 @@ impl Import<'_> {
             None => None,
         };
         let tangents = match p.get(&gltf::Semantic::Tangents) {
-            Some(a) => Some(read_vec4(&self.path, &a, &self.buffers)?),
+            Some(a) => Some(read_floats::<4>(&self.path, &a, &self.buffers)?),
             None => None,
         };
         for (name, len) in [
