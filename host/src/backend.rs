@@ -30,4 +30,7 @@ pub trait SampleBackend {
     /// Of the set-up: building the acceleration structure (the CPU's BVH, the GPU's BLAS and
     /// TLAS) and creating the pipeline (zero on the CPU).
     fn setup_times(&self) -> (Duration, Duration);
+    /// Bytes of the acceleration structure: the CPU's BVH beyond the primitives (with its
+    /// instanced meshes' trees), the GPU's BLASes and TLAS as the driver sizes them.
+    fn accel_bytes(&self) -> u64;
 }

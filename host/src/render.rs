@@ -53,6 +53,8 @@ pub struct RenderOutput {
     /// Of `setup`: the BVH build (CPU), or the acceleration-structure build (GPU).
     pub accel_build: Duration,
     pub pipeline: Duration,
+    /// Bytes of the acceleration structure (`SampleBackend::accel_bytes`).
+    pub accel_bytes: u64,
     /// Time spent rendering samples.
     pub render: Duration,
     /// Samples per pixel actually rendered (fewer than asked after Ctrl-C).
@@ -149,6 +151,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
         setup,
         accel_build,
         pipeline,
+        accel_bytes: backend.accel_bytes(),
         render,
         spp_done,
         interrupted: spp_done < spp,

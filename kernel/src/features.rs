@@ -55,6 +55,9 @@ pub const PUNCTUAL_LIGHTS: u32 = 1 << 16;
 /// A material has a normal map (`texture_slot::NORMAL`). Always set with [`SHADING_NORMALS`]:
 /// a mapped normal is a shading normal, which the vertex reads only under that bit.
 pub const NORMAL_MAPS: u32 = 1 << 17;
+/// The scene has instances (`scene::Instance`): a hit may carry object-space shading records
+/// whose normals and tangents `surface::shade` maps to world space.
+pub const INSTANCES: u32 = 1 << 18;
 
 /// The material bits of a scene with these materials: one per kind present besides the
 /// Lambertian. (A bit may also be set for a kind that is absent: it only keeps that kind's
@@ -232,6 +235,11 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn normal_maps(self) -> bool {
         self.answer(NORMAL_MAPS, true)
+    }
+    /// Whether a hit may belong to an instance (see [`INSTANCES`]).
+    #[inline]
+    fn instances(self) -> bool {
+        self.answer(INSTANCES, true)
     }
     /// Whether a light may be a point or spot light (see [`PUNCTUAL_LIGHTS`]).
     #[inline]

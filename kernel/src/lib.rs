@@ -18,6 +18,7 @@ pub mod frame;
 pub mod fresnel;
 pub mod geometry;
 pub mod hash;
+pub mod instance;
 pub mod intersect;
 pub mod light;
 pub mod microfacet;

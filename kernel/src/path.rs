@@ -11,6 +11,7 @@ use crate::geometry::{
     offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error, triangle_point,
     triangle_point_error_conditioned, TriangleShape,
 };
+use crate::instance::{normal_to_world, point_to_world, world_point_error};
 use crate::light::{
     emission_texture_at, eval_radiance, is_punctual, light_point_error, pdf_environment_light,
     pdf_light_from, punctual_radiance, sample_radiance, DirectionalLightSample,
@@ -18,8 +19,8 @@ use crate::light::{
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{
-    light_sampling, material_kind, mis, Light, Material, RenderParams, ShadingTriangle, Sphere,
-    Triangle, NONE,
+    light_sampling, material_kind, mis, Instance, Light, Material, RenderParams, ShadingTriangle,
+    Sphere, Triangle, NONE,
 };
 use crate::surface::{emission_at, shade};
 use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION, LENS_DIMENSION};
@@ -50,6 +51,9 @@ pub struct SurfaceHit {
     pub shading: u32,
     /// A triangle's barycentrics (u, v) of p1 and p2 at the hit.
     pub barycentrics: Vec2,
+    /// The instance (`scene::Instance`) whose mesh the triangle belongs to, else [`NONE`]
+    /// (the triangle is in world space): its shading record is then in object space.
+    pub instance: u32,
 }
 
 impl SurfaceHit {
@@ -66,6 +70,7 @@ impl SurfaceHit {
             arrived_behind: false,
             shading: NONE,
             barycentrics: Vec2::ZERO,
+            instance: NONE,
         }
     }
 
@@ -88,6 +93,7 @@ impl SurfaceHit {
             arrived_behind: from_center.dot(from_center) < radius * radius,
             shading: NONE,
             barycentrics: Vec2::ZERO,
+            instance: NONE,
         }
     }
 
@@ -120,6 +126,50 @@ impl SurfaceHit {
             arrived_behind: Self::behind_plane(shape.normal, dir),
             shading: tri.shading,
             barycentrics: Vec2::new(u, v),
+            instance: NONE,
+        }
+    }
+
+    /// The record of a ray along world direction `dir` meeting triangle `tri` (object space, of
+    /// shape `shape`) of instance `instance` (number `index`) at `t`, barycentric (u, v): the
+    /// object-space point from the barycentrics mapped to world space, the geometric normal
+    /// M^-T (edge1 x edge2) normalised (along the edge cross product of the same triangle
+    /// flattened into world space, whose winding a mirroring transform reverses), the world
+    /// point's error bound (`instance::world_point_error`), and the side by the sign of
+    /// `normal . dir`. Barycentrics and the shading record stay the object-space triangle's
+    /// (an affine map keeps barycentrics). Both backends build instanced hits here.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub fn instanced_triangle(
+        tri: &Triangle,
+        shape: TriangleShape,
+        instance: &Instance,
+        index: u32,
+        dir: Vec3,
+        t: f32,
+        u: f32,
+        v: f32,
+    ) -> Self {
+        let (p0, e1, e2) = (
+            Vec3::from(tri.p0),
+            Vec3::from(tri.edge1),
+            Vec3::from(tri.edge2),
+        );
+        let p_object = triangle_point(p0, e1, e2, u, v);
+        let object_error = triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition);
+        let position = point_to_world(instance, p_object);
+        let normal = normal_to_world(instance, shape.normal).normalize();
+        Self {
+            position,
+            t,
+            normal,
+            material: tri.material,
+            light: tri.light,
+            error: world_point_error(instance, p_object, object_error, position),
+            arrived_behind: Self::behind_plane(normal, dir),
+            shading: tri.shading,
+            barycentrics: Vec2::new(u, v),
+            instance: index,
         }
     }
 
@@ -222,6 +272,7 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
     environment: &[f32],
     shading: &[ShadingTriangle],
     textures: &[u32],
+    instances: &[Instance],
     origin: Vec3,
     dir: Vec3,
     rng: &mut SampleRng,
@@ -235,6 +286,7 @@ pub fn trace_path<T: Tracer, F: FeatureSet>(
         environment,
         shading,
         textures,
+        instances,
     );
     *rng = path.rng;
     path.radiance
@@ -323,6 +375,7 @@ impl PathState {
         environment: &[f32],
         shading: &[ShadingTriangle],
         textures: &[u32],
+        instances: &[Instance],
     ) -> Self {
         loop {
             let hit = if self.extend {
@@ -348,9 +401,11 @@ impl PathState {
                     hit.shading,
                     hit.barycentrics,
                     hit.normal,
+                    hit.instance,
                     materials,
                     shading,
                     textures,
+                    instances,
                 );
                 let query = self.vertex_query(features, params, &hit, &material, shading_normal);
                 let samples = VertexSamples::draw(&query, &mut self.rng);
@@ -932,6 +987,7 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
     environment: &[f32],
     shading: &[ShadingTriangle],
     textures: &[u32],
+    instances: &[Instance],
     px: u32,
     py: u32,
     sample: u32,
@@ -946,6 +1002,7 @@ pub fn render_sample<T: Tracer, F: FeatureSet>(
             environment,
             shading,
             textures,
+            instances,
         )
         .radiance
 }

@@ -76,6 +76,30 @@ impl ShadingTriangle {
     }
 }
 
+/// One placement of a shared mesh: the mesh's triangles, stored once in object space in the
+/// triangle table, seen through an affine transform (`crate::instance`). Both backends read the
+/// same record: the GPU's TLAS instance carries `object_to_world` and its custom index names
+/// the record; the CPU's two-level BVH maps rays by `world_to_object`. 112 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct Instance {
+    /// The 3 x 4 object-to-world matrix [linear | translation], row-major (Vulkan's
+    /// `VkTransformMatrixKHR`).
+    pub object_to_world: [f32; 12],
+    /// Its inverse, world to object, in the same layout (rounded from an f64 inverse).
+    pub world_to_object: [f32; 12],
+    /// The mesh's first triangle in the triangle table; a hit's primitive index counts from it.
+    pub first_triangle: u32,
+    /// The infinity norm (largest absolute row sum) of `object_to_world`'s linear part.
+    pub forward_norm: f32,
+    /// The infinity norm of `world_to_object`'s linear part.
+    pub inverse_norm: f32,
+    /// 1, or -1 where the transform mirrors (a negative determinant): the sign a tangent
+    /// frame's handedness takes in world space.
+    pub handedness: f32,
+}
+
 /// The material parameters a texture can give (`Material::textures[slot]`).
 pub mod texture_slot {
     /// Kd, the diffuse reflectance (a colour map: sRGB-decoded); METALLIC_ROUGHNESS: the base

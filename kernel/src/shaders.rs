@@ -8,16 +8,18 @@
 //! 8 adaptive-sampling pilots (rgba32f: luminance mean, luminance M2, count, unused),
 //! 9 the environment table (`crate::environment`; one number when there is no map),
 //! 10 the shading table (`ShadingTriangle`s; one zero record when there is none),
-//! 11 the texture table (`crate::texture`).
+//! 11 the texture table (`crate::texture`), 12 the instance table (`Instance`s; one zero record
+//! when there is none).
 //! Specialization constant 0: the feature bits of `crate::features` (0: generic path).
-//! Hit groups: 0 triangles (closest hit), 1 spheres (intersection + closest hit).
+//! Hit groups: 0 triangles (closest hit), then 1 spheres (intersection + closest hit), then
+//! instanced triangles (closest hit), each present only where the scene has that geometry.
 //! Miss shader 0 serves both kinds of ray.
 
 use crate::adaptive::{is_pilot_sample, luminance, pixel_converged};
 use crate::features::Dynamic;
 use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::path::{render_sample, SurfaceHit, Tracer};
-use crate::scene::{Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
+use crate::scene::{Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
 use spirv_std::glam::{UVec2, UVec3, UVec4, Vec2, Vec3, Vec4};
 use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
@@ -40,6 +42,8 @@ pub struct HitPayload {
     /// A triangle's barycentrics and shading-table index (`SurfaceHit::shading`).
     pub barycentrics: Vec2,
     pub shading: u32,
+    /// The hit's instance (`SurfaceHit::instance`).
+    pub instance: u32,
 }
 
 impl HitPayload {
@@ -53,6 +57,7 @@ impl HitPayload {
         self.behind = h.arrived_behind as u32;
         self.barycentrics = h.barycentrics;
         self.shading = h.shading;
+        self.instance = h.instance;
     }
 
     /// The record a closest-hit shader stored, or a miss.
@@ -70,6 +75,7 @@ impl HitPayload {
             arrived_behind: self.behind != 0,
             shading: self.shading,
             barycentrics: self.barycentrics,
+            instance: self.instance,
         }
     }
 }
@@ -145,6 +151,7 @@ pub fn raygen(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] environment: &[f32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] shading: &[ShadingTriangle],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] textures: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] instances: &[Instance],
     #[spirv(descriptor_set = 0, binding = 7)] accum_m2: &Image!(
         2D,
         format = rgba32f,
@@ -186,6 +193,7 @@ pub fn raygen(
             environment,
             shading,
             textures,
+            instances,
             px,
             py,
             index,
@@ -249,6 +257,36 @@ pub fn closest_hit_triangle(
     payload.store(&SurfaceHit::triangle(
         tri,
         shape,
+        dir,
+        t,
+        barycentrics.x,
+        barycentrics.y,
+    ));
+}
+
+/// Closest hit on an instanced triangle: the record of `SurfaceHit::instanced_triangle`, as on
+/// the CPU, from the instance table (`instance_custom_index` is the instance's record) and the
+/// triangle table (the instance's mesh from `Instance::first_triangle`). The hardware's `t` and
+/// barycentrics are the object-space ray's, which an affine map keeps.
+#[spirv(closest_hit)]
+pub fn closest_hit_instance(
+    #[spirv(incoming_ray_payload)] payload: &mut HitPayload,
+    #[spirv(hit_attribute)] barycentrics: &Vec2,
+    #[spirv(primitive_id)] primitive: u32,
+    #[spirv(instance_custom_index)] index: u32,
+    #[spirv(world_ray_direction)] dir: Vec3,
+    #[spirv(ray_tmax)] t: f32,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] instances: &[Instance],
+) {
+    let instance = &instances[index as usize];
+    let tri = &triangles[(instance.first_triangle + primitive) as usize];
+    let shape = TriangleShape::of(Vec3::from(tri.edge1), Vec3::from(tri.edge2));
+    payload.store(&SurfaceHit::instanced_triangle(
+        tri,
+        shape,
+        instance,
+        index,
         dir,
         t,
         barycentrics.x,

@@ -19,7 +19,8 @@
 use crate::bsdf::resolve_metallic_roughness;
 use crate::features::FeatureSet;
 use crate::geometry::{blend2, blend3};
-use crate::scene::{material_kind, texture_slot, Material, ShadingTriangle, NONE};
+use crate::instance::{normal_to_world, vector_to_world};
+use crate::scene::{material_kind, texture_slot, Instance, Material, ShadingTriangle, NONE};
 use crate::texture::{lookup, textured_material};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -99,6 +100,9 @@ pub fn mapped_normal(
 /// material's normal map give one, else zero (the hit shades with its geometric normal).
 /// `geometric` is the hit's unit geometric normal (`SurfaceHit::normal`, edge1 x edge2: the
 /// front a normal map's frame stands on when the triangle has no vertex normals).
+/// `instance` is the hit's instance (`SurfaceHit::instance`) or `NONE`: an instanced
+/// triangle's record is in object space, and its normal and tangents are mapped to world space
+/// here (`crate::instance`; a mirroring instance flips the frame's handedness).
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn shade<F: FeatureSet>(
@@ -107,16 +111,25 @@ pub fn shade<F: FeatureSet>(
     record: u32,
     bary: Vec2,
     geometric: Vec3,
+    instance: u32,
     materials: &[Material],
     shading: &[ShadingTriangle],
     textures: &[u32],
+    instances: &[Instance],
 ) -> (Material, Vec3) {
     let mut m = materials[material as usize];
     let mut normal = Vec3::ZERO;
     if (features.shading_normals() || features.textures()) && record != NONE {
         let tri = shading[record as usize];
+        let instanced = features.instances() && instance != NONE;
         if features.shading_normals() && tri.has_normals != 0 {
             normal = interpolated_normal(&tri, bary);
+            if instanced {
+                normal = unit_or(
+                    normal_to_world(&instances[instance as usize], normal),
+                    Vec3::ZERO,
+                );
+            }
         }
         if features.textures() {
             let uv = interpolated_uv(&tri, bary);
@@ -128,9 +141,17 @@ pub fn shade<F: FeatureSet>(
                 } else {
                     normal
                 };
+                let mut frame = shading[record as usize + 1];
+                if instanced {
+                    let inst = &instances[instance as usize];
+                    frame.normal0 = vector_to_world(inst, Vec3::from(frame.normal0)).to_array();
+                    frame.normal1 = vector_to_world(inst, Vec3::from(frame.normal1)).to_array();
+                    frame.normal2 = vector_to_world(inst, Vec3::from(frame.normal2)).to_array();
+                    frame.uv0[0] *= inst.handedness;
+                }
                 normal = mapped_normal(
                     base,
-                    &shading[record as usize + 1],
+                    &frame,
                     bary,
                     lookup(textures, map, uv),
                     m.normal_scale,

@@ -92,7 +92,11 @@ fn check_against_brute_force(
             f32::INFINITY
         };
         let (want, want_t) = brute_force(bvh, o, d, t_max);
-        let (got, got_t) = bvh.closest_prim(o, d, t_max);
+        let twinpath::cpu::bvh::PrimHit {
+            prim: got,
+            t: got_t,
+            ..
+        } = bvh.closest_prim(o, d, t_max);
         assert_eq!(
             got_t.to_bits(),
             want_t.to_bits(),
@@ -209,7 +213,7 @@ fn identical_triangles_and_tiny_scenes_match_brute_force() {
     }
     let empty = Bvh::build(Vec::new(), Vec::new());
     assert_eq!(
-        empty.closest_prim(Vec3::ZERO, Vec3::X, f32::INFINITY).0,
+        empty.closest_prim(Vec3::ZERO, Vec3::X, f32::INFINITY).prim,
         NONE
     );
     assert!(!empty.any_hit(Vec3::ZERO, Vec3::X, f32::INFINITY));
@@ -306,7 +310,11 @@ fn ray_measurement_and_ray_file_hold_what_was_traced() {
         for r in &rays {
             let (prim, t) = (u32_at(take(4)), f32_at(take(4)));
             let (o, d) = (Vec3::new(r[0], r[1], r[2]), Vec3::new(r[3], r[4], r[5]));
-            let (want, want_t) = bvh.closest_prim(o, d, r[6]);
+            let twinpath::cpu::bvh::PrimHit {
+                prim: want,
+                t: want_t,
+                ..
+            } = bvh.closest_prim(o, d, r[6]);
             assert_eq!((prim, t.to_bits()), (want, want_t.to_bits()));
             hits += (prim != NONE) as usize;
         }

@@ -130,9 +130,11 @@ fn the_mapped_normal_is_gltfs_formula() {
             0,
             Vec2::new(0.2, 0.3),
             Vec3::Z,
+            kernel::scene::NONE,
             &[m],
             &[smooth, frame],
             &table.words,
+            &[],
         );
         close(got, "shade, vertex normals");
         // ...and on the geometric normal where the triangle has none.
@@ -146,9 +148,11 @@ fn the_mapped_normal_is_gltfs_formula() {
             0,
             Vec2::new(0.2, 0.3),
             n.normalize(),
+            kernel::scene::NONE,
             &[m],
             &[flat, frame],
             &table.words,
+            &[],
         );
         close(got, "shade, geometric normal");
     }

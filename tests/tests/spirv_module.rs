@@ -2,7 +2,7 @@
 //! exactly the entry points the Vulkan backend binds (rust-gpu can silently drop one), and laying
 //! out every shared struct exactly as the host does.
 
-use kernel::scene::{Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
+use kernel::scene::{Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
 use std::collections::BTreeSet;
 use std::mem::{offset_of, size_of};
 use std::process::Command;
@@ -18,6 +18,7 @@ fn module_has_the_ray_tracing_and_probe_entry_points() {
         (5317, "shaders::miss"),
         (5316, "shaders::closest_hit_triangle"),
         (5316, "shaders::closest_hit_sphere"),
+        (5316, "shaders::closest_hit_instance"),
         (5314, "shaders::intersect_sphere_shader"),
         (5, "shaders::probe"),
     ]
@@ -34,6 +35,7 @@ fn module_has_the_ray_tracing_and_probe_entry_points() {
         p::MISS,
         p::CLOSEST_HIT_TRIANGLE,
         p::CLOSEST_HIT_SPHERE,
+        p::CLOSEST_HIT_INSTANCE,
         p::INTERSECT_SPHERE,
         twinpath::vulkan::compute::PROBE,
     ] {
@@ -206,6 +208,22 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
             "Sphere",
             binding::SPHERES,
             host_layout!(Sphere, [center, radius, material, light, _pad], true),
+        ),
+        (
+            "Instance",
+            binding::INSTANCES,
+            host_layout!(
+                Instance,
+                [
+                    object_to_world,
+                    world_to_object,
+                    first_triangle,
+                    forward_norm,
+                    inverse_norm,
+                    handedness
+                ],
+                true
+            ),
         ),
     ];
     for (name, b, host) in cases {

@@ -95,9 +95,9 @@ pub fn trace_all(bvh: &Bvh, rays: &RaySet) -> RayResults {
         t: Vec::with_capacity(rays.len()),
     };
     for i in 0..rays.len() {
-        let (prim, t) = bvh.closest_prim(rays.origins[i], rays.dirs[i], rays.t_max[i]);
-        out.prim.push(prim);
-        out.t.push(t);
+        let hit = bvh.closest_prim(rays.origins[i], rays.dirs[i], rays.t_max[i]);
+        out.prim.push(hit.prim);
+        out.t.push(hit.t);
     }
     out
 }
@@ -304,7 +304,7 @@ pub fn measure(
     ray_file: Option<&std::path::Path>,
 ) -> std::io::Result<RayReport> {
     let start = Instant::now();
-    let bvh = Bvh::build(scene.spheres.clone(), scene.triangles.clone());
+    let bvh = Bvh::build_scene(scene);
     let build_seconds = start.elapsed().as_secs_f64();
     let camera = camera_rays(scene, width, height);
     let bounce = bounce_rays(&bvh, &camera, scene.render.seed);

@@ -75,8 +75,18 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     // From here on Ctrl-C stops the render and keeps the image (the line below says so).
     install_interrupt_handler();
+    let instances = if scene.instances.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " ({} of them in {} meshes placed by {} instances)",
+            scene.triangles.len() - scene.world_triangle_count(),
+            scene.meshes.len(),
+            scene.instances.len()
+        )
+    };
     eprintln!(
-        "twinpath: {} ({}x{}, {} spheres, {} triangles, {} lights), {} spp, seed {}",
+        "twinpath: {} ({}x{}, {} spheres, {} triangles{instances}, {} lights), {} spp, seed {}",
         scene.name,
         scene.camera.width,
         scene.camera.height,
@@ -118,9 +128,10 @@ fn log_costs(result: &RenderOutput, asked: Backend) {
     let secs = result.render.as_secs_f64();
     let setup = match result.backend {
         Backend::Gpu => format!(
-            "setup {:.3} s (acceleration structures {:.3} s, pipeline {:.3} s)",
+            "setup {:.3} s (acceleration structures {:.3} s, {:.1} MiB; pipeline {:.3} s)",
             result.setup.as_secs_f64(),
             result.accel_build.as_secs_f64(),
+            mib(result.accel_bytes),
             result.pipeline.as_secs_f64()
         ),
         _ => {
@@ -133,9 +144,10 @@ fn log_costs(result: &RenderOutput, asked: Backend) {
                 String::new()
             };
             format!(
-                "setup {:.3} s ({probe}BVH {:.3} s)",
+                "setup {:.3} s ({probe}BVH {:.3} s, {:.1} MiB)",
                 result.setup.as_secs_f64(),
-                result.accel_build.as_secs_f64()
+                result.accel_build.as_secs_f64(),
+                mib(result.accel_bytes)
             )
         }
     };
@@ -174,4 +186,9 @@ fn write_sample_counts(
         eprintln!("twinpath: wrote {} (samples per pixel)", m.display());
     }
     Ok(())
+}
+
+/// `bytes` in MiB.
+fn mib(bytes: u64) -> f64 {
+    bytes as f64 / (1024.0 * 1024.0)
 }

@@ -7,27 +7,37 @@
 //! incoherent rays are bound by memory latency, and a shallower tree waits less (measured:
 //! 0.6x Embree's throughput with 4 lanes, 0.8x with 8; README "CPU traversal").
 //!
-//! Primitive ids below `spheres.len()` are spheres, the rest triangles. The closest hit is the
-//! kernel's own intersection functions' answer (bit-identical t), whatever the traversal order.
+//! Primitive ids below `spheres.len()` are spheres, then triangles, then instances. An instance
+//! (`kernel::scene::Instance`) places a mesh that has its own hierarchy in object space: a ray
+//! reaching it in a leaf is mapped into object space (`kernel::instance::ray_to_object`; its
+//! direction not normalised, so t means the same in both) and traced through the mesh's tree
+//! (a two-level BVH, as Embree and the GPU's TLAS over BLASes do). Traversal is compiled twice,
+//! with and without the instance step, so a scene without instances runs the one-level loop.
+//! The closest hit is the kernel's own intersection functions' answer (bit-identical t),
+//! whatever the traversal order.
 
 use super::bvh_build::{Aabb, BinaryBvh, SAH_MAX_DEPTH};
 use super::simd::{widest_simd, Boxes, Ray4, Spheres4, Triangles4, SLAB_PAD};
+use crate::scene::instancing::instance_box;
+use crate::scene::Scene;
 use glam::Vec3;
 use kernel::geometry::{
     intersect_sphere, intersect_triangle, intersect_triangle_uv, TriangleShape,
 };
-use kernel::scene::{Sphere, Triangle, NONE};
+use kernel::instance::ray_to_object;
+use kernel::scene::{Instance, Sphere, Triangle, NONE};
 use kernel::SurfaceHit;
+use rayon::prelude::*;
 use std::mem::MaybeUninit;
 use std::ops::Range;
 use std::simd::{f32x4, Mask, Simd};
 
 /// A child reference: a node index, or with this bit set a leaf. A leaf of triangles only is
-/// encoded in the reference itself (blocks - 1 in the two bits below [`SPHERES`], the first
+/// encoded in the reference itself (blocks - 1 in the two bits below [`LISTED`], the first
 /// block in the low [`BLOCK_BITS`]), saving a dependent memory load per leaf; a leaf with
-/// spheres (or past 2^28 blocks) has [`SPHERES`] set and indexes [`Bvh::leaves`].
+/// spheres or instances (or past 2^28 blocks) has [`LISTED`] set and indexes [`Bvh::leaves`].
 const LEAF: u32 = 1 << 31;
-const SPHERES: u32 = 1 << 30;
+const LISTED: u32 = 1 << 30;
 const BLOCK_BITS: u32 = 28;
 /// Traversal stack: each level pushes at most WIDTH - 1 entries, and the wide tree is no deeper
 /// than the binary one (< SAH_MAX_DEPTH + 32 levels for up to 2^32 primitives).
@@ -46,14 +56,35 @@ struct WideNode {
     used: u32,
 }
 
-/// A leaf: `triangle_blocks` blocks of four triangles from `first_block`, and `sphere_blocks`
-/// blocks of four spheres from `first_sphere_block`.
+/// A leaf: `triangle_blocks` blocks of four triangles from `first_block`, `sphere_blocks`
+/// blocks of four spheres from `first_sphere_block`, and `instance_count` instances listed
+/// from `first_instance` in [`Bvh::leaf_instances`].
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
     first_block: u32,
     triangle_blocks: u32,
     first_sphere_block: u32,
     sphere_blocks: u32,
+    first_instance: u32,
+    instance_count: u32,
+}
+
+/// What a leaf holds: ranges of [`Bvh::blocks`], [`Bvh::sphere_blocks`] and
+/// [`Bvh::leaf_instances`].
+struct LeafContents {
+    blocks: Range<usize>,
+    spheres: Range<usize>,
+    instances: Range<usize>,
+}
+
+/// The closest hit a traversal found: the primitive (a sphere or triangle of this tree, or of
+/// the mesh of `instance`, numbered as that mesh's tree numbers them), the instance or `NONE`,
+/// and t; `prim` is `NONE` for a miss.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimHit {
+    pub prim: u32,
+    pub instance: u32,
+    pub t: f32,
 }
 
 /// Four triangles of a leaf and their primitive ids (`NONE` in unused lanes, whose edges are
@@ -86,11 +117,25 @@ pub struct Bvh {
     pub triangles: Vec<Triangle>,
     /// By triangle, what its hit records need that depends on its shape alone (computed once).
     shapes: Vec<TriangleShape>,
+    /// The instances, the mesh (an index into `meshes`) each places, and the meshes' own
+    /// object-space trees (without instances of their own).
+    instances: Vec<Instance>,
+    instance_meshes: Vec<u32>,
+    meshes: Vec<Bvh>,
+    /// The instances of the leaves that have some, leaf by leaf.
+    leaf_instances: Vec<u32>,
 }
 
-fn prim_bounds(spheres: &[Sphere], triangles: &[Triangle], id: u32) -> Aabb {
+fn prim_bounds(
+    spheres: &[Sphere],
+    triangles: &[Triangle],
+    instance_boxes: &[Aabb],
+    id: u32,
+) -> Aabb {
     let id = id as usize;
-    if id < spheres.len() {
+    if id >= spheres.len() + triangles.len() {
+        instance_boxes[id - spheres.len() - triangles.len()]
+    } else if id < spheres.len() {
         let s = &spheres[id];
         let c = Vec3::from(s.center);
         Aabb {
@@ -110,9 +155,48 @@ fn prim_bounds(spheres: &[Sphere], triangles: &[Triangle], id: u32) -> Aabb {
 impl Bvh {
     /// Builds the hierarchy: the binary SAH tree (O(n log n)), then its wide collapse (O(n)).
     pub fn build(spheres: Vec<Sphere>, triangles: Vec<Triangle>) -> Bvh {
-        let n = spheres.len() + triangles.len();
+        Self::build_with_instances(spheres, triangles, Vec::new(), Vec::new(), Vec::new())
+    }
+
+    /// The scene's hierarchy: its world-space spheres and triangles, and its instances over a
+    /// tree per instanced mesh (built in parallel, each over that mesh's object-space
+    /// triangles).
+    pub fn build_scene(scene: &Scene) -> Bvh {
+        let world = scene.world_triangle_count();
+        let meshes: Vec<Bvh> = scene
+            .meshes
+            .par_iter()
+            .map(|m| Bvh::build(Vec::new(), scene.triangles[m.range.clone()].to_vec()))
+            .collect();
+        Self::build_with_instances(
+            scene.spheres.clone(),
+            scene.triangles[..world].to_vec(),
+            meshes,
+            scene.instances.clone(),
+            scene.instance_meshes.clone(),
+        )
+    }
+
+    /// The two-level hierarchy: `spheres`, `triangles` and `instances` (instance i places
+    /// `meshes[instance_meshes[i]]`) under one tree.
+    pub fn build_with_instances(
+        spheres: Vec<Sphere>,
+        triangles: Vec<Triangle>,
+        meshes: Vec<Bvh>,
+        instances: Vec<Instance>,
+        instance_meshes: Vec<u32>,
+    ) -> Bvh {
+        let instance_boxes: Vec<Aabb> = instances
+            .iter()
+            .zip(&instance_meshes)
+            .map(|(inst, &m)| {
+                let (lo, hi) = instance_box(inst, meshes[m as usize].object_box());
+                Aabb { min: lo, max: hi }
+            })
+            .collect();
+        let n = spheres.len() + triangles.len() + instances.len();
         let bounds: Vec<Aabb> = (0..n as u32)
-            .map(|i| prim_bounds(&spheres, &triangles, i))
+            .map(|i| prim_bounds(&spheres, &triangles, &instance_boxes, i))
             .collect();
         let binary = BinaryBvh::build(&bounds);
         let mut bvh = Bvh {
@@ -127,6 +211,10 @@ impl Bvh {
                 .collect(),
             spheres,
             triangles,
+            instances,
+            instance_meshes,
+            meshes,
+            leaf_instances: Vec::new(),
         };
         if n > 0 {
             bvh.root = Some(if binary.nodes[0].count > 0 {
@@ -186,8 +274,14 @@ impl Bvh {
         let node = binary.nodes[b];
         let prims = &binary.prims[node.first as usize..(node.first + node.count) as usize];
         let n_spheres = self.spheres.len() as u32;
+        let n_geometry = n_spheres + self.triangles.len() as u32;
         let first_sphere_block = self.sphere_blocks.len() as u32;
         let first_block = self.blocks.len() as u32;
+        let first_instance = self.leaf_instances.len() as u32;
+        let (instances, prims): (Vec<u32>, Vec<u32>) =
+            prims.iter().partition(|&&p| p >= n_geometry);
+        self.leaf_instances
+            .extend(instances.iter().map(|&p| p - n_geometry));
         let (spheres, tris): (Vec<u32>, Vec<u32>) = prims.iter().partition(|&&p| p < n_spheres);
         for chunk in spheres.chunks(4) {
             let mut block = SphereBlock {
@@ -229,7 +323,11 @@ impl Bvh {
         }
         let triangle_blocks = self.blocks.len() as u32 - first_block;
         let sphere_blocks = self.sphere_blocks.len() as u32 - first_sphere_block;
-        if sphere_blocks == 0 && (1..=4).contains(&triangle_blocks) && first_block < 1 << BLOCK_BITS
+        let instance_count = instances.len() as u32;
+        if sphere_blocks == 0
+            && instance_count == 0
+            && (1..=4).contains(&triangle_blocks)
+            && first_block < 1 << BLOCK_BITS
         {
             return LEAF | (triangle_blocks - 1) << BLOCK_BITS | first_block;
         }
@@ -238,8 +336,10 @@ impl Bvh {
             triangle_blocks,
             first_sphere_block,
             sphere_blocks,
+            first_instance,
+            instance_count,
         });
-        LEAF | SPHERES | (self.leaves.len() as u32 - 1)
+        LEAF | LISTED | (self.leaves.len() as u32 - 1)
     }
 
     /// Number of interior nodes (for statistics).
@@ -248,43 +348,81 @@ impl Bvh {
     }
 
     /// Bytes the hierarchy takes beyond the primitives themselves: nodes, leaves, the
-    /// leaves' packed copies of their triangles, and the triangles' precomputed shapes.
+    /// leaves' packed copies of their triangles, and the triangles' precomputed shapes; with
+    /// the instanced meshes' trees.
     pub fn hierarchy_bytes(&self) -> usize {
         std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.shapes.as_slice())
             + std::mem::size_of_val(self.leaves.as_slice())
             + std::mem::size_of_val(self.blocks.as_slice())
             + std::mem::size_of_val(self.sphere_blocks.as_slice())
+            + std::mem::size_of_val(self.leaf_instances.as_slice())
+            + self.meshes.iter().map(Bvh::hierarchy_bytes).sum::<usize>()
     }
 
-    /// Bytes of the primitives as the scene holds them (materials included).
+    /// Bytes of the primitives as the scene holds them (materials included): spheres,
+    /// triangles, instances, and the instanced meshes' triangles (once each).
     pub fn primitive_bytes(&self) -> usize {
         std::mem::size_of_val(self.spheres.as_slice())
             + std::mem::size_of_val(self.triangles.as_slice())
+            + std::mem::size_of_val(self.instances.as_slice())
+            + std::mem::size_of_val(self.instance_meshes.as_slice())
+            + self.meshes.iter().map(Bvh::primitive_bytes).sum::<usize>()
+    }
+
+    /// The box of this tree's geometry (empty for an empty tree).
+    fn object_box(&self) -> (Vec3, Vec3) {
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        if let Some(root) = self.nodes.first() {
+            for lane in 0..WIDTH {
+                if root.used & (1 << lane) != 0 {
+                    for axis in 0..3 {
+                        lo[axis] = lo[axis].min(root.boxes.min[axis][lane]);
+                        hi[axis] = hi[axis].max(root.boxes.max[axis][lane]);
+                    }
+                }
+            }
+        }
+        (lo, hi)
     }
 
     /// Closest hit along `origin + t dir`, t in (0, t_max).
     pub fn closest_hit(&self, origin: Vec3, dir: Vec3, t_max: f32) -> SurfaceHit {
-        let (best, best_t) = self.closest_prim(origin, dir, t_max);
-        if best == NONE {
+        let hit = self.closest_prim(origin, dir, t_max);
+        if hit.prim == NONE {
             return SurfaceHit::miss();
         }
-        self.surface(best, origin, dir, best_t)
+        self.surface(hit, origin, dir)
     }
 
     widest_simd! {
         /// The primitive hit first along `origin + t dir`, t in (0, t_max), and its t; `NONE`
         /// for a miss. Of primitives hit at exactly the same t, any one may be returned.
-        pub fn closest_prim(&self, origin: Vec3, dir: Vec3, t_max: f32) -> (u32, f32)
+        pub fn closest_prim(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit
             = closest_prim_any_cpu, closest_prim_avx512, closest_prim_avx2
     }
 
     #[inline(always)]
-    fn closest_prim_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> (u32, f32) {
+    fn closest_prim_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
+        if self.instances.is_empty() {
+            self.closest_in::<false>(origin, dir, t_max)
+        } else {
+            self.closest_in::<true>(origin, dir, t_max)
+        }
+    }
+
+    /// [`Bvh::closest_prim`], with the instance step compiled in where `INSTANCES`.
+    #[inline(always)]
+    fn closest_in<const INSTANCES: bool>(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
         let mut best_t = t_max;
         let mut best = NONE;
+        let mut best_instance = NONE;
         let Some(root) = self.root else {
-            return (best, best_t);
+            return PrimHit {
+                prim: best,
+                instance: best_instance,
+                t: best_t,
+            };
         };
         let ray = Ray4::new(origin, dir);
         // Not zero-filled (3 KiB per ray): entries below `sp` are always written first.
@@ -327,23 +465,38 @@ impl Bvh {
                     continue;
                 }
             } else {
-                let (blocks, spheres) = self.leaf_contents(current);
-                for block in &self.blocks[blocks] {
+                let leaf = self.leaf_contents(current);
+                for block in &self.blocks[leaf.blocks] {
                     let t = ray.triangles(&block.triangles, 0.0, best_t).to_array();
                     for (&t, &id) in t.iter().zip(&block.id) {
                         // Missed lanes are -1; hits are in (0, best_t) as it was at the call.
                         if t >= 0.0 && t < best_t {
                             best_t = t;
                             best = id;
+                            best_instance = NONE;
                         }
                     }
                 }
-                for block in &self.sphere_blocks[spheres] {
+                for block in &self.sphere_blocks[leaf.spheres] {
                     let t = ray.spheres(&block.spheres, 0.0, best_t).to_array();
                     for (&t, &id) in t.iter().zip(&block.id) {
                         if t >= 0.0 && t < best_t {
                             best_t = t;
                             best = id;
+                            best_instance = NONE;
+                        }
+                    }
+                }
+                if INSTANCES {
+                    for &i in &self.leaf_instances[leaf.instances] {
+                        let instance = &self.instances[i as usize];
+                        let (o, d) = ray_to_object(instance, origin, dir);
+                        let mesh = &self.meshes[self.instance_meshes[i as usize] as usize];
+                        let hit = mesh.closest_in::<false>(o, d, best_t);
+                        if hit.prim != NONE && hit.t < best_t {
+                            best_t = hit.t;
+                            best = hit.prim;
+                            best_instance = i;
                         }
                     }
                 }
@@ -352,7 +505,11 @@ impl Bvh {
             // against the padded far bound, exactly the slab test's verdict with today's t_max.
             loop {
                 if sp == 0 {
-                    return (best, best_t);
+                    return PrimHit {
+                        prim: best,
+                        instance: best_instance,
+                        t: best_t,
+                    };
                 }
                 sp -= 1;
                 // SAFETY: entry `sp` was written by a push (sp only grows by writing).
@@ -373,6 +530,16 @@ impl Bvh {
 
     #[inline(always)]
     fn any_hit_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        if self.instances.is_empty() {
+            self.any_in::<false>(origin, dir, t_max)
+        } else {
+            self.any_in::<true>(origin, dir, t_max)
+        }
+    }
+
+    /// [`Bvh::any_hit`], with the instance step compiled in where `INSTANCES`.
+    #[inline(always)]
+    fn any_in<const INSTANCES: bool>(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
         let Some(root) = self.root else {
             return false;
         };
@@ -392,17 +559,26 @@ impl Bvh {
                     sp += 1;
                 }
             } else {
-                let (blocks, spheres) = self.leaf_contents(current);
-                for block in &self.blocks[blocks] {
+                let leaf = self.leaf_contents(current);
+                for block in &self.blocks[leaf.blocks] {
                     let t = ray.triangles(&block.triangles, 0.0, t_max);
                     if t.to_array().iter().any(|&t| t >= 0.0) {
                         return true;
                     }
                 }
-                for block in &self.sphere_blocks[spheres] {
+                for block in &self.sphere_blocks[leaf.spheres] {
                     let t = ray.spheres(&block.spheres, 0.0, t_max);
                     if t.to_array().iter().any(|&t| t >= 0.0) {
                         return true;
+                    }
+                }
+                if INSTANCES {
+                    for &i in &self.leaf_instances[leaf.instances] {
+                        let (o, d) = ray_to_object(&self.instances[i as usize], origin, dir);
+                        let mesh = &self.meshes[self.instance_meshes[i as usize] as usize];
+                        if mesh.any_in::<false>(o, d, t_max) {
+                            return true;
+                        }
                     }
                 }
             }
@@ -426,7 +602,7 @@ impl Bvh {
             let (start, bytes) = if r & LEAF == 0 {
                 let node = self.nodes.as_ptr().wrapping_add(r as usize);
                 (node as *const i8, std::mem::size_of::<WideNode>())
-            } else if r & SPHERES == 0 {
+            } else if r & LISTED == 0 {
                 let first = (r & ((1 << BLOCK_BITS) - 1)) as usize;
                 let block = self.blocks.as_ptr().wrapping_add(first);
                 (block as *const i8, std::mem::size_of::<TriangleBlock>())
@@ -440,25 +616,32 @@ impl Bvh {
         }
     }
 
-    /// The triangle blocks and the sphere blocks of leaf reference `r`.
+    /// What leaf reference `r` holds.
     #[inline(always)]
-    fn leaf_contents(&self, r: u32) -> (Range<usize>, Range<usize>) {
-        if r & SPHERES == 0 {
+    fn leaf_contents(&self, r: u32) -> LeafContents {
+        if r & LISTED == 0 {
             let first = (r & ((1 << BLOCK_BITS) - 1)) as usize;
             let count = ((r >> BLOCK_BITS) & 3) as usize + 1;
-            (first..first + count, 0..0)
+            LeafContents {
+                blocks: first..first + count,
+                spheres: 0..0,
+                instances: 0..0,
+            }
         } else {
-            let leaf = &self.leaves[(r & !(LEAF | SPHERES)) as usize];
+            let leaf = &self.leaves[(r & !(LEAF | LISTED)) as usize];
             let first = leaf.first_block as usize;
             let sphere = leaf.first_sphere_block as usize;
-            (
-                first..first + leaf.triangle_blocks as usize,
-                sphere..sphere + leaf.sphere_blocks as usize,
-            )
+            let instance = leaf.first_instance as usize;
+            LeafContents {
+                blocks: first..first + leaf.triangle_blocks as usize,
+                spheres: sphere..sphere + leaf.sphere_blocks as usize,
+                instances: instance..instance + leaf.instance_count as usize,
+            }
         }
     }
 
-    /// The kernel's scalar intersection of primitive `id`: t in (0, t_max), or negative.
+    /// The kernel's scalar intersection of primitive `id` (a sphere or a triangle of this
+    /// tree): t in (0, t_max), or negative.
     pub fn intersect_prim(&self, id: u32, origin: Vec3, dir: Vec3, t_max: f32) -> f32 {
         let id = id as usize;
         if id < self.spheres.len() {
@@ -478,9 +661,41 @@ impl Bvh {
         }
     }
 
-    /// The hit record of primitive `id` at `t` along the ray, computed as the GPU's closest-hit
-    /// shaders do.
-    pub fn surface(&self, id: u32, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
+    /// The hit record of `hit` (from [`Bvh::closest_prim`] on this ray), computed as the GPU's
+    /// closest-hit shaders do. An instance's triangle is intersected again with the ray mapped
+    /// into its object space as the traversal mapped it (the same t and barycentrics).
+    pub fn surface(&self, hit: PrimHit, origin: Vec3, dir: Vec3) -> SurfaceHit {
+        if hit.instance == NONE {
+            return self.surface_of_prim(hit.prim, origin, dir, hit.t);
+        }
+        let instance = &self.instances[hit.instance as usize];
+        let mesh = &self.meshes[self.instance_meshes[hit.instance as usize] as usize];
+        let (o, d) = ray_to_object(instance, origin, dir);
+        let index = hit.prim as usize;
+        let tri = &mesh.triangles[index];
+        let h = intersect_triangle_uv(
+            o,
+            d,
+            Vec3::from(tri.p0),
+            Vec3::from(tri.edge1),
+            Vec3::from(tri.edge2),
+            0.0,
+            f32::INFINITY,
+        );
+        SurfaceHit::instanced_triangle(
+            tri,
+            mesh.shapes[index],
+            instance,
+            hit.instance,
+            dir,
+            hit.t,
+            h.u,
+            h.v,
+        )
+    }
+
+    /// The hit record of sphere or triangle `id` of this tree at `t` along the ray.
+    pub fn surface_of_prim(&self, id: u32, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
         let uv = if (id as usize) < self.spheres.len() {
             (0.0, 0.0)
         } else {
@@ -497,7 +712,7 @@ impl Bvh {
         self.surface_with_uv(id, origin, dir, t, uv)
     }
 
-    /// [`Bvh::surface`] with the barycentrics `uv` of a triangle's hit already known (as the
+    /// [`Bvh::surface_of_prim`] with the barycentrics `uv` of a triangle's hit already known (as the
     /// kernel's `intersect_triangle_uv` computes them; ignored for spheres).
     pub fn surface_with_uv(
         &self,

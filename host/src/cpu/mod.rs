@@ -19,7 +19,7 @@ use glam::Vec3;
 use indicatif::ProgressBar;
 use kernel::features::{self, Dynamic, FeatureSet, Static};
 use kernel::path::render_sample;
-use kernel::scene::{Light, Material, RenderParams, ShadingTriangle};
+use kernel::scene::{Instance, Light, Material, RenderParams, ShadingTriangle};
 use kernel::{SurfaceHit, Tracer};
 use packet::SmallScene;
 use rayon::prelude::*;
@@ -55,6 +55,8 @@ pub struct CpuRenderer {
     /// (`kernel::texture`).
     pub shading: Vec<ShadingTriangle>,
     pub textures: Vec<u32>,
+    /// The instance table (`kernel::scene::Instance`; one zero record without instances).
+    pub instances: Vec<Instance>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path).
     pub features: u32,
     /// How a tile's samples are computed, chosen once when the renderer is built.
@@ -135,14 +137,12 @@ fn with_all_extended(bits: u32) -> u32 {
 }
 
 impl CpuRenderer {
-    /// Builds the BVH over the scene's spheres and triangles (and, for a small scene, the
-    /// packets' copy of them).
+    /// Builds the BVH over the scene's spheres, triangles and instances (and, for a small
+    /// scene without instances, the packets' copy of its primitives).
     pub fn new(scene: &Scene) -> Self {
-        let bvh = Bvh::build(scene.spheres.clone(), scene.triangles.clone());
+        let bvh = Bvh::build_scene(scene);
         // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).
-        let small = scene
-            .render
-            .packets
+        let small = (scene.render.packets && scene.instances.is_empty())
             .then(|| SmallScene::if_small(&bvh.spheres, &bvh.triangles))
             .flatten();
         Self {
@@ -152,6 +152,7 @@ impl CpuRenderer {
             environment: scene.environment_table(),
             shading: scene.shading_table(),
             textures: scene.textures.words.clone(),
+            instances: scene.instance_table(),
             features: with_all_extended(scene.features()),
             tiles: small.map_or(TileStrategy::OnePath, TileStrategy::Packets),
         }
@@ -181,6 +182,7 @@ impl CpuRenderer {
             &self.environment,
             &self.shading,
             &self.textures,
+            &self.instances,
             px,
             py,
             sample,
@@ -344,5 +346,9 @@ impl SampleBackend for CpuBackend {
 
     fn setup_times(&self) -> (Duration, Duration) {
         (self.build_time, Duration::ZERO)
+    }
+
+    fn accel_bytes(&self) -> u64 {
+        self.renderer.bvh.hierarchy_bytes() as u64
     }
 }

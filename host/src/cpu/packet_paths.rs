@@ -154,9 +154,11 @@ impl CpuRenderer {
                             hit.shading,
                             hit.barycentrics,
                             hit.normal,
+                            hit.instance,
                             &self.materials,
                             &self.shading,
                             &self.textures,
+                            &self.instances,
                         );
                         materials[lane] = material;
                         path.vertex_query(features, params, hit, &material, shading_normal)

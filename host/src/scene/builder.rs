@@ -4,6 +4,7 @@
 
 use super::environment::EnvironmentMap;
 use super::file::MAX_COORDINATE;
+use super::instancing::{instance_box, instance_record, instances_box, mesh_box, MAX_INSTANCES};
 use super::light_table::{assign_light_selection, place_directional_lights, triangle_light};
 use super::mesh::TriangleSoup;
 use super::tangents::face_tangent;
@@ -14,7 +15,7 @@ use crate::settings::RenderSettings;
 use bytemuck::Zeroable;
 use glam::Vec3;
 use kernel::scene::{
-    material_kind, texture_slot, Light, Material, ShadingTriangle, Sphere, Triangle, NONE,
+    material_kind, texture_slot, Instance, Light, Material, ShadingTriangle, Sphere, Triangle, NONE,
 };
 
 /// The tables of a scene being loaded.
@@ -28,6 +29,19 @@ pub(super) struct SceneTables {
     pub lights: Vec<Light>,
     pub shading: Vec<ShadingTriangle>,
     pub textures: TextureTable,
+    /// Instanced meshes' object-space triangles (`finish` appends them after the world-space
+    /// ones), the meshes' ranges in it, and the instances with the mesh each places.
+    pub mesh_triangles: Vec<Triangle>,
+    pub meshes: Vec<TriangleGroup>,
+    pub instances: Vec<Instance>,
+    pub instance_meshes: Vec<u32>,
+}
+
+/// Where a loaded triangle goes: the world-space table, or an instanced mesh in object space.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Space {
+    World,
+    Object,
 }
 
 /// `corners` in reverse winding (the second and third swapped) where `mirror`: a mirroring
@@ -76,6 +90,19 @@ impl SceneTables {
         attributes: Option<ShadingTriangle>,
         tangents: Option<([Vec3; 3], f32)>,
     ) {
+        self.push_triangle_to(Space::World, p, material, attributes, tangents);
+    }
+
+    /// [`SceneTables::push_triangle`] into the world-space table or (`Space::Object`, never a
+    /// light) the instanced meshes' table.
+    fn push_triangle_to(
+        &mut self,
+        space: Space,
+        p: [Vec3; 3],
+        material: u32,
+        attributes: Option<ShadingTriangle>,
+        tangents: Option<([Vec3; 3], f32)>,
+    ) {
         let mut tri = super::triangle(p, material);
         let m = self.materials[material as usize];
         let normal_mapped = m.textures[texture_slot::NORMAL] != NONE;
@@ -102,6 +129,11 @@ impl SceneTables {
                 };
                 self.shading.push(frame);
             }
+        }
+        if space == Space::Object {
+            debug_assert!(!self.is_emissive(material), "instanced meshes do not emit");
+            self.mesh_triangles.push(tri);
+            return;
         }
         if self.is_emissive(material) {
             tri.light = self.lights.len() as u32;
@@ -130,9 +162,79 @@ impl SceneTables {
         transform: Option<&Transform>,
         material: u32,
     ) -> Result<(), (usize, String)> {
+        let start = self.triangles.len();
+        self.push_soup(Space::World, soup, transform, material)?;
+        self.triangle_groups.push(TriangleGroup {
+            name,
+            range: start..self.triangles.len(),
+        });
+        Ok(())
+    }
+
+    /// Starts an instanced mesh `name`: the parts [`SceneTables::push_mesh_part`] adds until
+    /// the next call make mesh number (the returned index) for [`SceneTables::add_instance`].
+    pub fn begin_instanced_mesh(&mut self, name: String) -> u32 {
+        let start = self.mesh_triangles.len();
+        self.meshes.push(TriangleGroup {
+            name,
+            range: start..start,
+        });
+        (self.meshes.len() - 1) as u32
+    }
+
+    /// Adds `soup` in object space, of a material that does not emit, to the mesh begun last
+    /// (zero-area triangles dropped). Err(k, message) as for [`SceneTables::push_mesh`].
+    pub fn push_mesh_part(
+        &mut self,
+        soup: &TriangleSoup,
+        material: u32,
+    ) -> Result<(), (usize, String)> {
+        self.push_soup(Space::Object, soup, None, material)?;
+        let end = self.mesh_triangles.len();
+        self.meshes
+            .last_mut()
+            .expect("begin_instanced_mesh comes first")
+            .range
+            .end = end;
+        Ok(())
+    }
+
+    /// Places instanced mesh `mesh` by `transform` (nothing for a mesh without triangles).
+    /// Err: the mesh's placed box leaves the supported coordinate range, or the scene has
+    /// [`MAX_INSTANCES`] already.
+    pub fn add_instance(&mut self, mesh: u32, transform: &Transform) -> Result<(), String> {
+        if self.instances.len() >= MAX_INSTANCES {
+            return Err(format!(
+                "more than {MAX_INSTANCES} instances (the GPU names them by 24 bits)"
+            ));
+        }
+        let range = self.meshes[mesh as usize].range.clone();
+        if range.is_empty() {
+            // Nothing to place (every triangle of the mesh had zero area).
+            return Ok(());
+        }
+        // The mesh's triangles move when `finish` appends them; it adds the offset.
+        let record = instance_record(transform, range.start as u32);
+        let (lo, hi) = instance_box(&record, mesh_box(&self.mesh_triangles[range]));
+        if !(lo.abs().max(hi.abs()).max_element() <= MAX_COORDINATE) {
+            return Err(format!("the placed mesh reaches beyond {MAX_COORDINATE:e}"));
+        }
+        self.instances.push(record);
+        self.instance_meshes.push(mesh);
+        Ok(())
+    }
+
+    /// Adds `soup`'s triangles, transformed, to the table of `space` (see
+    /// [`SceneTables::push_mesh`]).
+    fn push_soup(
+        &mut self,
+        space: Space,
+        soup: &TriangleSoup,
+        transform: Option<&Transform>,
+        material: u32,
+    ) -> Result<(), (usize, String)> {
         let mirror = transform.is_some_and(|t| t.mirrors());
         let textured = self.is_textured(material);
-        let start = self.triangles.len();
         for (k, t) in soup.triangles.iter().enumerate() {
             let p = t.map(|v| match transform {
                 Some(m) => m.point(Vec3::from(v)),
@@ -192,17 +294,14 @@ impl SceneTables {
                     has_normals: normals.is_some() as u32,
                 }
             });
-            self.push_triangle(p, material, attributes, tangents);
+            self.push_triangle_to(space, p, material, attributes, tangents);
         }
-        self.triangle_groups.push(TriangleGroup {
-            name,
-            range: start..self.triangles.len(),
-        });
         Ok(())
     }
 
     /// The scene: the tables with the environment map's light last and the light selection
-    /// assigned for `render.light_selection`.
+    /// assigned for `render.light_selection`; the instanced meshes' triangles follow the
+    /// world-space ones in the triangle table.
     pub fn finish(
         mut self,
         name: String,
@@ -211,9 +310,25 @@ impl SceneTables {
         background: Vec3,
         environment: Option<EnvironmentMap>,
     ) -> Scene {
-        place_directional_lights(&mut self.lights, &self.spheres, &self.triangles);
+        let world = self.triangles.len();
+        self.triangles.append(&mut self.mesh_triangles);
+        for m in &mut self.meshes {
+            m.range = m.range.start + world..m.range.end + world;
+        }
+        for inst in &mut self.instances {
+            inst.first_triangle += world as u32;
+        }
+        let instanced = instances_box(
+            &self.triangles,
+            &self.meshes,
+            &self.instances,
+            &self.instance_meshes,
+        );
+        let world_triangles = &self.triangles[..world];
+        place_directional_lights(&mut self.lights, &self.spheres, world_triangles, instanced);
         if let Some(map) = &environment {
-            self.lights.push(map.light(&self.spheres, &self.triangles));
+            let light = map.light(&self.spheres, world_triangles, instanced);
+            self.lights.push(light);
         }
         assign_light_selection(&mut self.lights, render.light_selection.code());
         Scene {
@@ -230,6 +345,9 @@ impl SceneTables {
             environment,
             shading: self.shading,
             textures: self.textures,
+            meshes: self.meshes,
+            instances: self.instances,
+            instance_meshes: self.instance_meshes,
             notes: Vec::new(),
         }
     }

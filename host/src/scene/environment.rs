@@ -118,8 +118,13 @@ impl EnvironmentMap {
     /// The environment map's entry in the light table: the sphere bounding the scene's geometry
     /// (which shadow rays toward the map leave), and its mean radiance, so that selection by power
     /// weighs it as a sphere of that radiance around the scene.
-    pub fn light(&self, spheres: &[Sphere], triangles: &[Triangle]) -> Light {
-        let (center, radius) = scene_bounds(spheres, triangles);
+    pub fn light(
+        &self,
+        spheres: &[Sphere],
+        triangles: &[Triangle],
+        instanced: (glam::Vec3, glam::Vec3),
+    ) -> Light {
+        let (center, radius) = scene_bounds(spheres, triangles, instanced);
         let mut l = sphere_light(center, radius, self.mean_radiance());
         l.kind = light_kind::ENVIRONMENT;
         l

@@ -5,16 +5,18 @@ use super::builder::{wound, SceneTables};
 use super::closed_surface::check_closed_outward;
 use super::environment::EnvironmentMap;
 use super::error::{line_of, SceneError};
+use super::instancing::INSTANCE_MIN_TRIANGLES;
 use super::light_table::sphere_light;
-use super::mesh::load_mesh;
+use super::mesh::{load_mesh, TriangleSoup};
 use super::transform::{parse_transform, TransformFields};
 use super::{CameraDesc, Scene, TriangleGroup};
 use crate::settings::RenderSettings;
 use glam::Vec3;
 use kernel::scene::{ShadingTriangle, Sphere, NONE};
 use serde::Deserialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
+use std::rc::Rc;
 use toml::Spanned;
 
 /// The built-in default scene: the Cornell scene of `scenes/cornell.toml`, embedded.
@@ -578,6 +580,15 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             range: quads_start..tables.triangles.len(),
         });
     }
+    // A mesh file that several entries place with the same material is read once; from
+    // INSTANCE_MIN_TRIANGLES triangles on and unless it emits, it is stored once and instanced.
+    let mesh_key = |mf: &MeshFile| (mf.file.get_ref().clone(), mf.material.get_ref().clone());
+    let mut mesh_uses: HashMap<(String, String), usize> = HashMap::new();
+    for m in &file.mesh {
+        *mesh_uses.entry(mesh_key(m.get_ref())).or_insert(0) += 1;
+    }
+    let mut loaded: HashMap<(String, String), Rc<TriangleSoup>> = HashMap::new();
+    let mut instanced: HashMap<(String, String), u32> = HashMap::new();
     for (i, m) in file.mesh.iter().enumerate() {
         let mf = m.get_ref();
         let field = format!("mesh[{i}]");
@@ -595,7 +606,17 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         } else {
             None
         };
-        let soup = load_mesh(&mesh_path)?;
+        let key = mesh_key(mf);
+        if let Some(&mesh) = instanced.get(&key) {
+            tables
+                .add_instance(mesh, &transform.unwrap_or_default())
+                .map_err(|msg| ck.err(m.span(), &field, msg))?;
+            continue;
+        }
+        let soup = match loaded.get(&key) {
+            Some(soup) => soup.clone(),
+            None => Rc::new(load_mesh(&mesh_path)?),
+        };
         if tables.is_dielectric(material) {
             check_closed_outward(&soup.triangles).map_err(|msg| {
                 SceneError::new(
@@ -617,6 +638,23 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 ),
             ));
         }
+        let triangle_err = |(k, msg): (usize, String)| {
+            ck.err(mf.file.span(), &format!("{field} triangle {k}"), msg)
+        };
+        if mesh_uses[&key] >= 2
+            && soup.triangles.len() >= INSTANCE_MIN_TRIANGLES
+            && !tables.is_emissive(material)
+        {
+            let mesh = tables.begin_instanced_mesh(mf.file.get_ref().clone());
+            tables
+                .push_mesh_part(&soup, material)
+                .map_err(triangle_err)?;
+            tables
+                .add_instance(mesh, &transform.unwrap_or_default())
+                .map_err(|msg| ck.err(m.span(), &field, msg))?;
+            instanced.insert(key, mesh);
+            continue;
+        }
         tables
             .push_mesh(
                 mf.file.get_ref().clone(),
@@ -624,7 +662,10 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 transform.as_ref(),
                 material,
             )
-            .map_err(|(k, msg)| ck.err(mf.file.span(), &format!("{field} triangle {k}"), msg))?;
+            .map_err(triangle_err)?;
+        if mesh_uses[&key] >= 2 {
+            loaded.insert(key, soup);
+        }
     }
 
     for (i, l) in file.light.iter().enumerate() {

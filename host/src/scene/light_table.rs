@@ -70,11 +70,16 @@ pub fn is_directional(l: &Light) -> bool {
     l.kind == light_kind::PUNCTUAL && l.radius > 0.0
 }
 
-/// The sphere bounding `spheres` and `triangles` (centre, radius; at least 1e-3), or the unit
-/// sphere at the origin for an empty scene: where the environment map and directional lights
-/// send their light from.
-pub fn scene_bounds(spheres: &[Sphere], triangles: &[Triangle]) -> (Vec3, f32) {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+/// The sphere bounding `spheres`, the world-space `triangles` and the box `instanced` of the
+/// instances (`instancing::instances_box`; empty without them) (centre, radius; at least
+/// 1e-3), or the unit sphere at the origin for an empty scene: where the environment map and
+/// directional lights send their light from.
+pub fn scene_bounds(
+    spheres: &[Sphere],
+    triangles: &[Triangle],
+    instanced: (Vec3, Vec3),
+) -> (Vec3, f32) {
+    let (mut lo, mut hi) = instanced;
     for s in spheres {
         let c = Vec3::from(s.center);
         lo = lo.min(c - s.radius);
@@ -95,11 +100,16 @@ pub fn scene_bounds(spheres: &[Sphere], triangles: &[Triangle]) -> (Vec3, f32) {
 }
 
 /// Gives every directional light of `lights` the scene's bounding sphere (`scene_bounds`).
-pub fn place_directional_lights(lights: &mut [Light], spheres: &[Sphere], triangles: &[Triangle]) {
+pub fn place_directional_lights(
+    lights: &mut [Light],
+    spheres: &[Sphere],
+    triangles: &[Triangle],
+    instanced: (Vec3, Vec3),
+) {
     if !lights.iter().any(is_directional) {
         return;
     }
-    let (center, radius) = scene_bounds(spheres, triangles);
+    let (center, radius) = scene_bounds(spheres, triangles, instanced);
     for l in lights.iter_mut().filter(|l| is_directional(l)) {
         l.position = center.to_array();
         l.radius = radius;

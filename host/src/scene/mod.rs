@@ -7,6 +7,7 @@ pub mod environment;
 mod error;
 mod file;
 pub mod gltf_scene;
+pub mod instancing;
 pub mod light_table;
 pub mod materials;
 pub mod mesh;
@@ -20,7 +21,9 @@ pub use file::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
 
 use crate::settings::RenderSettings;
 use glam::Vec3;
-use kernel::scene::{Camera, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
+use kernel::scene::{
+    Camera, Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle,
+};
 use std::ops::Range;
 use std::path::Path;
 
@@ -97,8 +100,16 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
     pub spheres: Vec<Sphere>,
+    /// The world-space triangles, then the instanced meshes' object-space ones
+    /// ([`Scene::world_triangle_count`] tells them apart).
     pub triangles: Vec<Triangle>,
+    /// Runs of world-space triangles by source.
     pub triangle_groups: Vec<TriangleGroup>,
+    /// The instanced meshes: runs of object-space triangles, each placed by instances.
+    pub meshes: Vec<TriangleGroup>,
+    /// The placements of instanced meshes (`instancing`), and the mesh each places.
+    pub instances: Vec<Instance>,
+    pub instance_meshes: Vec<u32>,
     pub lights: Vec<Light>,
     /// The environment map, if `[background] map` names one (its light is the last entry of
     /// `lights`).
@@ -202,6 +213,34 @@ impl Scene {
         }
     }
 
+    /// Number of world-space triangles: the triangle table's first entries (the instanced
+    /// meshes' follow).
+    pub fn world_triangle_count(&self) -> usize {
+        self.meshes
+            .first()
+            .map_or(self.triangles.len(), |m| m.range.start)
+    }
+
+    /// The world-space box of every instance (empty without instances).
+    pub fn instanced_box(&self) -> (Vec3, Vec3) {
+        instancing::instances_box(
+            &self.triangles,
+            &self.meshes,
+            &self.instances,
+            &self.instance_meshes,
+        )
+    }
+
+    /// The instance table as the kernel binds it: one zero record when empty (a storage buffer
+    /// needs something behind it).
+    pub fn instance_table(&self) -> Vec<Instance> {
+        if self.instances.is_empty() {
+            vec![bytemuck::Zeroable::zeroed()]
+        } else {
+            self.instances.clone()
+        }
+    }
+
     /// Replaces the environment map (and its light, the last entry of `lights`), keeping the
     /// light selection up to date: scenes built in code (tests) give maps this way.
     pub fn set_environment(&mut self, map: Option<environment::EnvironmentMap>) {
@@ -209,7 +248,9 @@ impl Scene {
             self.lights.pop();
         }
         if let Some(m) = &map {
-            self.lights.push(m.light(&self.spheres, &self.triangles));
+            let world = &self.triangles[..self.world_triangle_count()];
+            let light = m.light(&self.spheres, world, self.instanced_box());
+            self.lights.push(light);
         }
         self.environment = map;
         light_table::assign_light_selection(&mut self.lights, self.render.light_selection.code());
@@ -234,11 +275,13 @@ impl Scene {
     }
 
     /// Bytes of the scene's tables on either backend: triangles, spheres, shading records,
-    /// materials, lights, textures and the environment map (what `twinpath info` reports).
-    pub fn table_bytes(&self) -> [(&'static str, usize); 7] {
+    /// materials, lights, textures, the environment map and instances (what `twinpath info`
+    /// reports).
+    pub fn table_bytes(&self) -> [(&'static str, usize); 8] {
         use std::mem::size_of;
         [
             ("triangles", self.triangles.len() * size_of::<Triangle>()),
+            ("instances", self.instances.len() * size_of::<Instance>()),
             ("spheres", self.spheres.len() * size_of::<Sphere>()),
             ("shading", self.shading.len() * size_of::<ShadingTriangle>()),
             ("materials", self.materials.len() * size_of::<Material>()),
@@ -293,6 +336,11 @@ impl Scene {
                 | kernel::features::material_features(&self.materials)
                 | kernel::features::light_features(&self.lights)
                 | kernel::features::surface_features(&self.materials, &self.shading)
+                | if self.instances.is_empty() {
+                    0
+                } else {
+                    kernel::features::INSTANCES
+                }
         } else {
             0
         }

@@ -1,6 +1,9 @@
-//! Acceleration structures: one triangle BLAS per triangle group (each mesh, and the quads),
-//! one AABB BLAS for all spheres (intersected by the kernel's own ray/sphere function), and
-//! the TLAS over them. Geometry a scene lacks gets no BLAS.
+//! Acceleration structures: one triangle BLAS per world-space triangle group (each flattened
+//! mesh, and the quads), one AABB BLAS for all spheres (intersected by the kernel's own
+//! ray/sphere function), one triangle BLAS per instanced mesh (object space), and the TLAS over
+//! them: an identity instance per world-space BLAS, and per `kernel::scene::Instance` an
+//! instance of its mesh's BLAS with its object-to-world matrix. Geometry a scene lacks gets no
+//! BLAS.
 
 use super::device::Context;
 use super::memory::Buffer;
@@ -21,6 +24,13 @@ pub struct AccelerationStructure {
 pub struct SceneAccel {
     pub blases: Vec<AccelerationStructure>,
     pub tlas: AccelerationStructure,
+}
+
+impl SceneAccel {
+    /// Device bytes of every acceleration structure (the driver's sizes).
+    pub fn bytes(&self) -> u64 {
+        self.blases.iter().map(|b| b.buffer.size).sum::<u64>() + self.tlas.buffer.size
+    }
 }
 
 const INPUT_USAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::from_raw(
@@ -116,6 +126,43 @@ impl Context {
         })
     }
 
+    /// A BLAS over `triangles` (non-indexed vertices p0, p0 + edge1, p0 + edge2 per
+    /// triangle, as on the CPU); `inputs` keeps the vertex buffer until the TLAS is built.
+    fn triangle_blas(
+        &self,
+        name: &str,
+        triangles: &[kernel::scene::Triangle],
+        inputs: &mut Vec<Buffer>,
+    ) -> Result<AccelerationStructure> {
+        let mut vertices: Vec<[f32; 3]> = Vec::with_capacity(3 * triangles.len());
+        for t in triangles {
+            let p0 = glam::Vec3::from(t.p0);
+            vertices.push(t.p0);
+            vertices.push((p0 + glam::Vec3::from(t.edge1)).to_array());
+            vertices.push((p0 + glam::Vec3::from(t.edge2)).to_array());
+        }
+        let vb = self.upload_buffer("vertices", bytemuck::cast_slice(&vertices), INPUT_USAGE)?;
+        let data = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
+            .vertex_format(vk::Format::R32G32B32_SFLOAT)
+            .vertex_data(vk::DeviceOrHostAddressConstKHR {
+                device_address: vb.address,
+            })
+            .vertex_stride(12)
+            .max_vertex(vertices.len() as u32 - 1)
+            .index_type(vk::IndexType::NONE_KHR);
+        inputs.push(vb);
+        let geometry = vk::AccelerationStructureGeometryKHR::default()
+            .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
+            .geometry(vk::AccelerationStructureGeometryDataKHR { triangles: data })
+            .flags(vk::GeometryFlagsKHR::OPAQUE);
+        self.build_accel(
+            &format!("BLAS {name}"),
+            vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL,
+            geometry,
+            triangles.len() as u32,
+        )
+    }
+
     /// Builds the BLASes the scene needs and the TLAS over them.
     pub fn build_scene_accel(&self, scene: &Scene, hit_groups: HitGroups) -> Result<SceneAccel> {
         let mut blases = Vec::new();
@@ -132,41 +179,41 @@ impl Context {
                         group.name
                     );
                 }
-                // Non-indexed vertices: p0, p0 + edge1, p0 + edge2 per triangle, as on the CPU.
-                let mut vertices: Vec<[f32; 3]> = Vec::with_capacity(3 * group.range.len());
-                for t in &scene.triangles[group.range.clone()] {
-                    let p0 = glam::Vec3::from(t.p0);
-                    vertices.push(t.p0);
-                    vertices.push((p0 + glam::Vec3::from(t.edge1)).to_array());
-                    vertices.push((p0 + glam::Vec3::from(t.edge2)).to_array());
-                }
-                let vb =
-                    self.upload_buffer("vertices", bytemuck::cast_slice(&vertices), INPUT_USAGE)?;
-                let triangles = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
-                    .vertex_format(vk::Format::R32G32B32_SFLOAT)
-                    .vertex_data(vk::DeviceOrHostAddressConstKHR {
-                        device_address: vb.address,
-                    })
-                    .vertex_stride(12)
-                    .max_vertex(vertices.len() as u32 - 1)
-                    .index_type(vk::IndexType::NONE_KHR);
-                let geometry = vk::AccelerationStructureGeometryKHR::default()
-                    .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
-                    .geometry(vk::AccelerationStructureGeometryDataKHR { triangles })
-                    .flags(vk::GeometryFlagsKHR::OPAQUE);
-                let blas = self.build_accel(
-                    &format!("BLAS {}", group.name),
-                    vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL,
-                    geometry,
-                    group.range.len() as u32,
+                let blas = self.triangle_blas(
+                    &group.name,
+                    &scene.triangles[group.range.clone()],
+                    &mut inputs,
                 )?;
-                inputs.push(vb);
                 instances.push(instance(
                     blas.address,
+                    IDENTITY,
                     group.range.start as u32,
                     hit_groups.triangle_offset(),
                 ));
                 blases.push(blas);
+            }
+            let mut mesh_blases = Vec::with_capacity(scene.meshes.len());
+            for mesh in &scene.meshes {
+                let blas = self.triangle_blas(
+                    &mesh.name,
+                    &scene.triangles[mesh.range.clone()],
+                    &mut inputs,
+                )?;
+                mesh_blases.push(blas.address);
+                blases.push(blas);
+            }
+            for (k, (inst, &mesh)) in scene
+                .instances
+                .iter()
+                .zip(&scene.instance_meshes)
+                .enumerate()
+            {
+                instances.push(instance(
+                    mesh_blases[mesh as usize],
+                    inst.object_to_world,
+                    k as u32,
+                    hit_groups.instance_offset(),
+                ));
             }
             if !scene.spheres.is_empty() {
                 let aabbs: Vec<vk::AabbPositionsKHR> = scene
@@ -206,7 +253,12 @@ impl Context {
                     scene.spheres.len() as u32,
                 )?;
                 inputs.push(ab);
-                instances.push(instance(blas.address, 0, hit_groups.sphere_offset()));
+                instances.push(instance(
+                    blas.address,
+                    IDENTITY,
+                    0,
+                    hit_groups.sphere_offset(),
+                ));
                 blases.push(blas);
             }
             Ok(())
@@ -259,17 +311,20 @@ impl Context {
     }
 }
 
-/// An identity-transform instance of a BLAS; `custom_index` reaches the shaders as
-/// `instance_custom_index` (the group's first triangle), `hit_group` selects the SBT record.
+/// The identity as a row-major 3 x 4 matrix.
+const IDENTITY: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+/// An instance of a BLAS placed by the row-major 3 x 4 `transform`; `custom_index` reaches the
+/// shaders as `instance_custom_index` (a world-space group's first triangle, or the index of a
+/// `kernel::scene::Instance`), `hit_group` selects the SBT record.
 fn instance(
     blas: vk::DeviceAddress,
+    transform: [f32; 12],
     custom_index: u32,
     hit_group: u32,
 ) -> vk::AccelerationStructureInstanceKHR {
     vk::AccelerationStructureInstanceKHR {
-        transform: vk::TransformMatrixKHR {
-            matrix: [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
-        },
+        transform: vk::TransformMatrixKHR { matrix: transform },
         instance_custom_index_and_mask: vk::Packed24_8::new(custom_index, 0xff),
         instance_shader_binding_table_record_offset_and_flags: vk::Packed24_8::new(
             hit_group,

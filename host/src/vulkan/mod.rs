@@ -62,8 +62,9 @@ impl GpuRenderer {
         let features = scene.features();
         let hit_groups = if scene.render.specialize {
             HitGroups {
-                triangles: !scene.triangles.is_empty(),
+                triangles: scene.world_triangle_count() > 0,
                 spheres: !scene.spheres.is_empty(),
+                instances: !scene.instances.is_empty(),
             }
         } else {
             HitGroups::ALL
@@ -106,6 +107,11 @@ impl GpuRenderer {
                 bytemuck::cast_slice(&scene.textures.words),
                 STORAGE,
             )?,
+            ctx.upload_buffer(
+                "instances",
+                bytemuck::cast_slice(&scene.instance_table()),
+                STORAGE,
+            )?,
         ];
         let accum = ctx.create_storage_image("accum", w, h)?;
         let accum_sq = ctx.create_storage_image("accum_sq", w, h)?;
@@ -122,7 +128,7 @@ impl GpuRenderer {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 8,
+                descriptor_count: 9,
             },
         ];
         let (pool, set) = ctx.create_descriptor_set(pipeline.set_layout, &sizes)?;
@@ -152,6 +158,7 @@ impl GpuRenderer {
             buffer_info(&tables[4]),
             buffer_info(&tables[5]),
             buffer_info(&tables[6]),
+            buffer_info(&tables[7]),
         ];
         let buffer_bindings = [
             binding::PARAMS,
@@ -162,6 +169,7 @@ impl GpuRenderer {
             binding::ENVIRONMENT,
             binding::SHADING,
             binding::TEXTURES,
+            binding::INSTANCES,
         ];
         let mut writes = vec![
             vk::WriteDescriptorSet::default()
@@ -340,6 +348,10 @@ impl SampleBackend for GpuRenderer {
 
     fn setup_times(&self) -> (Duration, Duration) {
         (self.accel_build_time, self.pipeline_time)
+    }
+
+    fn accel_bytes(&self) -> u64 {
+        self.resources.as_ref().map_or(0, |r| r.accel.bytes())
     }
 }
 

@@ -13,6 +13,7 @@ pub const RAYGEN: &CStr = c"shaders::raygen";
 pub const MISS: &CStr = c"shaders::miss";
 pub const CLOSEST_HIT_TRIANGLE: &CStr = c"shaders::closest_hit_triangle";
 pub const CLOSEST_HIT_SPHERE: &CStr = c"shaders::closest_hit_sphere";
+pub const CLOSEST_HIT_INSTANCE: &CStr = c"shaders::closest_hit_instance";
 pub const INTERSECT_SPHERE: &CStr = c"shaders::intersect_sphere_shader";
 
 /// Descriptor bindings, as `kernel::shaders` declares them.
@@ -29,20 +30,24 @@ pub mod binding {
     pub const ENVIRONMENT: u32 = 9;
     pub const SHADING: u32 = 10;
     pub const TEXTURES: u32 = 11;
+    pub const INSTANCES: u32 = 12;
 }
 
-/// Which hit groups a pipeline has: a scene without triangles (or spheres) gets no triangle
-/// (or sphere) hit group when specialized; the generic pipeline has both.
+/// Which hit groups a pipeline has: a scene without world-space triangles (or spheres, or
+/// instances) gets no triangle (or sphere, or instance) hit group when specialized; the
+/// generic pipeline has all three.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HitGroups {
     pub triangles: bool,
     pub spheres: bool,
+    pub instances: bool,
 }
 
 impl HitGroups {
     pub const ALL: HitGroups = HitGroups {
         triangles: true,
         spheres: true,
+        instances: true,
     };
 
     /// SBT record offset of the triangle hit group (instances of triangle BLASes).
@@ -55,8 +60,13 @@ impl HitGroups {
         self.triangles as u32
     }
 
-    fn count(self) -> u32 {
+    /// SBT record offset of the instanced-triangle hit group: after the others present.
+    pub fn instance_offset(self) -> u32 {
         self.triangles as u32 + self.spheres as u32
+    }
+
+    fn count(self) -> u32 {
+        self.triangles as u32 + self.spheres as u32 + self.instances as u32
     }
 }
 
@@ -123,6 +133,7 @@ impl RtPipeline {
             b(binding::ENVIRONMENT, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::SHADING, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::TEXTURES, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::INSTANCES, vk::DescriptorType::STORAGE_BUFFER),
         ];
         let set_layout = unsafe {
             ctx.device.create_descriptor_set_layout(
@@ -169,7 +180,7 @@ impl RtPipeline {
             group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 0, unused, unused),
             group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 1, unused, unused),
         ];
-        // Hit groups in SBT order (HitGroups::triangle_offset, sphere_offset).
+        // Hit groups in SBT order (HitGroups::triangle_offset, sphere_offset, instance_offset).
         if hit_groups.triangles {
             stages.push(stage(
                 vk::ShaderStageFlags::CLOSEST_HIT_KHR,
@@ -196,6 +207,18 @@ impl RtPipeline {
                 unused,
                 stages.len() as u32 - 2,
                 stages.len() as u32 - 1,
+            ));
+        }
+        if hit_groups.instances {
+            stages.push(stage(
+                vk::ShaderStageFlags::CLOSEST_HIT_KHR,
+                CLOSEST_HIT_INSTANCE,
+            ));
+            groups.push(group(
+                vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP,
+                unused,
+                stages.len() as u32 - 1,
+                unused,
             ));
         }
         let info = vk::RayTracingPipelineCreateInfoKHR::default()

@@ -11,6 +11,7 @@ mod material;
 use super::builder::SceneTables;
 use super::closed_surface::check_closed_outward;
 use super::file::MAX_IMAGE_SIDE;
+use super::instancing::{instances_box, INSTANCE_MIN_TRIANGLES};
 use super::mesh::TriangleSoup;
 use super::textures::TextureUse;
 use super::transform::Transform;
@@ -58,6 +59,10 @@ pub(super) struct Import<'a> {
     notes: &'a mut Vec<String>,
     /// Kernel material of each glTF material index (`None`: the default material).
     materials: HashMap<Option<usize>, u32>,
+    /// How many nodes of the scene use each mesh (by glTF index).
+    mesh_uses: HashMap<usize, usize>,
+    /// The instanced mesh (`SceneTables::begin_instanced_mesh`) of each glTF mesh stored once.
+    instanced: HashMap<usize, u32>,
 }
 
 /// Reads the document and its buffers (external ones relative to `base`, refused without
@@ -231,6 +236,8 @@ fn import(
         tables,
         notes,
         materials: HashMap::new(),
+        mesh_uses: HashMap::new(),
+        instanced: HashMap::new(),
     };
     imp.walk(transform.map_or(DMat4::IDENTITY, |t| t.matrix()))
 }
@@ -324,10 +331,12 @@ impl Import<'_> {
         Ok(cameras)
     }
 
-    /// Refuses a node forest whose mesh instances would flatten into more than
-    /// [`MAX_TRIANGLES`] triangles, counted from the accessors' declared counts before anything
-    /// is read or allocated (cycles end the count; [`Import::walk`] reports them).
-    fn check_triangle_budget(&self, roots: &[gltf::Node]) -> Result<(), SceneError> {
+    /// Counts the nodes that use each mesh ([`Import::mesh_uses`]) and refuses a node forest
+    /// whose meshes would store more than [`MAX_TRIANGLES`] triangles, counted from the
+    /// accessors' declared counts before any geometry is read or allocated: a mesh several
+    /// nodes use counts once where it will be instanced ([`Import::instanceable`]), once per
+    /// node where it will be flattened (cycles end the count; [`Import::walk`] reports them).
+    fn check_triangle_budget(&mut self, roots: &[gltf::Node]) -> Result<(), SceneError> {
         let mut visited = vec![false; self.document.nodes().len()];
         let mut stack: Vec<gltf::Node> = roots.to_vec();
         let mut total = self.tables.triangles.len() as u64;
@@ -336,17 +345,11 @@ impl Import<'_> {
                 continue;
             }
             if let Some(mesh) = node.mesh() {
-                for p in mesh.primitives() {
-                    let count = p
-                        .indices()
-                        .or_else(|| p.get(&gltf::Semantic::Positions))
-                        .map_or(0, |a| a.count() as u64);
-                    let triangles = match p.mode() {
-                        Mode::Triangles => count / 3,
-                        Mode::TriangleStrip | Mode::TriangleFan => count.saturating_sub(2),
-                        _ => 0,
-                    };
-                    total = total.saturating_add(triangles);
+                let uses = self.mesh_uses.entry(mesh.index()).or_insert(0);
+                *uses += 1;
+                let first_use = *uses == 1;
+                if first_use || !self.instanceable(&mesh)? {
+                    total = total.saturating_add(declared_triangles(&mesh));
                 }
             }
             if total > MAX_TRIANGLES as u64 {
@@ -355,8 +358,9 @@ impl Import<'_> {
                     None,
                     "nodes",
                     format!(
-                        "its mesh instances would flatten into more than {MAX_TRIANGLES} \
-                         triangles (instancing is not supported yet)"
+                        "its meshes would store more than {MAX_TRIANGLES} triangles (a mesh \
+                         used by several nodes is stored once unless it emits light or has \
+                         fewer than {INSTANCE_MIN_TRIANGLES} triangles)"
                     ),
                 ));
             }
@@ -448,7 +452,10 @@ impl Import<'_> {
         Ok(())
     }
 
-    /// Adds every primitive of `mesh` as placed by `node` at `world`.
+    /// Adds every primitive of `mesh` as placed by `node` at `world`: flattened into world
+    /// space, or as an instance of the mesh stored once where several nodes use it, it has at
+    /// least [`INSTANCE_MIN_TRIANGLES`] triangles and none of its materials emits (an emissive
+    /// triangle is a light, whose record is in world space).
     fn add_mesh(
         &mut self,
         node: &gltf::Node,
@@ -463,6 +470,10 @@ impl Import<'_> {
                 msg,
             )
         })?;
+        let shared = self.mesh_uses.get(&mesh.index()).copied().unwrap_or(0) >= 2;
+        if shared && self.instanceable(mesh)? {
+            return self.add_instance(node, mesh, &transform.unwrap_or_default());
+        }
         for p in mesh.primitives() {
             let field = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());
             let soup = self.primitive(&p, &field)?;
@@ -477,45 +488,109 @@ impl Import<'_> {
                     ),
                 ));
             }
-            let gltf_material = p.material().index();
-            let material = match self.materials.get(&gltf_material) {
-                Some(&m) => m,
-                None => {
-                    let m = material::material(self, gltf_material.map(|_| p.material()))?;
-                    let name = match (gltf_material, p.material().name()) {
-                        (None, _) => "gltf default".to_string(),
-                        (Some(i), Some(n)) => format!("{n} (materials[{i}])"),
-                        (Some(i), None) => format!("materials[{i}]"),
-                    };
-                    let index = self.tables.add_material(name, m);
-                    self.materials.insert(gltf_material, index);
-                    index
-                }
-            };
-            if self.tables.is_textured(material) && soup.uvs.is_empty() {
-                return Err(SceneError::new(
-                    &self.path,
-                    None,
-                    field,
-                    "its material has textures but the primitive has no TEXCOORD_0",
-                ));
-            }
-            if self.tables.is_dielectric(material) {
-                check_closed_outward(&soup.triangles).map_err(|msg| {
-                    SceneError::new(
-                        &self.path,
-                        None,
-                        format!("{field} (a transmissive material: glass)"),
-                        msg,
-                    )
-                })?;
-            }
+            let material = self.material_of(&p)?;
+            self.check_primitive(&soup, material, &field)?;
             let name = format!("{}#{field}", self.path.display());
             self.tables
                 .push_mesh(name, &soup, transform.as_ref(), material)
                 .map_err(|(k, msg)| {
                     SceneError::new(&self.path, None, format!("{field} triangle {k}"), msg)
                 })?;
+        }
+        Ok(())
+    }
+
+    /// Whether `mesh`, when several nodes use it, is stored once and instanced: it has at
+    /// least [`INSTANCE_MIN_TRIANGLES`] triangles and none of its materials emits.
+    fn instanceable(&mut self, mesh: &gltf::Mesh) -> Result<bool, SceneError> {
+        if declared_triangles(mesh) < INSTANCE_MIN_TRIANGLES as u64 {
+            return Ok(false);
+        }
+        for p in mesh.primitives() {
+            let m = self.material_of(&p)?;
+            if self.tables.is_emissive(m) {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
+    /// Places the glTF mesh `mesh` (stored once, in object space, on its first use) at
+    /// `transform` as an instance.
+    fn add_instance(
+        &mut self,
+        node: &gltf::Node,
+        mesh: &gltf::Mesh,
+        transform: &Transform,
+    ) -> Result<(), SceneError> {
+        let index = match self.instanced.get(&mesh.index()) {
+            Some(&i) => i,
+            None => {
+                let name = format!("{}#meshes[{}]", self.path.display(), mesh.index());
+                let index = self.tables.begin_instanced_mesh(name);
+                for p in mesh.primitives() {
+                    let field = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());
+                    let soup = self.primitive(&p, &field)?;
+                    let material = self.material_of(&p)?;
+                    self.check_primitive(&soup, material, &field)?;
+                    self.tables
+                        .push_mesh_part(&soup, material)
+                        .map_err(|(k, msg)| {
+                            SceneError::new(&self.path, None, format!("{field} triangle {k}"), msg)
+                        })?;
+                }
+                self.instanced.insert(mesh.index(), index);
+                index
+            }
+        };
+        self.tables.add_instance(index, transform).map_err(|msg| {
+            SceneError::new(&self.path, None, format!("nodes[{}]", node.index()), msg)
+        })
+    }
+
+    /// The kernel material of primitive `p` (added on its first use).
+    fn material_of(&mut self, p: &gltf::Primitive) -> Result<u32, SceneError> {
+        let gltf_material = p.material().index();
+        if let Some(&m) = self.materials.get(&gltf_material) {
+            return Ok(m);
+        }
+        let m = material::material(self, gltf_material.map(|_| p.material()))?;
+        let name = match (gltf_material, p.material().name()) {
+            (None, _) => "gltf default".to_string(),
+            (Some(i), Some(n)) => format!("{n} (materials[{i}])"),
+            (Some(i), None) => format!("materials[{i}]"),
+        };
+        let index = self.tables.add_material(name, m);
+        self.materials.insert(gltf_material, index);
+        Ok(index)
+    }
+
+    /// Refuses primitive `field`'s triangles `soup` under `material` where the material needs
+    /// what the primitive lacks: texture coordinates for textures, a closed outward surface
+    /// for glass.
+    fn check_primitive(
+        &self,
+        soup: &TriangleSoup,
+        material: u32,
+        field: &str,
+    ) -> Result<(), SceneError> {
+        if self.tables.is_textured(material) && soup.uvs.is_empty() {
+            return Err(SceneError::new(
+                &self.path,
+                None,
+                field,
+                "its material has textures but the primitive has no TEXCOORD_0",
+            ));
+        }
+        if self.tables.is_dielectric(material) {
+            check_closed_outward(&soup.triangles).map_err(|msg| {
+                SceneError::new(
+                    &self.path,
+                    None,
+                    format!("{field} (a transmissive material: glass)"),
+                    msg,
+                )
+            })?;
         }
         Ok(())
     }
@@ -723,6 +798,24 @@ impl Import<'_> {
     }
 }
 
+/// The triangles `mesh` declares (from its accessors' counts, before reading them).
+fn declared_triangles(mesh: &gltf::Mesh) -> u64 {
+    let mut total = 0u64;
+    for p in mesh.primitives() {
+        let count = p
+            .indices()
+            .or_else(|| p.get(&gltf::Semantic::Positions))
+            .map_or(0, |a| a.count() as u64);
+        let triangles = match p.mode() {
+            Mode::Triangles => count / 3,
+            Mode::TriangleStrip | Mode::TriangleFan => count.saturating_sub(2),
+            _ => 0,
+        };
+        total = total.saturating_add(triangles);
+    }
+    total
+}
+
 /// A camera that sees the whole scene from +z (up +y, 40 degrees vertical field of view,
 /// 1280 x 720): for files without a perspective camera. `None` without triangles.
 fn framing_camera(tables: &SceneTables) -> Option<CameraDesc> {
@@ -735,6 +828,13 @@ fn framing_camera(tables: &SceneTables) -> Option<CameraDesc> {
             hi = hi.max(p);
         }
     }
+    let (ilo, ihi) = instances_box(
+        &tables.mesh_triangles,
+        &tables.meshes,
+        &tables.instances,
+        &tables.instance_meshes,
+    );
+    (lo, hi) = (lo.min(ilo), hi.max(ihi));
     if !(lo.x <= hi.x) {
         return None;
     }

@@ -1,0 +1,116 @@
+//! Instances: a mesh stored once in object space and seen through an affine transform
+//! ([`Instance`]). Here are the maps of points, directions, normals and rays between the two
+//! spaces, and the rounding-error bound of a hit point carried into world space, which sizes
+//! the offset of rays leaving it (`geometry::offset_ray_origin`).
+//!
+//! Every map is written out component by component in a fixed order (three products summed left
+//! to right, then the translation), so both backends compute the same `f32`s.
+
+use crate::scene::Instance;
+use spirv_std::glam::Vec3;
+
+/// The linear part of the row-major 3 x 4 matrix `m` applied to `v`.
+#[inline]
+fn linear(m: &[f32; 12], v: Vec3) -> Vec3 {
+    Vec3::new(
+        m[0] * v.x + m[1] * v.y + m[2] * v.z,
+        m[4] * v.x + m[5] * v.y + m[6] * v.z,
+        m[8] * v.x + m[9] * v.y + m[10] * v.z,
+    )
+}
+
+/// The transpose of `m`'s linear part applied to `v`.
+#[inline]
+fn linear_transposed(m: &[f32; 12], v: Vec3) -> Vec3 {
+    Vec3::new(
+        m[0] * v.x + m[4] * v.y + m[8] * v.z,
+        m[1] * v.x + m[5] * v.y + m[9] * v.z,
+        m[2] * v.x + m[6] * v.y + m[10] * v.z,
+    )
+}
+
+/// `m` applied to point `p`: its linear part, then its translation.
+#[inline]
+fn affine(m: &[f32; 12], p: Vec3) -> Vec3 {
+    linear(m, p) + Vec3::new(m[3], m[7], m[11])
+}
+
+/// The largest absolute translation component of `m`.
+#[inline]
+fn translation_norm(m: &[f32; 12]) -> f32 {
+    m[3].abs().max(m[7].abs()).max(m[11].abs())
+}
+
+/// Largest absolute component of `v`.
+#[inline]
+fn max_abs(v: Vec3) -> f32 {
+    v.abs().max_element()
+}
+
+/// The world-space image of object-space point `p`.
+#[inline]
+pub fn point_to_world(instance: &Instance, p: Vec3) -> Vec3 {
+    affine(&instance.object_to_world, p)
+}
+
+/// The world-space image of object-space direction `v` (a tangent: it maps like an edge).
+#[inline]
+pub fn vector_to_world(instance: &Instance, v: Vec3) -> Vec3 {
+    linear(&instance.object_to_world, v)
+}
+
+/// The world-space normal of a surface whose object-space normal is `n`: the inverse transpose
+/// of the linear part, M^-T n = (world_to_object)^T n (PBR 4e, section 3.10.3), not
+/// normalised. It points to the side of the surface `n` points to, mirroring or not.
+#[inline]
+pub fn normal_to_world(instance: &Instance, n: Vec3) -> Vec3 {
+    linear_transposed(&instance.world_to_object, n)
+}
+
+/// The object-space ray of world ray `origin + t dir`: origin and direction mapped by
+/// `world_to_object` (the direction not normalised, so a hit's `t` is the same in both
+/// spaces). The CPU's BVH traces instances this way; the GPU maps rays by its own inverse.
+#[inline]
+pub fn ray_to_object(instance: &Instance, origin: Vec3, dir: Vec3) -> (Vec3, Vec3) {
+    (
+        affine(&instance.world_to_object, origin),
+        linear(&instance.world_to_object, dir),
+    )
+}
+
+/// Bound on the transforms' rounding, in units of eps times the magnitudes of their terms: an
+/// affine map rounds each component at most gamma(3) ~ 3 eps of the sum of its terms' magnitudes
+/// (three products, three sums), and a stored inverse is within eps/2 of the exact one per
+/// entry; a factor of four spare covers a device that inverts the matrix itself in `f32`
+/// (Vulkan takes only `object_to_world`).
+pub const INSTANCE_ERROR_EPS: f32 = 16.0;
+
+/// Absolute error bound (per component) of the world point `p_world` =
+/// [`point_to_world`]`(p_object)`, where `p_object` is known to within `object_error`, as the
+/// origin of a ray that will be mapped back into object space to meet this instance again:
+/// 1. the object point's own error carried through the linear part, ||M|| e_o;
+/// 2. the forward map's rounding, a few eps of ||M|| |p_o| + |T|;
+/// 3. the round trip: a ray leaving from `p_world` is mapped back by an inverse (ours, or the
+///    device's), which rounds its origin by a few eps of ||W|| |p_w| + |T_w| in object space,
+///    up to ||M|| times that in world space. A ray leaving from beyond this bound along the
+///    normal starts, once mapped back, on the side it leaves toward (pbrt-v4's
+///    `Transform::operator()(Ray)` moves a mapped origin by its error for the same reason).
+///
+/// Norms are infinity norms (`Instance::forward_norm`, `inverse_norm`); `|.|` is the largest
+/// absolute component. For a rigid transform at the origin this is about 16 eps of the point's
+/// magnitude on top of the object-space bound; a badly conditioned map (||M|| ||W|| large)
+/// widens it in proportion, as it widens the round trip's error.
+#[inline]
+pub fn world_point_error(
+    instance: &Instance,
+    p_object: Vec3,
+    object_error: f32,
+    p_world: Vec3,
+) -> f32 {
+    let m = instance.forward_norm;
+    let w = instance.inverse_norm;
+    let carried = m * object_error * (1.0 + INSTANCE_ERROR_EPS * f32::EPSILON);
+    let forward = m * max_abs(p_object) + translation_norm(&instance.object_to_world);
+    let round_trip = m * (w * max_abs(p_world) + translation_norm(&instance.world_to_object));
+    carried + INSTANCE_ERROR_EPS * f32::EPSILON * (forward + round_trip)
+}
