@@ -77,7 +77,7 @@ fn estimate_at(scene: &Scene, x: Vec3, view_dir: Vec3, stream: u32, batch: u32) 
                 &cpu.environment,
                 &cpu.shading,
                 &cpu.textures,
-                &cpu.instances,
+                cpu.bvh.instances(),
                 origin,
                 view_dir,
                 &mut rng,

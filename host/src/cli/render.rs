@@ -78,10 +78,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let instances = if scene.instances.is_empty() {
         String::new()
     } else {
+        let meshes = scene.meshes.len();
         format!(
-            " ({} of them in {} meshes placed by {} instances)",
+            " ({} of them stored once in {meshes} {} placed by {} instances)",
             scene.triangles.len() - scene.world_triangle_count(),
-            scene.meshes.len(),
+            if meshes == 1 { "mesh" } else { "meshes" },
             scene.instances.len()
         )
     };

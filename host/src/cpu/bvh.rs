@@ -56,25 +56,15 @@ struct WideNode {
     used: u32,
 }
 
-/// A leaf: `triangle_blocks` blocks of four triangles from `first_block`, `sphere_blocks`
-/// blocks of four spheres from `first_sphere_block`, and `instance_count` instances listed
-/// from `first_instance` in [`Bvh::leaf_instances`].
+/// A leaf: `triangle_blocks` blocks of four triangles from `first_block`, and `sphere_blocks`
+/// blocks of four spheres from `first_sphere_block`; its instances are listed apart
+/// ([`Bvh::leaf_instance_ranges`]), so the one-level loop reads what it always read.
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
     first_block: u32,
     triangle_blocks: u32,
     first_sphere_block: u32,
     sphere_blocks: u32,
-    first_instance: u32,
-    instance_count: u32,
-}
-
-/// What a leaf holds: ranges of [`Bvh::blocks`], [`Bvh::sphere_blocks`] and
-/// [`Bvh::leaf_instances`].
-struct LeafContents {
-    blocks: Range<usize>,
-    spheres: Range<usize>,
-    instances: Range<usize>,
 }
 
 /// The closest hit a traversal found: the primitive (a sphere or triangle of this tree, or of
@@ -122,8 +112,10 @@ pub struct Bvh {
     instances: Vec<Instance>,
     instance_meshes: Vec<u32>,
     meshes: Vec<Bvh>,
-    /// The instances of the leaves that have some, leaf by leaf.
+    /// The instances of the listed leaves, leaf by leaf, and each listed leaf's range of them
+    /// (by the leaf's index in `leaves`).
     leaf_instances: Vec<u32>,
+    leaf_instance_ranges: Vec<(u32, u32)>,
 }
 
 fn prim_bounds(
@@ -215,6 +207,7 @@ impl Bvh {
             instance_meshes,
             meshes,
             leaf_instances: Vec::new(),
+            leaf_instance_ranges: Vec::new(),
         };
         if n > 0 {
             bvh.root = Some(if binary.nodes[0].count > 0 {
@@ -336,10 +329,15 @@ impl Bvh {
             triangle_blocks,
             first_sphere_block,
             sphere_blocks,
-            first_instance,
-            instance_count,
         });
+        self.leaf_instance_ranges
+            .push((first_instance, first_instance + instance_count));
         LEAF | LISTED | (self.leaves.len() as u32 - 1)
+    }
+
+    /// The instances (the kernel's instance table on the CPU: a hit's `instance` indexes it).
+    pub fn instances(&self) -> &[Instance] {
+        &self.instances
     }
 
     /// Number of interior nodes (for statistics).
@@ -357,6 +355,7 @@ impl Bvh {
             + std::mem::size_of_val(self.blocks.as_slice())
             + std::mem::size_of_val(self.sphere_blocks.as_slice())
             + std::mem::size_of_val(self.leaf_instances.as_slice())
+            + std::mem::size_of_val(self.leaf_instance_ranges.as_slice())
             + self.meshes.iter().map(Bvh::hierarchy_bytes).sum::<usize>()
     }
 
@@ -395,34 +394,62 @@ impl Bvh {
         self.surface(hit, origin, dir)
     }
 
-    widest_simd! {
-        /// The primitive hit first along `origin + t dir`, t in (0, t_max), and its t; `NONE`
-        /// for a miss. Of primitives hit at exactly the same t, any one may be returned.
-        pub fn closest_prim(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit
-            = closest_prim_any_cpu, closest_prim_avx512, closest_prim_avx2
-    }
-
-    #[inline(always)]
-    fn closest_prim_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
+    /// The primitive hit first along `origin + t dir`, t in (0, t_max), and its t; `NONE`
+    /// for a miss. Of primitives hit at exactly the same t, any one may be returned.
+    #[inline]
+    pub fn closest_prim(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
         if self.instances.is_empty() {
-            self.closest_in::<false>(origin, dir, t_max)
+            let (prim, t) = self.closest_one_level(origin, dir, t_max);
+            PrimHit {
+                prim,
+                instance: NONE,
+                t,
+            }
         } else {
-            self.closest_in::<true>(origin, dir, t_max)
+            self.closest_two_level(origin, dir, t_max)
         }
     }
 
-    /// [`Bvh::closest_prim`], with the instance step compiled in where `INSTANCES`.
+    widest_simd! {
+        /// [`Bvh::closest_prim`] of a tree without instances: the primitive and t.
+        fn closest_one_level(&self, origin: Vec3, dir: Vec3, t_max: f32) -> (u32, f32)
+            = closest_one_level_any_cpu, closest_one_level_avx512, closest_one_level_avx2
+    }
+
     #[inline(always)]
-    fn closest_in<const INSTANCES: bool>(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
+    fn closest_one_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> (u32, f32) {
+        let mut no_instance = NONE;
+        self.closest_in::<false>(origin, dir, t_max, &mut no_instance)
+    }
+
+    widest_simd! {
+        /// [`Bvh::closest_prim`] of a tree with instances.
+        fn closest_two_level(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit
+            = closest_two_level_any_cpu, closest_two_level_avx512, closest_two_level_avx2
+    }
+
+    #[inline(always)]
+    fn closest_two_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
+        let mut instance = NONE;
+        let (prim, t) = self.closest_in::<true>(origin, dir, t_max, &mut instance);
+        PrimHit { prim, instance, t }
+    }
+
+    /// [`Bvh::closest_prim`]'s primitive and t, with the instance step compiled in where
+    /// `INSTANCES`: the hit's instance is then written to `best_instance` (`NONE` for this
+    /// tree's own primitives), which the one-level loop never touches.
+    #[inline(always)]
+    fn closest_in<const INSTANCES: bool>(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        best_instance: &mut u32,
+    ) -> (u32, f32) {
         let mut best_t = t_max;
         let mut best = NONE;
-        let mut best_instance = NONE;
         let Some(root) = self.root else {
-            return PrimHit {
-                prim: best,
-                instance: best_instance,
-                t: best_t,
-            };
+            return (best, best_t);
         };
         let ray = Ray4::new(origin, dir);
         // Not zero-filled (3 KiB per ray): entries below `sp` are always written first.
@@ -465,38 +492,43 @@ impl Bvh {
                     continue;
                 }
             } else {
-                let leaf = self.leaf_contents(current);
-                for block in &self.blocks[leaf.blocks] {
+                let (blocks, spheres) = self.leaf_contents(current);
+                for block in &self.blocks[blocks] {
                     let t = ray.triangles(&block.triangles, 0.0, best_t).to_array();
                     for (&t, &id) in t.iter().zip(&block.id) {
                         // Missed lanes are -1; hits are in (0, best_t) as it was at the call.
                         if t >= 0.0 && t < best_t {
                             best_t = t;
                             best = id;
-                            best_instance = NONE;
+                            if INSTANCES {
+                                *best_instance = NONE;
+                            }
                         }
                     }
                 }
-                for block in &self.sphere_blocks[leaf.spheres] {
+                for block in &self.sphere_blocks[spheres] {
                     let t = ray.spheres(&block.spheres, 0.0, best_t).to_array();
                     for (&t, &id) in t.iter().zip(&block.id) {
                         if t >= 0.0 && t < best_t {
                             best_t = t;
                             best = id;
-                            best_instance = NONE;
+                            if INSTANCES {
+                                *best_instance = NONE;
+                            }
                         }
                     }
                 }
                 if INSTANCES {
-                    for &i in &self.leaf_instances[leaf.instances] {
+                    for &i in &self.leaf_instances[self.instances_of_leaf(current)] {
                         let instance = &self.instances[i as usize];
                         let (o, d) = ray_to_object(instance, origin, dir);
                         let mesh = &self.meshes[self.instance_meshes[i as usize] as usize];
-                        let hit = mesh.closest_in::<false>(o, d, best_t);
-                        if hit.prim != NONE && hit.t < best_t {
-                            best_t = hit.t;
-                            best = hit.prim;
-                            best_instance = i;
+                        let mut no_instance = NONE;
+                        let (prim, t) = mesh.closest_in::<false>(o, d, best_t, &mut no_instance);
+                        if prim != NONE && t < best_t {
+                            best_t = t;
+                            best = prim;
+                            *best_instance = i;
                         }
                     }
                 }
@@ -505,11 +537,7 @@ impl Bvh {
             // against the padded far bound, exactly the slab test's verdict with today's t_max.
             loop {
                 if sp == 0 {
-                    return PrimHit {
-                        prim: best,
-                        instance: best_instance,
-                        t: best_t,
-                    };
+                    return (best, best_t);
                 }
                 sp -= 1;
                 // SAFETY: entry `sp` was written by a push (sp only grows by writing).
@@ -522,19 +550,36 @@ impl Bvh {
         }
     }
 
+    /// Whether anything is hit along `origin + t dir`, t in (0, t_max).
+    #[inline]
+    pub fn any_hit(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        if self.instances.is_empty() {
+            self.any_one_level(origin, dir, t_max)
+        } else {
+            self.any_two_level(origin, dir, t_max)
+        }
+    }
+
     widest_simd! {
-        /// Whether anything is hit along `origin + t dir`, t in (0, t_max).
-        pub fn any_hit(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool
-            = any_hit_any_cpu, any_hit_avx512, any_hit_avx2
+        /// [`Bvh::any_hit`] of a tree without instances.
+        fn any_one_level(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool
+            = any_one_level_any_cpu, any_one_level_avx512, any_one_level_avx2
     }
 
     #[inline(always)]
-    fn any_hit_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        if self.instances.is_empty() {
-            self.any_in::<false>(origin, dir, t_max)
-        } else {
-            self.any_in::<true>(origin, dir, t_max)
-        }
+    fn any_one_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        self.any_in::<false>(origin, dir, t_max)
+    }
+
+    widest_simd! {
+        /// [`Bvh::any_hit`] of a tree with instances.
+        fn any_two_level(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool
+            = any_two_level_any_cpu, any_two_level_avx512, any_two_level_avx2
+    }
+
+    #[inline(always)]
+    fn any_two_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        self.any_in::<true>(origin, dir, t_max)
     }
 
     /// [`Bvh::any_hit`], with the instance step compiled in where `INSTANCES`.
@@ -559,21 +604,21 @@ impl Bvh {
                     sp += 1;
                 }
             } else {
-                let leaf = self.leaf_contents(current);
-                for block in &self.blocks[leaf.blocks] {
+                let (blocks, spheres) = self.leaf_contents(current);
+                for block in &self.blocks[blocks] {
                     let t = ray.triangles(&block.triangles, 0.0, t_max);
                     if t.to_array().iter().any(|&t| t >= 0.0) {
                         return true;
                     }
                 }
-                for block in &self.sphere_blocks[leaf.spheres] {
+                for block in &self.sphere_blocks[spheres] {
                     let t = ray.spheres(&block.spheres, 0.0, t_max);
                     if t.to_array().iter().any(|&t| t >= 0.0) {
                         return true;
                     }
                 }
                 if INSTANCES {
-                    for &i in &self.leaf_instances[leaf.instances] {
+                    for &i in &self.leaf_instances[self.instances_of_leaf(current)] {
                         let (o, d) = ray_to_object(&self.instances[i as usize], origin, dir);
                         let mesh = &self.meshes[self.instance_meshes[i as usize] as usize];
                         if mesh.any_in::<false>(o, d, t_max) {
@@ -616,27 +661,32 @@ impl Bvh {
         }
     }
 
-    /// What leaf reference `r` holds.
+    /// The triangle blocks and the sphere blocks of leaf reference `r`.
     #[inline(always)]
-    fn leaf_contents(&self, r: u32) -> LeafContents {
+    fn leaf_contents(&self, r: u32) -> (Range<usize>, Range<usize>) {
         if r & LISTED == 0 {
             let first = (r & ((1 << BLOCK_BITS) - 1)) as usize;
             let count = ((r >> BLOCK_BITS) & 3) as usize + 1;
-            LeafContents {
-                blocks: first..first + count,
-                spheres: 0..0,
-                instances: 0..0,
-            }
+            (first..first + count, 0..0)
         } else {
             let leaf = &self.leaves[(r & !(LEAF | LISTED)) as usize];
             let first = leaf.first_block as usize;
             let sphere = leaf.first_sphere_block as usize;
-            let instance = leaf.first_instance as usize;
-            LeafContents {
-                blocks: first..first + leaf.triangle_blocks as usize,
-                spheres: sphere..sphere + leaf.sphere_blocks as usize,
-                instances: instance..instance + leaf.instance_count as usize,
-            }
+            (
+                first..first + leaf.triangle_blocks as usize,
+                sphere..sphere + leaf.sphere_blocks as usize,
+            )
+        }
+    }
+
+    /// The range of [`Bvh::leaf_instances`] that leaf reference `r` holds.
+    #[inline(always)]
+    fn instances_of_leaf(&self, r: u32) -> Range<usize> {
+        if r & LISTED == 0 {
+            0..0
+        } else {
+            let (first, end) = self.leaf_instance_ranges[(r & !(LEAF | LISTED)) as usize];
+            first as usize..end as usize
         }
     }
 
@@ -664,10 +714,18 @@ impl Bvh {
     /// The hit record of `hit` (from [`Bvh::closest_prim`] on this ray), computed as the GPU's
     /// closest-hit shaders do. An instance's triangle is intersected again with the ray mapped
     /// into its object space as the traversal mapped it (the same t and barycentrics).
+    #[inline]
     pub fn surface(&self, hit: PrimHit, origin: Vec3, dir: Vec3) -> SurfaceHit {
         if hit.instance == NONE {
-            return self.surface_of_prim(hit.prim, origin, dir, hit.t);
+            self.surface_of_prim(hit.prim, origin, dir, hit.t)
+        } else {
+            self.surface_of_instance(hit, origin, dir)
         }
+    }
+
+    /// [`Bvh::surface`] of a hit on an instance's triangle.
+    #[inline(never)]
+    fn surface_of_instance(&self, hit: PrimHit, origin: Vec3, dir: Vec3) -> SurfaceHit {
         let instance = &self.instances[hit.instance as usize];
         let mesh = &self.meshes[self.instance_meshes[hit.instance as usize] as usize];
         let (o, d) = ray_to_object(instance, origin, dir);
@@ -712,8 +770,8 @@ impl Bvh {
         self.surface_with_uv(id, origin, dir, t, uv)
     }
 
-    /// [`Bvh::surface_of_prim`] with the barycentrics `uv` of a triangle's hit already known (as the
-    /// kernel's `intersect_triangle_uv` computes them; ignored for spheres).
+    /// [`Bvh::surface_of_prim`] with the barycentrics `uv` of a triangle's hit already known (as
+    /// the kernel's `intersect_triangle_uv` computes them; ignored for spheres).
     pub fn surface_with_uv(
         &self,
         id: u32,

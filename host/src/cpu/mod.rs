@@ -19,7 +19,7 @@ use glam::Vec3;
 use indicatif::ProgressBar;
 use kernel::features::{self, Dynamic, FeatureSet, Static};
 use kernel::path::render_sample;
-use kernel::scene::{Instance, Light, Material, RenderParams, ShadingTriangle};
+use kernel::scene::{Light, Material, RenderParams, ShadingTriangle};
 use kernel::{SurfaceHit, Tracer};
 use packet::SmallScene;
 use rayon::prelude::*;
@@ -55,8 +55,6 @@ pub struct CpuRenderer {
     /// (`kernel::texture`).
     pub shading: Vec<ShadingTriangle>,
     pub textures: Vec<u32>,
-    /// The instance table (`kernel::scene::Instance`; one zero record without instances).
-    pub instances: Vec<Instance>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path).
     pub features: u32,
     /// How a tile's samples are computed, chosen once when the renderer is built.
@@ -152,7 +150,6 @@ impl CpuRenderer {
             environment: scene.environment_table(),
             shading: scene.shading_table(),
             textures: scene.textures.words.clone(),
-            instances: scene.instance_table(),
             features: with_all_extended(scene.features()),
             tiles: small.map_or(TileStrategy::OnePath, TileStrategy::Packets),
         }
@@ -182,7 +179,7 @@ impl CpuRenderer {
             &self.environment,
             &self.shading,
             &self.textures,
-            &self.instances,
+            self.bvh.instances(),
             px,
             py,
             sample,

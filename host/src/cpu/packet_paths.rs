@@ -158,7 +158,7 @@ impl CpuRenderer {
                             &self.materials,
                             &self.shading,
                             &self.textures,
-                            &self.instances,
+                            self.bvh.instances(),
                         );
                         materials[lane] = material;
                         path.vertex_query(features, params, hit, &material, shading_normal)
