@@ -540,3 +540,11 @@ fn a_thousand_instances_of_a_100k_triangle_mesh_store_it_once_on_both_backends()
     }
     assert_validation_clean();
 }
+
+#[test]
+fn the_shipped_instances_scene_stores_its_two_meshes_once() {
+    let scene = Scene::load(&twinpath_tests::repo_root().join("scenes/instances.toml")).unwrap();
+    assert_eq!((scene.meshes.len(), scene.instances.len()), (2, 15));
+    assert_eq!(scene.world_triangle_count(), 2, "the ground alone");
+    assert_eq!(scene.triangles.len(), 2 + 2304 + 1280);
+}

@@ -8,10 +8,9 @@ use glam::{DMat4, Vec3};
 use kernel::scene::{Instance, Triangle};
 
 /// Fewest triangles a mesh used more than once needs to be instanced rather than flattened
-/// into world space. An instance record (112 bytes) and the CPU's object-to-world round trip
-/// per ray cost about what two flattened triangles do (48 bytes each and their BVH share), so
-/// a tiny mesh is cheaper flattened; from a few dozen triangles on, instancing saves memory in
-/// proportion to the mesh.
+/// into world space. An instance record (112 bytes) and the ray's map into object space cost
+/// about what a couple of flattened triangles do (48 bytes each and their BVH share), so a tiny
+/// mesh is cheaper flattened; from here on, instancing saves memory in proportion to the mesh.
 pub const INSTANCE_MIN_TRIANGLES: usize = 16;
 
 /// Most instances a scene may have: the GPU names an instance by its 24-bit custom index.
