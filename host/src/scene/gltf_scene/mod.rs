@@ -1,5 +1,6 @@
 //! glTF 2.0 scenes (`.gltf` with external or embedded buffers, and `.glb`): the default scene's
-//! node hierarchy flattened into the scene's tables, with its transforms, triangle meshes,
+//! node hierarchy read into the scene's tables (a mesh shared by nodes stored once, as
+//! instances: `super::instancing`), with its transforms, triangle meshes,
 //! materials (`material`), textures and cameras. A glTF file is a scene by itself
 //! (`twinpath render model.glb`) or part of a TOML scene (`[[gltf]]`). docs/gltf.md lists what
 //! is read, approximated and ignored; what a file uses that is approximated or ignored is noted
@@ -48,7 +49,7 @@ pub struct GltfCamera {
     pub desc: CameraDesc,
 }
 
-/// One glTF file being flattened into `tables`.
+/// One glTF file being read into `tables`.
 pub(super) struct Import<'a> {
     path: PathBuf,
     /// Where external images are read from (none: refused).
@@ -204,7 +205,7 @@ pub fn load_bytes(
     Ok(scene)
 }
 
-/// Flattens glTF file `path` into `tables` under `transform` (a TOML scene's `[[gltf]]`); the
+/// Reads glTF file `path` into `tables` under `transform` (a TOML scene's `[[gltf]]`); the
 /// file's perspective cameras, placed in the scene.
 pub(super) fn include(
     tables: &mut SceneTables,
@@ -218,7 +219,7 @@ pub(super) fn include(
     import(tables, path, &bytes, Some(base), transform, notes)
 }
 
-/// Flattens the glTF file of `bytes` into `tables` (see [`load_bytes`] for `base`).
+/// Reads the glTF file of `bytes` into `tables` (see [`load_bytes`] for `base`).
 fn import(
     tables: &mut SceneTables,
     path: &Path,
