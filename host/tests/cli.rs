@@ -79,6 +79,40 @@ fn render_writes_exr_and_png() {
     assert_eq!(out.status.code(), Some(1));
 }
 
+#[test]
+fn width_and_height_replace_the_scenes_image_size() {
+    let dir = temp_dir("size");
+    let scene = small_scene(&dir, 16);
+    let size = |args: &[&str]| {
+        let png = dir.join("s.png");
+        let _ = std::fs::remove_file(&png);
+        let out = Command::new(BIN)
+            .args(["render", "--backend", "cpu", "--spp", "1", "--quiet", "-o"])
+            .arg(&png)
+            .args(args)
+            .arg(&scene)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        out.status
+            .success()
+            .then(|| image::open(&png).unwrap())
+            .map(|i| (i.width(), i.height()))
+            .ok_or(err)
+    };
+    // Both given: exactly that; one alone: the scene's aspect ratio (1 here) kept.
+    assert_eq!(size(&["--width", "30", "--height", "10"]), Ok((30, 10)));
+    assert_eq!(size(&["--width", "24"]), Ok((24, 24)));
+    assert_eq!(size(&["--height", "7"]), Ok((7, 7)));
+    let err = size(&["--width", "0"]).unwrap_err();
+    assert!(
+        err.contains("--width 0: must be 1 to 32768 pixels"),
+        "{err}"
+    );
+    let err = size(&["--height", "40000"]).unwrap_err();
+    assert!(err.contains("--height 40000"), "{err}");
+}
+
 /// Starts a render that would take hours, sends SIGINT after `wait`, and returns its log and
 /// the image it wrote.
 fn interrupt_after(backend: &str, wait: Duration) -> (String, image::Rgb32FImage) {

@@ -16,6 +16,14 @@ pub struct RenderArgs {
     /// glTF: the perspective camera to render through, by name (default: the first).
     #[arg(long)]
     camera: Option<String>,
+    /// Image width in pixels, instead of the scene's (alone: the height follows the scene's
+    /// aspect ratio). The vertical field of view is kept.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels, instead of the scene's (alone: the width follows the scene's
+    /// aspect ratio).
+    #[arg(long)]
+    height: Option<u32>,
     #[arg(long, value_enum, default_value_t = Backend::Auto)]
     backend: Backend,
     /// Vulkan device index for the GPU backend (see `twinpath info`).
@@ -53,6 +61,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
         (path, None) => load_scene(path.as_deref())?,
     };
     a.settings.apply(&mut scene.render)?;
+    scene.camera = scene
+        .camera
+        .resized(a.width, a.height)
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
     if let Some(m) = &a.spp_map {
         if extension(m).as_deref() != Some("exr") {
             bail!("--spp-map {}: must be an .exr file", m.display());

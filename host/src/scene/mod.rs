@@ -44,6 +44,34 @@ pub struct CameraDesc {
 }
 
 impl CameraDesc {
+    /// The camera with image size `width` x `height` where given (the command line's
+    /// `--width`, `--height`): one alone keeps the aspect ratio (the other side rounded, at
+    /// least 1); the vertical field of view stays. Err: a side outside 1..=2^15 (the scene
+    /// file's own limit), naming the option.
+    pub fn resized(&self, width: Option<u32>, height: Option<u32>) -> Result<CameraDesc, String> {
+        let max = file::MAX_IMAGE_SIDE as u32;
+        for (name, v) in [("--width", width), ("--height", height)] {
+            if let Some(v) = v {
+                if !(1..=max).contains(&v) {
+                    return Err(format!("{name} {v}: must be 1 to {max} pixels"));
+                }
+            }
+        }
+        let aspect = self.width as f64 / self.height as f64;
+        let side = |x: f64| (x.round() as u32).clamp(1, max);
+        let (w, h) = match (width, height) {
+            (Some(w), Some(h)) => (w, h),
+            (Some(w), None) => (w, side(w as f64 / aspect)),
+            (None, Some(h)) => (side(h as f64 * aspect), h),
+            (None, None) => (self.width, self.height),
+        };
+        Ok(CameraDesc {
+            width: w,
+            height: h,
+            ..*self
+        })
+    }
+
     /// The kernel's camera: forward, and right/up scaled by the image plane's half-extents; the
     /// lens radius and the focus distance in the spare fourth components (`kernel::scene::Camera`).
     pub fn to_kernel(&self) -> Camera {
