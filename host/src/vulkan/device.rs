@@ -1,5 +1,6 @@
 //! Vulkan instance, device selection and the logical device with the ray-tracing extensions.
 
+use super::limits::DeviceLimits;
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::{ext, khr, vk};
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -98,6 +99,8 @@ pub struct Context {
     pub accel: khr::acceleration_structure::Device,
     pub rt: khr::ray_tracing_pipeline::Device,
     pub rt_properties: RtProperties,
+    /// What a scene must fit (`super::limits`).
+    pub limits: DeviceLimits,
     pub validation: bool,
 }
 
@@ -289,6 +292,7 @@ impl Context {
             .push_next(&mut rt_props)
             .push_next(&mut as_props);
         unsafe { instance.get_physical_device_properties2(pd, &mut props2) };
+        let max_storage_buffer_range = props2.properties.limits.max_storage_buffer_range as u64;
         let rt_properties = RtProperties {
             shader_group_handle_size: rt_props.shader_group_handle_size,
             shader_group_base_alignment: rt_props.shader_group_base_alignment,
@@ -296,6 +300,11 @@ impl Context {
             max_ray_recursion_depth: rt_props.max_ray_recursion_depth,
             min_scratch_offset_alignment: as_props
                 .min_acceleration_structure_scratch_offset_alignment,
+        };
+        let limits = DeviceLimits {
+            max_storage_buffer_range,
+            max_primitive_count: as_props.max_primitive_count,
+            max_instance_count: as_props.max_instance_count,
         };
 
         let allocator = Allocator::new(&AllocatorCreateDesc {
@@ -323,6 +332,7 @@ impl Context {
             accel,
             rt,
             rt_properties,
+            limits,
             validation,
         })
     }

@@ -4,6 +4,7 @@
 pub mod accel;
 pub mod compute;
 pub mod device;
+pub mod limits;
 pub mod memory;
 pub mod pipeline;
 
@@ -58,6 +59,7 @@ impl GpuRenderer {
     /// Opens a device (see [`Context::new`]) and uploads `scene`.
     pub fn new(scene: &Scene, device: Option<usize>, validation: bool) -> Result<GpuRenderer> {
         let ctx = Context::new(device, validation)?;
+        limits::check_scene_fits(scene, &ctx.limits)?;
         let (w, h) = (scene.camera.width, scene.camera.height);
         let features = scene.features();
         let hit_groups = if scene.render.specialize {
