@@ -181,10 +181,7 @@ impl Bvh {
         let instance_boxes: Vec<Aabb> = instances
             .iter()
             .zip(&instance_meshes)
-            .map(|(inst, &m)| {
-                let (lo, hi) = instance_box(inst, meshes[m as usize].object_box());
-                Aabb { min: lo, max: hi }
-            })
+            .map(|(inst, &m)| meshes[m as usize].placed_box(inst))
             .collect();
         let n = spheres.len() + triangles.len() + instances.len();
         let bounds: Vec<Aabb> = (0..n as u32)
@@ -369,20 +366,21 @@ impl Bvh {
             + self.meshes.iter().map(Bvh::primitive_bytes).sum::<usize>()
     }
 
-    /// The box of this tree's geometry (empty for an empty tree).
-    fn object_box(&self) -> (Vec3, Vec3) {
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    /// The world-space box of this tree's geometry placed by `instance`: the union of its root's
+    /// child boxes, each mapped by its eight corners (`instancing::instance_box`), which under
+    /// a rotation is tighter than the mapped box of the whole; empty for an empty tree.
+    fn placed_box(&self, instance: &Instance) -> Aabb {
+        let mut placed = Aabb::EMPTY;
         if let Some(root) = self.nodes.first() {
-            for lane in 0..WIDTH {
-                if root.used & (1 << lane) != 0 {
-                    for axis in 0..3 {
-                        lo[axis] = lo[axis].min(root.boxes.min[axis][lane]);
-                        hi[axis] = hi[axis].max(root.boxes.max[axis][lane]);
-                    }
-                }
+            for lane in (0..WIDTH).filter(|&lane| root.used & (1 << lane) != 0) {
+                let corner =
+                    |b: &[Simd<f32, WIDTH>; 3]| Vec3::new(b[0][lane], b[1][lane], b[2][lane]);
+                let (lo, hi) =
+                    instance_box(instance, (corner(&root.boxes.min), corner(&root.boxes.max)));
+                placed = placed.union(Aabb { min: lo, max: hi });
             }
         }
-        (lo, hi)
+        placed
     }
 
     /// Closest hit along `origin + t dir`, t in (0, t_max).
