@@ -77,9 +77,9 @@ pub mod function {
     /// out0 = light::sample_triangle_light's (position, pdf) for [`probe_triangle_light`],
     /// out1 = (its normal, spherical_triangle::solid_angle(x, vertices))
     pub const TRIANGLE_LIGHT: u32 = 15;
-    /// uv = in0.xy, (width, height) = in0.zw as u32, clamp = in1.x as u32, four RGBA8 texels
-    /// (x0 y0, x1 y0, x0 y1, x1 y1) = in2 as u32, read as byte / 256 -> out0 = texture::footprint's
-    /// (x0, x1, y0, y1) as u32, out1 = (texture::bilerp of the texels, fx)
+    /// uv = in0.xy, (width, height) = in0.zw as u32, wrap modes (u, v) = in1.xy as u32, four
+    /// RGBA8 texels (x0 y0, x1 y0, x0 y1, x1 y1) = in2 as u32, read as byte / 256 -> out0 =
+    /// texture::footprint's (x0, x1, y0, y1) as u32, out1 = (texture::bilerp of the texels, fx)
     pub const TEXTURE: u32 = 16;
     /// base normal = in0.xyz, scale = in0.w, tangent (at all three vertices) = in1.xyz,
     /// sign = in1.w, texel = in2.xyz, barycentrics = (in2.w, in3.x) -> out0.xyz =
@@ -293,7 +293,7 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
         )
     } else if function == function::TEXTURE {
         let i = input[0];
-        let fp = footprint(Vec2::new(i0.x, i0.y), i.z, i.w, input[1].x != 0);
+        let fp = footprint(Vec2::new(i0.x, i0.y), i.z, i.w, input[1].x, input[1].y);
         let t = input[2];
         let c = bilerp(
             probe_texel(t.x),

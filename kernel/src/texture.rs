@@ -36,8 +36,24 @@ pub mod flags {
     pub const FLOAT: u32 = 1 << 0;
     /// 8-bit texels are sRGB-encoded (colour maps), else linear.
     pub const SRGB: u32 = 1 << 1;
-    /// Coordinates outside [0, 1] clamp to the edge, else the image repeats.
-    pub const CLAMP: u32 = 1 << 2;
+    /// Bits 2-3: how u continues outside [0, 1] (one of `super::wrap`); bits 4-5: how v does.
+    pub const WRAP_U_SHIFT: u32 = 2;
+    pub const WRAP_V_SHIFT: u32 = 4;
+
+    /// The flag bits of wrap modes `u` and `v` (`super::wrap`).
+    pub const fn wrap(u: u32, v: u32) -> u32 {
+        (u << WRAP_U_SHIFT) | (v << WRAP_V_SHIFT)
+    }
+}
+
+/// How a texture continues outside [0, 1] along one axis (glTF's sampler `wrapS`, `wrapT`).
+pub mod wrap {
+    /// The image repeats (REPEAT).
+    pub const REPEAT: u32 = 0;
+    /// The edge texels continue (CLAMP_TO_EDGE).
+    pub const CLAMP: u32 = 1;
+    /// The image repeats mirrored every other time (MIRRORED_REPEAT).
+    pub const MIRROR: u32 = 2;
 }
 
 /// The four texels around a point and the point's position between them: texel columns `x0`,
@@ -53,14 +69,24 @@ pub struct Footprint {
     pub fy: f32,
 }
 
-/// The bilinear footprint of texture coordinates `uv` on a `width` x `height` image: repeated
-/// (the fractional part of each coordinate) or clamped to [0, 1] first, so texel indices are
-/// always in range whatever `uv` is (a non-finite coordinate reads as 0).
+/// The bilinear footprint of texture coordinates `uv` on a `width` x `height` image, u wrapping
+/// as `wrap_u` and v as `wrap_v` (`wrap`): each coordinate first brought into [0, 1], so texel
+/// indices are always in range whatever `uv` is (a non-finite coordinate reads as 0).
+///
+/// A mirrored repeat folds the coordinate (a triangle wave of period 2), then indexes as a
+/// clamp does: across a fold the neighbour of an edge texel is that texel itself, and inside a
+/// mirrored copy the folded coordinate's two texels and weights are the unfolded one's mirrored
+/// (OpenGL 4.6, section 8.14.2, mirrors the texel indices instead; the two agree, tested
+/// against that definition in f64).
 #[inline]
-pub fn footprint(uv: Vec2, width: u32, height: u32, clamp: bool) -> Footprint {
-    let (u, v) = (unit_coordinate(uv.x, clamp), unit_coordinate(uv.y, clamp));
-    let (x0, x1, fx) = axis(u * width as f32 - 0.5, width, clamp);
-    let (y0, y1, fy) = axis((1.0 - v) * height as f32 - 0.5, height, clamp);
+pub fn footprint(uv: Vec2, width: u32, height: u32, wrap_u: u32, wrap_v: u32) -> Footprint {
+    let (u, v) = (unit_coordinate(uv.x, wrap_u), unit_coordinate(uv.y, wrap_v));
+    let (x0, x1, fx) = axis(u * width as f32 - 0.5, width, wrap_u != wrap::REPEAT);
+    let (y0, y1, fy) = axis(
+        (1.0 - v) * height as f32 - 0.5,
+        height,
+        wrap_v != wrap::REPEAT,
+    );
     Footprint {
         x0,
         x1,
@@ -71,17 +97,25 @@ pub fn footprint(uv: Vec2, width: u32, height: u32, clamp: bool) -> Footprint {
     }
 }
 
-/// `t` in [0, 1]: clamped, or its fractional part (which rounding may leave at 1, handled by
-/// [`axis`]); 0 for a non-finite `t`.
+/// `t` in [0, 1] by wrap mode `mode`: clamped, folded (t reduced modulo 2, then 2 - t beyond
+/// 1), or its fractional part (which rounding may leave at 1, handled by [`axis`]); 0 for a
+/// non-finite `t`.
 #[inline]
-fn unit_coordinate(t: f32, clamp: bool) -> f32 {
+fn unit_coordinate(t: f32, mode: u32) -> f32 {
     if !t.is_finite() {
         return 0.0;
     }
-    if clamp {
+    if mode == wrap::REPEAT {
+        t - t.floor()
+    } else if mode == wrap::CLAMP {
         t.clamp(0.0, 1.0)
     } else {
-        t - t.floor()
+        let r = t - 2.0 * (0.5 * t).floor();
+        if r > 1.0 {
+            2.0 - r
+        } else {
+            r
+        }
     }
 }
 
@@ -173,7 +207,13 @@ fn decoded(table: &[u32], base: usize, word: u32) -> f32 {
 pub fn lookup(table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
     let r = RECORDS + RECORD_WORDS * texture as usize;
     let (offset, width, height, tex_flags) = (table[r], table[r + 1], table[r + 2], table[r + 3]);
-    let f = footprint(uv, width, height, tex_flags & flags::CLAMP != 0);
+    let f = footprint(
+        uv,
+        width,
+        height,
+        (tex_flags >> flags::WRAP_U_SHIFT) & 3,
+        (tex_flags >> flags::WRAP_V_SHIFT) & 3,
+    );
     bilerp(
         texel(table, offset, width, tex_flags, f.x0, f.y0),
         texel(table, offset, width, tex_flags, f.x1, f.y0),

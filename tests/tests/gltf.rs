@@ -466,7 +466,7 @@ fn texture_channels_srgb_and_the_metallic_roughness_map() {
             &save("base.png", [128, 64, 255]),
             TextureUse {
                 colour: true,
-                clamp: false,
+                wrap: [kernel::texture::wrap::REPEAT; 2],
             },
             "b",
         )
@@ -476,7 +476,7 @@ fn texture_channels_srgb_and_the_metallic_roughness_map() {
             &save("mr.png", [10, 128, 191]),
             TextureUse {
                 colour: false,
-                clamp: false,
+                wrap: [kernel::texture::wrap::REPEAT; 2],
             },
             "m",
         )
@@ -800,4 +800,71 @@ fn the_shipped_showcase_loads_and_renders_alike_on_both_backends() {
         "CPU and GPU disagree on the showcase: z = {z}"
     );
     assert_validation_clean();
+}
+
+#[test]
+fn sampler_wrap_modes_are_read_per_axis() {
+    use kernel::texture::{flags, wrap};
+    // Three textures of one image: MIRRORED_REPEAT x CLAMP_TO_EDGE, REPEAT x MIRRORED_REPEAT,
+    // and no sampler (repeat both ways), on three materials.
+    let mut g = GltfWriter::new();
+    let image = png(|x, y| [(x * 60) as u8, (y * 60) as u8, 0]);
+    let samplers = [
+        g.push("samplers", json!({ "wrapS": 33648, "wrapT": 33071 })),
+        g.push("samplers", json!({ "wrapS": 10497, "wrapT": 33648 })),
+    ];
+    let first = g.png_texture(&image);
+    g.json["textures"][first]["sampler"] = json!(samplers[0]);
+    let source = g.json["textures"][first]["source"].clone();
+    let second = g.push(
+        "textures",
+        json!({ "source": source, "sampler": samplers[1] }),
+    );
+    let third = g.push("textures", json!({ "source": source }));
+    let materials: Vec<usize> = [first, second, third]
+        .iter()
+        .map(|&t| {
+            g.push(
+                "materials",
+                json!({ "pbrMetallicRoughness": { "baseColorTexture": { "index": t } } }),
+            )
+        })
+        .collect();
+    for (k, &m) in materials.iter().enumerate() {
+        let mesh = g.mesh(
+            &[
+                [k as f32, 0.0, 0.0],
+                [k as f32 + 1.0, 0.0, 0.0],
+                [k as f32, 1.0, 0.0],
+            ],
+            None,
+            Some(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
+            &[0, 1, 2],
+            Some(m),
+        );
+        g.push("nodes", json!({ "mesh": mesh }));
+    }
+    g.push("scenes", json!({ "nodes": [0, 1, 2] }));
+    let scene =
+        twinpath::scene::gltf_scene::load_bytes(Path::new("samplers.glb"), &g.glb(), None, None)
+            .unwrap();
+    let modes: Vec<u32> = scene
+        .textures
+        .textures
+        .iter()
+        .map(|t| t.flags & (flags::wrap(3, 3)))
+        .collect();
+    assert_eq!(
+        modes,
+        vec![
+            flags::wrap(wrap::MIRROR, wrap::CLAMP),
+            flags::wrap(wrap::REPEAT, wrap::MIRROR),
+            flags::wrap(wrap::REPEAT, wrap::REPEAT)
+        ]
+    );
+    assert!(
+        scene.notes.iter().all(|n| !n.contains("wrap")),
+        "{:?}",
+        scene.notes
+    );
 }

@@ -280,7 +280,8 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                 ]);
                 r[0][2] = width;
                 r[0][3] = height;
-                r[1][0] = (g.u64() % 2) as u32;
+                r[1][0] = (g.u64() % 3) as u32;
+                r[1][1] = (g.u64() % 3) as u32;
                 r[2] = [0; 4].map(|_| g.u64() as u32);
                 r
             }

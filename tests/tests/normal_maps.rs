@@ -88,7 +88,7 @@ fn the_mapped_normal_is_gltfs_formula() {
                 &constant_png(&dir, rgb),
                 TextureUse {
                     colour: false,
-                    clamp: false,
+                    wrap: [kernel::texture::wrap::REPEAT; 2],
                 },
                 "n",
             )

@@ -1,10 +1,10 @@
 //! Image textures (`kernel::texture`, `twinpath::scene::textures`):
 //!
 //! 1. The decoding tables hold the sRGB curve and byte / 255, rounded once from f64.
-//! 2. The lookup is bilinear interpolation between texel centres, repeated or clamped, for 8-bit
-//!    sRGB, 8-bit linear and float textures in one table (an f64 reference written from the
-//!    definition), and exact at texel centres. (The GPU computes the same bits:
-//!    `gpu_functions.rs`, probe `TEXTURE`.)
+//! 2. The lookup is bilinear interpolation between texel centres, repeated, clamped or mirrored
+//!    along each axis, for 8-bit sRGB, 8-bit linear and float textures in one table (an f64
+//!    reference written from the definition, OpenGL's for the wrap modes), and exact at texel
+//!    centres. (The GPU computes the same bits: `gpu_functions.rs`, probe `TEXTURE`.)
 //! 3. A checkered plane under a sphere light matches the closed form kd(square) L (r/D)^2 cos in
 //!    every pixel inside a square, on both backends; the same images against the squares'
 //!    colours swapped fail by far (the test's power).
@@ -13,7 +13,7 @@
 //!    than they receive.
 
 use glam::{Vec2, Vec3};
-use kernel::texture::{flags, lookup, LINEAR_TABLE, SRGB_TABLE};
+use kernel::texture::{flags, lookup, wrap, LINEAR_TABLE, SRGB_TABLE};
 use std::path::{Path, PathBuf};
 use twinpath::render::Backend;
 use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse};
@@ -54,41 +54,55 @@ fn decoding_tables_hold_the_srgb_curve_and_linear_bytes() {
 struct Reference {
     width: u32,
     height: u32,
-    clamp: bool,
+    /// Wrap modes along u and v (`kernel::texture::wrap`).
+    wrap: [u32; 2],
     texels: Vec<[f64; 3]>,
 }
 
 impl Reference {
-    /// Bilinear interpolation between texel centres ((i + 1/2) / w, 1 - (j + 1/2) / h), the
-    /// coordinates first clamped to [0, 1] or reduced to their fractional part.
+    /// Bilinear interpolation between texel centres ((i + 1/2) / w, 1 - (j + 1/2) / h) as OpenGL
+    /// 4.6 defines it (section 8.14.2): the texel coordinate from the unreduced coordinate, the
+    /// two texel indices around it wrapped: repeat, i mod n; clamp, the coordinate first
+    /// clamped to [0, 1] and the indices to 0..n-1; mirrored repeat, i mod 2n folded onto
+    /// 0..n-1 (mirror(i) = i for i < n, 2n - 1 - i beyond).
     fn at(&self, uv: Vec2) -> [f64; 3] {
-        let unit = |t: f64| {
-            if self.clamp {
+        let unit = |t: f64, mode: u32| {
+            if mode == wrap::CLAMP {
                 t.clamp(0.0, 1.0)
             } else {
-                t - t.floor()
+                t
             }
         };
-        let (u, v) = (unit(uv.x as f64), unit(uv.y as f64));
-        let index = |i: f64, n: u32| -> usize {
+        let (u, v) = (
+            unit(uv.x as f64, self.wrap[0]),
+            unit(uv.y as f64, self.wrap[1]),
+        );
+        let index = |i: f64, n: u32, mode: u32| -> usize {
             let n = n as i64;
             let i = i as i64;
-            (if self.clamp {
-                i.clamp(0, n - 1)
-            } else {
-                i.rem_euclid(n)
+            (match mode {
+                wrap::CLAMP => i.clamp(0, n - 1),
+                wrap::MIRROR => {
+                    let j = i.rem_euclid(2 * n);
+                    if j < n {
+                        j
+                    } else {
+                        2 * n - 1 - j
+                    }
+                }
+                _ => i.rem_euclid(n),
             }) as usize
         };
         let x = u * self.width as f64 - 0.5;
         let y = (1.0 - v) * self.height as f64 - 0.5;
         let (fx, fy) = (x - x.floor(), y - y.floor());
         let (x0, x1) = (
-            index(x.floor(), self.width),
-            index(x.floor() + 1.0, self.width),
+            index(x.floor(), self.width, self.wrap[0]),
+            index(x.floor() + 1.0, self.width, self.wrap[0]),
         );
         let (y0, y1) = (
-            index(y.floor(), self.height),
-            index(y.floor() + 1.0, self.height),
+            index(y.floor(), self.height, self.wrap[1]),
+            index(y.floor() + 1.0, self.height, self.wrap[1]),
         );
         let t = |x: usize, y: usize| self.texels[y * self.width as usize + x];
         let mut out = [0.0; 3];
@@ -102,17 +116,30 @@ impl Reference {
 }
 
 #[test]
-fn lookup_is_bilinear_between_texel_centres_repeated_or_clamped() {
+fn lookup_is_bilinear_between_texel_centres_repeated_clamped_or_mirrored() {
     let mut g = SplitMix(0x7e47);
     let mut table = TextureTable::new();
     let mut refs = Vec::new();
     // 8-bit textures (sRGB and linear, repeat and clamp) and float textures, odd sizes, all in
     // one table: each later push moves the earlier records' texels.
-    for (k, (width, height)) in [(5u32, 3u32), (1, 1), (7, 2), (4, 6), (3, 5), (2, 2)]
-        .into_iter()
-        .enumerate()
+    for (k, (width, height)) in [
+        (5u32, 3u32),
+        (1, 1),
+        (7, 2),
+        (4, 6),
+        (3, 5),
+        (2, 2),
+        (6, 1),
+        (1, 4),
+        (3, 3),
+    ]
+    .into_iter()
+    .enumerate()
     {
-        let (float, srgb, clamp) = (k % 3 == 2, k % 2 == 0, k % 4 < 2);
+        let (float, srgb) = (k % 3 == 2, k % 2 == 0);
+        // Every pair of modes along u and v appears once among the nine textures.
+        let modes = [wrap::REPEAT, wrap::CLAMP, wrap::MIRROR];
+        let mode = [modes[k % 3], modes[(k / 3) % 3]];
         let n = (width * height) as usize;
         let (words, texels): (Vec<u32>, Vec<[f64; 3]>) = if float {
             let t: Vec<[f32; 3]> = (0..n).map(|_| [0; 3].map(|_| 4.0 * g.unit())).collect();
@@ -143,12 +170,10 @@ fn lookup_is_bilinear_between_texel_centres_repeated_or_clamped() {
         } else if srgb {
             tex_flags |= flags::SRGB;
         }
-        if clamp {
-            tex_flags |= flags::CLAMP;
-        }
+        tex_flags |= flags::wrap(mode[0], mode[1]);
         let usage = TextureUse {
             colour: srgb,
-            clamp,
+            wrap: mode,
         };
         table.push(
             Path::new("generated"),
@@ -161,7 +186,7 @@ fn lookup_is_bilinear_between_texel_centres_repeated_or_clamped() {
         refs.push(Reference {
             width,
             height,
-            clamp,
+            wrap: mode,
             texels,
         });
     }
@@ -195,13 +220,18 @@ fn lookup_is_bilinear_between_texel_centres_repeated_or_clamped() {
                 for c in 0..3 {
                     assert!((got[c] as f64 - want[c]).abs() <= 1e-6 * want[c].max(1.0));
                 }
-                if !r.clamp {
-                    // (u + 1 rounds u to fewer bits: a texel's value times 2^-23 times the
-                    // texture's width, at most.)
-                    let shifted = lookup(&table.words, k as u32, uv + Vec2::new(1.0, -2.0));
-                    for c in 0..3 {
-                        assert!((shifted[c] - got[c]).abs() <= 1e-5 * got[c].max(1.0));
-                    }
+                // Repeating, u + 1 reads as u; mirrored, u + 2 does, and -u mirrors u (the
+                // texel's centre maps onto itself). (u + 1 rounds u to fewer bits: a texel's
+                // value times 2^-23 times the texture's width, at most.)
+                let same =
+                    |a: Vec3, b: Vec3| (0..3).all(|c| (a[c] - b[c]).abs() <= 1e-5 * b[c].max(1.0));
+                let at = |p: Vec2| lookup(&table.words, k as u32, p);
+                if r.wrap == [wrap::REPEAT; 2] {
+                    assert!(same(at(uv + Vec2::new(1.0, -2.0)), got));
+                }
+                if r.wrap == [wrap::MIRROR; 2] {
+                    assert!(same(at(uv + Vec2::new(2.0, -4.0)), got));
+                    assert!(same(at(Vec2::new(-uv.x, 2.0 - uv.y)), got));
                 }
             }
         }
@@ -375,10 +405,15 @@ fn texture_errors_name_the_field_and_the_reason() {
             .join("scenes/meshes/icosphere.obj")
             .display()
     );
-    let cases: [(&str, &str, &str); 9] = [
+    let cases: [(&str, &str, &str); 10] = [
         ("m = { kd_map = \"checker.png\" }", quad, ""),
         (
             "m = { kd_map = \"checker.jpg\", wrap = \"clamp\" }",
+            quad,
+            "",
+        ),
+        (
+            "m = { kd_map = \"checker.jpg\", wrap = \"mirror\" }",
             quad,
             "",
         ),
@@ -403,9 +438,9 @@ fn texture_errors_name_the_field_and_the_reason() {
             "materials.m.kd_map",
         ),
         (
-            "m = { kd_map = \"checker.png\", wrap = \"mirror\" }",
+            "m = { kd_map = \"checker.png\", wrap = \"wobble\" }",
             quad,
-            "unknown wrap 'mirror'",
+            "unknown wrap 'wobble' (expected repeat, clamp or mirror)",
         ),
         (
             "m = { kd = [0.6, 0.6, 0.6], kd_map = \"bright.exr\" }",

@@ -90,7 +90,7 @@ pub(super) struct MaterialFile {
     pub ks_map: Option<Spanned<String>>,
     pub alpha_map: Option<Spanned<String>>,
     pub emission_map: Option<Spanned<String>>,
-    /// How the maps continue outside [0, 1]: "repeat" (default) or "clamp".
+    /// How the maps continue outside [0, 1]: "repeat" (default), "clamp" or "mirror".
     pub wrap: Option<Spanned<String>>,
     /// glTF's metallic-roughness material (`material_kind::METALLIC_ROUGHNESS`): base colour,
     /// metalness and perceptual roughness (alpha = roughness^2), each optional (defaults 1, as

@@ -6,6 +6,7 @@ use super::file::{Checker, MaterialFile};
 use super::textures::{TextureTable, TextureUse};
 use glam::Vec3;
 use kernel::scene::{material_kind, texture_slot, Material, NONE};
+use kernel::texture::wrap;
 use std::path::Path;
 use toml::Spanned;
 
@@ -324,16 +325,17 @@ pub(super) fn attach_textures(
     out: &mut Material,
 ) -> Result<(), SceneError> {
     let mf = m.get_ref();
-    let clamp = match &mf.wrap {
-        None => false,
+    let mode = match &mf.wrap {
+        None => wrap::REPEAT,
         Some(w) => match w.get_ref().as_str() {
-            "repeat" => false,
-            "clamp" => true,
+            "repeat" => wrap::REPEAT,
+            "clamp" => wrap::CLAMP,
+            "mirror" => wrap::MIRROR,
             other => {
                 return Err(ck.err(
                     w.span(),
                     &format!("{field}.wrap"),
-                    format!("unknown wrap '{other}' (expected repeat or clamp)"),
+                    format!("unknown wrap '{other}' (expected repeat, clamp or mirror)"),
                 ))
             }
         },
@@ -390,7 +392,14 @@ pub(super) fn attach_textures(
                 format!("texture file {} does not exist", file.display()),
             ));
         }
-        let index = table.add(&file, TextureUse { colour, clamp }, &map_field)?;
+        let index = table.add(
+            &file,
+            TextureUse {
+                colour,
+                wrap: [mode; 2],
+            },
+            &map_field,
+        )?;
         peak[slot] = table.peak(index);
         out.textures[slot] = index;
     }

@@ -31,11 +31,11 @@ pub struct TextureInfo {
 }
 
 /// How a texture is read: as colour (sRGB-encoded 8-bit images) or as linear data, and how
-/// coordinates outside [0, 1] wrap.
+/// coordinates outside [0, 1] wrap along u and v (`kernel::texture::wrap`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TextureUse {
     pub colour: bool,
-    pub clamp: bool,
+    pub wrap: [u32; 2],
 }
 
 /// The sRGB decoding of byte `b` (IEC 61966-2-1), in f64.
@@ -122,10 +122,7 @@ impl TextureTable {
             image.color(),
             image::ColorType::Rgb32F | image::ColorType::Rgba32F
         );
-        let mut tex_flags = 0;
-        if usage.clamp {
-            tex_flags |= flags::CLAMP;
-        }
+        let mut tex_flags = flags::wrap(usage.wrap[0], usage.wrap[1]);
         let texels: Vec<u32> = if float {
             tex_flags |= flags::FLOAT;
             let rgb = image.into_rgb32f();

@@ -10,6 +10,7 @@ use crate::scene::SceneError;
 use glam::Vec3;
 use gltf::texture::WrappingMode;
 use kernel::scene::{material_kind, texture_slot, Material};
+use kernel::texture::wrap;
 
 /// The kernel material for glTF material `m` (`None`: the specification's default material,
 /// white, metallic 1, roughness 1), its textures loaded.
@@ -149,7 +150,7 @@ fn normal_map(
 }
 
 /// The texture table's index of the image behind `info`, read as colour (sRGB) or linear data,
-/// wrapping as its sampler says (repeat or clamp; mirrored repeat is read as repeat).
+/// wrapping along u and v as its sampler's `wrapS` and `wrapT` say.
 fn texture(
     imp: &mut Import,
     label: &str,
@@ -174,22 +175,14 @@ fn texture_of(
         ));
     }
     let sampler = tex.sampler();
-    let (s, t) = (sampler.wrap_s(), sampler.wrap_t());
-    if s == WrappingMode::MirroredRepeat || t == WrappingMode::MirroredRepeat {
-        imp.note(format!(
-            "{label}: textures[{}] mirrored repeat read as repeat",
-            tex.index()
-        ));
-    }
-    if (s == WrappingMode::ClampToEdge) != (t == WrappingMode::ClampToEdge) {
-        imp.note(format!(
-            "{label}: textures[{}] wraps differently in s and t; s's mode is used for both",
-            tex.index()
-        ));
-    }
+    let mode = |m: WrappingMode| match m {
+        WrappingMode::Repeat => wrap::REPEAT,
+        WrappingMode::ClampToEdge => wrap::CLAMP,
+        WrappingMode::MirroredRepeat => wrap::MIRROR,
+    };
     let usage = TextureUse {
         colour,
-        clamp: s == WrappingMode::ClampToEdge,
+        wrap: [mode(sampler.wrap_s()), mode(sampler.wrap_t())],
     };
     imp.image(tex.source().index(), usage)
 }
