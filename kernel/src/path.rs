@@ -132,11 +132,11 @@ impl SurfaceHit {
 
     /// The record of a ray along world direction `dir` meeting triangle `tri` (object space, of
     /// shape `shape`) of instance `instance` (number `index`) at `t`, barycentric (u, v): the
-    /// object-space point from the barycentrics mapped to world space, the geometric normal
-    /// M^-T (edge1 x edge2) normalised (along the edge cross product of the same triangle
-    /// flattened into world space, whose winding a mirroring transform reverses), the world
-    /// point's error bound (`instance::world_point_error`), and the side by the sign of
-    /// `normal . dir`. Barycentrics and the shading record stay the object-space triangle's
+    /// object-space record of [`SurfaceHit::triangle`] with its point mapped to world space, the
+    /// geometric normal M^-T (edge1 x edge2) normalised (along the edge cross product of the
+    /// same triangle flattened into world space, whose winding a mirroring transform reverses),
+    /// the world point's error bound (`instance::world_point_error`), and the side by the sign
+    /// of `normal . dir`. Barycentrics and the shading record stay the object-space triangle's
     /// (an affine map keeps barycentrics). Both backends build instanced hits here.
     #[inline]
     #[allow(clippy::too_many_arguments)]
@@ -150,26 +150,16 @@ impl SurfaceHit {
         u: f32,
         v: f32,
     ) -> Self {
-        let (p0, e1, e2) = (
-            Vec3::from(tri.p0),
-            Vec3::from(tri.edge1),
-            Vec3::from(tri.edge2),
-        );
-        let p_object = triangle_point(p0, e1, e2, u, v);
-        let object_error = triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition);
-        let position = point_to_world(instance, p_object);
+        let object = Self::triangle(tri, shape, dir, t, u, v);
+        let position = point_to_world(instance, object.position);
         let normal = normal_to_world(instance, shape.normal).normalize();
         Self {
             position,
-            t,
             normal,
-            material: tri.material,
-            light: tri.light,
-            error: world_point_error(instance, p_object, object_error, position),
+            error: world_point_error(instance, object.position, object.error, position),
             arrived_behind: Self::behind_plane(normal, dir),
-            shading: tri.shading,
-            barycentrics: Vec2::new(u, v),
             instance: index,
+            ..object
         }
     }
 

@@ -28,7 +28,8 @@ use twinpath::scene::transform::Transform;
 use twinpath::scene::{parse_scene, Scene};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    pixel_quadrature, render_film, with_independent_samples, z_critical, SplitMix,
+    assert_noiseless_pixels, pixel_quadrature, render_film, with_independent_samples, z_critical,
+    SplitMix,
 };
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -388,19 +389,10 @@ fn a_far_mirrored_instanced_floor_is_exact_under_a_directional_light_on_both_bac
     });
     assert!(want.iter().flatten().count() > want.len() * 3 / 4);
     for backend in [Backend::Cpu, Backend::Gpu] {
-        // Every sample of a lit pixel is kd E cos / pi: no noise, only f32 rounding (see
-        // punctual_lights.rs); a shadow ray meeting its own floor would make a sample 0.
+        // Every sample of a lit pixel is kd E cos / pi; a shadow ray meeting its own floor
+        // would make a sample 0.
         let film = render_film(&scene, backend, 64);
-        let mean = film.mean();
-        for (i, w) in want.iter().enumerate() {
-            if let Some(w) = w {
-                let m = mean[i][0] as f64;
-                assert!(
-                    (m - w).abs() <= 1e-5 * w,
-                    "{backend:?}: pixel {i}: {m} vs {w}"
-                );
-            }
-        }
+        assert_noiseless_pixels(&film, &want, &format!("{backend:?}"));
     }
     // The hypothesis of a floor without its transform's normal (the object-space +z): the
     // cosine would differ; the exact test above rejects it by far.

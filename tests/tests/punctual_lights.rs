@@ -16,8 +16,9 @@ use twinpath::scene::Scene;
 use twinpath_tests::gltf_writer::GltfWriter;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches, assert_film_matches_with_variance, max_abs_z, pixel_quadrature,
-    render_film, scene_from_toml, variance_of_mean_from, with_independent_samples,
+    assert_film_matches, assert_film_matches_with_variance, assert_noiseless_pixels, max_abs_z,
+    pixel_quadrature, render_film, scene_from_toml, variance_of_mean_from,
+    with_independent_samples,
 };
 
 const KD: f32 = 0.6;
@@ -325,20 +326,10 @@ fn a_directional_light_and_its_shadow_match_the_closed_form_on_both_backends() {
     );
     let wrong_cos = KD as f64 / std::f64::consts::PI * E;
     for backend in [Backend::Cpu, Backend::Gpu] {
-        // A lit pixel's every sample is kd E cos / pi whatever its position: no noise, only
-        // the f32 rounding of the estimator's ~20 operations (each within 2^-24 relative;
-        // the running mean of equal values is exact): 1e-5 relative holds it 8 times over.
+        // A lit pixel's every sample is kd E cos / pi whatever its position.
         let film = render_film(&scene, backend, 64);
+        assert_noiseless_pixels(&film, &want, &format!("{backend:?}, lit"));
         let mean = film.mean();
-        for (i, w) in want.iter().enumerate() {
-            if let Some(w) = w {
-                let m = mean[i][0] as f64;
-                assert!(
-                    (m - w).abs() <= 1e-5 * w,
-                    "{backend:?}: lit pixel {i}: {m} vs {w}"
-                );
-            }
-        }
         for &i in &dark {
             assert_eq!(
                 mean[i][0], 0.0,

@@ -173,6 +173,11 @@ pub fn scene_stem(name: &str) -> String {
         .to_string()
 }
 
+/// `bytes` in MiB, for the log lines.
+pub fn mib(bytes: u64) -> f64 {
+    bytes as f64 / (1024.0 * 1024.0)
+}
+
 /// The lower-case extension of `path`, if any.
 pub fn extension(path: &Path) -> Option<String> {
     path.extension()

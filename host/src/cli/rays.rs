@@ -1,6 +1,6 @@
 //! `twinpath rays`: rays per second of the CPU traversal, and the BVH's build time and memory.
 
-use super::{load_scene, scene_stem};
+use super::{load_scene, mib, scene_stem};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::io::Write;
@@ -43,11 +43,10 @@ pub fn run(a: RaysArgs) -> Result<()> {
     let r =
         twinpath::bench::rays::measure(&scene, a.width, height, a.repeats, a.ray_file.as_deref())
             .context("writing the ray file")?;
-    let mib = |b: usize| b as f64 / (1024.0 * 1024.0);
     println!(
         "{}: {} triangles, {} spheres; BVH build {:.3} s ({} threads), {} nodes, {:.1} MiB hierarchy + {:.1} MiB primitives",
         scene.name, r.triangles, r.spheres, r.build_seconds, rayon::current_num_threads(), r.nodes,
-        mib(r.hierarchy_bytes), mib(r.primitive_bytes)
+        mib(r.hierarchy_bytes as u64), mib(r.primitive_bytes as u64)
     );
     for s in &r.sets {
         println!(

@@ -1,6 +1,6 @@
 //! `twinpath render`: a scene to EXR and/or PNG, with progress, Ctrl-C and an honest log.
 
-use super::{extension, load_scene, scene_stem, SettingFlags};
+use super::{extension, load_scene, mib, scene_stem, SettingFlags};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -199,9 +199,4 @@ fn write_sample_counts(
         eprintln!("twinpath: wrote {} (samples per pixel)", m.display());
     }
     Ok(())
-}
-
-/// `bytes` in MiB.
-fn mib(bytes: u64) -> f64 {
-    bytes as f64 / (1024.0 * 1024.0)
 }

@@ -33,6 +33,9 @@ pub(super) struct SceneTables {
     /// ones), the meshes' ranges in it, and the instances with the mesh each places.
     pub mesh_triangles: Vec<Triangle>,
     pub meshes: Vec<TriangleGroup>,
+    /// Each instanced mesh's object-space box, grown as its parts are added (placing a mesh
+    /// maps it; the triangles are not read again per instance).
+    pub mesh_boxes: Vec<(Vec3, Vec3)>,
     pub instances: Vec<Instance>,
     pub instance_meshes: Vec<u32>,
 }
@@ -179,6 +182,8 @@ impl SceneTables {
             name,
             range: start..start,
         });
+        self.mesh_boxes
+            .push((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)));
         (self.meshes.len() - 1) as u32
     }
 
@@ -189,6 +194,7 @@ impl SceneTables {
         soup: &TriangleSoup,
         material: u32,
     ) -> Result<(), (usize, String)> {
+        let start = self.mesh_triangles.len();
         self.push_soup(Space::Object, soup, None, material)?;
         let end = self.mesh_triangles.len();
         self.meshes
@@ -196,6 +202,9 @@ impl SceneTables {
             .expect("begin_instanced_mesh comes first")
             .range
             .end = end;
+        let (lo, hi) = mesh_box(&self.mesh_triangles[start..end]);
+        let grown = self.mesh_boxes.last_mut().expect("one box per mesh");
+        *grown = (grown.0.min(lo), grown.1.max(hi));
         Ok(())
     }
 
@@ -215,7 +224,7 @@ impl SceneTables {
         }
         // The mesh's triangles move when `finish` appends them; it adds the offset.
         let record = instance_record(transform, range.start as u32);
-        let (lo, hi) = instance_box(&record, mesh_box(&self.mesh_triangles[range]));
+        let (lo, hi) = instance_box(&record, self.mesh_boxes[mesh as usize]);
         if !(lo.abs().max(hi.abs()).max_element() <= MAX_COORDINATE) {
             return Err(format!("the placed mesh reaches beyond {MAX_COORDINATE:e}"));
         }
@@ -318,12 +327,7 @@ impl SceneTables {
         for inst in &mut self.instances {
             inst.first_triangle += world as u32;
         }
-        let instanced = instances_box(
-            &self.triangles,
-            &self.meshes,
-            &self.instances,
-            &self.instance_meshes,
-        );
+        let instanced = instances_box(&self.mesh_boxes, &self.instances, &self.instance_meshes);
         let world_triangles = &self.triangles[..world];
         place_directional_lights(&mut self.lights, &self.spheres, world_triangles, instanced);
         if let Some(map) = &environment {

@@ -3,7 +3,6 @@
 //! record of a placement, and the world-space box the instances fill.
 
 use super::transform::Transform;
-use super::TriangleGroup;
 use glam::{DMat4, Vec3};
 use kernel::scene::{Instance, Triangle};
 
@@ -82,21 +81,16 @@ pub fn instance_box(instance: &Instance, (lo, hi): (Vec3, Vec3)) -> (Vec3, Vec3)
     (wlo, whi)
 }
 
-/// The world-space box of every instance (empty without instances): `meshes` index
-/// `triangles`, `instance_meshes[i]` is instance i's mesh.
+/// The world-space box of every instance (empty without instances): `mesh_boxes` are the
+/// meshes' object-space boxes, `instance_meshes[i]` is instance i's mesh.
 pub fn instances_box(
-    triangles: &[Triangle],
-    meshes: &[TriangleGroup],
+    mesh_boxes: &[(Vec3, Vec3)],
     instances: &[Instance],
     instance_meshes: &[u32],
 ) -> (Vec3, Vec3) {
-    let boxes: Vec<(Vec3, Vec3)> = meshes
-        .iter()
-        .map(|m| mesh_box(&triangles[m.range.clone()]))
-        .collect();
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for (inst, &mesh) in instances.iter().zip(instance_meshes) {
-        let (a, b) = instance_box(inst, boxes[mesh as usize]);
+        let (a, b) = instance_box(inst, mesh_boxes[mesh as usize]);
         lo = lo.min(a);
         hi = hi.max(b);
     }

@@ -251,22 +251,17 @@ impl Scene {
 
     /// The world-space box of every instance (empty without instances).
     pub fn instanced_box(&self) -> (Vec3, Vec3) {
-        instancing::instances_box(
-            &self.triangles,
-            &self.meshes,
-            &self.instances,
-            &self.instance_meshes,
-        )
+        let boxes: Vec<(Vec3, Vec3)> = self
+            .meshes
+            .iter()
+            .map(|m| instancing::mesh_box(&self.triangles[m.range.clone()]))
+            .collect();
+        instancing::instances_box(&boxes, &self.instances, &self.instance_meshes)
     }
 
-    /// The instance table as the kernel binds it: one zero record when empty (a storage buffer
-    /// needs something behind it).
+    /// The instance table as the kernel binds it (see [`bindable`]).
     pub fn instance_table(&self) -> Vec<Instance> {
-        if self.instances.is_empty() {
-            vec![bytemuck::Zeroable::zeroed()]
-        } else {
-            self.instances.clone()
-        }
+        bindable(&self.instances)
     }
 
     /// Replaces the environment map (and its light, the last entry of `lights`), keeping the
@@ -292,14 +287,9 @@ impl Scene {
             .map_or_else(|| vec![0.0], |m| m.table())
     }
 
-    /// The shading table as the kernel binds it: one zero record when empty (a storage buffer
-    /// needs something behind it).
+    /// The shading table as the kernel binds it (see [`bindable`]).
     pub fn shading_table(&self) -> Vec<ShadingTriangle> {
-        if self.shading.is_empty() {
-            vec![bytemuck::Zeroable::zeroed()]
-        } else {
-            self.shading.clone()
-        }
+        bindable(&self.shading)
     }
 
     /// Bytes of the scene's tables on either backend: triangles, spheres, shading records,
@@ -384,5 +374,15 @@ impl Scene {
     /// Number of pixels.
     pub fn pixel_count(&self) -> usize {
         self.camera.width as usize * self.camera.height as usize
+    }
+}
+
+/// `records` as a storage buffer binds them: one zero record when empty (a buffer needs
+/// something behind it; the kernel never reads it, no index pointing there).
+fn bindable<T: bytemuck::Pod>(records: &[T]) -> Vec<T> {
+    if records.is_empty() {
+        vec![T::zeroed()]
+    } else {
+        records.to_vec()
     }
 }

@@ -180,18 +180,21 @@ impl RtPipeline {
             group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 0, unused, unused),
             group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 1, unused, unused),
         ];
-        // Hit groups in SBT order (HitGroups::triangle_offset, sphere_offset, instance_offset).
-        if hit_groups.triangles {
-            stages.push(stage(
-                vk::ShaderStageFlags::CLOSEST_HIT_KHR,
-                CLOSEST_HIT_TRIANGLE,
-            ));
+        // A triangle hit group of closest-hit shader `name` (world-space or instanced).
+        let triangle_group = |stages: &mut Vec<vk::PipelineShaderStageCreateInfo<'_>>,
+                              groups: &mut Vec<vk::RayTracingShaderGroupCreateInfoKHR<'_>>,
+                              name: &'static CStr| {
+            stages.push(stage(vk::ShaderStageFlags::CLOSEST_HIT_KHR, name));
             groups.push(group(
                 vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP,
                 unused,
                 stages.len() as u32 - 1,
                 unused,
             ));
+        };
+        // Hit groups in SBT order (HitGroups::triangle_offset, sphere_offset, instance_offset).
+        if hit_groups.triangles {
+            triangle_group(&mut stages, &mut groups, CLOSEST_HIT_TRIANGLE);
         }
         if hit_groups.spheres {
             stages.push(stage(
@@ -210,16 +213,7 @@ impl RtPipeline {
             ));
         }
         if hit_groups.instances {
-            stages.push(stage(
-                vk::ShaderStageFlags::CLOSEST_HIT_KHR,
-                CLOSEST_HIT_INSTANCE,
-            ));
-            groups.push(group(
-                vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP,
-                unused,
-                stages.len() as u32 - 1,
-                unused,
-            ));
+            triangle_group(&mut stages, &mut groups, CLOSEST_HIT_INSTANCE);
         }
         let info = vk::RayTracingPipelineCreateInfoKHR::default()
             .stages(&stages)

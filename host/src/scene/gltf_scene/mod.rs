@@ -62,6 +62,8 @@ pub(super) struct Import<'a> {
     materials: HashMap<Option<usize>, u32>,
     /// How many nodes of the scene use each mesh (by glTF index).
     mesh_uses: HashMap<usize, usize>,
+    /// [`Import::instanceable`]'s answer for each mesh asked about (asked once per node).
+    instanceable: HashMap<usize, bool>,
     /// The instanced mesh (`SceneTables::begin_instanced_mesh`) of each glTF mesh stored once.
     instanced: HashMap<usize, u32>,
 }
@@ -238,6 +240,7 @@ fn import(
         notes,
         materials: HashMap::new(),
         mesh_uses: HashMap::new(),
+        instanceable: HashMap::new(),
         instanced: HashMap::new(),
     };
     imp.walk(transform.map_or(DMat4::IDENTITY, |t| t.matrix()))
@@ -502,18 +505,24 @@ impl Import<'_> {
     }
 
     /// Whether `mesh`, when several nodes use it, is stored once and instanced: it has at
-    /// least [`INSTANCE_MIN_TRIANGLES`] triangles and none of its materials emits.
+    /// least [`INSTANCE_MIN_TRIANGLES`] triangles and none of its materials emits. Decided
+    /// once per mesh.
     fn instanceable(&mut self, mesh: &gltf::Mesh) -> Result<bool, SceneError> {
-        if declared_triangles(mesh) < INSTANCE_MIN_TRIANGLES as u64 {
-            return Ok(false);
+        if let Some(&known) = self.instanceable.get(&mesh.index()) {
+            return Ok(known);
         }
-        for p in mesh.primitives() {
-            let m = self.material_of(&p)?;
-            if self.tables.is_emissive(m) {
-                return Ok(false);
+        let mut answer = declared_triangles(mesh) >= INSTANCE_MIN_TRIANGLES as u64;
+        if answer {
+            for p in mesh.primitives() {
+                let m = self.material_of(&p)?;
+                if self.tables.is_emissive(m) {
+                    answer = false;
+                    break;
+                }
             }
         }
-        Ok(true)
+        self.instanceable.insert(mesh.index(), answer);
+        Ok(answer)
     }
 
     /// Places the glTF mesh `mesh` (stored once, in object space, on its first use) at
@@ -830,8 +839,7 @@ fn framing_camera(tables: &SceneTables) -> Option<CameraDesc> {
         }
     }
     let (ilo, ihi) = instances_box(
-        &tables.mesh_triangles,
-        &tables.meshes,
+        &tables.mesh_boxes,
         &tables.instances,
         &tables.instance_meshes,
     );
