@@ -18,7 +18,9 @@ else
 fi
 
 need_pkgs=()
-for p in libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools mesa-vulkan-drivers fonts-dejavu-core; do
+# slurmctld, slurmd, slurm-client: the one-node cluster of scripts/slurm/test_cluster.sh.
+for p in libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools mesa-vulkan-drivers fonts-dejavu-core \
+         slurmctld slurmd slurm-client; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || need_pkgs+=("$p")
 done
 # lavapipe must come from backports (Mesa >= 25 exposes the ray-tracing extensions)
@@ -42,4 +44,5 @@ if [ ${#need_pkgs[@]} -gt 0 ] || [ -n "${need_mesa:-}" ]; then
   $SUDO apt-get update -q
   $SUDO apt-get install -y -q -t bookworm-backports mesa-vulkan-drivers
   $SUDO apt-get install -y -q libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools fonts-dejavu-core
+  $SUDO apt-get install -y -q --no-install-recommends slurmctld slurmd slurm-client
 fi

@@ -1,9 +1,16 @@
 //! The film: per-pixel sums of samples and of their squares (so every pixel knows its own
 //! variance), and image files: EXR (linear float32 RGB) and PNG (sRGB, clamped).
+//!
+//! Sample sums are fixed-point integers (`fixed_sum`): a pixel's sum does not depend on how its
+//! samples were grouped into passes, tiles or parts, so a render split into parts and merged
+//! is the single render bit for bit (docs/parts.md). Sums of squares, which only estimate
+//! variance and never enter the image, stay f64.
 
+use crate::fixed_sum::FixedSum;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
 use kernel::adaptive::{is_pilot_sample, luminance};
+use kernel::film_sample::summable;
 use kernel::scene::RenderParams;
 use std::path::Path;
 
@@ -12,14 +19,15 @@ use std::path::Path;
 pub struct Film {
     pub width: u32,
     pub height: u32,
-    pub sum: Vec<[f64; 3]>,
+    pub sum: Vec<[FixedSum; 3]>,
     pub sum_sq: Vec<[f64; 3]>,
     /// Samples added per pixel.
     pub count: Vec<u32>,
-    /// Non-finite samples dropped (expected: 0).
+    /// Samples dropped: non-finite, or too large to sum (`kernel::film_sample`); expected 0.
     pub discarded: u64,
     /// Adaptive sampling's pilot samples (`kernel::adaptive`): luminance sum and sum of
-    /// squares per pixel, and their number. Not part of the image.
+    /// squares per pixel, and their number. Not part of the image (and never split into
+    /// parts, so plain f64 sums).
     pub pilot: Vec<[f64; 2]>,
     pub pilot_count: Vec<u32>,
 }
@@ -30,7 +38,7 @@ impl Film {
         Self {
             width,
             height,
-            sum: vec![[0.0; 3]; n],
+            sum: vec![[FixedSum::default(); 3]; n],
             sum_sq: vec![[0.0; 3]; n],
             count: vec![0; n],
             discarded: 0,
@@ -70,7 +78,7 @@ impl Film {
     pub fn add_sums(&mut self, px: u32, py: u32, s: &PixelSums) {
         let i = (py * self.width + px) as usize;
         for c in 0..3 {
-            self.sum[i][c] += s.sum[c];
+            self.sum[i][c].add(s.sum[c]);
             self.sum_sq[i][c] += s.sum_sq[c];
         }
         self.count[i] += s.count;
@@ -80,6 +88,21 @@ impl Film {
         self.pilot_count[i] += s.pilot_count;
     }
 
+    /// Adds every pixel's image sums of `other` (a film of the same size): the sample sums
+    /// exactly, so the image does not depend on the order films are added. Pilot sums are not
+    /// added.
+    pub fn add_film(&mut self, other: &Film) {
+        debug_assert_eq!((self.width, self.height), (other.width, other.height));
+        for i in 0..self.sum.len() {
+            for c in 0..3 {
+                self.sum[i][c].add(other.sum[i][c]);
+                self.sum_sq[i][c] += other.sum_sq[i][c];
+            }
+            self.count[i] += other.count[i];
+        }
+        self.discarded += other.discarded;
+    }
+
     /// The pixel values: the plain mean of each pixel's samples (box filter).
     pub fn mean(&self) -> Vec<[f32; 3]> {
         self.sum
@@ -87,7 +110,11 @@ impl Film {
             .zip(&self.count)
             .map(|(s, &n)| {
                 let n = n.max(1) as f64;
-                [(s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32]
+                [
+                    (s[0].to_f64() / n) as f32,
+                    (s[1].to_f64() / n) as f32,
+                    (s[2].to_f64() / n) as f32,
+                ]
             })
             .collect()
     }
@@ -100,7 +127,7 @@ impl Film {
                 let mut v = [0.0f32; 3];
                 if n >= 2.0 {
                     for (c, vc) in v.iter_mut().enumerate() {
-                        let m = self.sum[i][c] / n;
+                        let m = self.sum[i][c].to_f64() / n;
                         let var = ((self.sum_sq[i][c] - n * m * m) / (n - 1.0)).max(0.0);
                         *vc = (var / n) as f32;
                     }
@@ -120,7 +147,7 @@ impl Film {
 /// sampler's pilot samples (luminance only).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PixelSums {
-    pub sum: [f64; 3],
+    pub sum: [FixedSum; 3],
     pub sum_sq: [f64; 3],
     pub count: u32,
     pub discarded: u32,
@@ -132,10 +159,11 @@ pub struct PixelSums {
 impl PixelSums {
     /// Adds sample number `sample` of the pixel, of value `v`: to the pilot sums if adaptive
     /// sampling (`params.pilot_period > 0`) makes it a pilot sample, else to the image sums.
-    /// A non-finite value is counted as discarded instead.
+    /// A value that cannot be summed (non-finite, or beyond `kernel::film_sample::MAX_SAMPLE`) is
+    /// counted as discarded instead.
     #[inline]
     pub fn add_sample(&mut self, params: &RenderParams, sample: u32, v: Vec3) {
-        if !v.is_finite() {
+        if !summable(v) {
             self.discarded += 1;
         } else if params.pilot_period > 0 && is_pilot_sample(params, sample) {
             self.add_pilot(v);
@@ -144,13 +172,12 @@ impl PixelSums {
         }
     }
 
-    /// Adds an image sample (finite).
+    /// Adds an image sample (in range).
     #[inline]
     fn add(&mut self, v: Vec3) {
-        for c in 0..3 {
-            let x = v[c] as f64;
-            self.sum[c] += x;
-            self.sum_sq[c] += x * x;
+        for (c, x) in v.to_array().into_iter().enumerate() {
+            self.sum[c].add_sample(x);
+            self.sum_sq[c] += x as f64 * x as f64;
         }
         self.count += 1;
     }
@@ -204,10 +231,23 @@ impl RgbImage {
             .map(|e| e.to_ascii_lowercase());
         match ext.as_deref() {
             Some("exr") => {
-                let flat: Vec<f32> = self.pixels.iter().flatten().copied().collect();
-                let img = image::Rgb32FImage::from_raw(self.width, self.height, flat)
-                    .context("image size mismatch")?;
-                img.save_with_format(path, image::ImageFormat::OpenExr)
+                // The exr crate with scan lines in increasing order: the same pixels make the
+                // same bytes (the image crate's writer orders tiles as threads finish them).
+                use exr::prelude::*;
+                let width = self.width as usize;
+                let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+                    let [r, g, b] = self.pixels[p.y() * width + p.x()];
+                    (r, g, b)
+                });
+                let layer = Layer::new(
+                    (width, self.height as usize),
+                    LayerAttributes::default(),
+                    Encoding::SMALL_LOSSLESS,
+                    channels,
+                );
+                Image::from_layer(layer)
+                    .write()
+                    .to_file(path)
                     .with_context(|| format!("{}: cannot write EXR", path.display()))
             }
             Some("png") => {

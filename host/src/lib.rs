@@ -9,8 +9,12 @@ pub mod backend;
 pub mod bench;
 pub mod cpu;
 pub mod film;
+pub mod fixed_sum;
+pub mod merge;
+pub mod part_file;
 #[cfg(feature = "gpu")]
 pub mod render;
+pub mod sample_range;
 pub mod scene;
 pub mod settings;
 #[cfg(feature = "gpu")]

@@ -4,9 +4,10 @@
 use crate::backend::SampleBackend;
 use crate::cpu::CpuBackend;
 use crate::film::Film;
+use crate::sample_range::SampleRange;
 use crate::scene::Scene;
 use crate::vulkan::GpuRenderer;
-use anyhow::Result;
+use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -28,6 +29,9 @@ pub struct RenderOptions {
     pub device: Option<usize>,
     pub validation: bool,
     pub progress: bool,
+    /// The sample indices to render (`None`: all of `0..scene.render.spp`); a part of a
+    /// render split across processes (docs/parts.md).
+    pub samples: Option<SampleRange>,
 }
 
 impl Default for RenderOptions {
@@ -37,6 +41,7 @@ impl Default for RenderOptions {
             device: None,
             validation: false,
             progress: false,
+            samples: None,
         }
     }
 }
@@ -59,6 +64,9 @@ pub struct RenderOutput {
     pub render: Duration,
     /// Samples per pixel actually rendered (fewer than asked after Ctrl-C).
     pub spp_done: u32,
+    /// The sample indices actually rendered: the range asked for, or its beginning after
+    /// Ctrl-C.
+    pub samples: SampleRange,
     pub interrupted: bool,
 }
 
@@ -98,8 +106,13 @@ fn auto_prefers_cpu(device: Option<usize>) -> Option<String> {
     }
 }
 
-/// Renders `scene.render.spp` samples per pixel.
+/// Renders `scene.render.spp` samples per pixel, or the range `opts.samples` of them.
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
+    let range = opts.samples.unwrap_or(SampleRange::all(scene.render.spp));
+    if scene.render.adaptive_target > 0.0 && range.start != 0 {
+        // Which samples a pixel takes depends on all its earlier ones.
+        bail!("adaptive sampling renders a pixel's samples from index 0 on; it cannot render samples {range} alone");
+    }
     let t0 = Instant::now();
     let gpu = match opts.backend {
         Backend::Cpu => None,
@@ -123,7 +136,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
         None => (Box::new(CpuBackend::new(scene)), Backend::Cpu),
     };
     let setup = t0.elapsed();
-    let spp = scene.render.spp;
+    let spp = range.len();
     let progress = opts
         .progress
         .then(|| progress_bar(scene.pixel_count() as u64 * spp as u64));
@@ -131,12 +144,8 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
     let mut spp_done = 0;
     while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
         let count = backend.next_pass(spp_done, spp);
-        backend.add_samples(
-            &scene.params(spp_done, count),
-            spp_done,
-            count,
-            progress.as_ref(),
-        )?;
+        let first = range.start + spp_done;
+        backend.add_samples(&scene.params(first, count), first, count, progress.as_ref())?;
         spp_done += count;
     }
     let film = backend.read_film()?;
@@ -154,6 +163,10 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
         accel_bytes: backend.accel_bytes(),
         render,
         spp_done,
+        samples: SampleRange {
+            start: range.start,
+            end: range.start + spp_done,
+        },
         interrupted: spp_done < spp,
     })
 }

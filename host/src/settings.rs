@@ -220,6 +220,29 @@ impl RenderSettings {
         Ok(())
     }
 
+    /// Every setting of [`SETTINGS`] with its value as the vocabulary writes it (what
+    /// [`RenderSettings::set`] reads back), in [`SETTINGS`]'s order.
+    pub fn entries(&self) -> Vec<(&'static str, String)> {
+        let on_off = |b: bool| if b { "on" } else { "off" }.to_string();
+        let value = |key: &str| match key {
+            "spp" => self.spp.to_string(),
+            "seed" => self.seed.to_string(),
+            "roulette" => self.roulette.name().to_string(),
+            "russian_roulette" => self.rr_probability.to_string(),
+            "rr_start_depth" => self.roulette_start_depth().to_string(),
+            "mis" => self.mis.name().to_string(),
+            "max_depth" => self.max_depth.to_string(),
+            "light_sampling" => self.light_sampling.name().to_string(),
+            "light_selection" => self.light_selection.name().to_string(),
+            "sampler" => self.sampler.name().to_string(),
+            "specialize" => on_off(self.specialize),
+            "packets" => on_off(self.packets),
+            "adaptive_target" => self.adaptive_target.to_string(),
+            _ => unreachable!("every key of SETTINGS has a value"),
+        };
+        SETTINGS.iter().map(|&(k, _)| (k, value(k))).collect()
+    }
+
     /// The first vertex whose extension roulette decides: the setting, else 1 for constant
     /// roulette (the seed's) and 5 for throughput roulette (its q is 1 on the first bounces of
     /// bright paths anyway; starting later measured best on Cornell, `docs/performance.md`).
@@ -263,4 +286,48 @@ fn choice<T>(value: &str, parse: fn(&str) -> Option<T>, names: &[&str]) -> Resul
             format!("'{value}' is not {} or {last}", rest.join(", "))
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `entries` writes what `set` reads: every setting survives the round trip (part files
+    /// compare settings by these texts).
+    #[test]
+    fn entries_read_back_as_the_same_settings() {
+        let mut changed = RenderSettings::default();
+        for (k, v) in [
+            ("spp", "5"),
+            ("seed", "7"),
+            ("roulette", "constant"),
+            ("russian_roulette", "0.3"),
+            ("rr_start_depth", "2"),
+            ("mis", "half"),
+            ("max_depth", "9"),
+            ("light_sampling", "area"),
+            ("light_selection", "uniform"),
+            ("sampler", "independent"),
+            ("specialize", "off"),
+            ("packets", "off"),
+            ("adaptive_target", "0.05"),
+        ] {
+            changed.set(k, v).unwrap();
+        }
+        for settings in [RenderSettings::default(), changed] {
+            let entries = settings.entries();
+            assert_eq!(entries.len(), SETTINGS.len());
+            let mut back = RenderSettings {
+                spp: 1,
+                ..Default::default()
+            };
+            for (k, v) in &entries {
+                back.set(k, v).unwrap();
+            }
+            // The roulette's default start depth is written out, so compare effective values.
+            assert_eq!(back.roulette_start_depth(), settings.roulette_start_depth());
+            back.rr_start_depth = settings.rr_start_depth;
+            assert_eq!(back, settings);
+        }
+    }
 }

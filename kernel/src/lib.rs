@@ -14,6 +14,7 @@ pub mod bsdf;
 pub mod camera;
 pub mod environment;
 pub mod features;
+pub mod film_sample;
 pub mod frame;
 pub mod fresnel;
 pub mod geometry;

@@ -17,6 +17,7 @@
 
 use crate::adaptive::{is_pilot_sample, luminance, pixel_converged};
 use crate::features::Dynamic;
+use crate::film_sample::summable;
 use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::path::{render_sample, SurfaceHit, Tracer};
 use crate::scene::{Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
@@ -132,8 +133,8 @@ impl Tracer for RayTracer<'_> {
 /// Ray generation: `samples_per_launch` samples of this pixel, merged into the running mean and
 /// M2 (sum of squared deviations) of the accumulation images: Welford's update within the
 /// launch, Chan, Golub and LeVeque's pairwise combination with the earlier launches. Both stay
-/// accurate in f32 where a sum of squares minus n mean^2 would cancel. Non-finite samples are
-/// not merged; they are counted in `accum_m2.a`. With adaptive sampling, a converged pixel
+/// accurate in f32 where a sum of squares minus n mean^2 would cancel. Samples the film does not
+/// sum (`film_sample::summable`: non-finite or huge) are not merged; they are counted in `accum_m2.a`. With adaptive sampling, a converged pixel
 /// takes no samples, and pilot samples go to the pilot image instead (`crate::adaptive`).
 #[spirv(ray_generation)]
 pub fn raygen(
@@ -198,7 +199,7 @@ pub fn raygen(
             py,
             index,
         );
-        if !l.is_finite() {
+        if !summable(l) {
             discarded += 1.0;
         } else if is_pilot_sample(params, index) {
             // Welford on the pilots' luminance, straight into the pilot record.

@@ -109,6 +109,7 @@ pub fn render_film(
         device: None,
         validation: backend == twinpath::render::Backend::Gpu,
         progress: false,
+        samples: None,
     };
     let out = twinpath::render::render(&s, &opts).expect("render");
     assert_eq!(out.backend, backend);

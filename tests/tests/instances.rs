@@ -511,6 +511,7 @@ fn a_thousand_instances_of_a_100k_triangle_mesh_store_it_once_on_both_backends()
                 device: None,
                 validation: backend == Backend::Gpu,
                 progress: false,
+                samples: None,
             },
         )
         .unwrap();

@@ -3,6 +3,7 @@
 mod bench;
 mod diff;
 mod info;
+mod merge;
 mod rays;
 mod reference;
 mod render;
@@ -32,6 +33,9 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Render a converged reference as the mean of two independent halves, and estimate its noise.
     Reference(reference::ReferenceArgs),
+    /// Combine the part files of a render split with `render --part` or `--samples` into its
+    /// image (exactly the single render's for CPU parts).
+    Merge(merge::MergeArgs),
     /// Compare two images: RMSE, relMSE, mean signed difference, max abs difference.
     Diff(diff::DiffArgs),
     /// What this build contains: the SPIR-V module and the backends.
@@ -47,6 +51,7 @@ impl Cli {
             Command::Render(a) => render::run(*a),
             Command::Bench(a) => bench::run(a),
             Command::Reference(a) => reference::run(a),
+            Command::Merge(a) => merge::run(a),
             Command::Diff(a) => diff::run(a),
             Command::Info => info::run(),
             Command::Rays(a) => rays::run(a),
@@ -176,6 +181,21 @@ pub fn scene_stem(name: &str) -> String {
 /// `bytes` in MiB, for the log lines.
 pub fn mib(bytes: u64) -> f64 {
     bytes as f64 / (1024.0 * 1024.0)
+}
+
+/// Fails unless `path` can be written: the file is opened for appending (and removed again
+/// if it did not exist), so a render never runs for an hour to find its output unwritable.
+pub fn check_writable(path: &Path) -> Result<()> {
+    let existed = path.exists();
+    std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(path)
+        .map_err(|e| anyhow!("cannot write {}: {e}", path.display()))?;
+    if !existed {
+        let _ = std::fs::remove_file(path);
+    }
+    Ok(())
 }
 
 /// The lower-case extension of `path`, if any.

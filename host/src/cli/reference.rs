@@ -34,6 +34,7 @@ pub fn run(a: ReferenceArgs) -> Result<()> {
         device: None,
         validation: false,
         progress: true,
+        samples: None,
     };
     let first = render(&scene, &opts)?;
     scene.render.seed = scene.render.seed.wrapping_add(0x9e37_79b9);

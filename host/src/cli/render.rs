@@ -1,11 +1,13 @@
 //! `twinpath render`: a scene to EXR and/or PNG, with progress, Ctrl-C and an honest log.
 
-use super::{extension, load_scene, mib, scene_stem, SettingFlags};
+use super::{check_writable, extension, load_scene, mib, scene_stem, SettingFlags};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 use twinpath::film::RgbImage;
+use twinpath::part_file::{write_part, PartHeader};
 use twinpath::render::{install_interrupt_handler, render, Backend, RenderOptions, RenderOutput};
+use twinpath::sample_range::{Part, SampleRange};
 use twinpath::scene::Scene;
 
 /// Render a scene (default: the built-in Cornell scene) to EXR and/or PNG.
@@ -32,9 +34,19 @@ pub struct RenderArgs {
     /// Enable the Vulkan validation layers (Debian package vulkan-validationlayers).
     #[arg(long)]
     validation: bool,
-    /// Output file(s): .exr (linear float32) or .png (sRGB). Default: <scene stem>.exr and .png.
+    /// Output file(s): .exr (linear float32) or .png (sRGB). Default: <scene stem>.exr and .png
+    /// (with --part or --samples: one part file, <scene stem>.part-I-of-N.exr or
+    /// <scene stem>.samples-A-B.exr).
     #[arg(long = "out", short = 'o')]
     out: Vec<PathBuf>,
+    /// Render only part I of N of the samples (I counts from 0: a job array's index) and write
+    /// a part file for `twinpath merge`.
+    #[arg(long, value_name = "I/N", conflicts_with = "samples")]
+    part: Option<String>,
+    /// Render only sample indices A..B of every pixel and write a part file for `twinpath
+    /// merge`.
+    #[arg(long, value_name = "A..B")]
+    samples: Option<String>,
     #[command(flatten)]
     settings: SettingFlags,
     /// Write the samples each pixel received as an image (EXR: the count in every channel).
@@ -69,8 +81,19 @@ pub fn run(a: RenderArgs) -> Result<()> {
         if extension(m).as_deref() != Some("exr") {
             bail!("--spp-map {}: must be an .exr file", m.display());
         }
+        check_writable(m).with_context(|| format!("--spp-map {}", m.display()))?;
     }
-    let outputs = if a.out.is_empty() {
+    let share = PartShare::of(&a, &scene)?;
+    let outputs = if let Some(share) = &share {
+        let out = match a.out.as_slice() {
+            [] => PathBuf::from(share.file_name(&scene_stem(scene.name.as_str()))),
+            [o] if extension(o).as_deref() == Some("exr") => o.clone(),
+            _ => bail!(
+                "--out: a part renders one part file, an .exr (twinpath merge makes the image)"
+            ),
+        };
+        vec![out]
+    } else if a.out.is_empty() {
         let stem = scene_stem(scene.name.as_str());
         vec![
             PathBuf::from(format!("{stem}.exr")),
@@ -84,6 +107,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
             Some("exr") | Some("png") => {}
             _ => bail!("--out {}: unknown format (use .exr or .png)", o.display()),
         }
+        // Before the render, not after an hour of it.
+        check_writable(o).with_context(|| format!("--out {}", o.display()))?;
     }
     // From here on Ctrl-C stops the render and keeps the image (the line below says so).
     install_interrupt_handler();
@@ -98,15 +123,18 @@ pub fn run(a: RenderArgs) -> Result<()> {
             scene.instances.len()
         )
     };
+    let samples = match &share {
+        Some(s) => s.describe(),
+        None => format!("{} spp", scene.render.spp),
+    };
     eprintln!(
-        "twinpath: {} ({}x{}, {} spheres, {} triangles{instances}, {} lights), {} spp, seed {}",
+        "twinpath: {} ({}x{}, {} spheres, {} triangles{instances}, {} lights), {samples}, seed {}",
         scene.name,
         scene.camera.width,
         scene.camera.height,
         scene.spheres.len(),
         scene.triangles.len(),
         scene.lights.len(),
-        scene.render.spp,
         scene.render.seed
     );
     eprintln!("twinpath: scene memory: {}", scene.memory_report());
@@ -118,14 +146,31 @@ pub fn run(a: RenderArgs) -> Result<()> {
         device: a.device,
         validation: a.validation,
         progress: !a.quiet,
+        samples: share.as_ref().map(|s| s.samples),
     };
     let result = render(&scene, &opts)?;
     log_costs(&result, a.backend);
     if result.interrupted {
         eprintln!(
             "twinpath: interrupted: writing the image so far, {} of {} samples per pixel",
-            result.spp_done, scene.render.spp
+            result.spp_done,
+            opts.samples.map_or(scene.render.spp, |s| s.len())
         );
+    }
+    if let Some(share) = &share {
+        let backend = match result.backend {
+            Backend::Gpu => "gpu",
+            _ => "cpu",
+        };
+        let mut header = PartHeader::new(&scene, backend, result.samples);
+        header.part = share.part.map(|p| (p, SampleRange::all(scene.render.spp)));
+        write_part(&outputs[0], &header, &result.film)?;
+        eprintln!(
+            "twinpath: wrote part file {} (samples {})",
+            outputs[0].display(),
+            result.samples
+        );
+        return Ok(());
     }
     let image = RgbImage::from_film(&result.film);
     for o in &outputs {
@@ -133,6 +178,70 @@ pub fn run(a: RenderArgs) -> Result<()> {
         eprintln!("twinpath: wrote {}", o.display());
     }
     write_sample_counts(&scene, &result, a.spp_map.as_ref())
+}
+
+/// The samples of a render split into parts: `--part I/N` or `--samples A..B`.
+struct PartShare {
+    part: Option<Part>,
+    samples: SampleRange,
+}
+
+impl PartShare {
+    /// The share the flags ask for (`None`: the whole render).
+    fn of(a: &RenderArgs, scene: &Scene) -> Result<Option<Self>> {
+        let flag = if a.part.is_some() {
+            "--part"
+        } else {
+            "--samples"
+        };
+        let share = match (&a.part, &a.samples) {
+            (Some(text), _) => {
+                let part = Part::parse(text).with_context(|| format!("--part {text}"))?;
+                let spp = scene.render.spp;
+                if part.count > spp {
+                    bail!(
+                        "--part {text}: {} parts of {spp} samples per pixel would leave parts empty",
+                        part.count
+                    );
+                }
+                Self {
+                    part: Some(part),
+                    samples: part.samples(SampleRange::all(spp)),
+                }
+            }
+            (None, Some(text)) => Self {
+                part: None,
+                samples: SampleRange::parse(text).with_context(|| format!("--samples {text}"))?,
+            },
+            (None, None) => return Ok(None),
+        };
+        if scene.render.adaptive_target > 0.0 {
+            bail!(
+                "{flag}: adaptive sampling (--target-error) cannot be split into parts: which \
+                 samples a pixel takes depends on all its earlier ones (docs/parts.md)"
+            );
+        }
+        Ok(Some(share))
+    }
+
+    /// The part file's default name.
+    fn file_name(&self, stem: &str) -> String {
+        match self.part {
+            Some(p) => format!("{stem}.part-{}-of-{}.exr", p.index, p.count),
+            None => format!(
+                "{stem}.samples-{}-{}.exr",
+                self.samples.start, self.samples.end
+            ),
+        }
+    }
+
+    /// For the log: which samples.
+    fn describe(&self) -> String {
+        match self.part {
+            Some(p) => format!("part {p}: samples {} of each pixel", self.samples),
+            None => format!("samples {} of each pixel", self.samples),
+        }
+    }
 }
 
 /// The log line of set-up and render time, throughput and discarded samples.

@@ -353,6 +353,7 @@ impl SceneTables {
             instances: self.instances,
             instance_meshes: self.instance_meshes,
             notes: Vec::new(),
+            inputs: Vec::new(),
         }
     }
 }

@@ -28,8 +28,8 @@ impl EnvironmentMap {
     /// non-negative, its sides within [`MAX_MAP_SIDE`].
     pub fn load(path: &Path, field: &str) -> Result<Self, SceneError> {
         let err = |msg: String| SceneError::new(path, None, field, msg);
-        let reader = image::ImageReader::open(path)
-            .map_err(|e| err(format!("cannot read: {e}")))?
+        let bytes = super::inputs::read(path).map_err(|e| err(format!("cannot read: {e}")))?;
+        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| err(format!("cannot read: {e}")))?;
         let image = reader

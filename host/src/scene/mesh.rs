@@ -44,12 +44,12 @@ pub fn load_mesh(path: &Path) -> Result<TriangleSoup, SceneError> {
         .map(|e| e.to_ascii_lowercase());
     match ext.as_deref() {
         Some("obj") => {
-            let bytes = std::fs::read(path)
+            let bytes = super::inputs::read(path)
                 .map_err(|e| SceneError::new(path, None, "file", format!("cannot read: {e}")))?;
             parse_obj(path, &bytes)
         }
         Some("ply") => {
-            let bytes = std::fs::read(path)
+            let bytes = super::inputs::read(path)
                 .map_err(|e| SceneError::new(path, None, "file", format!("cannot read: {e}")))?;
             parse_ply(path, &bytes)
         }

@@ -7,6 +7,7 @@ pub mod environment;
 mod error;
 mod file;
 pub mod gltf_scene;
+pub mod inputs;
 pub mod instancing;
 pub mod light_table;
 pub mod materials;
@@ -150,6 +151,8 @@ pub struct Scene {
     /// What the loader approximated or ignored (glTF features twinpath does not read yet):
     /// shown to the user before a render.
     pub notes: Vec<String>,
+    /// The files the scene was read from, with their hashes (`inputs`).
+    pub inputs: Vec<inputs::InputFile>,
 }
 
 impl Scene {
@@ -161,6 +164,14 @@ impl Scene {
 
     /// [`Scene::load`], a glTF file seen through its perspective camera named `camera`.
     pub fn load_with_camera(path: &Path, camera: Option<&str>) -> Result<Scene, SceneError> {
+        let (scene, files) = inputs::recording(|| Self::read_scene(path, camera));
+        let mut scene = scene?;
+        scene.inputs = files;
+        Ok(scene)
+    }
+
+    /// [`Scene::load_with_camera`] without the record of the files read.
+    fn read_scene(path: &Path, camera: Option<&str>) -> Result<Scene, SceneError> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -176,7 +187,7 @@ impl Scene {
                 format!("a camera name ('{name}') selects among a glTF file's cameras; a TOML scene has one"),
             ));
         }
-        let text = std::fs::read(path)
+        let text = inputs::read(path)
             .map_err(|e| SceneError::new(path, None, "file", format!("cannot read: {e}")))?;
         let text = String::from_utf8(text).map_err(|e| {
             let line = error::line_of(
@@ -190,8 +201,13 @@ impl Scene {
 
     /// The built-in default scene (the Cornell scene of `scenes/cornell.toml`).
     pub fn builtin_default() -> Scene {
-        parse_scene(DEFAULT_SCENE_TOML, Path::new(DEFAULT_SCENE_NAME))
-            .expect("the built-in scene is valid (checked by a test)")
+        let mut scene = parse_scene(DEFAULT_SCENE_TOML, Path::new(DEFAULT_SCENE_NAME))
+            .expect("the built-in scene is valid (checked by a test)");
+        scene.inputs = vec![inputs::InputFile {
+            path: DEFAULT_SCENE_NAME.into(),
+            hash: blake3::hash(DEFAULT_SCENE_TOML.as_bytes()),
+        }];
+        scene
     }
 
     /// The kernel parameters for a launch of `samples_per_launch` samples starting at sample

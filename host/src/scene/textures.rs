@@ -82,8 +82,8 @@ impl TextureTable {
             return Ok(k);
         }
         let err = |msg: String| SceneError::new(path, None, field, msg);
-        let image = image::ImageReader::open(path)
-            .map_err(|e| err(format!("cannot read: {e}")))?
+        let bytes = super::inputs::read(path).map_err(|e| err(format!("cannot read: {e}")))?;
+        let image = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| err(format!("cannot read: {e}")))?
             .decode()

@@ -10,6 +10,7 @@ pub mod pipeline;
 
 use crate::backend::SampleBackend;
 use crate::film::Film;
+use crate::fixed_sum::FixedSum;
 use crate::scene::{Scene, ADAPTIVE_PASS};
 use accel::SceneAccel;
 use anyhow::{Context as _, Result};
@@ -303,7 +304,7 @@ impl GpuRenderer {
             let n = m[3] as f64;
             for c in 0..3 {
                 let mean = m[c] as f64;
-                film.sum[i][c] = n * mean;
+                film.sum[i][c] = FixedSum::from_f64(n * mean);
                 film.sum_sq[i][c] = q[c] as f64 + n * mean * mean;
             }
             film.count[i] = m[3] as u32;

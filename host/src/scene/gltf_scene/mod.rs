@@ -12,6 +12,7 @@ mod material;
 use super::builder::SceneTables;
 use super::closed_surface::check_closed_outward;
 use super::file::MAX_IMAGE_SIDE;
+use super::inputs;
 use super::instancing::{instances_box, INSTANCE_MIN_TRIANGLES};
 use super::mesh::TriangleSoup;
 use super::textures::TextureUse;
@@ -136,6 +137,14 @@ fn parse_document(
     }
     let buffers = gltf::import_buffers(&document, base, gltf.blob)
         .map_err(|e| err("buffers", format!("cannot read: {e}")))?;
+    // The gltf crate read the external buffers itself: record them for the part files.
+    for (buffer, data) in document.buffers().zip(&buffers) {
+        if let (gltf::buffer::Source::Uri(uri), Some(base)) = (buffer.source(), base) {
+            if !uri.starts_with("data:") {
+                inputs::record(&base.join(uri), &data.0);
+            }
+        }
+    }
     Ok((document, buffers))
 }
 
@@ -143,7 +152,7 @@ fn parse_document(
 /// sky, default render settings, seen through the perspective camera named `camera` (default:
 /// the first; without any, a camera framing the scene).
 pub fn load(path: &Path, camera: Option<&str>) -> Result<Scene, SceneError> {
-    let bytes = std::fs::read(path)
+    let bytes = inputs::read(path)
         .map_err(|e| SceneError::new(path, None, "file", format!("cannot read: {e}")))?;
     let base = path.parent().unwrap_or(Path::new("."));
     load_bytes(path, &bytes, Some(base), camera)
@@ -215,7 +224,7 @@ pub(super) fn include(
     transform: Option<&Transform>,
     notes: &mut Vec<String>,
 ) -> Result<Vec<GltfCamera>, SceneError> {
-    let bytes = std::fs::read(path)
+    let bytes = inputs::read(path)
         .map_err(|e| SceneError::new(path, None, "file", format!("cannot read: {e}")))?;
     let base = path.parent().unwrap_or(Path::new("."));
     import(tables, path, &bytes, Some(base), transform, notes)
@@ -792,7 +801,7 @@ impl Import<'_> {
                     })?;
                     let file = base.join(uri);
                     std::borrow::Cow::Owned(
-                        std::fs::read(&file)
+                        inputs::read(&file)
                             .map_err(|e| err(format!("cannot read {}: {e}", file.display())))?,
                     )
                 }
