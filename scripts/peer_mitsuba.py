@@ -9,10 +9,11 @@ the reference EXR with the definitions of `twinpath diff`:
 relMSE = mean over pixels and channels of (a - b)^2 / (b^2 + 0.01).
 
 Usage: peer_mitsuba.py REFERENCE.exr OUT.csv [--variant llvm_ad_rgb] [--max-spp 1024]
-       [--max-seconds 60] [--sampler independent]
+       [--max-seconds 60] [--sampler independent] [--mesh KNOT.ply]
 --sampler picks Mitsuba's sampler (the reference's is `independent`; `ldsampler` is its
 low-discrepancy one, `multijitter` / `stratified` its stratified ones); names other than
-independent are added to the variant column.
+independent are added to the variant column. --mesh replaces the two spheres by a PLY mesh in
+white, flat-shaded (scripts/knot_scenes.py's scenes); its file name is added to the variant.
 Install: pip install mitsuba numpy (scripts/peer_mitsuba.sh does it in a venv).
 """
 
@@ -103,7 +104,16 @@ def main():
     ap.add_argument("--max-spp", type=int, default=1024)
     ap.add_argument("--max-seconds", type=float, default=60.0)
     ap.add_argument("--sampler", default="independent")
+    ap.add_argument("--mesh", help="a PLY mesh in place of the spheres (scripts/knot_scenes.py)")
     args = ap.parse_args()
+
+    def make_dict(spp, seed):
+        d = scene_dict(spp, seed, args.sampler)
+        if args.mesh:
+            del d["sphere_left"], d["sphere_right"]
+            d["mesh"] = {"type": "ply", "filename": args.mesh, "face_normals": True,
+                         "bsdf": {"type": "ref", "id": "white"}}
+        return d
 
     mi.set_variant(args.variant)
     ref = np.array(mi.Bitmap(args.reference).convert(
@@ -114,7 +124,7 @@ def main():
         seeds = 4 if spp <= 4 else (2 if spp <= 32 else 1)
         for k in range(seeds):
             t0 = time.perf_counter()
-            scene = mi.load_dict(scene_dict(spp, 1 + k, args.sampler))
+            scene = mi.load_dict(make_dict(spp, 1 + k))
             setup = time.perf_counter() - t0
             # Warm-up render: the llvm variants compile a kernel for each new sample count (a
             # set-up cost, cached afterwards); it is timed as set-up, not render.
@@ -135,6 +145,8 @@ def main():
             break
         spp *= 2
     name = args.variant if args.sampler == "independent" else f"{args.variant}-{args.sampler}"
+    if args.mesh:
+        name += "-" + args.mesh.rsplit("/", 1)[-1].removesuffix(".ply")
     with open(args.out, "w") as f:
         f.write("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n")
         for spp, seed, setup, render_s, relmse, rmse, eff in rows:
