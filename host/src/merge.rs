@@ -9,7 +9,11 @@ use crate::film::Film;
 use crate::part_file::{read_part, read_part_header, PartHeader};
 use crate::sample_range::{Part, SampleRange};
 use anyhow::{bail, Result};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+
+/// Part files read at once (each holds a film's worth of memory while it is added).
+const PARALLEL_READS: usize = 4;
 
 /// The merged render.
 pub struct Merged {
@@ -29,24 +33,32 @@ pub fn merge_parts(paths: &[PathBuf]) -> Result<Merged> {
         .map(|p| Ok((p.as_path(), read_part_header(p)?)))
         .collect::<Result<Vec<_>>>()?;
     let (samples, notes) = check_parts(&headers)?;
+    // Parts are read (decompressed) a few at a time in parallel and added in order: memory
+    // holds the sum and at most PARALLEL_READS parts, whatever their number.
+    let parallel = rayon::current_num_threads().clamp(1, PARALLEL_READS);
     let mut film: Option<Film> = None;
-    for &(path, _) in &headers {
-        let (_, part) = read_part(path)?;
-        match &mut film {
-            None => film = Some(part),
-            Some(f) => {
-                if (f.width, f.height) != (part.width, part.height) {
-                    bail!(
-                        "{}: {}x{} pixels, but {} has {}x{}",
-                        path.display(),
-                        part.width,
-                        part.height,
-                        headers[0].0.display(),
-                        f.width,
-                        f.height
-                    );
+    for group in headers.chunks(parallel) {
+        let parts = group
+            .par_iter()
+            .map(|&(path, _)| Ok((path, read_part(path)?.1)))
+            .collect::<Result<Vec<_>>>()?;
+        for (path, part) in parts {
+            match &mut film {
+                None => film = Some(part),
+                Some(f) => {
+                    if (f.width, f.height) != (part.width, part.height) {
+                        bail!(
+                            "{}: {}x{} pixels, but {} has {}x{}",
+                            path.display(),
+                            part.width,
+                            part.height,
+                            headers[0].0.display(),
+                            f.width,
+                            f.height
+                        );
+                    }
+                    f.add_film(&part);
                 }
-                f.add_film(&part);
             }
         }
     }
