@@ -40,7 +40,7 @@ pub fn merge_parts(paths: &[PathBuf]) -> Result<Merged> {
     for group in headers.chunks(parallel) {
         let parts = group
             .par_iter()
-            .map(|&(path, _)| Ok((path, read_part(path)?.1)))
+            .map(|&(path, _)| Ok((path, read_part(path)?)))
             .collect::<Result<Vec<_>>>()?;
         for (path, part) in parts {
             match &mut film {

@@ -41,8 +41,6 @@ pub struct PartHeader {
     pub samples: SampleRange,
     /// With `--part I/N`: which part, of which whole range.
     pub part: Option<(Part, SampleRange)>,
-    /// Samples dropped as not summable (`kernel::film_sample`).
-    pub discarded: u64,
 }
 
 impl PartHeader {
@@ -70,7 +68,6 @@ impl PartHeader {
             backend: backend.to_string(),
             samples,
             part: None,
-            discarded: 0,
         }
     }
 
@@ -94,9 +91,8 @@ impl PartHeader {
 
     /// The header as EXR attributes named `twinpath.*` (values UTF-8).
     fn attributes(&self) -> Vec<(&'static str, String)> {
-        let lines = |pairs: &[(String, String)], sep: &str| {
+        let lines = |pairs: &mut dyn Iterator<Item = (&String, &String)>, sep: &str| {
             pairs
-                .iter()
                 .map(|(a, b)| format!("{a}{sep}{b}"))
                 .collect::<Vec<_>>()
                 .join("\n")
@@ -110,21 +106,19 @@ impl PartHeader {
             (
                 "twinpath.inputs",
                 lines(
-                    &self
-                        .inputs
-                        .iter()
-                        .map(|(path, hash)| (hash.clone(), path.clone()))
-                        .collect::<Vec<_>>(),
+                    &mut self.inputs.iter().map(|(path, hash)| (hash, path)),
                     " ",
                 ),
             ),
             ("twinpath.settings_hash", self.settings_hash()),
-            ("twinpath.settings", lines(&self.settings, " = ")),
+            (
+                "twinpath.settings",
+                lines(&mut self.settings.iter().map(|(k, v)| (k, v)), " = "),
+            ),
             ("twinpath.seed", self.seed.to_string()),
             ("twinpath.sampler", self.sampler.clone()),
             ("twinpath.backend", self.backend.clone()),
             ("twinpath.samples", self.samples.to_string()),
-            ("twinpath.discarded", self.discarded.to_string()),
         ];
         if let Some((part, all)) = self.part {
             a.push(("twinpath.part", format!("{part} of {all}")));
@@ -134,17 +128,7 @@ impl PartHeader {
 
     /// Reads the header back from a part file's attributes; `what` names the file in errors.
     fn from_attributes(other: &HashMap<Text, AttributeValue>, what: &Path) -> Result<Self> {
-        let get = |name: &str| -> Result<String> {
-            match other.get(&Text::from(name)) {
-                Some(AttributeValue::Text(t)) => String::from_utf8(t.bytes().to_vec())
-                    .map_err(|_| anyhow!("{}: attribute {name} is not UTF-8", what.display())),
-                Some(_) => bail!("{}: attribute {name} is not text", what.display()),
-                None => bail!(
-                    "{}: not a twinpath part file (no attribute {name})",
-                    what.display()
-                ),
-            }
-        };
+        let get = |name: &str| attribute(other, name, what);
         let format = get("twinpath.format")?;
         if format != FORMAT_VERSION.to_string() {
             bail!(
@@ -152,11 +136,6 @@ impl PartHeader {
                 what.display()
             );
         }
-        let number = |name: &str| -> Result<u64> {
-            let v = get(name)?;
-            v.parse()
-                .map_err(|_| anyhow!("{}: {name} '{v}' is not a number", what.display()))
-        };
         let pairs = |name: &str, sep: &str| -> Result<Vec<(String, String)>> {
             let v = get(name)?;
             v.lines()
@@ -191,12 +170,11 @@ impl PartHeader {
             scene: get("twinpath.scene")?,
             inputs,
             settings: pairs("twinpath.settings", " = ")?,
-            seed: number("twinpath.seed")? as u32,
+            seed: number(other, "twinpath.seed", what)? as u32,
             sampler: get("twinpath.sampler")?,
             backend: get("twinpath.backend")?,
             samples: range(&get("twinpath.samples")?)?,
             part,
-            discarded: number("twinpath.discarded")?,
         };
         if header.scene_hash() != get("twinpath.scene_hash")?
             || header.settings_hash() != get("twinpath.settings_hash")?
@@ -208,6 +186,26 @@ impl PartHeader {
         }
         Ok(header)
     }
+}
+
+/// The text attribute `name` of a part file's header (`what` names the file in errors).
+fn attribute(other: &HashMap<Text, AttributeValue>, name: &str, what: &Path) -> Result<String> {
+    match other.get(&Text::from(name)) {
+        Some(AttributeValue::Text(t)) => String::from_utf8(t.bytes().to_vec())
+            .map_err(|_| anyhow!("{}: attribute {name} is not UTF-8", what.display())),
+        Some(_) => bail!("{}: attribute {name} is not text", what.display()),
+        None => bail!(
+            "{}: not a twinpath part file (no attribute {name})",
+            what.display()
+        ),
+    }
+}
+
+/// The number in attribute `name`.
+fn number(other: &HashMap<Text, AttributeValue>, name: &str, what: &Path) -> Result<u64> {
+    let v = attribute(other, name, what)?;
+    v.parse()
+        .map_err(|_| anyhow!("{}: {name} '{v}' is not a number", what.display()))
 }
 
 /// 32-bit words of a fixed-point sum, and of an f64 sum of squares, per channel.
@@ -249,9 +247,8 @@ pub fn write_part(path: &Path, header: &PartHeader, film: &Film) -> Result<()> {
     ));
     debug_assert!(channels.iter().all(|ch| ch.sample_data.len() == n));
     let mut attributes = LayerAttributes::named("twinpath part");
-    let mut header = header.clone();
-    header.discarded = film.discarded;
-    for (name, value) in header.attributes() {
+    let discarded = ("twinpath.discarded", film.discarded.to_string());
+    for (name, value) in header.attributes().into_iter().chain([discarded]) {
         attributes.other.insert(
             Text::from(name),
             AttributeValue::Text(Text::from_slice_unchecked(value.as_bytes())),
@@ -280,8 +277,9 @@ pub fn read_part_header(path: &Path) -> Result<PartHeader> {
     PartHeader::from_attributes(&layer.own_attributes.other, path)
 }
 
-/// Reads the part file at `path`: its header and its film (image sums only).
-pub fn read_part(path: &Path) -> Result<(PartHeader, Film)> {
+/// Reads the film (image sums only) of the part file at `path`, whose header
+/// [`read_part_header`] reads.
+pub fn read_part(path: &Path) -> Result<Film> {
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -291,7 +289,6 @@ pub fn read_part(path: &Path) -> Result<(PartHeader, Film)> {
         .from_file(path)
         .with_context(|| format!("{}: not a readable EXR file", path.display()))?;
     let layer = &image.layer_data;
-    let header = PartHeader::from_attributes(&layer.attributes.other, path)?;
     let (w, h) = (layer.size.width(), layer.size.height());
     let mut film = Film::new(w as u32, h as u32);
     let channel = |name: &str| -> Result<&[u32]> {
@@ -321,6 +318,6 @@ pub fn read_part(path: &Path) -> Result<(PartHeader, Film)> {
             }
         }
     }
-    film.discarded = header.discarded;
-    Ok((header, film))
+    film.discarded = number(&layer.attributes.other, "twinpath.discarded", path)?;
+    Ok(film)
 }

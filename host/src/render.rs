@@ -108,11 +108,13 @@ fn auto_prefers_cpu(device: Option<usize>) -> Option<String> {
 
 /// Renders `scene.render.spp` samples per pixel, or the range `opts.samples` of them.
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
-    let range = opts.samples.unwrap_or(SampleRange::all(scene.render.spp));
-    if scene.render.adaptive_target > 0.0 && range.start != 0 {
-        // Which samples a pixel takes depends on all its earlier ones.
-        bail!("adaptive sampling renders a pixel's samples from index 0 on; it cannot render samples {range} alone");
+    if let (Some(range), true) = (opts.samples, scene.render.adaptive_target > 0.0) {
+        bail!(
+            "adaptive sampling (--target-error) cannot be split into parts (samples {range}): \
+             which samples a pixel takes depends on all its earlier ones (docs/parts.md)"
+        );
     }
+    let range = opts.samples.unwrap_or(SampleRange::all(scene.render.spp));
     let t0 = Instant::now();
     let gpu = match opts.backend {
         Backend::Cpu => None,

@@ -29,15 +29,12 @@ impl SampleRange {
 
     /// Reads `A..B` (`A < B`).
     pub fn parse(text: &str) -> Result<Self> {
-        let Some((a, b)) = text.split_once("..") else {
-            bail!("'{text}' is not a range A..B of sample indices");
-        };
-        let index = |s: &str| {
-            s.trim()
-                .parse::<u32>()
-                .map_err(|_| anyhow::anyhow!("'{s}' in '{text}' is not a sample index"))
-        };
-        let (start, end) = (index(a)?, index(b)?);
+        let (start, end) = two_numbers(
+            text,
+            "..",
+            "a range A..B of sample indices",
+            "a sample index",
+        )?;
         if start >= end {
             bail!("'{text}' is empty: A..B needs A < B");
         }
@@ -62,15 +59,12 @@ pub struct Part {
 impl Part {
     /// Reads `I/N` (`0 <= I < N`).
     pub fn parse(text: &str) -> Result<Self> {
-        let Some((i, n)) = text.split_once('/') else {
-            bail!("'{text}' is not I/N (part I of N, I counting from 0)");
-        };
-        let number = |s: &str| {
-            s.trim()
-                .parse::<u32>()
-                .map_err(|_| anyhow::anyhow!("'{s}' in '{text}' is not a number"))
-        };
-        let (index, count) = (number(i)?, number(n)?);
+        let (index, count) = two_numbers(
+            text,
+            "/",
+            "I/N (part I of N, I counting from 0)",
+            "a number",
+        )?;
         if count == 0 {
             bail!("'{text}': a render has at least one part");
         }
@@ -94,6 +88,20 @@ impl Part {
             end: at(self.index + 1),
         }
     }
+}
+
+/// The two numbers of `text`, written `X<separator>Y`; errors say that `text` is not `form`,
+/// or which number is not `number`.
+fn two_numbers(text: &str, separator: &str, form: &str, number: &str) -> Result<(u32, u32)> {
+    let Some((a, b)) = text.split_once(separator) else {
+        bail!("'{text}' is not {form}");
+    };
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .map_err(|_| anyhow::anyhow!("'{s}' in '{text}' is not {number}"))
+    };
+    Ok((parse(a)?, parse(b)?))
 }
 
 impl fmt::Display for Part {

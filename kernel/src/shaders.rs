@@ -134,8 +134,8 @@ impl Tracer for RayTracer<'_> {
 /// M2 (sum of squared deviations) of the accumulation images: Welford's update within the
 /// launch, Chan, Golub and LeVeque's pairwise combination with the earlier launches. Both stay
 /// accurate in f32 where a sum of squares minus n mean^2 would cancel. Samples the film does not
-/// sum (`film_sample::summable`: non-finite or huge) are not merged; they are counted in `accum_m2.a`. With adaptive sampling, a converged pixel
-/// takes no samples, and pilot samples go to the pilot image instead (`crate::adaptive`).
+/// sum (`film_sample::summable`: non-finite or huge) are not merged; they are counted in
+/// `accum_m2.a`. With adaptive sampling, a converged pixel takes no samples, and pilot samples go to the pilot image instead (`crate::adaptive`).
 #[spirv(ray_generation)]
 pub fn raygen(
     #[spirv(launch_id)] launch_id: UVec3,

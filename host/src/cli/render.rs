@@ -189,12 +189,7 @@ struct PartShare {
 impl PartShare {
     /// The share the flags ask for (`None`: the whole render).
     fn of(a: &RenderArgs, scene: &Scene) -> Result<Option<Self>> {
-        let flag = if a.part.is_some() {
-            "--part"
-        } else {
-            "--samples"
-        };
-        let share = match (&a.part, &a.samples) {
+        Ok(Some(match (&a.part, &a.samples) {
             (Some(text), _) => {
                 let part = Part::parse(text).with_context(|| format!("--part {text}"))?;
                 let spp = scene.render.spp;
@@ -214,14 +209,7 @@ impl PartShare {
                 samples: SampleRange::parse(text).with_context(|| format!("--samples {text}"))?,
             },
             (None, None) => return Ok(None),
-        };
-        if scene.render.adaptive_target > 0.0 {
-            bail!(
-                "{flag}: adaptive sampling (--target-error) cannot be split into parts: which \
-                 samples a pixel takes depends on all its earlier ones (docs/parts.md)"
-            );
-        }
-        Ok(Some(share))
+        }))
     }
 
     /// The part file's default name.
