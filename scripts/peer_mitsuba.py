@@ -9,11 +9,13 @@ the reference EXR with the definitions of `twinpath diff`:
 relMSE = mean over pixels and channels of (a - b)^2 / (b^2 + 0.01).
 
 Usage: peer_mitsuba.py REFERENCE.exr OUT.csv [--variant llvm_ad_rgb] [--max-spp 1024]
-       [--max-seconds 60] [--sampler independent] [--mesh KNOT.ply]
+       [--max-seconds 60] [--sampler independent] [--mesh KNOT.ply] [--once SPP]
 --sampler picks Mitsuba's sampler (the reference's is `independent`; `ldsampler` is its
 low-discrepancy one, `multijitter` / `stratified` its stratified ones); names other than
 independent are added to the variant column. --mesh replaces the two spheres by a PLY mesh in
 white, flat-shaded (scripts/knot_scenes.py's scenes); its file name is added to the variant.
+--once SPP renders once (seed 1, no warm-up), writes the image to OUT and prints its relMSE:
+scripts/mesh_table.sh times whole processes with it.
 Install: pip install mitsuba numpy (scripts/peer_mitsuba.sh does it in a venv).
 """
 
@@ -105,6 +107,10 @@ def main():
     ap.add_argument("--max-seconds", type=float, default=60.0)
     ap.add_argument("--sampler", default="independent")
     ap.add_argument("--mesh", help="a PLY mesh in place of the spheres (scripts/knot_scenes.py)")
+    ap.add_argument("--once", type=int, metavar="SPP",
+                    help="render once at SPP (seed 1, no warm-up: what a user's process does), "
+                         "write the image to OUT (EXR) and print its relMSE; for timing whole "
+                         "processes")
     args = ap.parse_args()
 
     def make_dict(spp, seed):
@@ -118,6 +124,12 @@ def main():
     mi.set_variant(args.variant)
     ref = np.array(mi.Bitmap(args.reference).convert(
         mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32), dtype=np.float64)
+    if args.once:
+        img = mi.render(mi.load_dict(make_dict(args.once, 1)), spp=args.once, seed=1)
+        mi.Bitmap(img).write(args.out)
+        d = np.array(img, dtype=np.float64) - ref
+        print(f"relmse {float(np.mean(d * d / (ref * ref + 0.01))):.6e}")
+        return
     rows = []
     spp = 1
     while spp <= args.max_spp:

@@ -4,8 +4,10 @@
 //! the build and the traversal: random soups with spheres, a dense generated mesh, an
 //! axis-aligned grid (flat boxes, rays in their planes), thousands of identical triangles (the
 //! median-split fallback), and 0 to 5 primitives (a root that is a leaf). Memory is checked to
-//! grow linearly with the triangle count. The packets of sixteen rays that small scenes use
-//! instead are held to the same brute force.
+//! grow linearly with the triangle count. Of primitives hit at exactly the same t the smallest
+//! id is returned (thousands of identical triangles, a grid's shared edges), so the answer does
+//! not depend on the traversal order. The packets of sixteen rays, against every primitive of a
+//! small scene and through the BVH, are held to the same brute force.
 
 #![feature(portable_simd)]
 
@@ -102,15 +104,11 @@ fn check_against_brute_force(
             want_t.to_bits(),
             "{name}: ray {i} from {o} along {d}: BVH t {got_t} (prim {got}), brute force {want_t} (prim {want})"
         );
-        if got != want {
-            // A tie at exactly the same t: the returned primitive must be hit there too.
-            assert_ne!(got, NONE, "{name}: ray {i}: BVH missed prim {want}");
-            assert_eq!(
-                bvh.intersect_prim(got, o, d, f32::INFINITY).to_bits(),
-                got_t.to_bits(),
-                "{name}: ray {i}: prim {got} is not hit at {got_t}"
-            );
-        }
+        // Of primitives at exactly the same t the smallest id, as brute force finds it.
+        assert_eq!(
+            got, want,
+            "{name}: ray {i} from {o} along {d}: BVH prim {got}, brute force {want} (t {got_t})"
+        );
         assert_eq!(
             bvh.any_hit(o, d, t_max),
             want != NONE,
@@ -439,4 +437,225 @@ fn packets_of_sixteen_rays_match_brute_force() {
         hits > rays / 4,
         "only {hits} of {rays} rays hit; the test would be weak"
     );
+}
+
+/// Sixteen rays at a time through the BVH (`cpu::bvh_packet`, what the renderer uses for larger
+/// scenes): per lane, the primitive, t and barycentrics bit-identical to brute force (the
+/// smallest id of a tie) and any-hit in agreement. Packets both coherent (origins close
+/// together, directions in a narrow cone: they stay together deep into the tree) and incoherent
+/// (lanes split early and finish one ray at a time), lanes without a ray (t_max 0), finite and
+/// infinite t_max, on random soups with spheres, the dense knot, the grid (rays in its planes,
+/// ties on its diagonals), identical triangles and trees of 1 to 5 primitives.
+#[test]
+fn bvh_packets_of_sixteen_rays_match_brute_force() {
+    let knot = Bvh::build(
+        vec![sphere(Vec3::ZERO, 0.3)],
+        to_triangles(&knot_mesh(20_000, Vec3::ZERO, 4.0), 0),
+    );
+    let mut grid = Vec::new();
+    for y in 0..3 {
+        for x in -4..4 {
+            for z in -4..4 {
+                let p = |dx: i32, dz: i32| Vec3::new((x + dx) as f32, y as f32, (z + dz) as f32);
+                grid.push([p(0, 0), p(1, 0), p(1, 1)]);
+                grid.push([p(0, 0), p(1, 1), p(0, 1)]);
+            }
+        }
+    }
+    let one = [
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    let mut scenes = vec![
+        ("soup 3000+40", random_soup(400, 3000, 40), 12.0),
+        ("soup 0+300", random_soup(401, 0, 300), 12.0),
+        ("knot 20k", knot, 2.5),
+        ("grid", Bvh::build(Vec::new(), to_triangles(&grid, 0)), 5.0),
+        (
+            "2000 identical",
+            Bvh::build(Vec::new(), to_triangles(&vec![one; 2000], 0)),
+            2.0,
+        ),
+    ];
+    for n in 1..=5 {
+        scenes.push((
+            "tiny",
+            random_soup(410 + n, n as usize, (n % 2) as usize),
+            12.0,
+        ));
+    }
+    for (k, (name, bvh, extent)) in scenes.iter().enumerate() {
+        let (hits, rays, ties) = check_bvh_packets(name, bvh, 500 + k as u32, *extent);
+        assert!(
+            hits > rays / 5,
+            "{name}: only {hits} of {rays} rays hit; the test would be weak"
+        );
+        if *name == "2000 identical" {
+            assert!(
+                ties > 100,
+                "{name}: only {ties} ties; the test would be weak"
+            );
+        }
+    }
+}
+
+/// 96 packets against `bvh` and brute force; returns the rays that hit, the rays, and the ties
+/// (hits where another primitive is hit at exactly the same t).
+fn check_bvh_packets(name: &str, bvh: &Bvh, stream: u32, extent: f32) -> (u32, u32, u32) {
+    use std::simd::Simd;
+    use twinpath::cpu::packet::{RayPacket, LANES};
+    let n = bvh.spheres.len() + bvh.triangles.len();
+    let mut rng = Uniform::new(stream);
+    let (mut hits, mut rays, mut ties) = (0, 0, 0);
+    for packet in 0..96 {
+        let coherent = packet % 2 == 0;
+        let base = rng.point(-extent, extent);
+        let k = (rng.0.next_u32() as usize) % n;
+        let target = if k < bvh.spheres.len() {
+            Vec3::from(bvh.spheres[k].center)
+        } else {
+            let t = &bvh.triangles[k - bvh.spheres.len()];
+            Vec3::from(t.p0) + (Vec3::from(t.edge1) + Vec3::from(t.edge2)) / 3.0
+        };
+        let mut p = RayPacket::zero();
+        let mut t_max = [f32::INFINITY; LANES];
+        let mut lanes = Vec::new();
+        for (lane, lane_t_max) in t_max.iter_mut().enumerate() {
+            let (origin, dir) = if coherent {
+                let o = base + 0.01 * extent * rng.point(-1.0, 1.0);
+                let aim = target + 0.05 * extent * rng.point(-1.0, 1.0);
+                (o, (aim - o).normalize())
+            } else {
+                let o = rng.point(-extent, extent);
+                let d = if lane % 2 == 0 {
+                    (target - o).normalize()
+                } else {
+                    rng.dir()
+                };
+                (o, d)
+            };
+            if (packet + lane) % 7 == 3 {
+                *lane_t_max = 0.0; // no ray in this lane
+            } else if (packet + lane) % 3 == 0 {
+                *lane_t_max = rng.f(0.0, 2.0 * extent);
+            }
+            p.set(lane, origin, dir);
+            lanes.push((origin, dir));
+        }
+        let found = bvh.closest_packet(&p, Simd::from_array(t_max));
+        let occluded = bvh.occluded_packet(&p, Simd::from_array(t_max)).to_array();
+        for (lane, &(origin, dir)) in lanes.iter().enumerate() {
+            let label = format!(
+                "{name}, packet {packet}, lane {lane}: ray from {origin} along {dir}, t_max {}",
+                t_max[lane]
+            );
+            let (want, want_t) = if t_max[lane] > 0.0 {
+                brute_force(bvh, origin, dir, t_max[lane])
+            } else {
+                (NONE, 0.0)
+            };
+            assert_eq!(found.t[lane].to_bits(), want_t.to_bits(), "{label}: t");
+            assert_eq!(found.prim[lane], want, "{label}: primitive");
+            assert_eq!(occluded[lane], want != NONE, "{label}: any-hit");
+            if want != NONE && want as usize >= bvh.spheres.len() {
+                let tri = &bvh.triangles[want as usize - bvh.spheres.len()];
+                let h = kernel::geometry::intersect_triangle_uv(
+                    origin,
+                    dir,
+                    Vec3::from(tri.p0),
+                    Vec3::from(tri.edge1),
+                    Vec3::from(tri.edge2),
+                    0.0,
+                    f32::INFINITY,
+                );
+                assert_eq!(
+                    (found.u[lane].to_bits(), found.v[lane].to_bits()),
+                    (h.u.to_bits(), h.v.to_bits()),
+                    "{label}: barycentrics"
+                );
+            }
+            if want != NONE {
+                hits += 1;
+                let tied = (0..n as u32)
+                    .filter(|&id| id != want)
+                    .any(|id| bvh.intersect_prim(id, origin, dir, f32::INFINITY) == want_t);
+                ties += tied as u32;
+            }
+            rays += (t_max[lane] > 0.0) as u32;
+        }
+    }
+    (hits, rays, ties)
+}
+
+/// Rays straight down onto a grid of unit squares (two triangles each, in shuffled id order)
+/// at its vertices, shared edges and diagonals, where two to six triangles are hit at exactly
+/// the same t: the one-ray traversal and the packets both report the smallest id, as brute
+/// force does, whatever order they visit the leaves in.
+#[test]
+fn ties_on_shared_edges_give_the_smallest_id() {
+    use std::simd::Simd;
+    use twinpath::cpu::packet::{RayPacket, LANES};
+    let mut tris = Vec::new();
+    for x in -6..6 {
+        for z in -6..6 {
+            let p = |dx: i32, dz: i32| Vec3::new((x + dx) as f32, 0.0, (z + dz) as f32);
+            tris.push([p(0, 0), p(1, 0), p(1, 1)]);
+            tris.push([p(0, 0), p(1, 1), p(0, 1)]);
+        }
+    }
+    // A fixed shuffle (Fisher-Yates on the kernel's hash) so ids do not follow the tree's order.
+    let mut rng = Uniform::new(77);
+    for i in (1..tris.len()).rev() {
+        tris.swap(i, rng.0.next_u32() as usize % (i + 1));
+    }
+    let bvh = Bvh::build(Vec::new(), to_triangles(&tris, 0));
+    let mut origins = Vec::new();
+    for x in -5..5 {
+        for z in -5..5 {
+            let (x, z) = (x as f32, z as f32);
+            // A vertex, the middles of two shared edges, and a point on a diagonal.
+            origins.extend([(x, z), (x, z + 0.5), (x + 0.5, z), (x + 0.25, z + 0.25)]);
+        }
+    }
+    let rays: Vec<(Vec3, Vec3)> = origins
+        .iter()
+        .map(|&(x, z)| (Vec3::new(x, 3.0, z), Vec3::NEG_Y))
+        .collect();
+    let mut ties = 0;
+    for (i, &(o, d)) in rays.iter().enumerate() {
+        let (want, want_t) = brute_force(&bvh, o, d, f32::INFINITY);
+        let got = bvh.closest_prim(o, d, f32::INFINITY);
+        assert_eq!(
+            (got.prim, got.t.to_bits()),
+            (want, want_t.to_bits()),
+            "ray {i} from {o}"
+        );
+        let tied = (0..tris.len() as u32)
+            .filter(|&id| bvh.intersect_prim(id, o, d, f32::INFINITY) == want_t)
+            .count();
+        ties += (tied > 1) as u32;
+    }
+    assert!(
+        ties > 300,
+        "only {ties} of {} rays meet a tie; the test would be weak",
+        rays.len()
+    );
+    for chunk in rays.chunks(LANES) {
+        let mut p = RayPacket::zero();
+        let mut t_max = [0.0; LANES];
+        for (lane, &(o, d)) in chunk.iter().enumerate() {
+            p.set(lane, o, d);
+            t_max[lane] = f32::INFINITY;
+        }
+        let found = bvh.closest_packet(&p, Simd::from_array(t_max));
+        for (lane, &(o, d)) in chunk.iter().enumerate() {
+            let (want, want_t) = brute_force(&bvh, o, d, f32::INFINITY);
+            assert_eq!(
+                (found.prim[lane], found.t[lane].to_bits()),
+                (want, want_t.to_bits()),
+                "packet lane {lane}: ray from {o}"
+            );
+        }
+    }
 }

@@ -1,9 +1,9 @@
 //! Sixteen paths at a time (`cpu::packet_paths`) against one path at a time over the BVH: the
 //! same kernel state machine and bit-identical intersections, so the same images, bit for bit,
-//! with every kernel variant, several lights, a background, and adaptive sampling. (Two
-//! primitives hit at exactly the same t may be reported differently by the two tracers, e.g.
-//! along a quad's diagonal; none is in these renders, and one would show up here as a
-//! difference of a pixel or two.)
+//! with every kernel variant, several lights, a background, and adaptive sampling, for small
+//! scenes (rays against every primitive) and larger ones (rays through the BVH as packets). Of
+//! primitives hit at exactly the same t every tracer reports the smallest id
+//! (`tests/tests/bvh.rs`), so the traversal order cannot change an image.
 
 use twinpath::cpu::{CpuRenderer, TileStrategy};
 use twinpath::render::Backend;
@@ -150,13 +150,96 @@ fn packets_of_paths_give_the_one_path_images() {
     }
 }
 
-#[test]
-fn large_scenes_keep_the_bvh() {
-    let scene = small("sky_meshes.toml");
-    assert!(
-        scene.spheres.len() + scene.triangles.len() > twinpath::cpu::packet::MAX_PRIMITIVES,
-        "the test needs a scene above the packet limit"
+/// The Cornell room with a generated torus knot of about 12k triangles in place of the left
+/// sphere (`bench::rays::knot_mesh`, written to a temporary OBJ file), 48x48.
+fn knot_room(lights: &str) -> Scene {
+    let dir = std::env::temp_dir().join(format!("twinpath-bvh-packets-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = dir.join("knot.obj");
+    let knot = twinpath::bench::rays::knot_mesh(12_000, glam::Vec3::ZERO, 1.0);
+    let mut text = String::new();
+    for tri in &knot {
+        for p in tri {
+            text += &format!("v {} {} {}\n", p.x, p.y, p.z);
+        }
+    }
+    for k in 0..knot.len() {
+        text += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+    }
+    std::fs::write(&obj, text).unwrap();
+    let cornell = std::fs::read_to_string(repo_root().join("scenes/cornell.toml")).unwrap();
+    let room = cornell.replace(
+        "center = [-0.45, 0.4, -0.3]",
+        "center = [-0.45, 0.4, -30.0]",
     );
+    let mut s = twinpath_tests::scene_from_toml(&format!(
+        "{room}\n[[mesh]]\nfile = \"{}\"\ntranslate = [-0.3, 0.6, -0.2]\nmaterial = \"white\"\n{lights}",
+        obj.display()
+    ));
+    s.camera.width = 48;
+    s.camera.height = 48;
+    s
+}
+
+/// Scenes above the packet limit without instances trace their packets through the BVH
+/// (`cpu::bvh_packet`); the images are the one-path loop's, bit for bit: the knot room (12k
+/// triangles) with both samplers, adaptive sampling and three more lights, and the shipped mesh,
+/// texture and environment scenes.
+#[test]
+fn packets_through_the_bvh_give_the_one_path_images() {
+    let mut independent = knot_room("");
+    independent.render.sampler = Sampler::Independent;
+    let mut adaptive = knot_room("");
+    adaptive.render.adaptive_target = 0.05;
+    let lamps = r#"
+        [[sphere]]
+        center = [0.6, 1.5, -0.5]
+        radius = 0.1
+        material = "light"
+        [[sphere]]
+        center = [-0.6, 0.2, 0.6]
+        radius = 0.05
+        material = "light"
+        [[quad]]
+        corner = [-0.9, 1.99, 0.5]
+        edge1 = [0.0, 0.0, 0.3]
+        edge2 = [0.3, 0.0, 0.0]
+        material = "light"
+    "#;
+    let scenes = vec![
+        ("knot room", knot_room("")),
+        ("knot room, independent sampler", independent),
+        ("knot room, adaptive 0.05", adaptive),
+        ("knot room with four lights", knot_room(lamps)),
+        ("meshes", small("meshes.toml")),
+        ("textures", small("textures.toml")),
+        ("sky_meshes (environment map)", small("sky_meshes.toml")),
+        ("showcase", small("showcase.toml")),
+    ];
+    for (name, scene) in scenes {
+        assert!(
+            matches!(CpuRenderer::new(&scene).tiles, TileStrategy::BvhPackets),
+            "{name}: a larger scene without instances, yet no packets through the BVH"
+        );
+        let mut one_path = scene.clone();
+        one_path.render.packets = false;
+        let spp = if scene.render.adaptive_target > 0.0 {
+            32
+        } else {
+            8
+        };
+        let a = render_film(&scene, Backend::Cpu, spp);
+        let b = render_film(&one_path, Backend::Cpu, spp);
+        assert_films_identical(&a, &b, name);
+        println!("{name}: packets through the BVH and one path identical at {spp} spp");
+    }
+}
+
+/// Instanced scenes keep one path at a time (packet traversal is one-level).
+#[test]
+fn instanced_scenes_trace_one_path_at_a_time() {
+    let scene = small("instances.toml");
+    assert!(!scene.instances.is_empty());
     assert!(matches!(
         CpuRenderer::new(&scene).tiles,
         TileStrategy::OnePath

@@ -5,7 +5,7 @@
 //! `scripts/embree_rays.c`) traces exactly the same rays.
 
 use crate::cpu::bvh::Bvh;
-use crate::cpu::packet::{RayPacket, SmallScene, LANES};
+use crate::cpu::packet::{PacketTracer, RayPacket, SmallScene, LANES};
 use crate::scene::Scene;
 use glam::Vec3;
 use kernel::camera::{camera_origin, camera_ray_direction};
@@ -122,15 +122,16 @@ fn packet_of(rays: &RaySet, first: usize) -> (RayPacket, [f32; LANES]) {
     (packet, t)
 }
 
-/// Closest hits of every ray of `rays` by [`SmallScene`] packets of 16, on this thread.
-pub fn trace_all_packets(scene: &SmallScene, rays: &RaySet) -> RayResults {
+/// Closest hits of every ray of `rays` by packets of 16 (against every primitive of a
+/// [`SmallScene`], or through a [`Bvh`]), on this thread.
+pub fn trace_all_packets(scene: &impl PacketTracer, rays: &RaySet) -> RayResults {
     let mut out = RayResults {
         prim: Vec::with_capacity(rays.len()),
         t: Vec::with_capacity(rays.len()),
     };
     for first in (0..rays.len()).step_by(LANES) {
         let (packet, t_max) = packet_of(rays, first);
-        let hits = scene.closest(&packet, Simd::from_array(t_max));
+        let hits = scene.closest_hits(&packet, Simd::from_array(t_max));
         let n = LANES.min(rays.len() - first);
         out.prim.extend_from_slice(&hits.prim.to_array()[..n]);
         out.t.extend_from_slice(&hits.t.to_array()[..n]);
@@ -138,15 +139,28 @@ pub fn trace_all_packets(scene: &SmallScene, rays: &RaySet) -> RayResults {
     out
 }
 
-/// Whether each ray of `rays` is occluded, by [`SmallScene`] packets of 16, on this thread.
-pub fn occluded_all_packets(scene: &SmallScene, rays: &RaySet) -> Vec<bool> {
+/// Whether each ray of `rays` is occluded, by packets of 16, on this thread.
+pub fn occluded_all_packets(scene: &impl PacketTracer, rays: &RaySet) -> Vec<bool> {
     let mut out = Vec::with_capacity(rays.len());
     for first in (0..rays.len()).step_by(LANES) {
         let (packet, t_max) = packet_of(rays, first);
-        let hit = scene.occluded(&packet, Simd::from_array(t_max)).to_array();
+        let hit = scene
+            .occluded_lanes(&packet, Simd::from_array(t_max))
+            .to_array();
         out.extend_from_slice(&hit[..LANES.min(rays.len() - first)]);
     }
     out
+}
+
+/// Closest-hit and any-hit rays per second of `tracer`'s packets over `rays`.
+fn packet_rates(tracer: &impl PacketTracer, rays: &RaySet, repeats: u32) -> (f64, f64) {
+    let closest = rays_per_second(rays, repeats, || {
+        std::hint::black_box(trace_all_packets(tracer, rays));
+    });
+    let occluded = rays_per_second(rays, repeats, || {
+        std::hint::black_box(occluded_all_packets(tracer, rays));
+    });
+    (closest, occluded)
 }
 
 /// Rays per second of `pass` over `rays`: the best of `repeats` timed passes (the least
@@ -288,8 +302,9 @@ pub struct RaySetReport {
     pub hits: usize,
     pub closest_per_second: f64,
     pub occluded_per_second: f64,
-    /// Closest-hit and any-hit rays per second by packets of 16 (`cpu::packet`), for scenes
-    /// small enough for them.
+    /// Closest-hit and any-hit rays per second by packets of 16 as the renderer traces them
+    /// (`cpu::packet` for scenes of at most `MAX_PRIMITIVES`, else `cpu::bvh_packet`); `None`
+    /// for scenes with instances.
     pub packets: Option<(f64, f64)>,
 }
 
@@ -318,16 +333,14 @@ pub fn measure(
         let occluded = rays_per_second(rays, repeats, || {
             std::hint::black_box(occluded_all(&bvh, rays));
         });
-        // Scenes small enough for the renderer's packets: the same rays sixteen at a time.
-        let packets = SmallScene::if_small(&bvh.spheres, &bvh.triangles).map(|small| {
-            let closest = rays_per_second(rays, repeats, || {
-                std::hint::black_box(trace_all_packets(&small, rays));
-            });
-            let occluded = rays_per_second(rays, repeats, || {
-                std::hint::black_box(occluded_all_packets(&small, rays));
-            });
-            (closest, occluded)
-        });
+        // The same rays sixteen at a time, as the renderer's packets trace them.
+        let packets = if let Some(small) = SmallScene::if_small(&bvh.spheres, &bvh.triangles) {
+            Some(packet_rates(&small, rays, repeats))
+        } else if bvh.instances().is_empty() {
+            Some(packet_rates(&bvh, rays, repeats))
+        } else {
+            None
+        };
         sets.push(RaySetReport {
             name: rays.name,
             rays: rays.len(),

@@ -36,24 +36,24 @@ use std::simd::{f32x4, Mask, Simd};
 /// encoded in the reference itself (blocks - 1 in the two bits below [`LISTED`], the first
 /// block in the low [`BLOCK_BITS`]), saving a dependent memory load per leaf; a leaf with
 /// spheres or instances (or past 2^28 blocks) has [`LISTED`] set and indexes [`Bvh::leaves`].
-const LEAF: u32 = 1 << 31;
+pub(super) const LEAF: u32 = 1 << 31;
 const LISTED: u32 = 1 << 30;
 const BLOCK_BITS: u32 = 28;
 /// Traversal stack: each level pushes at most WIDTH - 1 entries, and the wide tree is no deeper
 /// than the binary one (< SAH_MAX_DEPTH + 32 levels for up to 2^32 primitives).
-const STACK: usize = (WIDTH - 1) * (SAH_MAX_DEPTH + 32) + 1;
+pub(super) const STACK: usize = (WIDTH - 1) * (SAH_MAX_DEPTH + 32) + 1;
 
 /// Children per node.
-const WIDTH: usize = 8;
+pub(super) const WIDTH: usize = 8;
 
 /// An interior node: up to [`WIDTH`] children's boxes (lane i = child i) and references.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct WideNode {
-    boxes: Boxes<WIDTH>,
-    child: [u32; WIDTH],
+pub(super) struct WideNode {
+    pub(super) boxes: Boxes<WIDTH>,
+    pub(super) child: [u32; WIDTH],
     /// Used slots (the first lanes) as a bit mask.
-    used: u32,
+    pub(super) used: u32,
 }
 
 /// A leaf: `triangle_blocks` blocks of four triangles from `first_block`, and `sphere_blocks`
@@ -81,28 +81,28 @@ pub struct PrimHit {
 /// zero so that they never hit).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
-struct TriangleBlock {
-    triangles: Triangles4,
-    id: [u32; 4],
+pub(super) struct TriangleBlock {
+    pub(super) triangles: Triangles4,
+    pub(super) id: [u32; 4],
 }
 
 /// Four spheres of a leaf and their primitive ids (`NONE` in unused lanes, whose centres are
 /// NaN so that they never hit).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
-struct SphereBlock {
-    spheres: Spheres4,
-    id: [u32; 4],
+pub(super) struct SphereBlock {
+    pub(super) spheres: Spheres4,
+    pub(super) id: [u32; 4],
 }
 
 /// Geometry plus its hierarchy.
 pub struct Bvh {
-    nodes: Vec<WideNode>,
+    pub(super) nodes: Vec<WideNode>,
     leaves: Vec<Leaf>,
-    blocks: Vec<TriangleBlock>,
-    sphere_blocks: Vec<SphereBlock>,
+    pub(super) blocks: Vec<TriangleBlock>,
+    pub(super) sphere_blocks: Vec<SphereBlock>,
     /// The root's reference; `None` for an empty scene.
-    root: Option<u32>,
+    pub(super) root: Option<u32>,
     pub spheres: Vec<Sphere>,
     pub triangles: Vec<Triangle>,
     /// By triangle, what its hit records need that depends on its shape alone (computed once).
@@ -393,7 +393,7 @@ impl Bvh {
     }
 
     /// The primitive hit first along `origin + t dir`, t in (0, t_max), and its t; `NONE`
-    /// for a miss. Of primitives hit at exactly the same t, any one may be returned.
+    /// for a miss. Of a one-level tree's primitives hit at exactly the same t, the smallest id.
     #[inline]
     pub fn closest_prim(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
         if self.instances.is_empty() {
@@ -416,8 +416,11 @@ impl Bvh {
 
     #[inline(always)]
     fn closest_one_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> (u32, f32) {
+        let Some(root) = self.root else {
+            return (NONE, t_max);
+        };
         let mut no_instance = NONE;
-        self.closest_in::<false>(origin, dir, t_max, &mut no_instance)
+        self.closest_in::<false>(root, origin, dir, (NONE, t_max), &mut no_instance)
     }
 
     widest_simd! {
@@ -429,31 +432,40 @@ impl Bvh {
     #[inline(always)]
     fn closest_two_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
         let mut instance = NONE;
-        let (prim, t) = self.closest_in::<true>(origin, dir, t_max, &mut instance);
+        let Some(root) = self.root else {
+            return PrimHit {
+                prim: NONE,
+                instance,
+                t: t_max,
+            };
+        };
+        let (prim, t) = self.closest_in::<true>(root, origin, dir, (NONE, t_max), &mut instance);
         PrimHit { prim, instance, t }
     }
 
-    /// [`Bvh::closest_prim`]'s primitive and t, with the instance step compiled in where
-    /// `INSTANCES`: the hit's instance is then written to `best_instance` (`NONE` for this
-    /// tree's own primitives), which the one-level loop never touches.
+    /// The closest hit in the subtree `start` of a ray that has found `best` = (primitive, t)
+    /// so far (`NONE` and t_max at first): the primitive and t, with the instance step compiled
+    /// in where `INSTANCES` (the hit's instance is then written to `best_instance`, `NONE` for
+    /// this tree's own primitives; the one-level loop never touches it).
+    ///
+    /// Of this tree's primitives hit at exactly the same t, the smallest id wins, so the answer
+    /// is the least (t, id) whatever order the nodes are visited in: packet traversal
+    /// (`bvh_packet.rs`) gives the same hits. (An instance's hit replaces a world primitive's
+    /// only when strictly nearer.)
     #[inline(always)]
-    fn closest_in<const INSTANCES: bool>(
+    pub(super) fn closest_in<const INSTANCES: bool>(
         &self,
+        start: u32,
         origin: Vec3,
         dir: Vec3,
-        t_max: f32,
+        (mut best, mut best_t): (u32, f32),
         best_instance: &mut u32,
     ) -> (u32, f32) {
-        let mut best_t = t_max;
-        let mut best = NONE;
-        let Some(root) = self.root else {
-            return (best, best_t);
-        };
         let ray = Ray4::new(origin, dir);
         // Not zero-filled (3 KiB per ray): entries below `sp` are always written first.
         let mut stack = [const { MaybeUninit::<(u32, f32)>::uninit() }; STACK];
         let mut sp = 0;
-        let mut current = root;
+        let mut current = start;
         loop {
             if current & LEAF == 0 {
                 let node = &self.nodes[current as usize];
@@ -492,10 +504,11 @@ impl Bvh {
             } else {
                 let (blocks, spheres) = self.leaf_contents(current);
                 for block in &self.blocks[blocks] {
-                    let t = ray.triangles(&block.triangles, 0.0, best_t).to_array();
+                    let limit = tie_limit(best, best_t);
+                    let t = ray.triangles(&block.triangles, 0.0, limit).to_array();
                     for (&t, &id) in t.iter().zip(&block.id) {
-                        // Missed lanes are -1; hits are in (0, best_t) as it was at the call.
-                        if t >= 0.0 && t < best_t {
+                        // Missed lanes are -1; hits are below `limit` as it was at the call.
+                        if t >= 0.0 && (t < best_t || (t == best_t && id < best)) {
                             best_t = t;
                             best = id;
                             if INSTANCES {
@@ -505,9 +518,10 @@ impl Bvh {
                     }
                 }
                 for block in &self.sphere_blocks[spheres] {
-                    let t = ray.spheres(&block.spheres, 0.0, best_t).to_array();
+                    let limit = tie_limit(best, best_t);
+                    let t = ray.spheres(&block.spheres, 0.0, limit).to_array();
                     for (&t, &id) in t.iter().zip(&block.id) {
-                        if t >= 0.0 && t < best_t {
+                        if t >= 0.0 && (t < best_t || (t == best_t && id < best)) {
                             best_t = t;
                             best = id;
                             if INSTANCES {
@@ -521,8 +535,15 @@ impl Bvh {
                         let instance = &self.instances[i as usize];
                         let (o, d) = ray_to_object(instance, origin, dir);
                         let mesh = &self.meshes[self.instance_meshes[i as usize] as usize];
+                        let Some(mesh_root) = mesh.root else { continue };
                         let mut no_instance = NONE;
-                        let (prim, t) = mesh.closest_in::<false>(o, d, best_t, &mut no_instance);
+                        let (prim, t) = mesh.closest_in::<false>(
+                            mesh_root,
+                            o,
+                            d,
+                            (NONE, best_t),
+                            &mut no_instance,
+                        );
                         if prim != NONE && t < best_t {
                             best_t = t;
                             best = prim;
@@ -566,7 +587,11 @@ impl Bvh {
 
     #[inline(always)]
     fn any_one_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        self.any_in::<false>(origin, dir, t_max)
+        // Not `is_some_and`: a closure is not compiled with the caller's target features.
+        match self.root {
+            Some(root) => self.any_in::<false>(root, origin, dir, t_max),
+            None => false,
+        }
     }
 
     widest_simd! {
@@ -577,19 +602,27 @@ impl Bvh {
 
     #[inline(always)]
     fn any_two_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        self.any_in::<true>(origin, dir, t_max)
+        // Not `is_some_and`: a closure is not compiled with the caller's target features.
+        match self.root {
+            Some(root) => self.any_in::<true>(root, origin, dir, t_max),
+            None => false,
+        }
     }
 
-    /// [`Bvh::any_hit`], with the instance step compiled in where `INSTANCES`.
+    /// [`Bvh::any_hit`] in the subtree `start`, with the instance step compiled in where
+    /// `INSTANCES`.
     #[inline(always)]
-    fn any_in<const INSTANCES: bool>(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        let Some(root) = self.root else {
-            return false;
-        };
+    pub(super) fn any_in<const INSTANCES: bool>(
+        &self,
+        start: u32,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+    ) -> bool {
         let ray = Ray4::new(origin, dir);
         let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
         let mut sp = 0;
-        let mut current = root;
+        let mut current = start;
         loop {
             if current & LEAF == 0 {
                 let node = &self.nodes[current as usize];
@@ -619,7 +652,8 @@ impl Bvh {
                     for &i in &self.leaf_instances[self.instances_of_leaf(current)] {
                         let (o, d) = ray_to_object(&self.instances[i as usize], origin, dir);
                         let mesh = &self.meshes[self.instance_meshes[i as usize] as usize];
-                        if mesh.any_in::<false>(o, d, t_max) {
+                        let Some(mesh_root) = mesh.root else { continue };
+                        if mesh.any_in::<false>(mesh_root, o, d, t_max) {
                             return true;
                         }
                     }
@@ -638,7 +672,7 @@ impl Bvh {
     /// pushed child is usually popped soon, and incoherent rays on large meshes wait on memory
     /// (measured on the 1M-triangle mesh: 10-19% more closest-hit rays per second).
     #[inline(always)]
-    fn prefetch(&self, r: u32) {
+    pub(super) fn prefetch(&self, r: u32) {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
@@ -661,7 +695,7 @@ impl Bvh {
 
     /// The triangle blocks and the sphere blocks of leaf reference `r`.
     #[inline(always)]
-    fn leaf_contents(&self, r: u32) -> (Range<usize>, Range<usize>) {
+    pub(super) fn leaf_contents(&self, r: u32) -> (Range<usize>, Range<usize>) {
         if r & LISTED == 0 {
             let first = (r & ((1 << BLOCK_BITS) - 1)) as usize;
             let count = ((r >> BLOCK_BITS) & 3) as usize + 1;
@@ -786,6 +820,15 @@ impl Bvh {
             SurfaceHit::triangle(&self.triangles[index], self.shapes[index], dir, t, u, v)
         }
     }
+}
+
+/// The bound below which a leaf's hits are accepted by a ray whose closest hit so far is
+/// `best` at `best_t`: `best_t` itself while nothing is hit (t_max is excluded), else the next
+/// float above it, so that a hit at exactly `best_t` is seen and the smaller id can win.
+#[inline(always)]
+pub(super) fn tie_limit(best: u32, best_t: f32) -> f32 {
+    // Once something is hit, best_t is positive and finite: the next float is the next pattern.
+    f32::from_bits(best_t.to_bits() + (best != NONE) as u32)
 }
 
 /// Up to [`WIDTH`] boxes in lanes (unused lanes empty; the node's `used` masks them).

@@ -4,6 +4,7 @@
 
 pub mod bvh;
 pub mod bvh_build;
+pub mod bvh_packet;
 pub mod packet;
 pub mod packet_numbers;
 pub mod packet_paths;
@@ -70,6 +71,9 @@ pub enum TileStrategy {
     /// (`packet_paths.rs`): for scenes of at most `packet::MAX_PRIMITIVES` primitives unless
     /// the scene's `packets` setting is off. Holds all the primitives.
     Packets(SmallScene),
+    /// Sixteen paths at a time, their rays traced through the BVH as packets
+    /// (`bvh_packet.rs`): for larger scenes without instances unless `packets` is off.
+    BvhPackets,
 }
 
 /// `match bits { combo => body with f = Static::<combo>, ..., other => body with Dynamic(other) }`.
@@ -140,9 +144,13 @@ impl CpuRenderer {
     pub fn new(scene: &Scene) -> Self {
         let bvh = Bvh::build_scene(scene);
         // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).
-        let small = (scene.render.packets && scene.instances.is_empty())
-            .then(|| SmallScene::if_small(&bvh.spheres, &bvh.triangles))
-            .flatten();
+        let tiles = if !(scene.render.packets && scene.instances.is_empty()) {
+            TileStrategy::OnePath
+        } else if let Some(small) = SmallScene::if_small(&bvh.spheres, &bvh.triangles) {
+            TileStrategy::Packets(small)
+        } else {
+            TileStrategy::BvhPackets
+        };
         Self {
             bvh,
             materials: scene.materials.clone(),
@@ -151,7 +159,7 @@ impl CpuRenderer {
             shading: scene.shading_table(),
             textures: scene.textures.words.clone(),
             features: with_all_extended(scene.features()),
-            tiles: small.map_or(TileStrategy::OnePath, TileStrategy::Packets),
+            tiles,
         }
     }
 
@@ -219,6 +227,11 @@ impl CpuRenderer {
             TileStrategy::Packets(small) => {
                 self.render_tiles_by(params, film, progress, |pixels, film| {
                     self.tile_by_packets(features, small, params, pixels, first, count, film)
+                })
+            }
+            TileStrategy::BvhPackets => {
+                self.render_tiles_by(params, film, progress, |pixels, film| {
+                    self.tile_by_packets(features, &self.bvh, params, pixels, first, count, film)
                 })
             }
         }

@@ -83,6 +83,22 @@ pub struct PacketHits {
     pub v: Lanes,
 }
 
+/// What the packets of paths (`packet_paths.rs`) need of a scene: sixteen rays' closest hits
+/// and their occlusion, lane by lane the one-ray answers. Lanes with t_max 0 have no ray.
+pub trait PacketTracer: Sync {
+    fn closest_hits(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits;
+    fn occluded_lanes(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES>;
+}
+
+impl PacketTracer for SmallScene {
+    fn closest_hits(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
+        self.closest(rays, t_max)
+    }
+    fn occluded_lanes(&self, rays: &RayPacket, t_max: Lanes) -> Mask<i32, LANES> {
+        self.occluded(rays, t_max)
+    }
+}
+
 /// Scenes with at most this many primitives are traced by packets without a hierarchy.
 pub const MAX_PRIMITIVES: usize = 32;
 

@@ -4,7 +4,7 @@
 //! BVH, so a pixel's samples are the ones the one-path loop computes (up to which of two
 //! primitives at exactly the same distance is reported, e.g. along a quad's diagonal).
 
-use super::packet::{RayPacket, SmallScene, LANES};
+use super::packet::{PacketTracer, RayPacket, LANES};
 use super::packet_numbers::camera_numbers;
 use super::packet_vertices::fill_vertex_samples;
 use super::CpuRenderer;
@@ -47,10 +47,10 @@ impl CpuRenderer {
     /// converged, under adaptive sampling), sixteen paths at a time; returns each pixel's sums,
     /// added in sample order as the one-path loop adds them.
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn tile_by_packets<F: FeatureSet>(
+    pub(super) fn tile_by_packets<F: FeatureSet, T: PacketTracer>(
         &self,
         features: F,
-        small: &SmallScene,
+        tracer: &T,
         params: &RenderParams,
         pixels: &mut dyn Iterator<Item = (u32, u32)>,
         first: u32,
@@ -107,15 +107,15 @@ impl CpuRenderer {
             }
             let [(extension, ext_t_max), (shadow, shadow_t_max)] = gather(&slots);
             let (prims, ts, us, vs) = if ext_t_max.iter().any(|&t| t > 0.0) {
-                let h = small.closest(&extension, Simd::from_array(ext_t_max));
+                let h = tracer.closest_hits(&extension, Simd::from_array(ext_t_max));
                 let a = |x: Simd<f32, LANES>| x.to_array();
                 (h.prim.to_array(), a(h.t), a(h.u), a(h.v))
             } else {
                 ([NONE; LANES], [0.0; LANES], [0.0; LANES], [0.0; LANES])
             };
             let occluded = if shadow_t_max.iter().any(|&t| t > 0.0) {
-                small
-                    .occluded(&shadow, Simd::from_array(shadow_t_max))
+                tracer
+                    .occluded_lanes(&shadow, Simd::from_array(shadow_t_max))
                     .to_array()
             } else {
                 [false; LANES]
