@@ -173,10 +173,8 @@ fn dense_mesh_matches_brute_force() {
     );
 }
 
-#[test]
-fn axis_aligned_grid_with_rays_in_its_planes_matches_brute_force() {
-    // Unit squares in the planes y = 0, 1, 2: every triangle's box is flat in y, and a fifth of
-    // the rays start on those planes (some running inside them).
+/// Unit squares (two triangles each) in the planes y = 0, 1, 2 over [-4, 4]^2.
+fn grid_triangles() -> Vec<[Vec3; 3]> {
     let mut tris = Vec::new();
     for y in 0..3 {
         for x in -4..4 {
@@ -187,7 +185,14 @@ fn axis_aligned_grid_with_rays_in_its_planes_matches_brute_force() {
             }
         }
     }
-    let bvh = Bvh::build(Vec::new(), to_triangles(&tris, 0));
+    tris
+}
+
+#[test]
+fn axis_aligned_grid_with_rays_in_its_planes_matches_brute_force() {
+    // Unit squares in the planes y = 0, 1, 2: every triangle's box is flat in y, and a fifth of
+    // the rays start on those planes (some running inside them).
+    let bvh = Bvh::build(Vec::new(), to_triangles(&grid_triangles(), 0));
     let hits = check_against_brute_force("grid", &bvh, 11, 6000, -5.0, 5.0);
     assert!(
         hits > 500,
@@ -452,16 +457,7 @@ fn bvh_packets_of_sixteen_rays_match_brute_force() {
         vec![sphere(Vec3::ZERO, 0.3)],
         to_triangles(&knot_mesh(20_000, Vec3::ZERO, 4.0), 0),
     );
-    let mut grid = Vec::new();
-    for y in 0..3 {
-        for x in -4..4 {
-            for z in -4..4 {
-                let p = |dx: i32, dz: i32| Vec3::new((x + dx) as f32, y as f32, (z + dz) as f32);
-                grid.push([p(0, 0), p(1, 0), p(1, 1)]);
-                grid.push([p(0, 0), p(1, 1), p(0, 1)]);
-            }
-        }
-    }
+    let grid = grid_triangles();
     let one = [
         Vec3::new(-1.0, -1.0, 0.0),
         Vec3::new(1.0, -1.0, 0.0),

@@ -96,8 +96,8 @@ pub struct SettingFlags {
     /// Run the generic kernel path instead of one specialized to the scene's features.
     #[arg(long)]
     no_specialize: bool,
-    /// CPU: trace one path at a time over the BVH even in scenes small enough for
-    /// sixteen-path packets.
+    /// CPU: trace one path at a time instead of sixteen-path packets (the same image, bit for
+    /// bit; slower).
     #[arg(long)]
     no_packets: bool,
     /// Adaptive sampling: stop each pixel once its estimated relative error is below this
