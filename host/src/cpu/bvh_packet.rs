@@ -6,7 +6,7 @@
 //! lanes whose rays enter it, nearest first by the least entry distance among them; a leaf's
 //! triangles and spheres are broadcast to the lanes and tested with the same lane-wise kernel
 //! functions as the one-ray traversal. Where the lanes still wanting a subtree are few, they
-//! finish it one ray at a time ([`SINGLE_RAY_BELOW`]; the hybrid of Benthin, Wald, Woop, Ernst
+//! finish it one ray at a time ([`ONE_AT_A_TIME_LANES`]; the hybrid of Benthin, Wald, Woop, Ernst
 //! and Mark 2012), since a packet's tests cost the same for one lane as for sixteen.
 //!
 //! Every lane's answer is the one-ray traversal's, bit for bit: each box verdict and each t is
@@ -33,7 +33,7 @@ type Ids = Simd<u32, LANES>;
 type LaneMask = Mask<i32, LANES>;
 
 /// Subtrees wanted by at most this many lanes are traced one ray at a time.
-pub const SINGLE_RAY_BELOW: u32 = 2;
+pub const ONE_AT_A_TIME_LANES: u32 = 2;
 
 /// The packet's rays as the slab test reads them: 1 / dir by lane, and per axis whether some
 /// active lane's ray is parallel to it (1 / dir infinite, where 0 x inf can arise).
@@ -139,7 +139,7 @@ impl Bvh {
         let mut sp = 0;
         let (mut current, mut lanes) = (root, active);
         loop {
-            if lanes.count_ones() <= SINGLE_RAY_BELOW {
+            if lanes.count_ones() <= ONE_AT_A_TIME_LANES {
                 let mut rest = lanes;
                 while rest != 0 {
                     let lane = rest.trailing_zeros() as usize;
@@ -308,7 +308,7 @@ impl Bvh {
         let mut occluded = 0u32;
         let (mut current, mut lanes) = (root, active);
         loop {
-            if lanes.count_ones() <= SINGLE_RAY_BELOW {
+            if lanes.count_ones() <= ONE_AT_A_TIME_LANES {
                 let mut rest = lanes;
                 while rest != 0 {
                     let lane = rest.trailing_zeros() as usize;

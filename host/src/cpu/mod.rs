@@ -62,10 +62,10 @@ pub struct CpuRenderer {
     pub tiles: TileStrategy,
 }
 
-/// How the CPU renderer computes a tile's samples. Both give the same image bit for bit
-/// (`tests/tests/packets.rs`); packets are faster on small scenes.
+/// How the CPU renderer computes a tile's samples. All give the same image bit for bit
+/// (`tests/tests/packets.rs`); packets are faster (docs/performance.md).
 pub enum TileStrategy {
-    /// One path at a time through the BVH.
+    /// One path at a time through the BVH: scenes with instances, or `packets` off.
     OnePath,
     /// Sixteen paths at a time, their rays tested against every primitive by SIMD lanes
     /// (`packet_paths.rs`): for scenes of at most `packet::MAX_PRIMITIVES` primitives unless
@@ -140,7 +140,8 @@ fn with_all_extended(bits: u32) -> u32 {
 
 impl CpuRenderer {
     /// Builds the BVH over the scene's spheres, triangles and instances (and, for a small
-    /// scene without instances, the packets' copy of its primitives).
+    /// scene without instances, the packets' copy of its primitives), and picks the
+    /// [`TileStrategy`].
     pub fn new(scene: &Scene) -> Self {
         let bvh = Bvh::build_scene(scene);
         // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).

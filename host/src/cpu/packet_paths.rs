@@ -1,8 +1,9 @@
 //! Sixteen paths at a time: the kernel's path state machine (`kernel::path::PathState`) with
-//! each round's rays traced as packets by [`SmallScene`] (SIMD over rays). Every path runs
-//! the same kernel code as `render_sample`, and the packet tests return the same t as the
-//! BVH, so a pixel's samples are the ones the one-path loop computes (up to which of two
-//! primitives at exactly the same distance is reported, e.g. along a quad's diagonal).
+//! each round's rays traced as packets by a [`PacketTracer`] (SIMD over rays: against every
+//! primitive of a small scene, `packet.rs`, or through the BVH, `bvh_packet.rs`). Every path
+//! runs the same kernel code as `render_sample`, and the packet tracers return the one-ray
+//! traversal's primitive, t and barycentrics bit for bit (ties at equal t go to the smallest id
+//! in both), so a pixel's samples are the ones the one-path loop computes.
 
 use super::packet::{PacketTracer, RayPacket, LANES};
 use super::packet_numbers::camera_numbers;
