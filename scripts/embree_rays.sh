@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Ray throughput of twinpath's CPU traversal against Embree 3 on the same rays, and BVH build
-# time and memory at 10k, 100k and 1M triangles. One thread each; see `twinpath rays --help`
-# and scripts/embree_rays.c.
+# Ray throughput of twinpath's CPU traversal against Embree 3 on the same rays, one ray at a time
+# and in packets of 16 (rtcIntersect16 / rtcOccluded16), and BVH build time and memory at 10k,
+# 100k and 1M triangles. One thread each; see `twinpath rays --help` and scripts/embree_rays.c.
 # Usage: scripts/embree_rays.sh OUT.csv [REPEATS]
 set -euo pipefail
 cd "$(dirname "$0")/.."

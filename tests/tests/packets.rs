@@ -184,7 +184,7 @@ fn knot_room(lights: &str) -> Scene {
 /// Scenes above the packet limit without instances trace their packets through the BVH
 /// (`cpu::bvh_packet`); the images are the one-path loop's, bit for bit: the knot room (12k
 /// triangles) with both samplers, adaptive sampling and three more lights, and the shipped mesh,
-/// texture and environment scenes.
+/// texture, environment-map and glTF scenes.
 #[test]
 fn packets_through_the_bvh_give_the_one_path_images() {
     let mut independent = knot_room("");
@@ -215,6 +215,10 @@ fn packets_through_the_bvh_give_the_one_path_images() {
         ("textures", small("textures.toml")),
         ("sky_meshes (environment map)", small("sky_meshes.toml")),
         ("showcase", small("showcase.toml")),
+        (
+            "gltf_showcase (normal map, spot light: the Dynamic path)",
+            small("gltf_showcase.toml"),
+        ),
     ];
     for (name, scene) in scenes {
         assert!(

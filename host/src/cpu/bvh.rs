@@ -393,7 +393,8 @@ impl Bvh {
     }
 
     /// The primitive hit first along `origin + t dir`, t in (0, t_max), and its t; `NONE`
-    /// for a miss. Of a one-level tree's primitives hit at exactly the same t, the smallest id.
+    /// for a miss. Of a one-level tree's primitives hit at exactly the same t, the smallest id
+    /// (with instances, see `closest_in`).
     #[inline]
     pub fn closest_prim(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
         if self.instances.is_empty() {
@@ -450,8 +451,8 @@ impl Bvh {
     ///
     /// Of this tree's primitives hit at exactly the same t, the smallest id wins, so the answer
     /// is the least (t, id) whatever order the nodes are visited in: packet traversal
-    /// (`bvh_packet.rs`) gives the same hits. (An instance's hit replaces a world primitive's
-    /// only when strictly nearer.)
+    /// (`bvh_packet.rs`) gives the same hits. (A tie between an instance's triangle and any
+    /// other primitive still depends on the order; packets are not used with instances.)
     #[inline(always)]
     pub(super) fn closest_in<const INSTANCES: bool>(
         &self,
