@@ -46,20 +46,28 @@ static bool monitor(void *user, ssize_t bytes, bool post) {
     return true;
 }
 
-/* Closest hits of rays first..first+16 (the lanes past n invalid) by rtcIntersect16; their
- * primitives in twinpath's numbering go to prim. */
-static void intersect16(RTCScene scene, struct RTCIntersectContext *context, const float *rays,
-                        uint32_t n, uint32_t first, uint32_t nsph, uint32_t *prim) {
-    RTC_ALIGN(64) int valid[16];
-    RTC_ALIGN(64) struct RTCRayHit16 rh;
+/* Rays first..first+16 as a packet; the lanes past n are invalid (repeating the last ray). */
+static void set_packet(struct RTCRay16 *ray, int *valid, const float *rays, uint32_t n,
+                       uint32_t first) {
     for (int k = 0; k < 16; k++) {
         uint32_t i = first + k < n ? first + k : n - 1;
         const float *q = rays + 7 * (size_t)i;
         valid[k] = first + k < n ? -1 : 0;
-        rh.ray.org_x[k] = q[0], rh.ray.org_y[k] = q[1], rh.ray.org_z[k] = q[2];
-        rh.ray.dir_x[k] = q[3], rh.ray.dir_y[k] = q[4], rh.ray.dir_z[k] = q[5];
-        rh.ray.tnear[k] = 0.0f, rh.ray.tfar[k] = q[6], rh.ray.time[k] = 0.0f;
-        rh.ray.mask[k] = 0xffffffffu, rh.ray.id[k] = 0, rh.ray.flags[k] = 0;
+        ray->org_x[k] = q[0], ray->org_y[k] = q[1], ray->org_z[k] = q[2];
+        ray->dir_x[k] = q[3], ray->dir_y[k] = q[4], ray->dir_z[k] = q[5];
+        ray->tnear[k] = 0.0f, ray->tfar[k] = q[6], ray->time[k] = 0.0f;
+        ray->mask[k] = 0xffffffffu, ray->id[k] = 0, ray->flags[k] = 0;
+    }
+}
+
+/* Closest hits of rays first..first+16 by rtcIntersect16; their primitives in twinpath's
+ * numbering go to prim. */
+static void intersect16(RTCScene scene, struct RTCIntersectContext *context, const float *rays,
+                        uint32_t n, uint32_t first, uint32_t nsph, uint32_t *prim) {
+    RTC_ALIGN(64) int valid[16];
+    RTC_ALIGN(64) struct RTCRayHit16 rh;
+    set_packet(&rh.ray, valid, rays, n, first);
+    for (int k = 0; k < 16; k++) {
         rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
@@ -70,20 +78,12 @@ static void intersect16(RTCScene scene, struct RTCIntersectContext *context, con
                                                                       : nsph + rh.hit.primID[k];
 }
 
-/* How many of rays first..first+16 (the lanes past n invalid) rtcOccluded16 finds occluded. */
+/* How many of rays first..first+16 rtcOccluded16 finds occluded. */
 static uint32_t occluded16(RTCScene scene, struct RTCIntersectContext *context,
                            const float *rays, uint32_t n, uint32_t first) {
     RTC_ALIGN(64) int valid[16];
     RTC_ALIGN(64) struct RTCRay16 ray;
-    for (int k = 0; k < 16; k++) {
-        uint32_t i = first + k < n ? first + k : n - 1;
-        const float *q = rays + 7 * (size_t)i;
-        valid[k] = first + k < n ? -1 : 0;
-        ray.org_x[k] = q[0], ray.org_y[k] = q[1], ray.org_z[k] = q[2];
-        ray.dir_x[k] = q[3], ray.dir_y[k] = q[4], ray.dir_z[k] = q[5];
-        ray.tnear[k] = 0.0f, ray.tfar[k] = q[6], ray.time[k] = 0.0f;
-        ray.mask[k] = 0xffffffffu, ray.id[k] = 0, ray.flags[k] = 0;
-    }
+    set_packet(&ray, valid, rays, n, first);
     rtcOccluded16(valid, scene, context, &ray);
     uint32_t count = 0;
     for (int k = 0; k < 16 && first + k < n; k++) count += ray.tfar[k] < 0.0f;
