@@ -69,6 +69,47 @@ fn brute_force(bvh: &Bvh, o: Vec3, d: Vec3, t_max: f32) -> (u32, f32) {
     (best, best_t)
 }
 
+/// The centre of primitive `k` (a sphere's centre, a triangle's centroid): where rays aim so
+/// that they hit something in scenes that are mostly empty.
+fn centre(bvh: &Bvh, k: usize) -> Vec3 {
+    if k < bvh.spheres.len() {
+        Vec3::from(bvh.spheres[k].center)
+    } else {
+        let t = &bvh.triangles[k - bvh.spheres.len()];
+        Vec3::from(t.p0) + (Vec3::from(t.edge1) + Vec3::from(t.edge2)) / 3.0
+    }
+}
+
+/// Asserts that `uv` are, bit for bit, the barycentrics the kernel's scalar
+/// `intersect_triangle_uv` gives where the ray meets primitive `prim` when that is a triangle.
+fn assert_kernel_barycentrics(
+    bvh: &Bvh,
+    prim: u32,
+    origin: Vec3,
+    dir: Vec3,
+    (u, v): (f32, f32),
+    label: &str,
+) {
+    if prim == NONE || (prim as usize) < bvh.spheres.len() {
+        return;
+    }
+    let tri = &bvh.triangles[prim as usize - bvh.spheres.len()];
+    let h = kernel::geometry::intersect_triangle_uv(
+        origin,
+        dir,
+        Vec3::from(tri.p0),
+        Vec3::from(tri.edge1),
+        Vec3::from(tri.edge2),
+        0.0,
+        f32::INFINITY,
+    );
+    assert_eq!(
+        (u.to_bits(), v.to_bits()),
+        (h.u.to_bits(), h.v.to_bits()),
+        "{label}: barycentrics"
+    );
+}
+
 /// Casts `rays` rays (origins in [lo, hi]^3, some on the grid's planes, and finite and
 /// infinite t_max) and compares the BVH with brute force; returns how many hit.
 fn check_against_brute_force(
@@ -389,13 +430,7 @@ fn packets_of_sixteen_rays_match_brute_force() {
                 let origin = rng.point(-12.0, 12.0);
                 // Half the rays aim at a primitive's centre (random soups are mostly empty).
                 let dir = if lane % 2 == 0 && n > 0 {
-                    let k = (rng.0.next_u32() as usize) % n;
-                    let target = if k < bvh.spheres.len() {
-                        Vec3::from(bvh.spheres[k].center)
-                    } else {
-                        let t = &bvh.triangles[k - bvh.spheres.len()];
-                        Vec3::from(t.p0) + (Vec3::from(t.edge1) + Vec3::from(t.edge2)) / 3.0
-                    };
+                    let target = centre(&bvh, (rng.0.next_u32() as usize) % n);
                     (target - origin).normalize()
                 } else {
                     rng.dir()
@@ -416,23 +451,7 @@ fn packets_of_sixteen_rays_match_brute_force() {
                 assert_eq!(ts[lane].to_bits(), want_t.to_bits(), "{label}: t");
                 assert_eq!(prims[lane], want, "{label}: primitive");
                 assert_eq!(occluded[lane], want != NONE, "{label}: any-hit");
-                if want != NONE && want as usize >= bvh.spheres.len() {
-                    let tri = &bvh.triangles[want as usize - bvh.spheres.len()];
-                    let h = kernel::geometry::intersect_triangle_uv(
-                        origin,
-                        dir,
-                        Vec3::from(tri.p0),
-                        Vec3::from(tri.edge1),
-                        Vec3::from(tri.edge2),
-                        0.0,
-                        f32::INFINITY,
-                    );
-                    assert_eq!(
-                        (us[lane].to_bits(), vs[lane].to_bits()),
-                        (h.u.to_bits(), h.v.to_bits()),
-                        "{label}: barycentrics"
-                    );
-                }
+                assert_kernel_barycentrics(&bvh, want, origin, dir, (us[lane], vs[lane]), &label);
                 hits += (want != NONE) as u32;
                 rays += 1;
             }
@@ -507,13 +526,7 @@ fn check_bvh_packets(name: &str, bvh: &Bvh, stream: u32, extent: f32) -> (u32, u
     for packet in 0..96 {
         let coherent = packet % 2 == 0;
         let base = rng.point(-extent, extent);
-        let k = (rng.0.next_u32() as usize) % n;
-        let target = if k < bvh.spheres.len() {
-            Vec3::from(bvh.spheres[k].center)
-        } else {
-            let t = &bvh.triangles[k - bvh.spheres.len()];
-            Vec3::from(t.p0) + (Vec3::from(t.edge1) + Vec3::from(t.edge2)) / 3.0
-        };
+        let target = centre(bvh, (rng.0.next_u32() as usize) % n);
         let mut p = RayPacket::zero();
         let mut t_max = [f32::INFINITY; LANES];
         let mut lanes = Vec::new();
@@ -554,23 +567,8 @@ fn check_bvh_packets(name: &str, bvh: &Bvh, stream: u32, extent: f32) -> (u32, u
             assert_eq!(found.t[lane].to_bits(), want_t.to_bits(), "{label}: t");
             assert_eq!(found.prim[lane], want, "{label}: primitive");
             assert_eq!(occluded[lane], want != NONE, "{label}: any-hit");
-            if want != NONE && want as usize >= bvh.spheres.len() {
-                let tri = &bvh.triangles[want as usize - bvh.spheres.len()];
-                let h = kernel::geometry::intersect_triangle_uv(
-                    origin,
-                    dir,
-                    Vec3::from(tri.p0),
-                    Vec3::from(tri.edge1),
-                    Vec3::from(tri.edge2),
-                    0.0,
-                    f32::INFINITY,
-                );
-                assert_eq!(
-                    (found.u[lane].to_bits(), found.v[lane].to_bits()),
-                    (h.u.to_bits(), h.v.to_bits()),
-                    "{label}: barycentrics"
-                );
-            }
+            let uv = (found.u[lane], found.v[lane]);
+            assert_kernel_barycentrics(bvh, want, origin, dir, uv, &label);
             if want != NONE {
                 hits += 1;
                 let tied = (0..n as u32)

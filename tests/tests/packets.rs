@@ -132,22 +132,28 @@ fn packets_of_paths_give_the_one_path_images() {
             matches!(CpuRenderer::new(&scene).tiles, TileStrategy::Packets(_)),
             "{name}: small enough for packets, yet the renderer would not use them"
         );
-        let mut one_path = scene.clone();
-        one_path.render.packets = false;
-        assert!(matches!(
-            CpuRenderer::new(&one_path).tiles,
-            TileStrategy::OnePath
-        ));
-        let spp = if scene.render.adaptive_target > 0.0 {
-            32
-        } else {
-            8
-        };
-        let a = render_film(&scene, Backend::Cpu, spp);
-        let b = render_film(&one_path, Backend::Cpu, spp);
-        assert_films_identical(&a, &b, name);
-        println!("{name}: packets and one path identical at {spp} spp");
+        assert_packets_give_the_one_path_image(name, &scene);
     }
+}
+
+/// Renders `scene` as it is (with packets) and with `packets` off (one path at a time), 8 spp
+/// or 32 under adaptive sampling, and asserts the films identical, sample for sample.
+fn assert_packets_give_the_one_path_image(name: &str, scene: &Scene) {
+    let mut one_path = scene.clone();
+    one_path.render.packets = false;
+    assert!(matches!(
+        CpuRenderer::new(&one_path).tiles,
+        TileStrategy::OnePath
+    ));
+    let spp = if scene.render.adaptive_target > 0.0 {
+        32
+    } else {
+        8
+    };
+    let a = render_film(scene, Backend::Cpu, spp);
+    let b = render_film(&one_path, Backend::Cpu, spp);
+    assert_films_identical(&a, &b, name);
+    println!("{name}: packets and one path identical at {spp} spp");
 }
 
 /// The Cornell room with a generated torus knot of about 12k triangles in place of the left
@@ -225,17 +231,7 @@ fn packets_through_the_bvh_give_the_one_path_images() {
             matches!(CpuRenderer::new(&scene).tiles, TileStrategy::BvhPackets),
             "{name}: a larger scene without instances, yet no packets through the BVH"
         );
-        let mut one_path = scene.clone();
-        one_path.render.packets = false;
-        let spp = if scene.render.adaptive_target > 0.0 {
-            32
-        } else {
-            8
-        };
-        let a = render_film(&scene, Backend::Cpu, spp);
-        let b = render_film(&one_path, Backend::Cpu, spp);
-        assert_films_identical(&a, &b, name);
-        println!("{name}: packets through the BVH and one path identical at {spp} spp");
+        assert_packets_give_the_one_path_image(name, &scene);
     }
 }
 

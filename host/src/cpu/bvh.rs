@@ -787,20 +787,26 @@ impl Bvh {
 
     /// The hit record of sphere or triangle `id` of this tree at `t` along the ray.
     pub fn surface_of_prim(&self, id: u32, origin: Vec3, dir: Vec3, t: f32) -> SurfaceHit {
-        let uv = if (id as usize) < self.spheres.len() {
-            (0.0, 0.0)
-        } else {
-            // The winning triangle again, for its barycentrics (once per ray).
-            let tri = &self.triangles[id as usize - self.spheres.len()];
-            let (p0, e1, e2) = (
-                Vec3::from(tri.p0),
-                Vec3::from(tri.edge1),
-                Vec3::from(tri.edge2),
-            );
-            let h = intersect_triangle_uv(origin, dir, p0, e1, e2, 0.0, f32::INFINITY);
-            (h.u, h.v)
-        };
+        // The winning triangle again, for its barycentrics (once per ray).
+        let uv = self.barycentrics(id, origin, dir);
         self.surface_with_uv(id, origin, dir, t, uv)
+    }
+
+    /// The barycentrics u, v where the ray meets primitive `id` of this tree, as the kernel's
+    /// `intersect_triangle_uv` computes them; (0, 0) for a sphere.
+    #[inline(always)]
+    pub fn barycentrics(&self, id: u32, origin: Vec3, dir: Vec3) -> (f32, f32) {
+        if (id as usize) < self.spheres.len() {
+            return (0.0, 0.0);
+        }
+        let tri = &self.triangles[id as usize - self.spheres.len()];
+        let (p0, e1, e2) = (
+            Vec3::from(tri.p0),
+            Vec3::from(tri.edge1),
+            Vec3::from(tri.edge2),
+        );
+        let h = intersect_triangle_uv(origin, dir, p0, e1, e2, 0.0, f32::INFINITY);
+        (h.u, h.v)
     }
 
     /// [`Bvh::surface_of_prim`] with the barycentrics `uv` of a triangle's hit already known (as

@@ -17,16 +17,14 @@
 use super::bvh::{Bvh, LEAF, STACK, WIDTH};
 use super::packet::{PacketHits, PacketTracer, RayPacket, LANES};
 use super::simd::{
-    max_or_second, min_or_second, sphere_lanes, triangle_lanes, triangle_lanes_uv, widest_simd,
-    Boxes, SLAB_PAD,
+    slab_lanes, sphere_lanes, triangle_lanes, triangle_lanes_uv, widest_simd, Boxes, SLAB_PAD,
 };
 use glam::Vec3;
-use kernel::geometry::intersect_triangle_uv;
 use kernel::scene::NONE;
 use std::mem::MaybeUninit;
 use std::simd::cmp::{SimdPartialEq, SimdPartialOrd};
 use std::simd::num::SimdFloat;
-use std::simd::{f32x4, Mask, Select, Simd};
+use std::simd::{Mask, Select, Simd};
 
 type Lanes = Simd<f32, LANES>;
 type Ids = Simd<u32, LANES>;
@@ -57,30 +55,16 @@ impl<'a> SlabRays<'a> {
         }
     }
 
-    /// The slab test of child `c` of a node against every lane, as `simd::Ray4::slab` performs
-    /// it for one ray: each lane's entry distance and whether its ray enters the box within
-    /// (0, t_max] (far widened by [`SLAB_PAD`]).
+    /// The slab test of child `c` of a node against every lane (`simd::slab_lanes`, as
+    /// `simd::Ray4::slab` runs it for one ray): each lane's entry distance and whether its ray
+    /// enters the box within (0, t_max].
     #[inline(always)]
     fn slab(&self, b: &Boxes<WIDTH>, c: usize, t_max: Lanes) -> (Lanes, LaneMask) {
-        let mut near = Lanes::splat(0.0);
-        let mut far = t_max;
-        for axis in 0..3 {
-            let o = self.rays.origin[axis];
-            let inv = self.inv_dir[axis];
-            let t0 = (Lanes::splat(b.min[axis][c]) - o) * inv;
-            let t1 = (Lanes::splat(b.max[axis][c]) - o) * inv;
-            let mut axis_near = min_or_second(t0, t1);
-            let mut axis_far = max_or_second(t0, t1);
-            if self.parallel[axis] {
-                let on_plane = t0.is_nan() | t1.is_nan();
-                axis_near = on_plane.select(Lanes::splat(f32::NEG_INFINITY), axis_near);
-                axis_far = on_plane.select(Lanes::splat(f32::INFINITY), axis_far);
-            }
-            near = max_or_second(axis_near, near);
-            far = min_or_second(axis_far, far);
-        }
-        let far = far * Lanes::splat(SLAB_PAD);
-        (near, near.simd_le(far))
+        let b = Boxes {
+            min: column(&b.min, c),
+            max: column(&b.max, c),
+        };
+        slab_lanes(&self.rays.origin, &self.inv_dir, &b, t_max, self.parallel)
     }
 }
 
@@ -91,9 +75,10 @@ fn lane_ray(rays: &RayPacket, lane: usize) -> (Vec3, Vec3) {
     (v(&rays.origin), v(&rays.dir))
 }
 
-/// Lane `j` of a block's vector, in every lane of a packet.
+/// Lane `j` of a vector of any width (a node's child box, a block's triangle), in every lane of
+/// a packet.
 #[inline(always)]
-fn broadcast(v: &[f32x4; 3], j: usize) -> [Lanes; 3] {
+fn column<const N: usize>(v: &[Simd<f32, N>; 3], j: usize) -> [Lanes; 3] {
     [
         Lanes::splat(v[0][j]),
         Lanes::splat(v[1][j]),
@@ -108,7 +93,32 @@ fn tie_limits(hits: &PacketHits) -> Lanes {
     hits.prim.simd_eq(Ids::splat(NONE)).select(hits.t, next_up)
 }
 
+/// Primitive `id`'s hits t (negative: missed) with barycentrics u, v replace the `inside`
+/// lanes' hits so far where nearer, or at the same t where `id` is smaller (`bvh.rs`,
+/// `closest_in`: the least (t, id) wins).
+#[inline(always)]
+fn keep_nearer(hits: &mut PacketHits, inside: LaneMask, id: u32, t: Lanes, u: Lanes, v: Lanes) {
+    let ids = Ids::splat(id);
+    let nearer = t.simd_lt(hits.t) | (t.simd_eq(hits.t) & ids.simd_lt(hits.prim));
+    let take = inside & t.simd_ge(Lanes::splat(0.0)) & nearer;
+    hits.t = take.select(t, hits.t);
+    hits.u = take.select(u, hits.u);
+    hits.v = take.select(v, hits.v);
+    hits.prim = take.select(ids, hits.prim);
+}
+
 impl Bvh {
+    /// The root and the lanes with a ray (t_max > 0) as a bit mask; `None` when there is no
+    /// tree or no ray.
+    #[inline(always)]
+    fn packet_start(&self, t_max: Lanes) -> Option<(u32, u32)> {
+        let active = t_max.simd_gt(Lanes::splat(0.0)).to_bitmask() as u32;
+        match self.root {
+            Some(root) if active != 0 => Some((root, active)),
+            _ => None,
+        }
+    }
+
     widest_simd! {
         /// Each lane's closest hit in (0, t_max) of a tree without instances (`NONE` and t_max
         /// for a miss; lanes with t_max 0 have no ray), with a triangle's barycentrics: lane by
@@ -121,16 +131,9 @@ impl Bvh {
     fn closest_packet_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
         debug_assert!(self.instances().is_empty());
         let zero = Lanes::splat(0.0);
-        let mut hits = PacketHits {
-            prim: Ids::splat(NONE),
-            t: t_max,
-            u: zero,
-            v: zero,
-        };
-        let active = t_max.simd_gt(zero).to_bitmask() as u32;
-        let root = match self.root {
-            Some(root) if active != 0 => root,
-            _ => return hits,
+        let mut hits = PacketHits::miss(t_max);
+        let Some((root, active)) = self.packet_start(t_max) else {
+            return hits;
         };
         let slab_rays = SlabRays::new(rays, active);
         // Entries: a subtree, the lanes that entered its box, and the least entry distance
@@ -192,20 +195,13 @@ impl Bvh {
                         let (t, u, v) = triangle_lanes_uv(
                             &rays.origin,
                             &rays.dir,
-                            &broadcast(&tri.p0, j),
-                            &broadcast(&tri.edge1, j),
-                            &broadcast(&tri.edge2, j),
+                            &column(&tri.p0, j),
+                            &column(&tri.edge1, j),
+                            &column(&tri.edge2, j),
                             zero,
                             tie_limits(&hits),
                         );
-                        let ids = Ids::splat(id);
-                        let nearer =
-                            t.simd_lt(hits.t) | (t.simd_eq(hits.t) & ids.simd_lt(hits.prim));
-                        let take = inside & t.simd_ge(zero) & nearer;
-                        hits.t = take.select(t, hits.t);
-                        hits.u = take.select(u, hits.u);
-                        hits.v = take.select(v, hits.v);
-                        hits.prim = take.select(ids, hits.prim);
+                        keep_nearer(&mut hits, inside, id, t, u, v);
                     }
                 }
                 for block in &self.sphere_blocks[spheres] {
@@ -214,7 +210,7 @@ impl Bvh {
                             break;
                         }
                         let s = &block.spheres;
-                        let center = broadcast(&s.center, j);
+                        let center = column(&s.center, j);
                         let radius = Lanes::splat(s.radius[j]);
                         let t = sphere_lanes(
                             &rays.origin,
@@ -224,14 +220,7 @@ impl Bvh {
                             zero,
                             tie_limits(&hits),
                         );
-                        let ids = Ids::splat(id);
-                        let nearer =
-                            t.simd_lt(hits.t) | (t.simd_eq(hits.t) & ids.simd_lt(hits.prim));
-                        let take = inside & t.simd_ge(zero) & nearer;
-                        hits.t = take.select(t, hits.t);
-                        hits.u = take.select(zero, hits.u);
-                        hits.v = take.select(zero, hits.v);
-                        hits.prim = take.select(ids, hits.prim);
+                        keep_nearer(&mut hits, inside, id, t, zero, zero);
                     }
                 }
             }
@@ -256,7 +245,7 @@ impl Bvh {
     }
 
     /// Lane `lane`'s closest hit in subtree `start` by the one-ray traversal, from its hit so
-    /// far; a new triangle hit's barycentrics are computed as `Bvh::surface_of_prim` does.
+    /// far, with a new hit's barycentrics ([`Bvh::barycentrics`]).
     #[inline(always)]
     fn closest_of_lane(&self, start: u32, rays: &RayPacket, lane: usize, hits: &mut PacketHits) {
         let (origin, dir) = lane_ray(rays, lane);
@@ -266,20 +255,7 @@ impl Bvh {
         if (prim, t) == best {
             return;
         }
-        let (mut u, mut v) = (0.0, 0.0);
-        if prim as usize >= self.spheres.len() {
-            let tri = &self.triangles[prim as usize - self.spheres.len()];
-            let h = intersect_triangle_uv(
-                origin,
-                dir,
-                Vec3::from(tri.p0),
-                Vec3::from(tri.edge1),
-                Vec3::from(tri.edge2),
-                0.0,
-                f32::INFINITY,
-            );
-            (u, v) = (h.u, h.v);
-        }
+        let (u, v) = self.barycentrics(prim, origin, dir);
         hits.prim[lane] = prim;
         hits.t[lane] = t;
         hits.u[lane] = u;
@@ -297,10 +273,8 @@ impl Bvh {
     fn occluded_packet_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> LaneMask {
         debug_assert!(self.instances().is_empty());
         let zero = Lanes::splat(0.0);
-        let active = t_max.simd_gt(zero).to_bitmask() as u32;
-        let root = match self.root {
-            Some(root) if active != 0 => root,
-            _ => return LaneMask::splat(false),
+        let Some((root, active)) = self.packet_start(t_max) else {
+            return LaneMask::splat(false);
         };
         let slab_rays = SlabRays::new(rays, active);
         let mut stack = [const { MaybeUninit::<(u32, u32)>::uninit() }; STACK];
@@ -342,9 +316,9 @@ impl Bvh {
                         let t = triangle_lanes(
                             &rays.origin,
                             &rays.dir,
-                            &broadcast(&tri.p0, j),
-                            &broadcast(&tri.edge1, j),
-                            &broadcast(&tri.edge2, j),
+                            &column(&tri.p0, j),
+                            &column(&tri.edge1, j),
+                            &column(&tri.edge2, j),
                             zero,
                             t_max,
                         );
@@ -360,7 +334,7 @@ impl Bvh {
                             break;
                         }
                         let s = &block.spheres;
-                        let center = broadcast(&s.center, j);
+                        let center = column(&s.center, j);
                         let radius = Lanes::splat(s.radius[j]);
                         let t = sphere_lanes(&rays.origin, &rays.dir, &center, radius, zero, t_max);
                         occluded |= t.simd_ge(zero).to_bitmask() as u32 & lanes;

@@ -99,6 +99,20 @@ impl PacketTracer for SmallScene {
     }
 }
 
+impl PacketHits {
+    /// Sixteen misses: no primitive, t = t_max, barycentrics 0.
+    #[inline(always)]
+    pub fn miss(t_max: Lanes) -> Self {
+        let zero = Lanes::splat(0.0);
+        PacketHits {
+            prim: Ids::splat(NONE),
+            t: t_max,
+            u: zero,
+            v: zero,
+        }
+    }
+}
+
 /// Scenes with at most this many primitives are traced by packets without a hierarchy.
 pub const MAX_PRIMITIVES: usize = 32;
 
@@ -142,12 +156,7 @@ impl SmallScene {
     #[inline(always)]
     fn closest_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
         let zero = Lanes::splat(0.0);
-        let mut hits = PacketHits {
-            prim: Ids::splat(NONE),
-            t: t_max,
-            u: zero,
-            v: zero,
-        };
+        let mut hits = PacketHits::miss(t_max);
         for (i, s) in self.spheres.iter().enumerate() {
             let t = rays.sphere(s, hits.t);
             let closer = t.simd_ge(zero) & t.simd_lt(hits.t);

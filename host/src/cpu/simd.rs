@@ -74,25 +74,15 @@ impl Ray4 {
     /// min/max are single instructions (minps/maxps).
     #[inline(always)]
     pub fn slab<const N: usize>(&self, b: &Boxes<N>, t_max: f32) -> (Simd<f32, N>, Mask<i32, N>) {
-        let mut near = Simd::splat(0.0);
-        let mut far = Simd::splat(t_max);
-        for axis in 0..3 {
-            let o = Simd::splat(self.origin_xyz[axis]);
-            let inv = Simd::splat(self.inv_dir[axis]);
-            let t0 = (b.min[axis] - o) * inv;
-            let t1 = (b.max[axis] - o) * inv;
-            let mut axis_near = min_or_second(t0, t1);
-            let mut axis_far = max_or_second(t0, t1);
-            if self.parallel {
-                let on_plane = t0.is_nan() | t1.is_nan();
-                axis_near = on_plane.select(Simd::splat(f32::NEG_INFINITY), axis_near);
-                axis_far = on_plane.select(Simd::splat(f32::INFINITY), axis_far);
-            }
-            near = max_or_second(axis_near, near);
-            far = min_or_second(axis_far, far);
-        }
-        let far = far * Simd::splat(SLAB_PAD);
-        (near, near.simd_le(far))
+        let [ox, oy, oz] = self.origin_xyz;
+        let [ix, iy, iz] = self.inv_dir;
+        slab_lanes(
+            &[Simd::splat(ox), Simd::splat(oy), Simd::splat(oz)],
+            &[Simd::splat(ix), Simd::splat(iy), Simd::splat(iz)],
+            b,
+            Simd::splat(t_max),
+            [self.parallel; 3],
+        )
     }
 
     /// Moller-Trumbore against four triangles (the kernel's `intersect_triangle_uv`, lane by
@@ -123,6 +113,40 @@ impl Ray4 {
             f32x4::splat(t_max),
         )
     }
+}
+
+/// The slab test on N lanes, each lane a ray (origin, 1 / dir) against a box (`b`'s lane):
+/// the entry distance (clamped at 0) and whether the ray enters the box within (0, t_max];
+/// boxes are closed, and the far distance is widened by [`SLAB_PAD`]. Either side may be
+/// broadcast: one ray against N boxes ([`Ray4::slab`]) or N rays against one box
+/// (`cpu::bvh_packet`), so both make the same verdict for the same ray and box. Where
+/// `parallel[axis]` (some lane's 1 / dir is infinite on that axis), a NaN from 0 x inf (an
+/// origin on a face's plane) leaves that axis's interval open, as [`Ray4::slab`] explains.
+#[inline(always)]
+pub fn slab_lanes<const N: usize>(
+    origin: &[Simd<f32, N>; 3],
+    inv_dir: &[Simd<f32, N>; 3],
+    b: &Boxes<N>,
+    t_max: Simd<f32, N>,
+    parallel: [bool; 3],
+) -> (Simd<f32, N>, Mask<i32, N>) {
+    let mut near = Simd::splat(0.0);
+    let mut far = t_max;
+    for axis in 0..3 {
+        let t0 = (b.min[axis] - origin[axis]) * inv_dir[axis];
+        let t1 = (b.max[axis] - origin[axis]) * inv_dir[axis];
+        let mut axis_near = min_or_second(t0, t1);
+        let mut axis_far = max_or_second(t0, t1);
+        if parallel[axis] {
+            let on_plane = t0.is_nan() | t1.is_nan();
+            axis_near = on_plane.select(Simd::splat(f32::NEG_INFINITY), axis_near);
+            axis_far = on_plane.select(Simd::splat(f32::INFINITY), axis_far);
+        }
+        near = max_or_second(axis_near, near);
+        far = min_or_second(axis_far, far);
+    }
+    let far = far * Simd::splat(SLAB_PAD);
+    (near, near.simd_le(far))
 }
 
 /// [`triangle_lanes_uv`]'s t only.
