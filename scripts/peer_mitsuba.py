@@ -98,6 +98,12 @@ def scene_dict(spp, seed, sampler="independent"):
     }
 
 
+def relmse(img, ref):
+    """`twinpath diff`'s relMSE: mean of (img - ref)^2 / (ref^2 + 0.01) over pixels and channels."""
+    d = img - ref
+    return float(np.mean(d * d / (ref * ref + 0.01)))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("reference")
@@ -127,8 +133,7 @@ def main():
     if args.once:
         img = mi.render(mi.load_dict(make_dict(args.once, 1)), spp=args.once, seed=1)
         mi.Bitmap(img).write(args.out)
-        d = np.array(img, dtype=np.float64) - ref
-        print(f"relmse {float(np.mean(d * d / (ref * ref + 0.01))):.6e}")
+        print(f"relmse {relmse(np.array(img, dtype=np.float64), ref):.6e}")
         return
     rows = []
     spp = 1
@@ -148,11 +153,11 @@ def main():
             img = np.array(mi.render(scene, spp=spp, seed=1 + k), dtype=np.float64)
             render_s = time.perf_counter() - t0
             d = img - ref
-            relmse = float(np.mean(d * d / (ref * ref + 0.01)))
+            rel = relmse(img, ref)
             rmse = float(np.sqrt(np.mean(d * d)))
-            rows.append((spp, 1 + k, setup, render_s, relmse, rmse, 1.0 / (relmse * render_s)))
+            rows.append((spp, 1 + k, setup, render_s, rel, rmse, 1.0 / (rel * render_s)))
             print(f"mitsuba {args.variant} {args.sampler} spp {spp} seed {1 + k}: {render_s:.3f} s, "
-                  f"relMSE {relmse:.4e}", file=sys.stderr)
+                  f"relMSE {rel:.4e}", file=sys.stderr)
         if render_s > args.max_seconds:
             break
         spp *= 2
@@ -161,9 +166,9 @@ def main():
         name += "-" + args.mesh.rsplit("/", 1)[-1].removesuffix(".ply")
     with open(args.out, "w") as f:
         f.write("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n")
-        for spp, seed, setup, render_s, relmse, rmse, eff in rows:
+        for spp, seed, setup, render_s, rel, rmse, eff in rows:
             f.write(f"mitsuba-{name},Cpu,{spp},{seed},{setup:.6f},{render_s:.6f},"
-                    f"{relmse:.6e},{rmse:.6e},{eff:.6e}\n")
+                    f"{rel:.6e},{rmse:.6e},{eff:.6e}\n")
 
 
 if __name__ == "__main__":
