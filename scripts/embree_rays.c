@@ -7,7 +7,7 @@
  * rtcOccluded1, one ray at a time, which is what a path tracer's incoherent rays get, and
  * rtcIntersect16 and rtcOccluded16 on packets of sixteen consecutive rays, as `twinpath rays`
  * times its packets (a short last packet masks its unused lanes). Scene flags and build quality
- * are Embree's defaults. Prints rays per second and how often Embree's closest primitive is the
+ * are Embree's defaults; EMBREE_QUALITY=high sets Mitsuba 3's build quality (spatial splits). Prints rays per second and how often Embree's closest primitive is the
  * one twinpath found; appends rows in twinpath's CSV format (tracer embree3 and
  * embree3_packets).
  *
@@ -111,6 +111,10 @@ int main(int argc, char **argv) {
     rtcSetDeviceMemoryMonitorFunction(device, monitor, NULL);
     double t0 = now();
     RTCScene scene = rtcNewScene(device);
+    /* EMBREE_QUALITY=high: Mitsuba 3's setting (spatial splits in the build). */
+    const char *quality = getenv("EMBREE_QUALITY");
+    if (quality && strcmp(quality, "high") == 0)
+        rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
     if (ntri) {
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
         float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,

@@ -14,8 +14,9 @@ Usage: peer_mitsuba.py REFERENCE.exr OUT.csv [--variant llvm_ad_rgb] [--max-spp 
 low-discrepancy one, `multijitter` / `stratified` its stratified ones); names other than
 independent are added to the variant column. --mesh replaces the two spheres by a PLY mesh in
 white, flat-shaded (scripts/knot_scenes.py's scenes); its file name is added to the variant.
---once SPP renders once (seed 1, no warm-up), writes the image to OUT and prints its relMSE:
-scripts/mesh_table.sh times whole processes with it.
+--once SPP renders once (seed 1, no warm-up), writes the image to OUT and prints its relMSE and
+its number of samples: scripts/mesh_table.sh times whole processes with it, and
+scripts/traversal_floor.sh counts its rays.
 Install: pip install mitsuba numpy (scripts/peer_mitsuba.sh does it in a venv).
 """
 
@@ -131,9 +132,12 @@ def main():
     ref = np.array(mi.Bitmap(args.reference).convert(
         mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32), dtype=np.float64)
     if args.once:
-        img = mi.render(mi.load_dict(make_dict(args.once, 1)), spp=args.once, seed=1)
+        scene = mi.load_dict(make_dict(args.once, 1))
+        img = mi.render(scene, spp=args.once, seed=1)
         mi.Bitmap(img).write(args.out)
         print(f"relmse {relmse(np.array(img, dtype=np.float64), ref):.6e}")
+        width, height = scene.sensors()[0].film().size()
+        print(f"samples {width * height * args.once}")
         return
     rows = []
     spp = 1

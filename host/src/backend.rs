@@ -33,4 +33,31 @@ pub trait SampleBackend {
     /// Bytes of the acceleration structure: the CPU's BVH beyond the primitives (with its
     /// instanced meshes' trees), the GPU's BLASes and TLAS as the driver sizes them.
     fn accel_bytes(&self) -> u64;
+    /// The rays traced so far, where the backend counts them (the CPU; the GPU does not).
+    fn rays_traced(&self) -> Option<RayCounts> {
+        None
+    }
+}
+
+/// Rays a render traced: closest-hit rays (camera rays and path extensions) and shadow rays
+/// (next-event estimation's visibility tests). Counted where a ray is handed to the traversal,
+/// so that a ray count per sample can be compared with another renderer's
+/// (docs/performance.md, "Rays per sample").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    pub closest: u64,
+    pub shadow: u64,
+}
+
+impl RayCounts {
+    pub fn total(&self) -> u64 {
+        self.closest + self.shadow
+    }
+}
+
+impl std::ops::AddAssign for RayCounts {
+    fn add_assign(&mut self, other: Self) {
+        self.closest += other.closest;
+        self.shadow += other.shadow;
+    }
 }

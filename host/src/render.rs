@@ -1,7 +1,7 @@
 //! The render driver: a scene, a backend, a sample count in, a film out, with progress and
 //! Ctrl-C (the samples finished so far are kept and written).
 
-use crate::backend::SampleBackend;
+use crate::backend::{RayCounts, SampleBackend};
 use crate::cpu::CpuBackend;
 use crate::film::Film;
 use crate::sample_range::SampleRange;
@@ -62,6 +62,8 @@ pub struct RenderOutput {
     pub accel_bytes: u64,
     /// Time spent rendering samples.
     pub render: Duration,
+    /// The rays traced, where the backend counts them (`SampleBackend::rays_traced`).
+    pub rays: Option<RayCounts>,
     /// Samples per pixel actually rendered (fewer than asked after Ctrl-C).
     pub spp_done: u32,
     /// The sample indices actually rendered: the range asked for, or its beginning after
@@ -164,6 +166,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
         pipeline,
         accel_bytes: backend.accel_bytes(),
         render,
+        rays: backend.rays_traced(),
         spp_done,
         samples: SampleRange {
             start: range.start,

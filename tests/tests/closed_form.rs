@@ -65,7 +65,7 @@ fn estimate_at(scene: &Scene, x: Vec3, view_dir: Vec3, stream: u32, batch: u32) 
     (batch * BATCH..(batch + 1) * BATCH)
         .into_par_iter()
         .map(|s| {
-            let mut tracer = BvhTracer { bvh: &cpu.bvh };
+            let mut tracer = BvhTracer::new(&cpu.bvh);
             let mut rng = SampleRng::new(params.seed, stream, s);
             rng.seek(kernel::vertex_samples::CAMERA_DIMENSIONS);
             let l = trace_path(

@@ -232,7 +232,8 @@ impl PartShare {
     }
 }
 
-/// The log line of set-up and render time, throughput and discarded samples.
+/// The log lines of set-up and render time, throughput and discarded samples, and the rays
+/// traced per sample where the backend counts them.
 fn log_costs(result: &RenderOutput, asked: Backend) {
     let samples = result.film.total_samples();
     let secs = result.render.as_secs_f64();
@@ -268,6 +269,16 @@ fn log_costs(result: &RenderOutput, asked: Backend) {
         samples as f64 / secs.max(1e-9) / 1e6,
         result.film.discarded
     );
+    if let Some(rays) = result.rays {
+        let per_sample = |n: u64| n as f64 / samples.max(1) as f64;
+        eprintln!(
+            "twinpath: rays: {:.3} per sample ({:.3} closest-hit, {:.3} shadow), {:.3} M rays/s",
+            per_sample(rays.total()),
+            per_sample(rays.closest),
+            per_sample(rays.shadow),
+            rays.total() as f64 / secs.max(1e-9) / 1e6
+        );
+    }
 }
 
 /// Adaptive sampling's summary, and the sample-count image if asked for.

@@ -11,7 +11,7 @@ pub mod packet_paths;
 pub mod packet_vertices;
 pub mod simd;
 
-use crate::backend::SampleBackend;
+use crate::backend::{RayCounts, SampleBackend};
 use crate::film::{Film, PixelSums};
 use crate::scene::{Scene, ADAPTIVE_PASS};
 use anyhow::Result;
@@ -29,18 +29,34 @@ use std::time::{Duration, Instant};
 /// Side of the square image tiles that threads take one at a time.
 pub const TILE: u32 = 16;
 
-/// [`Tracer`] over the BVH; the same answers as the GPU's acceleration structure.
+/// What a tile's samples give: each pixel's sums, in row order, and the rays traced.
+pub(crate) type TileSums = (Vec<PixelSums>, RayCounts);
+
+/// [`Tracer`] over the BVH; the same answers as the GPU's acceleration structure. Counts the
+/// rays it traces.
 pub struct BvhTracer<'a> {
     pub bvh: &'a Bvh,
+    pub rays: RayCounts,
+}
+
+impl<'a> BvhTracer<'a> {
+    pub fn new(bvh: &'a Bvh) -> Self {
+        Self {
+            bvh,
+            rays: RayCounts::default(),
+        }
+    }
 }
 
 impl Tracer for BvhTracer<'_> {
     #[inline]
     fn closest_hit(&mut self, origin: Vec3, dir: Vec3) -> SurfaceHit {
+        self.rays.closest += 1;
         self.bvh.closest_hit(origin, dir, f32::INFINITY)
     }
     #[inline]
     fn occluded(&mut self, from: Vec3, to: Vec3) -> bool {
+        self.rays.shadow += 1;
         self.bvh.any_hit(from, to - from, 1.0)
     }
 }
@@ -166,21 +182,22 @@ impl CpuRenderer {
 
     /// One sample of one pixel, exactly as the GPU's ray-generation shader computes it.
     pub fn sample(&self, params: &RenderParams, px: u32, py: u32, sample: u32) -> Vec3 {
-        with_features!(self.features, f => self.sample_with(f, params, px, py, sample))
+        let mut tracer = BvhTracer::new(&self.bvh);
+        with_features!(self.features, f => self.sample_with(f, &mut tracer, params, px, py, sample))
     }
 
     #[inline]
     fn sample_with<F: FeatureSet>(
         &self,
         features: F,
+        tracer: &mut BvhTracer,
         params: &RenderParams,
         px: u32,
         py: u32,
         sample: u32,
     ) -> Vec3 {
-        let mut tracer = BvhTracer { bvh: &self.bvh };
         render_sample(
-            &mut tracer,
+            tracer,
             features,
             params,
             &self.materials,
@@ -198,7 +215,8 @@ impl CpuRenderer {
     /// Adds samples `first..first + count` of every pixel to `film`, tiles in parallel.
     /// Non-finite samples are not added; they are counted in `film.discarded`. With adaptive
     /// sampling (`params.pilot_period > 0`), pixels the film says have converged are skipped
-    /// and pilot samples go to the film's pilot sums (`kernel::adaptive`).
+    /// and pilot samples go to the film's pilot sums (`kernel::adaptive`). Returns the rays
+    /// traced.
     pub fn render_into(
         &self,
         params: &RenderParams,
@@ -206,7 +224,7 @@ impl CpuRenderer {
         count: u32,
         film: &mut Film,
         progress: Option<&ProgressBar>,
-    ) {
+    ) -> RayCounts {
         with_features!(self.features, f => self.render_tiles(f, params, first, count, film, progress))
     }
 
@@ -218,7 +236,7 @@ impl CpuRenderer {
         count: u32,
         film: &mut Film,
         progress: Option<&ProgressBar>,
-    ) {
+    ) -> RayCounts {
         match &self.tiles {
             TileStrategy::OnePath => {
                 self.render_tiles_by(params, film, progress, |pixels, film| {
@@ -239,15 +257,17 @@ impl CpuRenderer {
     }
 
     /// Runs `tile` on every image tile in parallel (it returns each pixel's sums, in row
-    /// order, reading `film` only to skip converged pixels) and adds the sums to `film`.
+    /// order, reading `film` only to skip converged pixels, and the rays it traced), adds the
+    /// sums to `film` and returns the rays.
     fn render_tiles_by<T>(
         &self,
         params: &RenderParams,
         film: &mut Film,
         progress: Option<&ProgressBar>,
         tile: T,
-    ) where
-        T: Fn(&mut dyn Iterator<Item = (u32, u32)>, &Film) -> Vec<PixelSums> + Sync,
+    ) -> RayCounts
+    where
+        T: Fn(&mut dyn Iterator<Item = (u32, u32)>, &Film) -> TileSums + Sync,
     {
         let (w, h) = (params.width, params.height);
         let tile_pixels = move |tx: u32, ty: u32| {
@@ -258,10 +278,10 @@ impl CpuRenderer {
             .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
             .collect();
         let film_ref = &*film;
-        let results: Vec<((u32, u32), Vec<PixelSums>)> = tiles
+        let results: Vec<((u32, u32), TileSums)> = tiles
             .par_iter()
             .map(|&(tx, ty)| {
-                let sums = tile(&mut tile_pixels(tx, ty), film_ref);
+                let (sums, rays) = tile(&mut tile_pixels(tx, ty), film_ref);
                 if let Some(p) = progress {
                     p.inc(
                         sums.iter()
@@ -269,18 +289,22 @@ impl CpuRenderer {
                             .sum(),
                     );
                 }
-                ((tx, ty), sums)
+                ((tx, ty), (sums, rays))
             })
             .collect();
-        for ((tx, ty), sums) in results {
+        let mut rays = RayCounts::default();
+        for ((tx, ty), (sums, tile_rays)) in results {
             for ((px, py), s) in tile_pixels(tx, ty).zip(&sums) {
                 film.add_sums(px, py, s);
             }
+            rays += tile_rays;
         }
+        rays
     }
 
     /// Samples `first..first + count` of each of `pixels` (skipping those `film` says have
-    /// converged, under adaptive sampling), one path at a time, in sample order.
+    /// converged, under adaptive sampling), one path at a time, in sample order; returns each
+    /// pixel's sums and the rays traced.
     fn tile_by_paths<F: FeatureSet>(
         &self,
         features: F,
@@ -289,19 +313,22 @@ impl CpuRenderer {
         first: u32,
         count: u32,
         film: &Film,
-    ) -> Vec<PixelSums> {
+    ) -> TileSums {
         let adaptive = params.pilot_period > 0;
-        pixels
+        let mut tracer = BvhTracer::new(&self.bvh);
+        let sums = pixels
             .map(|(px, py)| {
                 let mut acc = PixelSums::default();
                 if !(adaptive && film.converged(params, px, py)) {
                     for s in first..first + count {
-                        acc.add_sample(params, s, self.sample_with(features, params, px, py, s));
+                        let l = self.sample_with(features, &mut tracer, params, px, py, s);
+                        acc.add_sample(params, s, l);
                     }
                 }
                 acc
             })
-            .collect()
+            .collect();
+        (sums, tracer.rays)
     }
 }
 
@@ -312,6 +339,8 @@ pub struct CpuBackend {
     /// Time [`CpuRenderer::new`] took (the BVH).
     pub build_time: Duration,
     adaptive: bool,
+    /// The rays traced by the passes so far.
+    rays: RayCounts,
 }
 
 impl CpuBackend {
@@ -323,6 +352,7 @@ impl CpuBackend {
             film: Film::new(scene.camera.width, scene.camera.height),
             build_time: t.elapsed(),
             adaptive: scene.render.adaptive_target > 0.0,
+            rays: RayCounts::default(),
         }
     }
 }
@@ -346,7 +376,8 @@ impl SampleBackend for CpuBackend {
         count: u32,
         progress: Option<&ProgressBar>,
     ) -> Result<()> {
-        self.renderer
+        self.rays += self
+            .renderer
             .render_into(params, first, count, &mut self.film, progress);
         Ok(())
     }
@@ -361,5 +392,9 @@ impl SampleBackend for CpuBackend {
 
     fn accel_bytes(&self) -> u64 {
         self.renderer.bvh.hierarchy_bytes() as u64
+    }
+
+    fn rays_traced(&self) -> Option<RayCounts> {
+        Some(self.rays)
     }
 }

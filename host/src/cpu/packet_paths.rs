@@ -8,7 +8,8 @@
 use super::packet::{PacketTracer, RayPacket, LANES};
 use super::packet_numbers::camera_numbers;
 use super::packet_vertices::fill_vertex_samples;
-use super::CpuRenderer;
+use super::{CpuRenderer, TileSums};
+use crate::backend::RayCounts;
 use crate::film::Film;
 use crate::film::PixelSums;
 use glam::Vec3;
@@ -46,7 +47,7 @@ type Path = PathState;
 impl CpuRenderer {
     /// Samples `first..first + count` of each of `pixels` (skipping those `film` says have
     /// converged, under adaptive sampling), sixteen paths at a time; returns each pixel's sums,
-    /// added in sample order as the one-path loop adds them.
+    /// added in sample order as the one-path loop adds them, and the rays traced.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn tile_by_packets<F: FeatureSet, T: PacketTracer>(
         &self,
@@ -57,7 +58,7 @@ impl CpuRenderer {
         first: u32,
         count: u32,
         film: &Film,
-    ) -> Vec<PixelSums> {
+    ) -> TileSums {
         let adaptive = params.pilot_period > 0;
         let pixels: Vec<(u32, u32, bool)> = pixels
             .map(|(px, py)| (px, py, !(adaptive && film.converged(params, px, py))))
@@ -80,6 +81,7 @@ impl CpuRenderer {
         // textures or shading normals (else the table's entries are read in place).
         let surfaces = features.textures() || features.shading_normals();
         let mut materials = [Material::diffuse([0.0; 3]); LANES];
+        let mut rays = RayCounts::default();
         loop {
             for slot in slots.iter_mut().filter(|s| s.is_none()) {
                 if next == n {
@@ -107,6 +109,9 @@ impl CpuRenderer {
                 break;
             }
             let [(extension, ext_t_max), (shadow, shadow_t_max)] = gather(&slots);
+            let lanes = |t_max: &[f32; LANES]| t_max.iter().filter(|&&t| t > 0.0).count() as u64;
+            rays.closest += lanes(&ext_t_max);
+            rays.shadow += lanes(&shadow_t_max);
             let (prims, ts, us, vs) = if ext_t_max.iter().any(|&t| t > 0.0) {
                 let h = tracer.closest_hits(&extension, Simd::from_array(ext_t_max));
                 let a = |x: Simd<f32, LANES>| x.to_array();
@@ -199,7 +204,7 @@ impl CpuRenderer {
             }
         }
         let mut samples = radiance.chunks(count.max(1) as usize);
-        pixels
+        let sums = pixels
             .iter()
             .map(|&(_, _, sampled)| {
                 let mut acc = PixelSums::default();
@@ -211,6 +216,7 @@ impl CpuRenderer {
                 }
                 acc
             })
-            .collect()
+            .collect();
+        (sums, rays)
     }
 }
