@@ -17,6 +17,7 @@
 //! whatever the traversal order.
 
 use super::bvh_build::{Aabb, BinaryBvh, SAH_MAX_DEPTH};
+use super::huge_pages;
 use super::simd::{widest_simd, Boxes, Ray4, Spheres4, Triangles4, SLAB_PAD};
 use crate::scene::instancing::instance_box;
 use crate::scene::Scene;
@@ -158,11 +159,16 @@ impl Bvh {
         let meshes: Vec<Bvh> = scene
             .meshes
             .par_iter()
-            .map(|m| Bvh::build(Vec::new(), scene.triangles[m.range.clone()].to_vec()))
+            .map(|m| {
+                Bvh::build(
+                    Vec::new(),
+                    huge_pages::copy_of(&scene.triangles[m.range.clone()]),
+                )
+            })
             .collect();
         Self::build_with_instances(
             scene.spheres.clone(),
-            scene.triangles[..world].to_vec(),
+            huge_pages::copy_of(&scene.triangles[..world]),
             meshes,
             scene.instances.clone(),
             scene.instance_meshes.clone(),
@@ -189,15 +195,22 @@ impl Bvh {
             .collect();
         let binary = BinaryBvh::build(&bounds);
         let mut bvh = Bvh {
-            nodes: Vec::with_capacity(binary.nodes.len() / 2 + 1),
+            nodes: huge_pages::vec_with_capacity(binary.nodes.len() / 2 + 1),
             leaves: Vec::new(),
-            blocks: Vec::with_capacity(triangles.len() / 4 + 1),
+            // Each leaf's last block may be partly empty: at most one block per binary leaf
+            // beyond a quarter of the triangles (so the advised buffer never reallocates).
+            blocks: huge_pages::vec_with_capacity(triangles.len() / 4 + binary.nodes.len() / 2 + 1),
             sphere_blocks: Vec::new(),
             root: None,
-            shapes: triangles
-                .iter()
-                .map(|t| TriangleShape::of(Vec3::from(t.edge1), Vec3::from(t.edge2)))
-                .collect(),
+            shapes: {
+                let mut shapes = huge_pages::vec_with_capacity(triangles.len());
+                shapes.extend(
+                    triangles
+                        .iter()
+                        .map(|t| TriangleShape::of(Vec3::from(t.edge1), Vec3::from(t.edge2))),
+                );
+                shapes
+            },
             spheres,
             triangles,
             instances,

@@ -5,6 +5,7 @@
 pub mod bvh;
 pub mod bvh_build;
 pub mod bvh_packet;
+mod huge_pages;
 pub mod packet;
 pub mod packet_numbers;
 pub mod packet_paths;
