@@ -12,11 +12,12 @@
 # ERROR_RATIO, default 0.82), twinpath may spend 0.5 / E of Mitsuba's process per sample; the
 # column says how many times Embree's rate twinpath's traversal would need if everything else in
 # its sample stayed as it is.
-#   scripts/traversal_floor.sh OUTDIR SPP [N | bunnyL ...]   (default: 10000 100000 1000000 bunny3)
+#   scripts/traversal_floor.sh OUTDIR SPP [N | bunnyL | cornell ...]
+# (default: 10000 100000 1000000 bunny3; `cornell`: scenes/cornell.toml and Mitsuba's spheres)
 # Needs perf (Debian's linux-perf); run from the repository root on an otherwise idle machine.
 set -euo pipefail
-out=${1:?usage: scripts/traversal_floor.sh OUTDIR SPP [N | bunnyL ...]}
-spp=${2:?usage: scripts/traversal_floor.sh OUTDIR SPP [N | bunnyL ...]}
+out=${1:?usage: scripts/traversal_floor.sh OUTDIR SPP [N | bunnyL | cornell ...]}
+spp=${2:?usage: scripts/traversal_floor.sh OUTDIR SPP [N | bunnyL | cornell ...]}
 shift 2
 sizes=("$@")
 [ ${#sizes[@]} -gt 0 ] || sizes=(10000 100000 1000000 bunny3)
@@ -34,21 +35,26 @@ samples() {
     perf report -i "$1" --no-children --stdio -n --sort dso,sym -g none 2>/dev/null \
         | awk -v p="$2" '!/^#/ && NF > 2 { t += $2; if ($0 ~ p) m += $2 } END { print t, m + 0 }'
 }
-twinpath_traversal='closest_packet|occluded_packet|closest_in|any_in|closest_of_lane|closest_hit|any_hit'
+twinpath_traversal='SmallScene>::closest|SmallScene>::occluded|closest_packet|occluded_packet|closest_in|any_in|closest_of_lane|closest_hit|any_hit'
 mitsuba_traversal='Intersector|intersect16|occluded16|intersect8|occluded8|ray_intersect_preliminary_impl|ray_test_impl|embree_intersect|embree_occluded'
 rate=2000 # perf samples per CPU second
 
 printf "%-14s %-9s %9s %11s %11s %9s %11s %9s\n" scene renderer "rays/spl" "process s" \
     "travers. s" "share" "Mrays/cpu-s" "floor x" | tee "$out/floor.txt"
 for size in "${sizes[@]}"; do
-    if [[ $size == bunny* ]]; then
+    mesh=()
+    if [ "$size" = cornell ]; then
+        name=cornell
+        mkdir -p "$out/scenes"
+        cp scenes/cornell.toml "$out/scenes/cornell.toml"
+    elif [[ $size == bunny* ]]; then
         name=$(python3 scripts/bunny_scene.py "$out/scenes" "${size#bunny}")
     else
         python3 scripts/knot_scenes.py "$out/scenes" "$size" > /dev/null
         name=knot_$size
     fi
     scene=$out/scenes/$name.toml
-    ply=$out/scenes/$name.ply
+    [ "$name" = cornell ] || mesh=(--mesh "$out/scenes/$name.ply")
     perf record -q -e cpu-clock -F "$rate" -o "$out/$name.twinpath.perf" "$bin" render "$scene" \
         --backend cpu --spp "$spp" --width 256 --height 256 --quiet -o "$out/$name.twinpath.exr" \
         2> "$out/$name.twinpath.log"
@@ -56,7 +62,7 @@ for size in "${sizes[@]}"; do
     # Mitsuba's image is compared with twinpath's (only to satisfy --once; the error is unused).
     LD_PRELOAD=$shim DRJIT_LIBLLVM_PATH=$llvm perf record -q -e cpu-clock -F "$rate" \
         -o "$out/$name.mitsuba.perf" "$venv/bin/python" scripts/peer_mitsuba.py \
-        "$out/$name.twinpath.exr" "$out/$name.mitsuba.exr" --once "$spp" --mesh "$ply" \
+        "$out/$name.twinpath.exr" "$out/$name.mitsuba.exr" --once "$spp" "${mesh[@]}" \
         --sampler ldsampler > "$out/$name.mitsuba.log" 2>&1
     m_rays=$(awk '$1 == "samples" { n = $2 } $1 == "embree" { gsub(",", ""); r = $4 + $6 }
         END { printf "%.4f", r / n }' "$out/$name.mitsuba.log")
