@@ -291,8 +291,9 @@ fn memory_grows_linearly_with_the_triangle_count() {
 }
 
 /// `twinpath rays`' measurement on a small scene: the reported counts are those of the rays it
-/// made, and the ray file (what `scripts/embree_rays.c` reads) holds the scene's primitives,
-/// both ray sets, and for every ray exactly the hit the BVH finds.
+/// made (the paths' sets: the rays the renderer counts), and the ray file (what
+/// `scripts/embree_rays.c` reads) holds the scene's primitives, all four ray sets, and for every
+/// ray exactly the hit the BVH finds.
 #[test]
 fn ray_measurement_and_ray_file_hold_what_was_traced() {
     use twinpath::bench::rays::{add_knot_mesh, measure};
@@ -305,10 +306,32 @@ fn ray_measurement_and_ray_file_hold_what_was_traced() {
     let report = measure(&scene, 48, 32, 1, Some(&path)).unwrap();
     assert_eq!(report.triangles, scene.triangles.len());
     assert_eq!(report.spheres, scene.spheres.len());
-    assert_eq!(report.sets.len(), 2);
+    assert_eq!(report.sets.len(), 4);
     assert_eq!(report.sets[0].rays, 48 * 32);
     // One bounce ray per camera ray that hit.
     assert_eq!(report.sets[1].rays, report.sets[0].hits);
+    // The paths' rays are those the renderer counts at 1 spp of the same image.
+    let mut image = scene.clone();
+    (image.camera.width, image.camera.height, image.render.spp) = (48, 32, 1);
+    image.render.packets = false;
+    let rendered = twinpath::render::render(
+        &image,
+        &twinpath::render::RenderOptions {
+            backend: twinpath::render::Backend::Cpu,
+            device: None,
+            validation: false,
+            progress: false,
+            samples: None,
+        },
+    )
+    .unwrap()
+    .rays
+    .unwrap();
+    assert_eq!(
+        (report.sets[2].rays as u64, report.sets[3].rays as u64),
+        (rendered.closest, rendered.shadow)
+    );
+    assert!(report.sets[2].rays > report.sets[0].rays && report.sets[3].rays > 0);
     assert!(report
         .sets
         .iter()
@@ -328,7 +351,7 @@ fn ray_measurement_and_ray_file_hold_what_was_traced() {
     let (ntri, nsph, nsets) = (u32_at(take(4)), u32_at(take(4)), u32_at(take(4)));
     assert_eq!(
         (ntri as usize, nsph as usize, nsets),
-        (scene.triangles.len(), scene.spheres.len(), 2)
+        (scene.triangles.len(), scene.spheres.len(), 4)
     );
     for t in &scene.triangles {
         let v: Vec<f32> = (0..9).map(|_| f32_at(take(4))).collect();

@@ -1,18 +1,22 @@
 //! Ray throughput of the CPU traversal, on two ray sets with opposite coherence: the camera's
 //! rays (one per pixel centre, neighbours nearly parallel) and diffuse bounce rays (one
 //! cosine-distributed direction from each camera ray's hit, as a path tracer's second
-//! vertex shoots them). Both sets can be written to a file so another ray tracer (Embree, in
-//! `scripts/embree_rays.c`) traces exactly the same rays.
+//! vertex shoots them); and on the rays a render itself traces (one path per pixel: its
+//! extension rays and its shadow segments). Every set can be written to a file so another ray
+//! tracer (Embree, in `scripts/embree_rays.c`) traces exactly the same rays.
 
 use crate::cpu::bvh::Bvh;
 use crate::cpu::packet::{PacketTracer, RayPacket, SmallScene, LANES};
+use crate::cpu::{BvhTracer, CpuRenderer};
 use crate::scene::Scene;
 use glam::Vec3;
 use kernel::camera::{camera_origin, camera_ray_direction};
+use kernel::features::Dynamic;
 use kernel::geometry::offset_ray_origin;
 use kernel::rng::SampleRng;
 use kernel::sampling::sample_cosine_hemisphere;
 use kernel::scene::NONE;
+use kernel::{SurfaceHit, Tracer};
 use std::io::Write;
 use std::simd::Simd;
 use std::time::Instant;
@@ -308,8 +312,8 @@ pub struct RaySetReport {
     pub packets: Option<(f64, f64)>,
 }
 
-/// Builds the BVH over `scene` (timed), makes the camera rays of a `width` x `height` image and
-/// their diffuse bounces, and times closest-hit and any-hit traversal of each set on one
+/// Builds the BVH over `scene` (timed), makes the camera rays of a `width` x `height` image,
+/// their diffuse bounces and the rays of one path per pixel ([`path_rays`]), and times closest-hit and any-hit traversal of each set on one
 /// thread. With `ray_file`, also writes the rays and our hits for `scripts/embree_rays.c`.
 pub fn measure(
     scene: &Scene,
@@ -323,9 +327,10 @@ pub fn measure(
     let build_seconds = start.elapsed().as_secs_f64();
     let camera = camera_rays(scene, width, height);
     let bounce = bounce_rays(&bvh, &camera, scene.render.seed);
+    let (path_ext, path_shadow) = path_rays(scene, width, height);
     let mut sets = Vec::new();
     let mut results = Vec::new();
-    for rays in [&camera, &bounce] {
+    for rays in [&camera, &bounce, &path_ext, &path_shadow] {
         let found = trace_all(&bvh, rays);
         let closest = rays_per_second(rays, repeats, || {
             std::hint::black_box(trace_all(&bvh, rays));
@@ -355,7 +360,12 @@ pub fn measure(
         write_ray_file(
             path,
             &bvh,
-            &[(&camera, &results[0]), (&bounce, &results[1])],
+            &[
+                (&camera, &results[0]),
+                (&bounce, &results[1]),
+                (&path_ext, &results[2]),
+                (&path_shadow, &results[3]),
+            ],
         )?;
     }
     Ok(RayReport {
@@ -391,4 +401,64 @@ pub fn add_knot_mesh(scene: &mut Scene, n: usize) {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| scene.name.clone());
     scene.name = format!("{stem}+knot{}k", n / 1000);
+}
+
+/// The rays a render traces: one path per pixel of a `width` x `height` image of `scene`
+/// (sample 0, the scene's settings, the one-path loop), its extension rays (the camera ray
+/// first) and its shadow segments (from + t (to - from), t_max 1), each set ordered by depth,
+/// then pixel, so that sixteen consecutive rays are those of neighbouring pixels' paths at the
+/// same depth. Deeper bounces start anywhere in the scene, unlike [`bounce_rays`]'s from the
+/// camera's hits; this is the distribution the renderer's traversal meets.
+pub fn path_rays(scene: &Scene, width: u32, height: u32) -> (RaySet, RaySet) {
+    /// A tracer that records each ray with its path's depth and pixel, then traces it.
+    struct Recorder<'a> {
+        inner: BvhTracer<'a>,
+        key: (u32, u32),
+        extensions: Vec<((u32, u32), Vec3, Vec3)>,
+        shadows: Vec<((u32, u32), Vec3, Vec3)>,
+    }
+    impl Tracer for Recorder<'_> {
+        fn closest_hit(&mut self, origin: Vec3, dir: Vec3) -> SurfaceHit {
+            self.extensions.push((self.key, origin, dir));
+            self.key.0 += 1;
+            self.inner.closest_hit(origin, dir)
+        }
+        fn occluded(&mut self, from: Vec3, to: Vec3) -> bool {
+            self.shadows.push((self.key, from, to));
+            self.inner.occluded(from, to)
+        }
+    }
+    let mut sized = scene.clone();
+    sized.camera.width = width;
+    sized.camera.height = height;
+    let cpu = CpuRenderer::new(&sized);
+    let params = sized.params(0, 1);
+    let mut recorder = Recorder {
+        inner: BvhTracer::new(&cpu.bvh),
+        key: (0, 0),
+        extensions: Vec::new(),
+        shadows: Vec::new(),
+    };
+    for py in 0..height {
+        for px in 0..width {
+            recorder.key = (0, py * width + px);
+            cpu.sample_with(Dynamic(cpu.features), &mut recorder, &params, px, py, 0);
+        }
+    }
+    let set = |name, mut rays: Vec<((u32, u32), Vec3, Vec3)>, segments: bool| {
+        rays.sort_by_key(|r| r.0);
+        RaySet {
+            name,
+            origins: rays.iter().map(|r| r.1).collect(),
+            dirs: rays
+                .iter()
+                .map(|r| if segments { r.2 - r.1 } else { r.2 })
+                .collect(),
+            t_max: vec![if segments { 1.0 } else { f32::INFINITY }; rays.len()],
+        }
+    };
+    (
+        set("path extensions (render)", recorder.extensions, false),
+        set("path shadows (render)", recorder.shadows, true),
+    )
 }

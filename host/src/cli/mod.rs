@@ -40,8 +40,8 @@ enum Command {
     Diff(diff::DiffArgs),
     /// What this build contains: the SPIR-V module and the backends.
     Info,
-    /// Ray throughput of the CPU traversal on one thread (camera rays and diffuse bounce rays),
-    /// and the BVH's build time and memory.
+    /// Ray throughput of the CPU traversal on one thread (camera rays, diffuse bounce rays and the
+    /// rays of one path per pixel), and the BVH's build time and memory.
     Rays(rays::RaysArgs),
 }
 

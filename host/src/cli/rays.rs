@@ -6,9 +6,9 @@ use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
 
-/// Ray throughput of the CPU traversal on one thread (camera rays and diffuse bounce rays),
-/// one ray at a time and in packets of 16 as the renderer traces them, and the BVH's build time
-/// and memory.
+/// Ray throughput of the CPU traversal on one thread (camera rays, diffuse bounce rays and the
+/// rays of one path per pixel), one ray at a time and in packets of 16 as the renderer traces
+/// them, and the BVH's build time and memory.
 #[derive(Args)]
 pub struct RaysArgs {
     /// Scene file (TOML). Without it, the built-in Cornell scene.

@@ -187,11 +187,13 @@ impl CpuRenderer {
         with_features!(self.features, f => self.sample_with(f, &mut tracer, params, px, py, sample))
     }
 
+    /// [`Self::sample`] under `features` with its rays traced by `tracer` (which may record
+    /// them, as `bench::rays::path_rays` does, and must answer as the BVH does).
     #[inline]
-    fn sample_with<F: FeatureSet>(
+    pub fn sample_with<F: FeatureSet, T: Tracer>(
         &self,
         features: F,
-        tracer: &mut BvhTracer,
+        tracer: &mut T,
         params: &RenderParams,
         px: u32,
         py: u32,
