@@ -102,6 +102,16 @@ pub fn render_film(
     backend: twinpath::render::Backend,
     spp: u32,
 ) -> twinpath::film::Film {
+    render_output(scene, backend, spp).film
+}
+
+/// What [`render_film`]'s render produced: the film, and the rays where the backend counts
+/// them.
+pub fn render_output(
+    scene: &Scene,
+    backend: twinpath::render::Backend,
+    spp: u32,
+) -> twinpath::render::RenderOutput {
     let mut s = scene.clone();
     s.render.spp = spp;
     let opts = twinpath::render::RenderOptions {
@@ -114,7 +124,7 @@ pub fn render_film(
     let out = twinpath::render::render(&s, &opts).expect("render");
     assert_eq!(out.backend, backend);
     assert_eq!(out.spp_done, spp);
-    out.film
+    out
 }
 
 /// z of the difference between two images' overall means, each with the variance of its mean

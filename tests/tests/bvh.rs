@@ -312,21 +312,11 @@ fn ray_measurement_and_ray_file_hold_what_was_traced() {
     assert_eq!(report.sets[1].rays, report.sets[0].hits);
     // The paths' rays are those the renderer counts at 1 spp of the same image.
     let mut image = scene.clone();
-    (image.camera.width, image.camera.height, image.render.spp) = (48, 32, 1);
+    (image.camera.width, image.camera.height) = (48, 32);
     image.render.packets = false;
-    let rendered = twinpath::render::render(
-        &image,
-        &twinpath::render::RenderOptions {
-            backend: twinpath::render::Backend::Cpu,
-            device: None,
-            validation: false,
-            progress: false,
-            samples: None,
-        },
-    )
-    .unwrap()
-    .rays
-    .unwrap();
+    let rendered = twinpath_tests::render_output(&image, twinpath::render::Backend::Cpu, 1)
+        .rays
+        .unwrap();
     assert_eq!(
         (report.sets[2].rays as u64, report.sets[3].rays as u64),
         (rendered.closest, rendered.shadow)

@@ -10,9 +10,9 @@
 //!    path by path the same, so their counts are equal.
 
 use twinpath::backend::RayCounts;
-use twinpath::render::{render, Backend, RenderOptions};
+use twinpath::render::Backend;
 use twinpath::scene::Scene;
-use twinpath_tests::{scene_from_toml, with_independent_samples, z_critical};
+use twinpath_tests::{render_output, scene_from_toml, with_independent_samples, z_critical};
 
 const Q: f64 = 0.5;
 const SPP: u32 = 64;
@@ -31,16 +31,7 @@ fn closed_sphere(light: &str) -> Scene {
 
 /// Renders `scene` at `spp` on the CPU; its ray counts and sample count.
 fn rays_of(scene: &Scene, spp: u32) -> (RayCounts, u64) {
-    let mut s = scene.clone();
-    s.render.spp = spp;
-    let opts = RenderOptions {
-        backend: Backend::Cpu,
-        device: None,
-        validation: false,
-        progress: false,
-        samples: None,
-    };
-    let out = render(&s, &opts).expect("render");
+    let out = render_output(scene, Backend::Cpu, spp);
     let rays = out.rays.expect("the CPU backend counts rays");
     (rays, out.film.total_samples())
 }

@@ -313,8 +313,8 @@ pub struct RaySetReport {
 }
 
 /// Builds the BVH over `scene` (timed), makes the camera rays of a `width` x `height` image,
-/// their diffuse bounces and the rays of one path per pixel ([`path_rays`]), and times closest-hit and any-hit traversal of each set on one
-/// thread. With `ray_file`, also writes the rays and our hits for `scripts/embree_rays.c`.
+/// their diffuse bounces and the rays of one path per pixel ([`path_rays`]), and times
+/// closest-hit and any-hit traversal of each set on one thread. With `ray_file`, also writes the rays and our hits for `scripts/embree_rays.c`.
 pub fn measure(
     scene: &Scene,
     width: u32,
@@ -325,24 +325,26 @@ pub fn measure(
     let start = Instant::now();
     let bvh = Bvh::build_scene(scene);
     let build_seconds = start.elapsed().as_secs_f64();
+    let renderer = CpuRenderer::with_bvh(scene, bvh);
+    let bvh = &renderer.bvh;
     let camera = camera_rays(scene, width, height);
-    let bounce = bounce_rays(&bvh, &camera, scene.render.seed);
-    let (path_ext, path_shadow) = path_rays(scene, width, height);
+    let bounce = bounce_rays(bvh, &camera, scene.render.seed);
+    let (path_ext, path_shadow) = path_rays(&renderer, scene, width, height);
     let mut sets = Vec::new();
     let mut results = Vec::new();
     for rays in [&camera, &bounce, &path_ext, &path_shadow] {
-        let found = trace_all(&bvh, rays);
+        let found = trace_all(bvh, rays);
         let closest = rays_per_second(rays, repeats, || {
-            std::hint::black_box(trace_all(&bvh, rays));
+            std::hint::black_box(trace_all(bvh, rays));
         });
         let occluded = rays_per_second(rays, repeats, || {
-            std::hint::black_box(occluded_all(&bvh, rays));
+            std::hint::black_box(occluded_all(bvh, rays));
         });
         // The same rays sixteen at a time, as the renderer's packets trace them.
         let packets = if let Some(small) = SmallScene::if_small(&bvh.spheres, &bvh.triangles) {
             Some(packet_rates(&small, rays, repeats))
         } else if bvh.instances().is_empty() {
-            Some(packet_rates(&bvh, rays, repeats))
+            Some(packet_rates(bvh, rays, repeats))
         } else {
             None
         };
@@ -359,7 +361,7 @@ pub fn measure(
     if let Some(path) = ray_file {
         write_ray_file(
             path,
-            &bvh,
+            bvh,
             &[
                 (&camera, &results[0]),
                 (&bounce, &results[1]),
@@ -404,12 +406,12 @@ pub fn add_knot_mesh(scene: &mut Scene, n: usize) {
 }
 
 /// The rays a render traces: one path per pixel of a `width` x `height` image of `scene`
-/// (sample 0, the scene's settings, the one-path loop), its extension rays (the camera ray
+/// (sample 0, the scene's settings, the one-path loop of `cpu`, built over `scene`), its extension rays (the camera ray
 /// first) and its shadow segments (from + t (to - from), t_max 1), each set ordered by depth,
 /// then pixel, so that sixteen consecutive rays are those of neighbouring pixels' paths at the
 /// same depth. Deeper bounces start anywhere in the scene, unlike [`bounce_rays`]'s from the
 /// camera's hits; this is the distribution the renderer's traversal meets.
-pub fn path_rays(scene: &Scene, width: u32, height: u32) -> (RaySet, RaySet) {
+pub fn path_rays(cpu: &CpuRenderer, scene: &Scene, width: u32, height: u32) -> (RaySet, RaySet) {
     /// A tracer that records each ray with its path's depth and pixel, then traces it.
     struct Recorder<'a> {
         inner: BvhTracer<'a>,
@@ -428,10 +430,10 @@ pub fn path_rays(scene: &Scene, width: u32, height: u32) -> (RaySet, RaySet) {
             self.inner.occluded(from, to)
         }
     }
+    // The image size only changes the camera, i.e. the parameters, not the renderer's tables.
     let mut sized = scene.clone();
     sized.camera.width = width;
     sized.camera.height = height;
-    let cpu = CpuRenderer::new(&sized);
     let params = sized.params(0, 1);
     let mut recorder = Recorder {
         inner: BvhTracer::new(&cpu.bvh),

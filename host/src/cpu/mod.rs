@@ -160,7 +160,12 @@ impl CpuRenderer {
     /// scene without instances, the packets' copy of its primitives), and picks the
     /// [`TileStrategy`].
     pub fn new(scene: &Scene) -> Self {
-        let bvh = Bvh::build_scene(scene);
+        Self::with_bvh(scene, Bvh::build_scene(scene))
+    }
+
+    /// [`Self::new`] over `bvh`, already built over `scene` by [`Bvh::build_scene`] (for
+    /// `bench::rays`, which times the build apart).
+    pub fn with_bvh(scene: &Scene, bvh: Bvh) -> Self {
         // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).
         let tiles = if !(scene.render.packets && scene.instances.is_empty()) {
             TileStrategy::OnePath

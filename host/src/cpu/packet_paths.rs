@@ -110,16 +110,17 @@ impl CpuRenderer {
             }
             let [(extension, ext_t_max), (shadow, shadow_t_max)] = gather(&slots);
             let lanes = |t_max: &[f32; LANES]| t_max.iter().filter(|&&t| t > 0.0).count() as u64;
-            rays.closest += lanes(&ext_t_max);
-            rays.shadow += lanes(&shadow_t_max);
-            let (prims, ts, us, vs) = if ext_t_max.iter().any(|&t| t > 0.0) {
+            let (extensions, shadows) = (lanes(&ext_t_max), lanes(&shadow_t_max));
+            rays.closest += extensions;
+            rays.shadow += shadows;
+            let (prims, ts, us, vs) = if extensions > 0 {
                 let h = tracer.closest_hits(&extension, Simd::from_array(ext_t_max));
                 let a = |x: Simd<f32, LANES>| x.to_array();
                 (h.prim.to_array(), a(h.t), a(h.u), a(h.v))
             } else {
                 ([NONE; LANES], [0.0; LANES], [0.0; LANES], [0.0; LANES])
             };
-            let occluded = if shadow_t_max.iter().any(|&t| t > 0.0) {
+            let occluded = if shadows > 0 {
                 tracer
                     .occluded_lanes(&shadow, Simd::from_array(shadow_t_max))
                     .to_array()
