@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Mitsuba 3 on the Cornell scene: time against error, in the CSV columns of `twinpath bench`.
 
-Builds the scene of ../shared/reference/cornell_spheres/scene.md with mi.load_dict (the same
+Builds the scene of tests/reference/cornell_spheres/scene.md with mi.load_dict (the same
 numbers as scenes/cornell.toml), renders it at 1, 2, 4, ... spp with the `path` integrator
 (max_depth -1, rr_depth 5, independent sampler), several seeds per point at low spp, and
 measures render seconds (mi.render plus the evaluation of the image) and relMSE / RMSE against

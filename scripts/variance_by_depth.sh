@@ -7,4 +7,4 @@ cd "$(dirname "$0")/.."
 source scripts/mitsuba_venv.sh
 cargo build -q -p twinpath
 "$venv/bin/python" scripts/variance_by_depth.py target/debug/twinpath \
-    ../shared/reference/cornell_spheres/mitsuba_ref.exr "${1:-16}"
+    tests/reference/cornell_spheres/mitsuba_ref.exr "${1:-16}"

@@ -1,5 +1,5 @@
 //! Agreement with an independent renderer: `scenes/cornell.toml` against Mitsuba 3's converged
-//! render of the same scene (../shared/reference/cornell_spheres, 13312 spp), and
+//! render of the same scene (tests/reference/cornell_spheres, 13312 spp), and
 //! `scenes/cornell_materials.toml` (a rough gold and a glass sphere) against Mitsuba's
 //! `roughconductor` and `dielectric` (tests/reference/cornell_materials, 8192 spp, rendered by
 //! `scripts/mitsuba_reference.sh cornell_materials`). Both estimators are unbiased, so the
@@ -20,7 +20,7 @@ const BATCHES: u32 = 16;
 fn cornell_agrees_with_mitsuba_reference() {
     agrees_with_mitsuba(
         "scenes/cornell.toml",
-        &repo_root().join("../shared/reference/cornell_spheres"),
+        &repo_root().join("tests/reference/cornell_spheres"),
     );
 }
 
