@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs everything twinpath needs on Debian 12 (idempotent):
-#   - the pinned nightly toolchain rust-gpu 0.11 needs, with its components (rustup);
+#   - the pinned nightly toolchain (rustup) with rustfmt and clippy; with --kernel-from-source
+#     also rust-src, rustc-dev and llvm-tools, which rust-gpu needs to compile the kernel to
+#     SPIR-V (scripts/build_kernel.sh; a plain build runs the shipped module and needs neither);
 #   - Vulkan loader, lavapipe (Mesa 25 from bookworm-backports, for the GPU backend without a GPU),
 #     vulkan-tools, validation layers, spirv-tools (spirv-val), DejaVu fonts (bench plot text).
 # Apt steps run only as root or via sudo; they are skipped when everything is already installed.
@@ -8,13 +10,19 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 TOOLCHAIN=$(sed -n 's/^channel *= *"\(.*\)"/\1/p' rust-toolchain.toml)
+components=(rustfmt clippy)
+[ "${1:-}" = --kernel-from-source ] && components+=(rust-src rustc-dev llvm-tools)
 if ! rustup toolchain list | grep -q "^${TOOLCHAIN}"; then
-  echo "setup: installing Rust toolchain ${TOOLCHAIN}" >&2
-  rustup toolchain install "${TOOLCHAIN}" --profile minimal \
-    -c rust-src -c rustc-dev -c llvm-tools -c rustfmt -c clippy
+  echo "setup: installing Rust toolchain ${TOOLCHAIN} (${components[*]})" >&2
+  rustup toolchain install "${TOOLCHAIN}" --profile minimal "${components[@]/#/-c}"
 else
-  # make sure components are present (fast no-op when they are)
-  rustup component add --toolchain "${TOOLCHAIN}" rust-src rustc-dev llvm-tools rustfmt clippy >/dev/null 2>&1 || true
+  installed=$(rustup component list --toolchain "${TOOLCHAIN}" --installed)
+  for c in "${components[@]}"; do
+    if ! grep -q "^$c" <<<"$installed"; then
+      echo "setup: adding $c to ${TOOLCHAIN}" >&2
+      rustup component add --toolchain "${TOOLCHAIN}" "$c"
+    fi
+  done
 fi
 
 need_pkgs=()

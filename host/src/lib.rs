@@ -20,6 +20,12 @@ pub mod settings;
 #[cfg(feature = "gpu")]
 pub mod vulkan;
 
-/// The SPIR-V module rust-gpu compiled from `kernel/` at build time (host/build.rs).
+/// The kernel's SPIR-V module: the shipped `kernel/shipped/kernel.spv`, whose manifest the build
+/// checked against the kernel's sources, or with the feature `kernel-from-source` the module
+/// rust-gpu compiled at build time (host/build.rs).
 #[cfg(feature = "gpu")]
 pub const KERNEL_SPV: &[u8] = include_bytes!(env!("kernel.spv"));
+
+/// Where [`KERNEL_SPV`] came from, in words (shipped, or compiled from source).
+#[cfg(feature = "gpu")]
+pub const KERNEL_ORIGIN: &str = env!("TWINPATH_KERNEL_ORIGIN");

@@ -6,8 +6,9 @@ use anyhow::Result;
 pub fn run() -> Result<()> {
     println!("twinpath {}", env!("CARGO_PKG_VERSION"));
     println!(
-        "kernel SPIR-V module: {} bytes (compiled by rust-gpu at build time)",
-        twinpath::KERNEL_SPV.len()
+        "kernel SPIR-V module: {} bytes, {}",
+        twinpath::KERNEL_SPV.len(),
+        twinpath::KERNEL_ORIGIN
     );
     println!("cpu backend: {} threads", rayon::current_num_threads());
     match twinpath::vulkan::device::list_devices() {
