@@ -2,8 +2,9 @@
 # Runs every twinpath test: installs what is missing (scripts/setup.sh), then formatting,
 # clippy (warnings are errors), the whole test suite (samplers, closed-form scenes, the Mitsuba
 # comparison, CPU-vs-GPU equivalence on lavapipe, numerical robustness, scene errors, the SPIR-V
-# module, render parts and their merge), the Slurm scripts on a one-node cluster, and a bounded
-# fuzzing run of the scene and mesh parsers.
+# module and the shipped module's manifest, render parts and their merge), and the Slurm scripts on
+# a one-node cluster. CI (.ci/run) adds a bounded fuzzing run of the parsers (scripts/fuzz.sh) and
+# the byte-for-byte check of the shipped kernel module (scripts/build_kernel.sh --check).
 # One build profile (dev, optimised) serves tests and renders alike.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,7 +15,5 @@ mkdir -p target
 cargo test --workspace -- --nocapture "$@" 2>&1 | tee target/test.log
 # The Slurm job-array scripts on a one-node Slurm cluster started for the test (scripts/slurm/).
 bash scripts/slurm/test_cluster.sh target/debug/twinpath 2>&1 | tee -a target/test.log
-# libFuzzer on the scene parser, the mesh loaders and the glTF loader, 60 s each (cargo-fuzz; see scripts/fuzz.sh).
-bash scripts/fuzz.sh 60
 # One closing line with the totals of every cargo test binary above.
 awk '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p, f }' target/test.log
