@@ -246,13 +246,20 @@ pub fn check_shipped(root: &Path) -> Result<Manifest, Error> {
     let manifest_path = root.join(MANIFEST_PATH);
     let shipped = Manifest::parse(&read_text(&manifest_path)?, &manifest_path)?;
     let now = Manifest::describe(root, &module)?;
-    let mut differences = now.differences(&shipped);
-    if let Some(i) = differences.iter().position(|d| d.contains("module_blake3")) {
-        differences[i] = format!(
+    let mut differences = Vec::new();
+    if now.build.get("module_blake3") != shipped.build.get("module_blake3") {
+        differences.push(format!(
             "{MODULE_PATH} is not the module the manifest describes (its BLAKE3 hash differs)"
-        );
+        ));
     }
-    differences.retain(|d| !d.contains("module_bytes"));
+    // The module's own hash and size are compared above; what remains are its inputs.
+    let inputs = |m: &Manifest| {
+        let mut m = m.clone();
+        m.build.remove("module_blake3");
+        m.build.remove("module_bytes");
+        m
+    };
+    differences.extend(inputs(&now).differences(&inputs(&shipped)));
     if differences.is_empty() {
         Ok(shipped)
     } else {
