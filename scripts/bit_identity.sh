@@ -1,15 +1,23 @@
 #!/usr/bin/env bash
-# Renders the diffuse scenes in five configurations with two twinpath binaries and compares the
-# EXRs byte for byte: the check that a change leaves scenes without its feature exactly as they
-# were (docs/design.md, "Skip what a scene doesn't need").
-#   scripts/bit_identity.sh OLD_BINARY NEW_BINARY [OUT_DIR]
+# Renders scenes in five configurations with two twinpath binaries and compares the EXRs byte
+# for byte: the check that a change leaves scenes without its feature exactly as they were
+# (docs/design.md, "Skip what a scene doesn't need"), or that a refactoring changed no image.
+#   scripts/bit_identity.sh OLD_BINARY NEW_BINARY [OUT_DIR [SCENE...]]
+# SCENE is a name in scenes/ without .toml; the default is every scene there.
 # Run from the repository root; the GPU configuration needs a Vulkan ray-tracing device
 # (lavapipe here).
 set -euo pipefail
 old=$1
 new=$2
 out=${3:-target/bit_identity}
+shift $(( $# < 3 ? $# : 3 ))
 mkdir -p "$out"
+if [ $# -gt 0 ]; then
+  scenes=("$@")
+else
+  scenes=()
+  for f in scenes/*.toml; do scenes+=("$(basename "$f" .toml)"); done
+fi
 configs=(
   "cpu16:--backend cpu --spp 16"
   "onepath:--backend cpu --spp 16 --set packets=false"
@@ -18,7 +26,7 @@ configs=(
   "gpu4:--backend gpu --spp 4"
 )
 differ=0
-for scene in cornell many_lights meshes sky_meshes; do
+for scene in "${scenes[@]}"; do
   for config in "${configs[@]}"; do
     name=${config%%:*}
     args=${config#*:}

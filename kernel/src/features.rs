@@ -8,8 +8,7 @@
 //! answer is the same (`scene_features` derives both from the same parameters).
 
 use crate::scene::{
-    light_kind, light_sampling, material_kind, mis, roulette, texture_slot, Light, Material,
-    RenderParams, ShadingTriangle, NONE,
+    light_sampling, mis, roulette, texture_slot, Material, RenderParams, ShadingTriangle, NONE,
 };
 
 /// The bits are answers fixed before the render; without it, they are ignored.
@@ -58,38 +57,6 @@ pub const NORMAL_MAPS: u32 = 1 << 17;
 /// The scene has instances (`scene::Instance`): a hit may carry object-space shading records
 /// whose normals and tangents `surface::shade` maps to world space.
 pub const INSTANCES: u32 = 1 << 18;
-
-/// The material bits of a scene with these materials: one per kind present besides the
-/// Lambertian. (A bit may also be set for a kind that is absent: it only keeps that kind's
-/// code, which the material's own `kind` then skips.)
-#[inline]
-pub fn material_features(materials: &[Material]) -> u32 {
-    let mut f = 0;
-    for m in materials {
-        f |= match m.kind {
-            material_kind::GLOSSY => GLOSSY,
-            material_kind::CONDUCTOR => CONDUCTOR,
-            material_kind::DIELECTRIC => DIELECTRIC,
-            material_kind::METALLIC_ROUGHNESS => GLOSSY | METALLIC_ROUGHNESS,
-            _ => 0,
-        };
-    }
-    f
-}
-
-/// The light bits of a scene with these lights: [`TRIANGLE_LIGHTS`] if any is a triangle,
-/// [`PUNCTUAL_LIGHTS`] if any is a point or spot light.
-#[inline]
-pub fn light_features(lights: &[Light]) -> u32 {
-    let mut f = 0;
-    if lights.iter().any(|l| l.kind == light_kind::TRIANGLE) {
-        f |= TRIANGLE_LIGHTS;
-    }
-    if lights.iter().any(|l| l.kind == light_kind::PUNCTUAL) {
-        f |= PUNCTUAL_LIGHTS;
-    }
-    f
-}
 
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
 /// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals,
@@ -154,6 +121,12 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn specialized(self) -> bool {
         self.bits() & SPECIALIZED != 0
+    }
+    /// Whether every bit of `bits` may be set (a kind's `FEATURES`, `crate::bsdf`); always
+    /// without [`SPECIALIZED`].
+    #[inline]
+    fn has_all(self, bits: u32) -> bool {
+        !self.specialized() || self.bits() & bits == bits
     }
     #[inline]
     fn answer(self, bit: u32, run_time: bool) -> bool {

@@ -9,26 +9,25 @@
 #![cfg_attr(not(target_arch = "spirv"), feature(portable_simd))]
 
 pub mod adaptive;
-pub mod brdf;
 pub mod bsdf;
 pub mod camera;
 pub mod environment;
 pub mod features;
 pub mod film_sample;
 pub mod frame;
-pub mod fresnel;
 pub mod geometry;
 pub mod hash;
+pub mod hit;
 pub mod instance;
 pub mod intersect;
 pub mod light;
-pub mod microfacet;
 pub mod path;
 pub mod probe;
 pub mod real;
 pub mod rng;
 pub mod sampling;
 pub mod scene;
+pub mod scene_view;
 #[cfg(target_arch = "spirv")]
 pub mod shaders;
 pub mod sobol;
@@ -39,7 +38,9 @@ pub mod turns;
 pub mod vertex_samples;
 pub mod word;
 
-pub use path::{trace_path, SurfaceHit, Tracer};
+pub use hit::SurfaceHit;
+pub use path::{trace_path, Tracer};
+pub use scene_view::SceneView;
 pub use spirv_std::glam;
 
 /// `f32` methods (sqrt, sin, ...) on the GPU come from this trait; natively they are inherent.

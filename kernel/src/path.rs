@@ -2,189 +2,21 @@
 //! generic over how rays meet the scene ([`Tracer`]).
 
 use crate::adaptive::sample_stream;
-use crate::brdf::{eval_scattering, pdf_brdf, sampled_brdf_weight};
+use crate::bsdf::lambert::{eval_scattering, pdf_brdf, sampled_brdf_weight};
 use crate::bsdf::{self, DELTA_PDF};
 use crate::camera::{camera_origin, camera_ray_direction, lens_radius, thin_lens_ray};
 use crate::environment;
 use crate::features::FeatureSet;
-use crate::geometry::{
-    offset_ray_origin, reproject_to_sphere, shadow_ray_end, sphere_point_error, triangle_point,
-    triangle_point_error_conditioned, TriangleShape,
-};
-use crate::instance::{normal_to_world, point_to_world, world_point_error};
-use crate::light::{
-    emission_texture_at, eval_radiance, is_punctual, light_point_error, pdf_environment_light,
-    pdf_light_from, punctual_radiance, sample_radiance, DirectionalLightSample,
-};
+use crate::geometry::{offset_ray_origin, shadow_ray_end};
+use crate::hit::SurfaceHit;
+use crate::light::{self, eval_radiance, LightKinds, LightSample};
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
-use crate::scene::{
-    light_sampling, material_kind, mis, Instance, Light, Material, RenderParams, ShadingTriangle,
-    Sphere, Triangle, NONE,
-};
+use crate::scene::{light_sampling, mis, Light, Material, RenderParams, NONE};
+use crate::scene_view::SceneView;
 use crate::surface::{emission_at, shade};
 use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION, LENS_DIMENSION};
-use spirv_std::glam::{Vec2, Vec3};
-
-/// Where a ray meets the scene first. `t < 0` means it met nothing.
-#[derive(Clone, Copy, Debug)]
-pub struct SurfaceHit {
-    pub position: Vec3,
-    /// Ray parameter of the hit (in units of the ray's direction), negative for a miss.
-    pub t: f32,
-    /// Unit geometric normal: outward for spheres, edge1 x edge2 for triangles.
-    pub normal: Vec3,
-    /// Index into the material table.
-    pub material: u32,
-    /// Index into the light table if the surface is a light, else [`NONE`].
-    pub light: u32,
-    /// Absolute bound on the rounding error of `position` (per component), which sizes the
-    /// offset of rays leaving it (`geometry::offset_ray_origin`).
-    pub error: f32,
-    /// Whether the ray arrived from the side `normal` points away from (a sphere's inside, a
-    /// triangle's back). Decided where the record is made, and robustly for spheres: by which
-    /// side of the sphere the ray's origin lies on, not by the sign of `normal . dir`, which
-    /// rounding flips at grazing hits (a grazing ray would otherwise leave inward and be
-    /// trapped inside the sphere).
-    pub arrived_behind: bool,
-    /// A triangle's index into the shading table (`Triangle::shading`), else [`NONE`].
-    pub shading: u32,
-    /// A triangle's barycentrics (u, v) of p1 and p2 at the hit.
-    pub barycentrics: Vec2,
-    /// The instance (`scene::Instance`) whose mesh the triangle belongs to, else [`NONE`]
-    /// (the triangle is in world space): its shading record is then in object space.
-    pub instance: u32,
-}
-
-impl SurfaceHit {
-    /// The record of a ray that left the scene.
-    #[inline]
-    pub fn miss() -> Self {
-        Self {
-            position: Vec3::ZERO,
-            t: -1.0,
-            normal: Vec3::ZERO,
-            material: NONE,
-            light: NONE,
-            error: 0.0,
-            arrived_behind: false,
-            shading: NONE,
-            barycentrics: Vec2::ZERO,
-            instance: NONE,
-        }
-    }
-
-    /// The record of ray `origin + t dir` meeting `sphere` at `t`: the
-    /// point re-projected onto the surface, the outward normal, the point's error bound, and
-    /// the side the ray came from (the side its origin is on: exact geometry for a convex
-    /// surface, and a sign that holds at grazing hits). Both backends build sphere hits here.
-    #[inline]
-    pub fn sphere(origin: Vec3, dir: Vec3, t: f32, sphere: &Sphere) -> Self {
-        let (center, radius) = (Vec3::from(sphere.center), sphere.radius);
-        let position = reproject_to_sphere(origin + t * dir, center, radius);
-        let from_center = origin - center;
-        Self {
-            position,
-            t,
-            normal: (position - center) / radius,
-            material: sphere.material,
-            light: sphere.light,
-            error: sphere_point_error(center, radius),
-            arrived_behind: from_center.dot(from_center) < radius * radius,
-            shading: NONE,
-            barycentrics: Vec2::ZERO,
-            instance: NONE,
-        }
-    }
-
-    /// The record of a ray along `dir` meeting triangle `tri` (of shape `shape`) at `t`, at
-    /// barycentric (u, v): the point from the barycentrics (`triangle_point`: on the plane up to
-    /// a few roundings, whatever t's error), the geometric normal edge1 x edge2, the point's
-    /// error bound, and the side by the sign of `normal . dir`. Both backends build triangle
-    /// hits here.
-    #[inline]
-    pub fn triangle(
-        tri: &Triangle,
-        shape: TriangleShape,
-        dir: Vec3,
-        t: f32,
-        u: f32,
-        v: f32,
-    ) -> Self {
-        let (p0, e1, e2) = (
-            Vec3::from(tri.p0),
-            Vec3::from(tri.edge1),
-            Vec3::from(tri.edge2),
-        );
-        Self {
-            position: triangle_point(p0, e1, e2, u, v),
-            t,
-            normal: shape.normal,
-            material: tri.material,
-            light: tri.light,
-            error: triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition),
-            arrived_behind: Self::behind_plane(shape.normal, dir),
-            shading: tri.shading,
-            barycentrics: Vec2::new(u, v),
-            instance: NONE,
-        }
-    }
-
-    /// The record of a ray along world direction `dir` meeting triangle `tri` (object space, of
-    /// shape `shape`) of instance `instance` (number `index`) at `t`, barycentric (u, v): the
-    /// object-space record of [`SurfaceHit::triangle`] with its point mapped to world space, the
-    /// geometric normal M^-T (edge1 x edge2) normalised (along the edge cross product of the
-    /// same triangle flattened into world space, whose winding a mirroring transform reverses),
-    /// the world point's error bound (`instance::world_point_error`), and the side by the sign
-    /// of `normal . dir`. Barycentrics and the shading record stay the object-space triangle's
-    /// (an affine map keeps barycentrics). Both backends build instanced hits here.
-    #[inline]
-    #[allow(clippy::too_many_arguments)]
-    pub fn instanced_triangle(
-        tri: &Triangle,
-        shape: TriangleShape,
-        instance: &Instance,
-        index: u32,
-        dir: Vec3,
-        t: f32,
-        u: f32,
-        v: f32,
-    ) -> Self {
-        let object = Self::triangle(tri, shape, dir, t, u, v);
-        let position = point_to_world(instance, object.position);
-        let normal = normal_to_world(instance, shape.normal).normalize();
-        Self {
-            position,
-            normal,
-            error: world_point_error(instance, object.position, object.error, position),
-            arrived_behind: Self::behind_plane(normal, dir),
-            instance: index,
-            ..object
-        }
-    }
-
-    /// Whether a ray along `dir` meets a flat surface of unit normal `normal` from behind.
-    #[inline]
-    pub fn behind_plane(normal: Vec3, dir: Vec3) -> bool {
-        normal.dot(-dir) < 0.0
-    }
-
-    /// The normal on the side the ray arrived from, which light leaving toward the ray's
-    /// origin leaves from (surfaces are two-sided): the `n` of a vertex's BRDF.
-    #[inline]
-    pub fn facing_normal(&self) -> Vec3 {
-        if self.arrived_behind {
-            -self.normal
-        } else {
-            self.normal
-        }
-    }
-
-    #[inline]
-    pub fn is_hit(&self) -> bool {
-        self.t >= 0.0
-    }
-}
+use spirv_std::glam::Vec3;
 
 /// How the kernel meets the scene: the GPU implements it with `trace_ray` on an acceleration
 /// structure, the CPU with a BVH. Both must return the same surfaces for the same rays.
@@ -252,32 +84,15 @@ pub trait Tracer {
 /// backend can trace many paths' rays together (the CPU's packets); this function runs one
 /// path to its end ([`PathState::run`], the GPU's way).
 #[inline]
-#[allow(clippy::too_many_arguments)]
 pub fn trace_path<T: Tracer, F: FeatureSet>(
     tracer: &mut T,
     features: F,
-    params: &RenderParams,
-    materials: &[Material],
-    lights: &[Light],
-    environment: &[f32],
-    shading: &[ShadingTriangle],
-    textures: &[u32],
-    instances: &[Instance],
+    scene: &SceneView,
     origin: Vec3,
     dir: Vec3,
     rng: &mut SampleRng,
 ) -> Vec3 {
-    let path = PathState::new(origin, dir, *rng).run(
-        tracer,
-        features,
-        params,
-        materials,
-        lights,
-        environment,
-        shading,
-        textures,
-        instances,
-    );
+    let path = PathState::new(origin, dir, *rng).run(tracer, features, scene);
     *rng = path.rng;
     path.radiance
 }
@@ -322,6 +137,14 @@ pub struct PathState {
     pub rng: SampleRng,
 }
 
+/// A vertex a path reached ([`PathState::arrival`]): its surface there (textures applied,
+/// resolved for its BSDF: `surface::shade`) and what it will draw.
+#[derive(Clone, Copy, Debug)]
+pub struct Arrival {
+    pub material: Material,
+    pub query: VertexQuery,
+}
+
 impl PathState {
     /// A path whose camera ray `origin + t dir` is to be traced; `rng` is past the camera's
     /// dimensions.
@@ -352,20 +175,16 @@ impl PathState {
     }
 
     /// Runs the path to its end, one ray cast at a time through `tracer`; the result is in
-    /// `radiance` of the returned (finished) state.
+    /// `radiance` of the returned (finished) state. Each round is one step of the protocol the
+    /// CPU's packets also follow: trace the waiting rays, [`PathState::advance`] with their
+    /// answers, and if that reached a vertex, its [`PathState::arrival`], the vertex's
+    /// samples (here drawn from the path's own stream), and [`PathState::leave`].
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     pub fn run<T: Tracer, F: FeatureSet>(
         mut self,
         tracer: &mut T,
         features: F,
-        params: &RenderParams,
-        materials: &[Material],
-        lights: &[Light],
-        environment: &[f32],
-        shading: &[ShadingTriangle],
-        textures: &[u32],
-        instances: &[Instance],
+        scene: &SceneView,
     ) -> Self {
         loop {
             let hit = if self.extend {
@@ -374,47 +193,51 @@ impl PathState {
                 SurfaceHit::miss()
             };
             let occluded = self.shadow && tracer.occluded(self.shadow_from, self.shadow_to);
-            if self.advance(
-                features,
-                params,
-                materials,
-                lights,
-                environment,
-                shading,
-                textures,
-                &hit,
-                occluded,
-            ) {
-                let (material, shading_normal) = shade(
-                    features,
-                    hit.material,
-                    hit.shading,
-                    hit.barycentrics,
-                    hit.normal,
-                    hit.instance,
-                    materials,
-                    shading,
-                    textures,
-                    instances,
-                );
-                let query = self.vertex_query(features, params, &hit, &material, shading_normal);
-                let samples = VertexSamples::draw(&query, &mut self.rng);
-                self.vertex(
-                    features,
-                    params,
-                    lights,
-                    environment,
-                    textures,
-                    &hit,
-                    &material,
-                    &query,
-                    &samples,
-                );
+            if self.advance(features, scene, &hit, occluded) {
+                let arrival = self.arrival(features, scene, &hit);
+                let samples = VertexSamples::draw(&arrival.query, &mut self.rng);
+                self.leave(features, scene, &hit, &arrival, &samples);
             }
             if self.finished() {
                 return self;
             }
         }
+    }
+
+    /// The vertex [`PathState::advance`] reached at `hit`: its surface (`surface::shade`) and
+    /// what it will draw ([`PathState::vertex_query`]). The caller fills that query's samples
+    /// and hands both to [`PathState::leave`].
+    #[inline]
+    pub fn arrival<F: FeatureSet>(
+        &self,
+        features: F,
+        scene: &SceneView,
+        hit: &SurfaceHit,
+    ) -> Arrival {
+        let (material, shading_normal) = shade(features, scene, hit);
+        let query = self.vertex_query(features, scene.params, hit, &material, shading_normal);
+        Arrival { material, query }
+    }
+
+    /// The last part of a step: the vertex of `arrival` (the [`PathState::arrival`] at `hit`)
+    /// with its samples filled ([`PathState::vertex`]).
+    #[inline]
+    pub fn leave<F: FeatureSet>(
+        &mut self,
+        features: F,
+        scene: &SceneView,
+        hit: &SurfaceHit,
+        arrival: &Arrival,
+        samples: &VertexSamples,
+    ) {
+        self.vertex(
+            features,
+            scene,
+            hit,
+            &arrival.material,
+            &arrival.query,
+            samples,
+        );
     }
 
     /// Takes the answers to this round's rays: `hit`, the closest hit of the extension ray
@@ -424,19 +247,14 @@ impl PathState {
     /// states its query ([`PathState::vertex_query`]), fills its samples and hands them to
     /// [`PathState::vertex`], which prepares the next rays.
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     pub fn advance<F: FeatureSet>(
         &mut self,
         features: F,
-        params: &RenderParams,
-        materials: &[Material],
-        lights: &[Light],
-        environment: &[f32],
-        shading: &[ShadingTriangle],
-        textures: &[u32],
+        scene: &SceneView,
         hit: &SurfaceHit,
         occluded: bool,
     ) -> bool {
+        let (params, lights, environment) = (scene.params, scene.lights, scene.environment);
         if self.shadow && !occluded {
             self.radiance += self.shadow_radiance;
         }
@@ -453,11 +271,10 @@ impl PathState {
                 if self.depth == 0 {
                     self.radiance = emitted;
                 } else {
-                    let pdf_l = pdf_environment_light(
+                    let pdf_l = light::environment::pdf(
                         &lights[params.env_light as usize],
                         light_sampling_of(features, params),
-                        params,
-                        environment,
+                        scene,
                         self.ray_dir,
                     );
                     let weight = self.found_light_weight(features, params, pdf_l);
@@ -474,26 +291,19 @@ impl PathState {
             return false;
         }
         if hit.light != NONE {
-            let material = &materials[hit.material as usize];
+            let material = &scene.materials[hit.material as usize];
             let two_sided = features.triangle_lights() && lights[hit.light as usize].two_sided != 0;
-            let emission = emission_at(
-                features,
-                material,
-                hit.shading,
-                hit.barycentrics,
-                shading,
-                textures,
-            );
+            let emission = emission_at(features, scene, material, hit);
             let emitted = eval_radiance(emission, hit.arrived_behind, two_sided);
             if self.depth == 0 {
                 // 1: a light seen directly (it reflects nothing, so the path ends).
                 self.radiance = emitted;
             } else {
                 // 2(b): the extension found a light.
-                let pdf_l = pdf_light_from(
+                let pdf_l = light::pdf(
                     lights,
+                    LightKinds::of(features, params),
                     light_sampling_of(features, params),
-                    features.triangle_lights(),
                     hit.light,
                     self.previous_vertex,
                     hit.position,
@@ -521,11 +331,12 @@ impl PathState {
         material: &Material,
         shading_normal: Vec3,
     ) -> VertexQuery {
-        let lambertian = !features.materials() || material.kind == material_kind::DIFFUSE;
+        let lambertian = !features.materials() || bsdf::is_lambertian(material);
+        let flags = bsdf::flags(material);
         let reflects = if lambertian {
             Vec3::from(material.albedo).max_element() > 0.0
         } else {
-            !bsdf::is_delta(material)
+            !flags.delta
         };
         let light_count = if !(features.lights(params) && reflects)
             || features.mis_mode(params) == mis::BSDF_ONLY
@@ -562,14 +373,12 @@ impl PathState {
             smooth,
             light_count,
             mode: light_sampling_of(features, params),
-            triangle_lights: features.triangle_lights(),
-            environment_light: features.environment(params),
-            punctual_lights: features.punctual_lights(),
+            light_kinds: LightKinds::of(features, params),
             extend: self.depth < params.max_depth,
             roulette: self.depth >= params.rr_start_depth,
             survival,
             lambertian,
-            chooses_lobe: !lambertian && bsdf::chooses_lobe(material),
+            chooses_lobe: !lambertian && flags.chooses_lobe,
         }
     }
 
@@ -579,61 +388,34 @@ impl PathState {
     /// path ends here, the extension. A Lambertian vertex runs the diffuse renderer's exact
     /// arithmetic; any other material, its BSDF (`crate::bsdf`).
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     pub fn vertex<F: FeatureSet>(
         &mut self,
         features: F,
-        params: &RenderParams,
-        lights: &[Light],
-        environment: &[f32],
-        textures: &[u32],
+        scene: &SceneView,
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
         samples: &VertexSamples,
     ) {
         if query.lambertian {
-            self.lambertian_vertex(
-                features,
-                params,
-                lights,
-                environment,
-                textures,
-                hit,
-                material,
-                query,
-                samples,
-            );
+            self.lambertian_vertex(features, scene, hit, material, query, samples);
         } else {
-            self.bsdf_vertex(
-                features,
-                params,
-                lights,
-                environment,
-                textures,
-                hit,
-                material,
-                query,
-                samples,
-            );
+            self.bsdf_vertex(features, scene, hit, material, query, samples);
         }
     }
 
     /// [`PathState::vertex`] on a Lambertian surface.
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     fn lambertian_vertex<F: FeatureSet>(
         &mut self,
         features: F,
-        params: &RenderParams,
-        lights: &[Light],
-        environment: &[f32],
-        textures: &[u32],
+        scene: &SceneView,
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
         samples: &VertexSamples,
     ) {
+        let (params, lights) = (scene.params, scene.lights);
         let (x, n, ng) = (query.x, query.n, query.ng);
         let albedo = Vec3::from(material.albedo);
         let ray_origin = offset_ray_origin(x, ng, hit.error);
@@ -643,7 +425,7 @@ impl PathState {
 
         // 2(a): next-event estimation.
         if query.samples_light() {
-            let ls = samples.light_sample(query, params, lights, environment);
+            let ls = samples.light_sample(query, scene);
             let y = ls.point.position;
             let wi = (y - x).normalize();
             let cos_x = n.dot(wi);
@@ -651,25 +433,18 @@ impl PathState {
             let pdf_w = ls.pdf_solid_angle;
             let above = !smooth || ng.dot(wi) > 0.0;
             if cos_x > 0.0 && cos_y > 0.0 && pdf_w > 0.0 && above {
-                let emitted = light_sample_radiance(
-                    features,
-                    query,
-                    params,
-                    lights,
-                    environment,
-                    textures,
-                    &ls,
-                );
+                let emitted = light::radiance(features, scene, query.light_kinds, &ls);
                 let weight = light_sample_weight(
                     features,
                     params,
+                    query.light_kinds,
                     &lights[ls.light as usize],
                     pdf_w,
                     pdf_brdf(n, wi),
                 );
                 let radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
-                self.await_shadow(features, lights, ray_origin, &ls, radiance);
+                self.await_shadow(query.light_kinds, lights, ray_origin, &ls, radiance);
             }
         }
 
@@ -701,19 +476,16 @@ impl PathState {
     /// extension drawn from the BSDF. Rays leave from the side of the direction they take
     /// (through the surface after a refraction).
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     fn bsdf_vertex<F: FeatureSet>(
         &mut self,
         features: F,
-        params: &RenderParams,
-        lights: &[Light],
-        environment: &[f32],
-        textures: &[u32],
+        scene: &SceneView,
         hit: &SurfaceHit,
         material: &Material,
         query: &VertexQuery,
         samples: &VertexSamples,
     ) {
+        let (params, lights) = (scene.params, scene.lights);
         let (x, n, ng) = (query.x, query.n, query.ng);
         let smooth = features.shading_normals() && query.smooth;
         let wo = -self.ray_dir;
@@ -727,7 +499,7 @@ impl PathState {
 
         // 2(a): next-event estimation.
         if query.samples_light() {
-            let ls = samples.light_sample(query, params, lights, environment);
+            let ls = samples.light_sample(query, scene);
             let y = ls.point.position;
             let wi = (y - x).normalize();
             let cos_y = -ls.point.normal.dot(wi);
@@ -737,20 +509,18 @@ impl PathState {
             // its transmission cross the surface (`crate::surface`).
             let consistent = !smooth || (n.dot(wi) > 0.0) == (ng.dot(wi) > 0.0);
             if cos_y > 0.0 && pdf_w > 0.0 && f_cos.max_element() > 0.0 && consistent {
-                let emitted = light_sample_radiance(
+                let emitted = light::radiance(features, scene, query.light_kinds, &ls);
+                let weight = light_sample_weight(
                     features,
-                    query,
                     params,
-                    lights,
-                    environment,
-                    textures,
-                    &ls,
+                    query.light_kinds,
+                    &lights[ls.light as usize],
+                    pdf_w,
+                    pdf_b,
                 );
-                let weight =
-                    light_sample_weight(features, params, &lights[ls.light as usize], pdf_w, pdf_b);
                 let from = offset_ray_origin(x, side(ng, ng.dot(wi) > 0.0), hit.error);
                 let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
-                self.await_shadow(features, lights, from, &ls, radiance);
+                self.await_shadow(query.light_kinds, lights, from, &ls, radiance);
             }
         }
 
@@ -796,12 +566,12 @@ impl PathState {
     /// The light sample `ls` waits for its shadow segment from `from` (offset off the surface)
     /// to the light point; `radiance` is what it adds if the segment is clear.
     #[inline]
-    fn await_shadow<F: FeatureSet>(
+    fn await_shadow(
         &mut self,
-        features: F,
+        kinds: LightKinds,
         lights: &[Light],
         from: Vec3,
-        ls: &DirectionalLightSample,
+        ls: &LightSample,
         radiance: Vec3,
     ) {
         self.shadow = true;
@@ -810,7 +580,7 @@ impl PathState {
             from,
             ls.point.position,
             ls.point.normal,
-            light_point_error(features.triangle_lights(), &lights[ls.light as usize]),
+            light::point_error(kinds, &lights[ls.light as usize]),
         );
         self.shadow_radiance = radiance;
     }
@@ -852,34 +622,6 @@ impl PathState {
     }
 }
 
-/// The radiance light sample `ls` (drawn for `query`) sends toward the vertex: the light's, or
-/// the environment map's along the sample, times the light's emission texture at the sampled
-/// point where the scene has textures. Always inlined: it sits in the Lambertian vertex's hot
-/// path, where a call costs more than the two lines it saves.
-#[inline(always)]
-fn light_sample_radiance<F: FeatureSet>(
-    features: F,
-    query: &VertexQuery,
-    params: &RenderParams,
-    lights: &[Light],
-    environment: &[f32],
-    textures: &[u32],
-    ls: &DirectionalLightSample,
-) -> Vec3 {
-    let light = &lights[ls.light as usize];
-    // The punctual branch is its own, under its feature bit: folded into `sample_radiance`, it
-    // kept that function from being inlined into the Lambertian vertex (+3% instructions).
-    if is_punctual(features.punctual_lights(), light) {
-        return punctual_radiance(light, ls);
-    }
-    let emitted = sample_radiance(query.environment_light, params, environment, light, ls);
-    if features.textures() {
-        emitted * emission_texture_at(textures, light, ls)
-    } else {
-        emitted
-    }
-}
-
 /// `n` where `toward_n`, else `-n`: the normal of the side a ray leaves from.
 #[inline]
 fn side(n: Vec3, toward_n: bool) -> Vec3 {
@@ -891,17 +633,18 @@ fn side(n: Vec3, toward_n: bool) -> Vec3 {
 }
 
 /// The MIS weight of a sample of light `light` (density `pdf_light`, the BSDF's `pdf_bsdf`):
-/// 1 for a point or spot light, which no BSDF sample can meet (a delta light, as pbrt-v4's
-/// `LightSampleContext` treats them), else [`light_strategy_weight`]'s.
+/// 1 for a delta light (`light::is_delta`), which no BSDF sample can meet, else
+/// [`light_strategy_weight`]'s.
 #[inline]
 fn light_sample_weight<F: FeatureSet>(
     features: F,
     params: &RenderParams,
+    kinds: LightKinds,
     light: &Light,
     pdf_light: f32,
     pdf_bsdf: f32,
 ) -> f32 {
-    if is_punctual(features.punctual_lights(), light) {
+    if light::is_delta(kinds, light) {
         1.0
     } else {
         light_strategy_weight(features, params, pdf_light, pdf_bsdf)
@@ -967,33 +710,16 @@ pub fn light_sampling_of<F: FeatureSet>(features: F, params: &RenderParams) -> u
 /// sample is the same function of (seed, pixel, sample): the GPU by this function, the CPU's
 /// packets by [`start_sample`] and [`PathState::advance`].
 #[inline]
-#[allow(clippy::too_many_arguments)]
 pub fn render_sample<T: Tracer, F: FeatureSet>(
     tracer: &mut T,
     features: F,
-    params: &RenderParams,
-    materials: &[Material],
-    lights: &[Light],
-    environment: &[f32],
-    shading: &[ShadingTriangle],
-    textures: &[u32],
-    instances: &[Instance],
+    scene: &SceneView,
     px: u32,
     py: u32,
     sample: u32,
 ) -> Vec3 {
-    start_sample(features, params, px, py, sample)
-        .run(
-            tracer,
-            features,
-            params,
-            materials,
-            lights,
-            environment,
-            shading,
-            textures,
-            instances,
-        )
+    start_sample(features, scene.params, px, py, sample)
+        .run(tracer, features, scene)
         .radiance
 }
 

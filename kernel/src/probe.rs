@@ -3,18 +3,18 @@
 //! Records are four `[u32; 4]` in, two out; floats travel as their bits, so no load or store
 //! on either side can touch a value (denormals, NaN payloads) before the function sees it.
 
-use crate::brdf::{eval_scattering, pdf_brdf, sample_brdf};
 use crate::bsdf;
+use crate::bsdf::fresnel::{conductor, dielectric, schlick};
+use crate::bsdf::lambert::{eval_scattering, pdf_brdf, sample_brdf};
+use crate::bsdf::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal};
 use crate::camera::camera_ray_direction;
 use crate::features::Dynamic;
 use crate::frame::orthonormal_basis;
-use crate::fresnel::{conductor, dielectric, schlick};
 use crate::geometry::{
     geometry_factor, intersect_sphere, intersect_triangle_uv, offset_ray_origin,
     reproject_to_sphere, shadow_ray_end, triangle_point, triangle_point_error,
 };
-use crate::light::sample_triangle_light;
-use crate::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal};
+use crate::light::triangle;
 use crate::rng::{pcg4d, u32_to_unit_f32};
 use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
 use crate::scene::{light_kind, Camera, Light, Material, ShadingTriangle};
@@ -74,7 +74,7 @@ pub mod function {
     pub const BSDF_SAMPLE: u32 = 14;
     /// x = in0.xyz, mode = in0.w as u32 (`scene::light_sampling`), p0 = in1.xyz, u1 = in1.w,
     /// e1 = in2.xyz, u2 = in2.w, e2 = in3.xyz, two-sided = in3.w as u32 ->
-    /// out0 = light::sample_triangle_light's (position, pdf) for [`probe_triangle_light`],
+    /// out0 = light::triangle::sample's (position, pdf) for [`probe_triangle_light`],
     /// out1 = (its normal, spherical_triangle::solid_angle(x, vertices))
     pub const TRIANGLE_LIGHT: u32 = 15;
     /// uv = in0.xy, (width, height) = in0.zw as u32, wrap modes (u, v) = in1.xy as u32, four
@@ -131,7 +131,7 @@ pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material
         m.specular = [0.0; 3];
         m.metallic = if complex != 0 { 0.9 } else { 0.3 };
         m.roughness = alpha.sqrt();
-        m = crate::bsdf::resolve_metallic_roughness(&m);
+        m = crate::bsdf::metallic_roughness::resolve(&m);
     }
     m
 }
@@ -284,7 +284,7 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
     } else if function == function::TRIANGLE_LIGHT {
         let (x, p0, e1, e2) = (i0.truncate(), i1.truncate(), i2.truncate(), i3.truncate());
         let l = probe_triangle_light(p0, e1, e2, input[3].w);
-        let s = sample_triangle_light(&l, 0, input[0].w, x, i1.w, i2.w);
+        let s = triangle::sample(&l, 0, input[0].w, x, i1.w, i2.w);
         (
             s.point.position.extend(s.pdf_solid_angle),
             s.point

@@ -223,11 +223,13 @@ pub mod light_kind {
     /// A point or spot light (glTF's `KHR_lights_punctual`): a delta light at `position` of
     /// radiant intensity `radiance` (per steradian) along its axis `edge1` (unit), attenuated
     /// off the axis by glTF's spot falloff, clamp(cos * edge2[0] + edge2[1], 0, 1)^2 (a point
-    /// light: edge2 = [0, 1]). With `radius` > 0 it is a directional light instead (glTF's
-    /// "directional"; pbrt-v4's `DistantLight`): irradiance `radiance` arriving along `edge1`
-    /// (the direction the light travels) from beyond the sphere `position`, `radius` that
-    /// bounds the scene. Next-event estimation alone finds it (`light::sample_punctual_light`).
+    /// light: edge2 = [0, 1]). Next-event estimation alone finds it (`light::punctual`).
     pub const PUNCTUAL: u32 = 3;
+    /// A directional light (glTF's "directional"; pbrt-v4's `DistantLight`): irradiance
+    /// `radiance` arriving along `edge1` (unit: the direction the light travels) from beyond
+    /// the sphere `position`, `radius` that bounds the scene. Next-event estimation alone
+    /// finds it (`light::directional`).
+    pub const DIRECTIONAL: u32 = 4;
 }
 
 /// An area light: the light table lists every emissive sphere and every emissive triangle.

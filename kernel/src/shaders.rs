@@ -19,8 +19,10 @@ use crate::adaptive::{is_pilot_sample, luminance, pixel_converged};
 use crate::features::Dynamic;
 use crate::film_sample::summable;
 use crate::geometry::{intersect_sphere, TriangleShape};
-use crate::path::{render_sample, SurfaceHit, Tracer};
+use crate::hit::SurfaceHit;
+use crate::path::{render_sample, Tracer};
 use crate::scene::{Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
+use crate::scene_view::SceneView;
 use spirv_std::glam::{UVec2, UVec3, UVec4, Vec2, Vec3, Vec4};
 use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
@@ -182,23 +184,19 @@ pub fn raygen(
     let mut mean_b = Vec3::ZERO;
     let mut m2_b = Vec3::ZERO;
     let mut discarded = 0.0;
+    let scene = SceneView {
+        params,
+        materials,
+        lights,
+        environment,
+        shading,
+        textures,
+        instances,
+    };
     let mut s = 0;
     while s < params.samples_per_launch {
         let index = params.sample_offset + s;
-        let l = render_sample(
-            &mut tracer,
-            Dynamic(features),
-            params,
-            materials,
-            lights,
-            environment,
-            shading,
-            textures,
-            instances,
-            px,
-            py,
-            index,
-        );
+        let l = render_sample(&mut tracer, Dynamic(features), &scene, px, py, index);
         if !summable(l) {
             discarded += 1.0;
         } else if is_pilot_sample(params, index) {

@@ -16,11 +16,13 @@
 //! the same way): no leaks, at the price of a little energy lost where the normals disagree,
 //! which is near silhouettes of coarse meshes (docs/materials.md, "Shading normals").
 
-use crate::bsdf::resolve_metallic_roughness;
+use crate::bsdf;
 use crate::features::FeatureSet;
 use crate::geometry::{blend2, blend3};
+use crate::hit::SurfaceHit;
 use crate::instance::{normal_to_world, vector_to_world};
-use crate::scene::{material_kind, texture_slot, Instance, Material, ShadingTriangle, NONE};
+use crate::scene::{texture_slot, Material, ShadingTriangle, NONE};
+use crate::scene_view::SceneView;
 use crate::texture::{lookup, textured_material};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -92,32 +94,23 @@ pub fn mapped_normal(
     unit_or(t * m.x + b * m.y + base * m.z, base)
 }
 
-/// The material at a vertex on material `material` and shading record `record` (a hit's
-/// `SurfaceHit::material` and `shading`) at barycentrics `bary`: a copy of its table entry, with
+/// The material at the vertex of `hit` (its `SurfaceHit::material`, shading record
+/// `SurfaceHit::shading` and barycentrics): a copy of its table entry in `scene`, with
 /// its textures applied where the scene has any and, for glTF's metallic-roughness material,
-/// resolved into the form `crate::bsdf` evaluates (`bsdf::resolve_metallic_roughness`); and the
+/// resolved into the form `crate::bsdf` evaluates (`bsdf::at_point`); and the
 /// unit shading normal (either orientation) where the record's vertex normals or the
 /// material's normal map give one, else zero (the hit shades with its geometric normal).
-/// `geometric` is the hit's unit geometric normal (`SurfaceHit::normal`, edge1 x edge2: the
-/// front a normal map's frame stands on when the triangle has no vertex normals).
-/// `instance` is the hit's instance (`SurfaceHit::instance`) or `NONE`: an instanced
+/// The hit's unit geometric normal (`SurfaceHit::normal`, edge1 x edge2) is the front a normal
+/// map's frame stands on when the triangle has no vertex normals.
+/// The hit's instance (`SurfaceHit::instance`), unless `NONE`: an instanced
 /// triangle's record is in object space, and its normal and tangents are mapped to world space
 /// here (`crate::instance`; a mirroring instance flips the frame's handedness).
 #[inline]
-#[allow(clippy::too_many_arguments)]
-pub fn shade<F: FeatureSet>(
-    features: F,
-    material: u32,
-    record: u32,
-    bary: Vec2,
-    geometric: Vec3,
-    instance: u32,
-    materials: &[Material],
-    shading: &[ShadingTriangle],
-    textures: &[u32],
-    instances: &[Instance],
-) -> (Material, Vec3) {
-    let mut m = materials[material as usize];
+pub fn shade<F: FeatureSet>(features: F, scene: &SceneView, hit: &SurfaceHit) -> (Material, Vec3) {
+    let (record, bary, geometric, instance) =
+        (hit.shading, hit.barycentrics, hit.normal, hit.instance);
+    let (shading, textures, instances) = (scene.shading, scene.textures, scene.instances);
+    let mut m = scene.materials[hit.material as usize];
     let mut normal = Vec3::ZERO;
     if (features.shading_normals() || features.textures()) && record != NONE {
         let tri = shading[record as usize];
@@ -159,28 +152,24 @@ pub fn shade<F: FeatureSet>(
             }
         }
     }
-    if features.metallic_roughness() && m.kind == material_kind::METALLIC_ROUGHNESS {
-        m = resolve_metallic_roughness(&m);
-    }
-    (m, normal)
+    (bsdf::at_point(features, &m), normal)
 }
 
-/// The radiance `material` emits at a light hit on shading record `record` at barycentrics
-/// `bary`: its emission, times its emission texture there where it has one.
+/// The radiance `material` emits at light hit `hit`: its emission, times its emission texture
+/// at the hit's texture coordinates where it has one.
 #[inline]
 pub fn emission_at<F: FeatureSet>(
     features: F,
+    scene: &SceneView,
     material: &Material,
-    record: u32,
-    bary: Vec2,
-    shading: &[ShadingTriangle],
-    textures: &[u32],
+    hit: &SurfaceHit,
 ) -> Vec3 {
+    let (record, bary) = (hit.shading, hit.barycentrics);
     let emission = Vec3::from(material.emission);
     let texture = material.textures[texture_slot::EMISSION];
     if features.textures() && texture != NONE && record != NONE {
-        let uv = interpolated_uv(&shading[record as usize], bary);
-        emission * lookup(textures, texture, uv)
+        let uv = interpolated_uv(&scene.shading[record as usize], bary);
+        emission * lookup(scene.textures, texture, uv)
     } else {
         emission
     }

@@ -16,7 +16,8 @@
 //! ((i + 1/2) / w, 1 - (j + 1/2) / h). Bilinear filtering between the four texel centres around
 //! the point (pbrt-v4 `Image::Bilerp`, the same weights).
 
-use crate::scene::{material_kind, texture_slot, Material, NONE};
+use crate::bsdf;
+use crate::scene::{texture_slot, Material, NONE};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
@@ -235,14 +236,7 @@ pub fn textured_material(material: &Material, table: &[u32], uv: Vec2) -> Materi
         m.albedo = (Vec3::from(m.albedo) * lookup(table, t[texture_slot::KD], uv)).to_array();
     }
     if t[texture_slot::KS] != NONE {
-        let value = lookup(table, t[texture_slot::KS], uv);
-        if m.kind == material_kind::METALLIC_ROUGHNESS {
-            // glTF's metallic-roughness map: blue is metalness, green roughness.
-            m.metallic *= value.z;
-            m.roughness *= value.y;
-        } else {
-            m.specular = (Vec3::from(m.specular) * value).to_array();
-        }
+        bsdf::apply_ks_texture(&mut m, lookup(table, t[texture_slot::KS], uv));
     }
     if t[texture_slot::ALPHA] != NONE {
         m.alpha *= lookup(table, t[texture_slot::ALPHA], uv).x;

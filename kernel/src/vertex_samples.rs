@@ -9,11 +9,10 @@
 //! sample it gives, exactly what the vertex would compute. This module alone owns the layout of
 //! a vertex's dimensions.
 
-use crate::brdf::sample_brdf;
-use crate::light::{sample_light_from, DirectionalLightSample};
+use crate::bsdf::lambert::sample_brdf;
+use crate::light::{self, LightKinds, LightSample};
 use crate::rng::SampleRng;
-use crate::sampling::SurfacePoint;
-use crate::scene::{Light, RenderParams, NONE};
+use crate::scene_view::SceneView;
 use spirv_std::glam::Vec3;
 
 /// Random dimensions per path vertex: light choice (1) and point (2), roulette (1), BRDF (2).
@@ -29,7 +28,7 @@ pub const BRDF_DIMENSION: u32 = 4;
 /// The camera's pair (the position inside the pixel), before the first vertex's block.
 pub const CAMERA_DIMENSION: u32 = 0;
 pub const CAMERA_DIMENSIONS: u32 = 2;
-/// The lobe choice of the vertex at depth d (a BSDF that mixes lobes, `bsdf::chooses_lobe`) is
+/// The lobe choice of the vertex at depth d (a BSDF that mixes lobes, `bsdf::BsdfFlags::chooses_lobe`) is
 /// dimension `LOBE_DIMENSION + d`: outside every vertex's block, so scenes without such a
 /// material draw exactly the numbers they drew before it existed. (Both samplers hash the
 /// dimension into an independent stream: any dimension is as good as the next.)
@@ -59,12 +58,8 @@ pub struct VertexQuery {
     pub light_count: u32,
     /// How a point on the chosen light is sampled (`scene::light_sampling`).
     pub mode: u32,
-    /// Whether a light may be a triangle (`features::TRIANGLE_LIGHTS`).
-    pub triangle_lights: bool,
-    /// Whether a light may be the environment map (`features::ENVIRONMENT`).
-    pub environment_light: bool,
-    /// Whether a light may be a point or spot light (`features::PUNCTUAL_LIGHTS`).
-    pub punctual_lights: bool,
+    /// The light kinds the table may hold besides spheres.
+    pub light_kinds: LightKinds,
     /// Whether the vertex may extend the path (its depth is below `max_depth`).
     pub extend: bool,
     /// The roulette's survival probability: a number is drawn only where `roulette` and not
@@ -156,9 +151,9 @@ pub struct VertexSamples {
     /// The lobe choice, where [`VertexQuery::lobe_dimension`] names one and the path survives
     /// roulette.
     pub u_lobe: f32,
-    /// `sample_light_from(lights, light_count, mode, ..., x, u_select, u_light)`, if
+    /// `light::sample(scene, light_kinds, light_count, mode, x, u_select, u_light)`, if
     /// `has_light`.
-    pub light: DirectionalLightSample,
+    pub light: LightSample,
     pub has_light: bool,
     /// `sample_brdf(n, u_brdf)`, if `has_brdf_dir`.
     pub brdf_dir: Vec3,
@@ -173,14 +168,7 @@ impl VertexSamples {
         u_roulette: 0.0,
         u_brdf: (0.0, 0.0),
         u_lobe: 0.0,
-        light: DirectionalLightSample {
-            point: SurfacePoint {
-                position: Vec3::ZERO,
-                normal: Vec3::ZERO,
-            },
-            light: NONE,
-            pdf_solid_angle: 0.0,
-        },
+        light: LightSample::NONE,
         has_light: false,
         brdf_dir: Vec3::ZERO,
         has_brdf_dir: false,
@@ -242,33 +230,20 @@ impl VertexSamples {
         s
     }
 
-    /// The light sample for `query`: the one given, or computed now (`params` and `table`
-    /// describe the environment map, if any).
+    /// The light sample for `query`: the one given, or computed now.
     #[inline]
-    pub fn light_sample(
-        &self,
-        query: &VertexQuery,
-        params: &RenderParams,
-        lights: &[Light],
-        table: &[f32],
-    ) -> DirectionalLightSample {
+    pub fn light_sample(&self, query: &VertexQuery, scene: &SceneView) -> LightSample {
         if self.has_light {
             return self.light;
         }
-        let (u1, u2) = self.u_light;
-        sample_light_from(
-            lights,
+        light::sample(
+            scene,
+            query.light_kinds,
             query.light_count,
             query.mode,
-            query.triangle_lights,
-            query.environment_light,
-            query.punctual_lights,
-            params,
-            table,
             query.x,
             self.u_select,
-            u1,
-            u2,
+            self.u_light,
         )
     }
 

@@ -89,6 +89,42 @@ pub fn white_cornell_toml() -> String {
 pub fn repo_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
+/// `kernel::surface::shade` at a hit on material `material` (of `materials`), shading record
+/// `record` at barycentrics `bary`, geometric normal `normal`, instance `instance`, over the
+/// given tables (the rest of the scene empty).
+#[allow(clippy::too_many_arguments)]
+pub fn shade_at(
+    material: u32,
+    record: u32,
+    bary: glam::Vec2,
+    normal: glam::Vec3,
+    instance: u32,
+    materials: &[kernel::scene::Material],
+    shading: &[kernel::scene::ShadingTriangle],
+    textures: &[u32],
+    instances: &[kernel::scene::Instance],
+) -> (kernel::scene::Material, glam::Vec3) {
+    let params: kernel::scene::RenderParams = bytemuck::Zeroable::zeroed();
+    let scene = kernel::SceneView {
+        params: &params,
+        materials,
+        lights: &[],
+        environment: &[0.0],
+        shading,
+        textures,
+        instances,
+    };
+    let hit = kernel::SurfaceHit {
+        material,
+        shading: record,
+        barycentrics: bary,
+        normal,
+        instance,
+        ..kernel::SurfaceHit::miss()
+    };
+    kernel::surface::shade(kernel::features::Dynamic(0), &scene, &hit)
+}
+
 pub mod cubature;
 pub mod gltf_writer;
 pub mod gpu;

@@ -158,7 +158,7 @@ impl RefMaterial {
     pub fn kernel_at_hit(&self) -> kernel::scene::Material {
         let m = self.kernel();
         if m.kind == kernel::scene::material_kind::METALLIC_ROUGHNESS {
-            kernel::bsdf::resolve_metallic_roughness(&m)
+            kernel::bsdf::metallic_roughness::resolve(&m)
         } else {
             m
         }

@@ -11,7 +11,6 @@
 //! 4. Hostile files are errors naming the file and the JSON path, never panics.
 
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
-use kernel::features::Dynamic;
 use kernel::scene::{material_kind, texture_slot, Material, NONE};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -391,7 +390,7 @@ fn appendix_b_rules_each_hold() {
     // metallic), alpha = roughness^2.
     let mut q = m;
     q.roughness = 0.5;
-    let r = kernel::bsdf::resolve_metallic_roughness(&q);
+    let r = kernel::bsdf::metallic_roughness::resolve(&q);
     let expect_kd = [0.4, 0.2, 0.1];
     let expect_f0 = [0.032 + 0.1, 0.032 + 0.05, 0.032 + 0.025];
     for c in 0..3 {
@@ -496,8 +495,7 @@ fn texture_channels_srgb_and_the_metallic_roughness_map() {
         uv2: [0.5, 0.5],
         has_normals: 0,
     };
-    let (at, _) = kernel::surface::shade(
-        Dynamic(0),
+    let (at, _) = twinpath_tests::shade_at(
         0,
         0,
         Vec2::new(0.3, 0.3),
@@ -532,8 +530,7 @@ fn texture_channels_srgb_and_the_metallic_roughness_map() {
         at.alpha
     );
     // Without the record (no texture coordinates) the factors alone are resolved.
-    let (plain, _) = kernel::surface::shade(
-        Dynamic(0),
+    let (plain, _) = twinpath_tests::shade_at(
         0,
         NONE,
         Vec2::ZERO,

@@ -10,7 +10,6 @@
 //! 3. Scene-file errors name the field.
 
 use glam::{DVec3, Vec2, Vec3};
-use kernel::features::Dynamic;
 use kernel::scene::{texture_slot, Material, ShadingTriangle};
 use std::path::{Path, PathBuf};
 use twinpath::render::Backend;
@@ -124,8 +123,7 @@ fn the_mapped_normal_is_gltfs_formula() {
             uv2: [0.4, 0.8],
             has_normals: 1,
         };
-        let (_, got) = kernel::surface::shade(
-            Dynamic(0),
+        let (_, got) = twinpath_tests::shade_at(
             0,
             0,
             Vec2::new(0.2, 0.3),
@@ -142,8 +140,7 @@ fn the_mapped_normal_is_gltfs_formula() {
             has_normals: 0,
             ..smooth
         };
-        let (_, got) = kernel::surface::shade(
-            Dynamic(0),
+        let (_, got) = twinpath_tests::shade_at(
             0,
             0,
             Vec2::new(0.2, 0.3),

@@ -329,6 +329,7 @@ fn numbers_computed_for_sixteen_streams_are_sample_rng_numbers() {
 #[test]
 fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
     use glam::Vec3;
+    use kernel::light::LightKinds;
     use kernel::rng::{pcg4d, u32_to_unit_f32, SampleRng};
     use kernel::scene::{light_sampling, sampler};
     use kernel::vertex_samples::{VertexQuery, VertexSamples, NO_DIMENSION};
@@ -404,9 +405,11 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
                     light_sampling::SOLID_ANGLE
                 },
                 // A table with triangles needs the bit; a table of spheres runs either way.
-                triangle_lights: round % 3 == 2 || h(lane, 23) % 2 == 0,
-                environment_light: false,
-                punctual_lights: false,
+                light_kinds: LightKinds {
+                    triangles: round % 3 == 2 || h(lane, 23) % 2 == 0,
+                    environment: false,
+                    delta: false,
+                },
                 extend: h(lane, 19) % 5 != 0,
                 roulette: h(lane, 20) % 3 != 0,
                 survival,
@@ -416,6 +419,15 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
             Some((rng, query))
         });
         let filled = fill_vertex_samples(&queries, lights);
+        let scene = kernel::SceneView {
+            params: &params,
+            materials: &[],
+            lights,
+            environment: &[0.0],
+            shading: &[],
+            textures: &[],
+            instances: &[],
+        };
         for (lane, entry) in queries.iter().enumerate() {
             let Some((rng, q)) = entry else { continue };
             let want = VertexSamples::draw(q, &mut { *rng });
@@ -427,10 +439,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
             if q.samples_light() {
                 assert_eq!(pair_bits(got.u_light), pair_bits(want.u_light));
                 // What the vertex uses: the sample given, or the one it computes itself.
-                let (g, w) = (
-                    got.light_sample(q, &params, lights, &[0.0]),
-                    want.light_sample(q, &params, lights, &[0.0]),
-                );
+                let (g, w) = (got.light_sample(q, &scene), want.light_sample(q, &scene));
                 assert_eq!(
                     (
                         bits(g.point.position),

@@ -12,14 +12,14 @@
 #![feature(portable_simd)]
 
 use glam::Vec3;
-use kernel::brdf::{eval_scattering, pdf_brdf, sample_brdf};
+use kernel::bsdf::lambert::{eval_scattering, pdf_brdf, sample_brdf};
 use kernel::frame::orthonormal_basis;
 use kernel::geometry::{
     area_to_solid_angle_pdf, geometry_factor, intersect_sphere, intersect_triangle,
     intersect_triangle_uv, offset_ray_origin, shadow_ray_end, sphere_point_error, triangle_point,
     triangle_point_error,
 };
-use kernel::light::{pdf_triangle_light, sample_triangle_light};
+use kernel::light::triangle::{pdf as pdf_triangle_light, sample as sample_triangle_light};
 use kernel::probe::probe_triangle_light;
 use kernel::rng::{pcg4d, u32_to_unit_f32};
 use kernel::sampling::{

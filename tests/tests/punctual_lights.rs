@@ -263,7 +263,7 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
     .unwrap();
     assert_eq!(s.lights.len(), 2);
     let d = s.lights[0];
-    assert_eq!(d.kind, kernel::scene::light_kind::PUNCTUAL);
+    assert_eq!(d.kind, kernel::scene::light_kind::DIRECTIONAL);
     assert!((Vec3::from(d.edge1) - Vec3::new(0.0, -1.0, 0.0)).length() < 1e-6);
     assert_eq!(d.radiance, [3.0, 1.5, 1.5]);
     assert!((Vec3::from(d.position) - Vec3::new(0.5, 0.0, -0.5)).length() < 1e-6);

@@ -207,7 +207,7 @@ fn shadow_rays_never_hit_the_light_they_sample() {
 /// side the light faces (the renderer casts no shadow ray where cos theta_light <= 0).
 #[test]
 fn shadow_rays_never_hit_the_triangle_light_they_sample() {
-    use kernel::light::sample_triangle_light;
+    use kernel::light::triangle::sample as sample_triangle_light;
     use kernel::scene::{light_sampling, Triangle, NONE};
     let mut g = Gen(twinpath_tests::SplitMix(4));
     let (mut fails, mut tested) = (0, 0);

@@ -3,8 +3,9 @@
 //! a sampler and its pdf that disagree fail, whichever of the two is wrong.
 
 use glam::Vec3;
-use kernel::brdf::{pdf_brdf, sample_brdf};
-use kernel::light::{pdf_light, sample_light};
+use kernel::bsdf::lambert::{pdf_brdf, sample_brdf};
+use kernel::light::choose_light;
+use kernel::light::sphere::{pdf_area, sample_area};
 use kernel::rng::SampleRng;
 use kernel::sampling::{
     pdf_sphere_area, pdf_sphere_cone, sample_lobe, sample_sphere, sample_sphere_cone,
@@ -177,11 +178,12 @@ fn sample_light_selects_by_pmf_and_pdf_light_matches() {
     let mut observed = vec![0.0; n];
     let mut r = rng(3);
     for _ in 0..SAMPLES {
-        let s = sample_light(&lights, n as u32, r.next_f32(), r.next_f32(), r.next_f32());
+        let light = choose_light(&lights, n as u32, r.next_f32());
+        let s = sample_area(&lights[light as usize], light, r.next_f32(), r.next_f32());
         observed[s.light as usize] += 1.0;
         let l = lights[s.light as usize];
         assert!(((s.point.position - Vec3::from(l.position)).length() - l.radius).abs() < 1e-5);
-        assert_eq!(s.pdf_area, pdf_light(&lights, s.light));
+        assert_eq!(s.pdf_area, pdf_area(&lights[s.light as usize]));
         let want = 1.0 / (n as f64 * 4.0 * PI * (l.radius as f64).powi(2));
         assert!((s.pdf_area as f64 / want - 1.0).abs() < 1e-6);
     }

@@ -1,7 +1,7 @@
 //! Triangle lights (emissive quads and meshes), tested as every light is:
 //!
 //! 1. Both samplers (uniform in area, and uniform in the spherical triangle, Arvo 1995) follow
-//!    the density MIS uses for them (`light::pdf_triangle_light`): chi-square tests in solid
+//!    the density MIS uses for them (`light::triangle::pdf`): chi-square tests in solid
 //!    angle, with expected counts from integrating that pdf function over each bin (a sub-triangle
 //!    of the light, its solid angle by Van Oosterom and Strackee's formula in f64), so a sampler
 //!    and a pdf that disagree fail, whichever is wrong; and every sample's pdf is that
@@ -13,7 +13,9 @@
 //!    either sampler.
 
 use glam::{DVec3, Vec3};
-use kernel::light::{pdf_triangle_light, sample_triangle_light, spherical_triangle_used};
+use kernel::light::triangle::{
+    pdf as pdf_triangle_light, sample as sample_triangle_light, spherical_triangle_used,
+};
 use kernel::rng::SampleRng;
 use kernel::scene::{light_sampling, Triangle, NONE};
 use kernel::spherical_triangle::{

@@ -22,6 +22,7 @@ use indicatif::ProgressBar;
 use kernel::features::{self, Dynamic, FeatureSet, Static};
 use kernel::path::render_sample;
 use kernel::scene::{Light, Material, RenderParams, ShadingTriangle};
+use kernel::SceneView;
 use kernel::{SurfaceHit, Tracer};
 use packet::SmallScene;
 use rayon::prelude::*;
@@ -204,20 +205,20 @@ impl CpuRenderer {
         py: u32,
         sample: u32,
     ) -> Vec3 {
-        render_sample(
-            tracer,
-            features,
+        render_sample(tracer, features, &self.view(params), px, py, sample)
+    }
+
+    /// The scene's tables as the kernel reads them, with the render's parameters.
+    pub fn view<'a>(&'a self, params: &'a RenderParams) -> SceneView<'a> {
+        SceneView {
             params,
-            &self.materials,
-            &self.lights,
-            &self.environment,
-            &self.shading,
-            &self.textures,
-            self.bvh.instances(),
-            px,
-            py,
-            sample,
-        )
+            materials: &self.materials,
+            lights: &self.lights,
+            environment: &self.environment,
+            shading: &self.shading,
+            textures: &self.textures,
+            instances: self.bvh.instances(),
+        }
     }
 
     /// Adds samples `first..first + count` of every pixel to `film`, tiles in parallel.

@@ -3,7 +3,10 @@
 //! primitive of a small scene, `packet.rs`, or through the BVH, `bvh_packet.rs`). Every path
 //! runs the same kernel code as `render_sample`, and the packet tracers return the one-ray
 //! traversal's primitive, t and barycentrics bit for bit (ties at equal t go to the smallest id
-//! in both), so a pixel's samples are the ones the one-path loop computes.
+//! in both), so a pixel's samples are the ones the one-path loop computes. Each round is the
+//! kernel's step protocol, as `PathState::run` follows it: `advance` with the round's answers,
+//! the `arrival` at each vertex reached, the vertices' samples (here filled for sixteen at
+//! once), `leave`.
 
 use super::packet::{PacketTracer, RayPacket, LANES};
 use super::packet_numbers::camera_numbers;
@@ -15,8 +18,7 @@ use crate::film::PixelSums;
 use glam::Vec3;
 use kernel::features::FeatureSet;
 use kernel::path::{sample_rng, start_path_at, PathState};
-use kernel::scene::{Material, RenderParams, NONE};
-use kernel::surface::shade;
+use kernel::scene::{RenderParams, NONE};
 use kernel::SurfaceHit;
 use std::simd::Simd;
 
@@ -77,10 +79,7 @@ impl CpuRenderer {
         let mut batch = [None; LANES];
         let mut batch_camera = [(0.0, 0.0); LANES];
         let mut hits = [SurfaceHit::miss(); LANES];
-        // The materials of this round's vertices, with textures applied, where the scene has
-        // textures or shading normals (else the table's entries are read in place).
-        let surfaces = features.textures() || features.shading_normals();
-        let mut materials = [Material::diffuse([0.0; 3]); LANES];
+        let scene = self.view(params);
         let mut rays = RayCounts::default();
         loop {
             for slot in slots.iter_mut().filter(|s| s.is_none()) {
@@ -139,64 +138,26 @@ impl CpuRenderer {
             }
             // Each path takes its round's answers; those that reach a vertex state what it will
             // draw, and the sixteen vertices' samples are filled together.
-            let mut queries = [None; LANES];
+            let mut arrivals = [None; LANES];
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((_, path)) = slot else { continue };
                 let hit = &hits[lane];
-                if path.advance(
-                    features,
-                    params,
-                    &self.materials,
-                    &self.lights,
-                    &self.environment,
-                    &self.shading,
-                    &self.textures,
-                    hit,
-                    occluded[lane],
-                ) {
-                    let query = if surfaces {
-                        let (material, shading_normal) = shade(
-                            features,
-                            hit.material,
-                            hit.shading,
-                            hit.barycentrics,
-                            hit.normal,
-                            hit.instance,
-                            &self.materials,
-                            &self.shading,
-                            &self.textures,
-                            self.bvh.instances(),
-                        );
-                        materials[lane] = material;
-                        path.vertex_query(features, params, hit, &material, shading_normal)
-                    } else {
-                        let material = &self.materials[hit.material as usize];
-                        path.vertex_query(features, params, hit, material, Vec3::ZERO)
-                    };
-                    queries[lane] = Some((path.rng, query));
+                if path.advance(features, &scene, hit, occluded[lane]) {
+                    arrivals[lane] = Some(path.arrival(features, &scene, hit));
                 }
             }
+            let queries: [_; LANES] = std::array::from_fn(|lane| {
+                let path = slots[lane].as_ref().map(|(_, path)| path);
+                match (path, &arrivals[lane]) {
+                    (Some(path), Some(arrival)) => Some((path.rng, arrival.query)),
+                    _ => None,
+                }
+            });
             let samples = fill_vertex_samples(&queries, &self.lights);
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((k, path)) = slot else { continue };
-                if let Some((_, query)) = &queries[lane] {
-                    let hit = &hits[lane];
-                    let material = if surfaces {
-                        &materials[lane]
-                    } else {
-                        &self.materials[hit.material as usize]
-                    };
-                    path.vertex(
-                        features,
-                        params,
-                        &self.lights,
-                        &self.environment,
-                        &self.textures,
-                        hit,
-                        material,
-                        query,
-                        &samples[lane],
-                    );
+                if let Some(arrival) = &arrivals[lane] {
+                    path.leave(features, &scene, &hits[lane], arrival, &samples[lane]);
                 }
                 if path.finished() {
                     radiance[*k] = path.radiance;

@@ -2,7 +2,7 @@
 //! [`VertexQuery`]s: the numbers on SIMD lanes (`packet_numbers`), and from them the cone light
 //! samples of sphere lights and the Lambertian BRDF directions (other materials' directions are the vertex's
 //! own, from the numbers; the lobe choice is drawn one lane at a time) by the kernel's samplers in their
-//! [`kernel::real::Real`] form (`sample_sphere_cone_v3`, `brdf::sample_brdf_v3`) on lanes. Any
+//! [`kernel::real::Real`] form (`sample_sphere_cone_v3`, `bsdf::lambert::sample_brdf_v3`) on lanes. Any
 //! other sample (area sampling, a receiver inside its light) is left to the vertex, which
 //! computes it from the numbers with the scalar sampler. Each lane's numbers are exactly what
 //! `VertexSamples::draw` gives, and each sample given exactly what the vertex would compute
@@ -12,8 +12,9 @@ use super::packet::LANES;
 use super::packet_numbers::NumberRequests;
 use super::simd::widest_simd;
 use glam::Vec3;
-use kernel::brdf::sample_brdf_v3;
-use kernel::light::{choose_light, cone_light_sample, uses_cone};
+use kernel::bsdf::lambert::sample_brdf_v3;
+use kernel::light::choose_light;
+use kernel::light::sphere::{cone_sample, uses_cone};
 use kernel::real::V3;
 use kernel::rng::SampleRng;
 use kernel::sampling::{sample_sphere_cone_v3, ConeSample, SurfacePoint};
@@ -173,10 +174,10 @@ pub fn fill_vertex_samples(
                 },
                 pdf_solid_angle: results.pdf[lane],
             };
-            s.light = cone_light_sample(&lights[light as usize], light, cone);
+            s.light = cone_sample(&lights[light as usize], light, cone);
             s.has_light = true;
         }
-        // The Lambertian direction (`brdf::sample_brdf`); other materials sample their own.
+        // The Lambertian direction (`bsdf::lambert::sample_brdf`); other materials sample their own.
         s.brdf_dir = lane3(&results.wi, lane);
         s.has_brdf_dir = q.extend && q.lambertian;
     }

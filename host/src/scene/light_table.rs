@@ -54,12 +54,13 @@ pub fn punctual_light(
     l
 }
 
-/// A directional light (`light_kind::PUNCTUAL` with `radius` > 0): irradiance `irradiance`
+/// A directional light (`light_kind::DIRECTIONAL`): irradiance `irradiance`
 /// (per unit area perpendicular to the light) arriving along `travel`, the direction the light
 /// travels. Its bounding sphere is a placeholder (unit, at the origin) until
 /// [`place_directional_lights`] sets the scene's.
 pub fn directional_light(travel: Vec3, irradiance: [f32; 3]) -> Light {
     let mut l = punctual_light(Vec3::ZERO, irradiance, None);
+    l.kind = light_kind::DIRECTIONAL;
     l.radius = 1.0;
     l.edge1 = travel.normalize().to_array();
     l
@@ -67,7 +68,7 @@ pub fn directional_light(travel: Vec3, irradiance: [f32; 3]) -> Light {
 
 /// Whether `l` is a directional light.
 pub fn is_directional(l: &Light) -> bool {
-    l.kind == light_kind::PUNCTUAL && l.radius > 0.0
+    l.kind == light_kind::DIRECTIONAL
 }
 
 /// The sphere bounding `spheres`, the world-space `triangles` and the box `instanced` of the

@@ -367,8 +367,8 @@ impl Scene {
     pub fn features(&self) -> u32 {
         if self.render.specialize {
             kernel::features::scene_features(&self.params(0, 1))
-                | kernel::features::material_features(&self.materials)
-                | kernel::features::light_features(&self.lights)
+                | kernel::bsdf::material_features(&self.materials)
+                | kernel::light::light_features(&self.lights)
                 | kernel::features::surface_features(&self.materials, &self.shading)
                 | if self.instances.is_empty() {
                     0

@@ -1,8 +1,13 @@
-//! The two-sided Lambertian BRDF, f = Kd / pi. `n` is always the normal flipped to the side the
-//! light leaves toward (the side of the outgoing direction), so both sides reflect alike.
+//! The two-sided Lambertian BRDF, f = Kd / pi (`material_kind::DIFFUSE`). `n` is always the
+//! normal flipped to the side the light leaves toward (the side of the outgoing direction), so
+//! both sides reflect alike. The path's Lambertian vertex (`path::PathState`) and the CPU's
+//! packets call these functions directly; [`eval`] and [`sample`] are the kind's entries in
+//! `bsdf`'s dispatch.
 
+use super::{BsdfFlags, BsdfSample};
 use crate::real::{self, V3};
 use crate::sampling::{pdf_cosine_hemisphere, sample_cosine_hemisphere_v3};
+use crate::scene::Material;
 use core::f32::consts::PI;
 use spirv_std::glam::Vec3;
 
@@ -40,4 +45,30 @@ pub fn pdf_brdf(n: Vec3, wi: Vec3) -> f32 {
 #[inline]
 pub fn sampled_brdf_weight(albedo: Vec3) -> Vec3 {
     albedo
+}
+
+/// The kind's flags: a Lambertian lobe, never a delta distribution, one lobe.
+pub const FLAGS: BsdfFlags = BsdfFlags {
+    delta: false,
+    chooses_lobe: false,
+};
+
+/// The kind's entry in `bsdf::eval`: (f |n . wi|, the density of [`sample`]).
+#[inline]
+pub fn eval(m: &Material, n: Vec3, wi: Vec3) -> (Vec3, f32) {
+    (
+        eval_scattering(n, wi, Vec3::from(m.albedo)),
+        pdf_brdf(n, wi),
+    )
+}
+
+/// The kind's entry in `bsdf::sample`: a cosine-weighted direction, weight exactly Kd.
+#[inline]
+pub fn sample(m: &Material, n: Vec3, u1: f32, u2: f32) -> BsdfSample {
+    let wi = sample_brdf(n, u1, u2);
+    BsdfSample::reflected(
+        wi,
+        sampled_brdf_weight(Vec3::from(m.albedo)),
+        pdf_brdf(n, wi),
+    )
 }

@@ -1,0 +1,61 @@
+//! glTF 2.0's metallic-roughness material (`material_kind::METALLIC_ROUGHNESS`; the
+//! specification's Appendix B), stored as base colour (`albedo`), `metallic` and `roughness`
+//! and resolved at each point ([`resolve`], after its textures) into the `mixture`'s Kd + Ks
+//! form with the dielectric layer, which evaluates and samples it.
+
+use super::mixture::{self, LAYER_F0};
+use super::{BsdfFlags, BsdfSample};
+use crate::features;
+use crate::scene::Material;
+use spirv_std::glam::Vec3;
+
+/// The feature bits of a scene with this kind: the mixture's code and the layer's weight.
+pub const FEATURES: u32 = features::GLOSSY | features::METALLIC_ROUGHNESS;
+
+/// The mixture's flags: a Lambertian lobe beside the glossy one.
+pub const FLAGS: BsdfFlags = mixture::FLAGS;
+
+/// glTF's dielectric reflectance at normal incidence (index 1.5), the mixture's layer.
+pub const GLTF_DIELECTRIC_F0: f32 = LAYER_F0;
+
+/// The material in the Kd + Ks form the mixture reads, from its base colour (`albedo`),
+/// `metallic` and `roughness` as textures left them:
+///
+/// `mix(dielectric_brdf, metal_brdf, metallic)` with
+/// `dielectric_brdf = fresnel_mix(0.04; diffuse(base), specular)` and
+/// `metal_brdf = specular * F_Schlick(F0 = base)`. The specular lobes share D and G, and
+/// Schlick's F is affine in F0, so their sum is one GGX lobe with
+/// F_Schlick(F0 = lerp(0.04, base, metallic)) (`specular`), and the diffuse part is
+/// `(1 - metallic) base / pi` (`albedo`) weighed by 1 - F_Schlick(0.04, |wo . h|) (the
+/// mixture's layer); alpha = roughness^2. The kind stays METALLIC_ROUGHNESS, which is what
+/// selects that weight.
+#[inline]
+pub fn resolve(m: &Material) -> Material {
+    let mut r = *m;
+    let base = Vec3::from(m.albedo);
+    let metallic = m.metallic;
+    r.albedo = (base * (1.0 - metallic)).to_array();
+    r.specular = (Vec3::splat(GLTF_DIELECTRIC_F0) * (1.0 - metallic) + base * metallic).to_array();
+    r.alpha = m.roughness * m.roughness;
+    r
+}
+
+/// glTF's metallic-roughness map's value `value` at a point applied to `m`: blue is metalness,
+/// green roughness.
+#[inline]
+pub fn apply_ks_texture(m: &mut Material, value: Vec3) {
+    m.metallic *= value.z;
+    m.roughness *= value.y;
+}
+
+/// `bsdf::eval` of the resolved material: the mixture's, with the layer.
+#[inline]
+pub fn eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+    mixture::eval(m, n, wo, wi, true)
+}
+
+/// `bsdf::sample` of the resolved material: the mixture's, with the layer.
+#[inline]
+pub fn sample(m: &Material, n: Vec3, wo: Vec3, u_lobe: f32, u1: f32, u2: f32) -> BsdfSample {
+    mixture::sample(m, n, wo, true, u_lobe, u1, u2)
+}

@@ -1,0 +1,118 @@
+//! The seed's Kd + Ks BRDF (`material_kind::GLOSSY`): a Lambertian lobe Kd / pi plus a GGX
+//! microfacet lobe with Schlick's Fresnel (F0 = Ks), each sampled in proportion to an estimate
+//! of its albedo. With `layered`, the Lambertian lobe lies under a dielectric layer of
+//! reflectance F0 [`LAYER_F0`] and is weighed by the share it lets through (glTF's
+//! `fresnel_mix`, which `metallic_roughness` resolves into this form).
+
+use super::fresnel::schlick;
+use super::lambert::sample_brdf;
+use super::microfacet::{reflection, sample_visible_normal};
+use super::{reflect, BsdfFlags, BsdfSample, DELTA_ALPHA};
+use crate::features;
+use crate::scene::Material;
+use core::f32::consts::PI;
+use spirv_std::glam::Vec3;
+
+/// The feature bits of a scene with this kind.
+pub const FEATURES: u32 = features::GLOSSY;
+
+/// A Lambertian lobe (never a delta distribution) beside the glossy one: the vertex chooses.
+pub const FLAGS: BsdfFlags = BsdfFlags {
+    delta: false,
+    chooses_lobe: true,
+};
+
+/// The dielectric layer's reflectance at normal incidence, ((1 - 1.5) / (1 + 1.5))^2 (glTF 2.0,
+/// Appendix B, "dielectric_brdf", index 1.5).
+pub const LAYER_F0: f32 = 0.04;
+
+/// The probability that the mixture samples its glossy lobe from `wo` at cosine `cos_o`: each
+/// lobe in proportion to an estimate of its albedo, mean(Kd) for the diffuse and
+/// mean(F_Schlick(cos_o)) for the glossy (the masking left out); 0 when both are 0.
+#[inline]
+pub fn glossy_lobe_probability(m: &Material, cos_o: f32) -> f32 {
+    let fd = Vec3::from(m.albedo).dot(Vec3::ONE);
+    let fs = schlick(Vec3::from(m.specular), cos_o).dot(Vec3::ONE);
+    if fd + fs > 0.0 {
+        fs / (fd + fs)
+    } else {
+        0.0
+    }
+}
+
+/// The factor on the Kd lobe for light from `wi` toward `wo`: 1 without the layer, and with it
+/// the share the layer lets through, 1 - F_Schlick(F0 = [`LAYER_F0`], |wo . h|) at the half
+/// vector h of `wo` and `wi` (Appendix B's `fresnel_mix`).
+#[inline]
+fn diffuse_share(layered: bool, wo: Vec3, wi: Vec3) -> f32 {
+    if layered {
+        let h = (wo + wi).normalize();
+        1.0 - schlick(Vec3::splat(LAYER_F0), wo.dot(h).abs()).x
+    } else {
+        1.0
+    }
+}
+
+/// `bsdf::eval` of the mixture: Kd/pi cos (times the layer's share) + D G F_Schlick(wi . h) /
+/// (4 cos_o), density the mixture of the cosine lobe and the visible-normal reflection. Zero
+/// where `wo` is not above `n` (rounding at grazing hits).
+#[inline]
+pub fn eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, layered: bool) -> (Vec3, f32) {
+    let cos_o = n.dot(wo);
+    let cos_i = n.dot(wi);
+    if !(cos_o > 0.0) || !(cos_i > 0.0) {
+        return (Vec3::ZERO, 0.0);
+    }
+    let p_glossy = glossy_lobe_probability(m, cos_o);
+    let c = cos_i * (1.0 / PI);
+    let mut f = Vec3::from(m.albedo) * (c * diffuse_share(layered, wo, wi));
+    let mut pdf = (1.0 - p_glossy) * c;
+    if !(m.alpha < DELTA_ALPHA) {
+        let r = reflection(n, wo, wi, cos_o, cos_i, m.alpha);
+        f += schlick(Vec3::from(m.specular), wi.dot(r.h)) * r.value;
+        pdf += p_glossy * r.pdf;
+    }
+    (f, pdf)
+}
+
+/// `bsdf::sample` of the mixture: `u_lobe` below the glossy lobe's probability chooses it.
+#[inline]
+pub fn sample(
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    layered: bool,
+    u_lobe: f32,
+    u1: f32,
+    u2: f32,
+) -> BsdfSample {
+    let cos_o = n.dot(wo);
+    if !(cos_o > 0.0) {
+        return BsdfSample::NONE;
+    }
+    let smooth = m.alpha < DELTA_ALPHA;
+    let p_glossy = glossy_lobe_probability(m, cos_o);
+    let glossy = u_lobe < p_glossy;
+    if smooth && glossy {
+        return BsdfSample::mirror(
+            n,
+            reflect(wo, n),
+            schlick(Vec3::from(m.specular), cos_o) / p_glossy,
+        );
+    }
+    let wi = if glossy {
+        reflect(wo, sample_visible_normal(n, wo, m.alpha, u1, u2))
+    } else {
+        sample_brdf(n, u1, u2)
+    };
+    if smooth {
+        // The diffuse lobe beside a delta one: (Kd/pi cos) / ((1 - p) cos/pi), exactly.
+        let weight = Vec3::from(m.albedo) * (diffuse_share(layered, wo, wi) / (1.0 - p_glossy));
+        return BsdfSample::reflected(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
+    }
+    let (f, pdf) = eval(m, n, wo, wi, layered);
+    if !(pdf > 0.0) {
+        return BsdfSample::NONE;
+    }
+    BsdfSample::reflected(wi, f / pdf, pdf)
+}

@@ -1,0 +1,59 @@
+//! The environment map as a light (`light_kind::ENVIRONMENT`): radiance arriving from
+//! infinitely far in every direction, sampled by `crate::environment` (by luminance or
+//! uniformly). Its light-table entry holds a sphere bounding the scene, which shadow rays toward
+//! it leave, and the map's mean radiance (for the selection by power).
+
+use super::LightSample;
+use crate::environment as map;
+use crate::geometry::sphere_point_error;
+use crate::sampling::SurfacePoint;
+use crate::scene::Light;
+use crate::scene_view::SceneView;
+use spirv_std::glam::Vec3;
+
+/// A direction toward the map (light `l`, index `light`) for receiver `x`, by
+/// `environment::sample` under `mode`, as a light point: beyond the sphere bounding the scene
+/// (`l.position`, `l.radius`) along the direction, facing back along it, so the shadow ray to
+/// it crosses the whole scene. Density: the map's, times the selection probability.
+#[inline]
+pub fn sample(
+    l: &Light,
+    light: u32,
+    mode: u32,
+    scene: &SceneView,
+    x: Vec3,
+    u1: f32,
+    u2: f32,
+) -> LightSample {
+    let (params, table) = (scene.params, scene.environment);
+    let dir = map::sample(params, table, mode, u1, u2);
+    let far = 2.0 * (l.radius + (x - Vec3::from(l.position)).length());
+    LightSample {
+        point: SurfacePoint {
+            position: x + dir * far,
+            normal: -dir,
+        },
+        light,
+        pdf_solid_angle: l.select_pmf * map::pdf(params, table, mode, dir),
+    }
+}
+
+/// The solid-angle density with which light sampling chooses the map (light `l`) and direction
+/// `dir`: what MIS needs when a path escapes along `dir`.
+#[inline]
+pub fn pdf(l: &Light, mode: u32, scene: &SceneView, dir: Vec3) -> f32 {
+    l.select_pmf * map::pdf(scene.params, scene.environment, mode, dir)
+}
+
+/// The radiance the map sends along light sample `ls` (toward -normal's opposite: the
+/// receiver looks along -normal).
+#[inline]
+pub fn radiance(scene: &SceneView, ls: &LightSample) -> Vec3 {
+    map::eval(scene.params, scene.environment, -ls.point.normal)
+}
+
+/// The error bound the shadow ray's end is lifted by: the bounding sphere's.
+#[inline]
+pub fn point_error(l: &Light) -> f32 {
+    sphere_point_error(Vec3::from(l.position), l.radius)
+}
