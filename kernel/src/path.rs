@@ -178,7 +178,7 @@ impl PathState {
     /// `radiance` of the returned (finished) state. Each round is one step of the protocol the
     /// CPU's packets also follow: trace the waiting rays, [`PathState::advance`] with their
     /// answers, and if that reached a vertex, its [`PathState::arrival`], the vertex's
-    /// samples (here drawn from the path's own stream), and [`PathState::leave`].
+    /// samples (here drawn from the path's own stream), and [`PathState::vertex`].
     #[inline]
     pub fn run<T: Tracer, F: FeatureSet>(
         mut self,
@@ -196,7 +196,14 @@ impl PathState {
             if self.advance(features, scene, &hit, occluded) {
                 let arrival = self.arrival(features, scene, &hit);
                 let samples = VertexSamples::draw(&arrival.query, &mut self.rng);
-                self.leave(features, scene, &hit, &arrival, &samples);
+                self.vertex(
+                    features,
+                    scene,
+                    &hit,
+                    &arrival.material,
+                    &arrival.query,
+                    &samples,
+                );
             }
             if self.finished() {
                 return self;
@@ -206,7 +213,7 @@ impl PathState {
 
     /// The vertex [`PathState::advance`] reached at `hit`: its surface (`surface::shade`) and
     /// what it will draw ([`PathState::vertex_query`]). The caller fills that query's samples
-    /// and hands both to [`PathState::leave`].
+    /// and hands them with both to [`PathState::vertex`].
     #[inline]
     pub fn arrival<F: FeatureSet>(
         &self,
@@ -217,27 +224,6 @@ impl PathState {
         let (material, shading_normal) = shade(features, scene, hit);
         let query = self.vertex_query(features, scene.params, hit, &material, shading_normal);
         Arrival { material, query }
-    }
-
-    /// The last part of a step: the vertex of `arrival` (the [`PathState::arrival`] at `hit`)
-    /// with its samples filled ([`PathState::vertex`]).
-    #[inline]
-    pub fn leave<F: FeatureSet>(
-        &mut self,
-        features: F,
-        scene: &SceneView,
-        hit: &SurfaceHit,
-        arrival: &Arrival,
-        samples: &VertexSamples,
-    ) {
-        self.vertex(
-            features,
-            scene,
-            hit,
-            &arrival.material,
-            &arrival.query,
-            samples,
-        );
     }
 
     /// Takes the answers to this round's rays: `hit`, the closest hit of the extension ray

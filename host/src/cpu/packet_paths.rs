@@ -6,7 +6,7 @@
 //! in both), so a pixel's samples are the ones the one-path loop computes. Each round is the
 //! kernel's step protocol, as `PathState::run` follows it: `advance` with the round's answers,
 //! the `arrival` at each vertex reached, the vertices' samples (here filled for sixteen at
-//! once), `leave`.
+//! once), `vertex`.
 
 use super::packet::{PacketTracer, RayPacket, LANES};
 use super::packet_numbers::camera_numbers;
@@ -18,7 +18,7 @@ use crate::film::PixelSums;
 use glam::Vec3;
 use kernel::features::FeatureSet;
 use kernel::path::{sample_rng, start_path_at, PathState};
-use kernel::scene::{RenderParams, NONE};
+use kernel::scene::{Material, RenderParams, NONE};
 use kernel::SurfaceHit;
 use std::simd::Simd;
 
@@ -80,6 +80,8 @@ impl CpuRenderer {
         let mut batch_camera = [(0.0, 0.0); LANES];
         let mut hits = [SurfaceHit::miss(); LANES];
         let scene = self.view(params);
+        // The materials of this round's vertices as `PathState::arrival` gives them.
+        let mut materials = [Material::diffuse([0.0; 3]); LANES];
         let mut rays = RayCounts::default();
         loop {
             for slot in slots.iter_mut().filter(|s| s.is_none()) {
@@ -138,26 +140,29 @@ impl CpuRenderer {
             }
             // Each path takes its round's answers; those that reach a vertex state what it will
             // draw, and the sixteen vertices' samples are filled together.
-            let mut arrivals = [None; LANES];
+            let mut queries = [None; LANES];
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((_, path)) = slot else { continue };
                 let hit = &hits[lane];
                 if path.advance(features, &scene, hit, occluded[lane]) {
-                    arrivals[lane] = Some(path.arrival(features, &scene, hit));
+                    let arrival = path.arrival(features, &scene, hit);
+                    materials[lane] = arrival.material;
+                    queries[lane] = Some((path.rng, arrival.query));
                 }
             }
-            let queries: [_; LANES] = std::array::from_fn(|lane| {
-                let path = slots[lane].as_ref().map(|(_, path)| path);
-                match (path, &arrivals[lane]) {
-                    (Some(path), Some(arrival)) => Some((path.rng, arrival.query)),
-                    _ => None,
-                }
-            });
             let samples = fill_vertex_samples(&queries, &self.lights);
             for (lane, slot) in slots.iter_mut().enumerate() {
                 let Some((k, path)) = slot else { continue };
-                if let Some(arrival) = &arrivals[lane] {
-                    path.leave(features, &scene, &hits[lane], arrival, &samples[lane]);
+                if let Some((_, query)) = &queries[lane] {
+                    let hit = &hits[lane];
+                    path.vertex(
+                        features,
+                        &scene,
+                        hit,
+                        &materials[lane],
+                        query,
+                        &samples[lane],
+                    );
                 }
                 if path.finished() {
                     radiance[*k] = path.radiance;

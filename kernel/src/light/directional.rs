@@ -4,7 +4,6 @@
 //! `radius`) that bounds the scene. A delta light: next-event estimation alone finds it.
 
 use super::LightSample;
-use crate::geometry::sphere_point_error;
 use crate::sampling::SurfacePoint;
 use crate::scene::Light;
 use spirv_std::glam::Vec3;
@@ -32,10 +31,4 @@ pub fn sample(l: &Light, light: u32, x: Vec3) -> LightSample {
 #[inline]
 pub fn radiance(l: &Light) -> Vec3 {
     Vec3::from(l.radiance)
-}
-
-/// The error bound the shadow ray's end is lifted by: the bounding sphere's.
-#[inline]
-pub fn point_error(l: &Light) -> f32 {
-    sphere_point_error(Vec3::from(l.position), l.radius)
 }

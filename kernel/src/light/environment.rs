@@ -5,7 +5,6 @@
 
 use super::LightSample;
 use crate::environment as map;
-use crate::geometry::sphere_point_error;
 use crate::sampling::SurfacePoint;
 use crate::scene::Light;
 use crate::scene_view::SceneView;
@@ -50,10 +49,4 @@ pub fn pdf(l: &Light, mode: u32, scene: &SceneView, dir: Vec3) -> f32 {
 #[inline]
 pub fn radiance(scene: &SceneView, ls: &LightSample) -> Vec3 {
     map::eval(scene.params, scene.environment, -ls.point.normal)
-}
-
-/// The error bound the shadow ray's end is lifted by: the bounding sphere's.
-#[inline]
-pub fn point_error(l: &Light) -> f32 {
-    sphere_point_error(Vec3::from(l.position), l.radius)
 }

@@ -161,14 +161,13 @@ pub fn is_delta(kinds: LightKinds, l: &Light) -> bool {
 }
 
 /// Rounding-error bound of a point sampled on `l`: what lifts the end of its shadow ray off
-/// the light's surface.
+/// the light's surface. A triangle's is its own; every other kind's point is bounded as a point
+/// c + r n of its sphere (a sphere light's own; the bounding sphere the environment map and a
+/// directional light send their light from; a point light's position, radius 0).
 #[inline]
 pub fn point_error(kinds: LightKinds, l: &Light) -> f32 {
     match l.kind {
         light_kind::TRIANGLE if kinds.triangles => triangle::point_error(l),
-        light_kind::ENVIRONMENT => environment::point_error(l),
-        light_kind::PUNCTUAL => punctual::point_error(l),
-        light_kind::DIRECTIONAL => directional::point_error(l),
         _ => sphere::point_error(l),
     }
 }

@@ -4,7 +4,6 @@
 //! alone finds it: no ray can hit it, so its samples have MIS weight 1.
 
 use super::LightSample;
-use crate::geometry::sphere_point_error;
 use crate::sampling::SurfacePoint;
 use crate::scene::Light;
 #[cfg(target_arch = "spirv")]
@@ -48,11 +47,4 @@ pub fn sample(l: &Light, light: u32, x: Vec3) -> LightSample {
 #[inline]
 pub fn radiance(l: &Light, ls: &LightSample) -> Vec3 {
     Vec3::from(l.radiance) * spot_attenuation(l, ls.point.normal)
-}
-
-/// The error bound the shadow ray's end is lifted by: the representation error of the light's
-/// position.
-#[inline]
-pub fn point_error(l: &Light) -> f32 {
-    sphere_point_error(Vec3::from(l.position), l.radius)
 }
