@@ -5,5 +5,5 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = twinpath::scene::gltf_scene::load_bytes(std::path::Path::new("fuzz.glb"), data, None, None);
+    let _ = twinpath::scene::gltf::load_bytes(std::path::Path::new("fuzz.glb"), data, None, None);
 });

@@ -9,8 +9,8 @@
 use crate::fixed_sum::FixedSum;
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
-use kernel::adaptive::{is_pilot_sample, luminance};
-use kernel::film_sample::summable;
+use kernel::adaptive::luminance;
+use kernel::film_sample::{classify, sample_use};
 use kernel::scene::RenderParams;
 use std::path::Path;
 
@@ -158,17 +158,15 @@ pub struct PixelSums {
 
 impl PixelSums {
     /// Adds sample number `sample` of the pixel, of value `v`: to the pilot sums if adaptive
-    /// sampling (`params.pilot_period > 0`) makes it a pilot sample, else to the image sums.
+    /// sampling (`kernel::adaptive::is_adaptive`) makes it a pilot sample, else to the image sums.
     /// A value that cannot be summed (non-finite, or beyond `kernel::film_sample::MAX_SAMPLE`) is
     /// counted as discarded instead.
     #[inline]
     pub fn add_sample(&mut self, params: &RenderParams, sample: u32, v: Vec3) {
-        if !summable(v) {
-            self.discarded += 1;
-        } else if params.pilot_period > 0 && is_pilot_sample(params, sample) {
-            self.add_pilot(v);
-        } else {
-            self.add(v);
+        match classify(params, sample, v) {
+            sample_use::DISCARDED => self.discarded += 1,
+            sample_use::PILOT => self.add_pilot(v),
+            _ => self.add(v),
         }
     }
 

@@ -5,14 +5,12 @@
 #![feature(portable_simd)]
 
 pub mod backend;
-#[cfg(feature = "gpu")]
 pub mod bench;
 pub mod cpu;
 pub mod film;
 pub mod fixed_sum;
 pub mod merge;
 pub mod part_file;
-#[cfg(feature = "gpu")]
 pub mod render;
 pub mod sample_range;
 pub mod scene;

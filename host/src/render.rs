@@ -1,25 +1,16 @@
 //! The render driver: a scene, a backend, a sample count in, a film out, with progress and
 //! Ctrl-C (the samples finished so far are kept and written).
 
-use crate::backend::{RayCounts, SampleBackend};
-use crate::cpu::CpuBackend;
+pub use crate::backend::Backend;
+
+use crate::backend::{open, RayCounts};
 use crate::film::Film;
 use crate::sample_range::SampleRange;
 use crate::scene::Scene;
-use crate::vulkan::GpuRenderer;
 use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
-
-/// Which backend renders.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
-pub enum Backend {
-    /// The GPU when a Vulkan ray-tracing device is present, else the CPU.
-    Auto,
-    Cpu,
-    Gpu,
-}
 
 /// Options of a render besides the scene.
 #[derive(Clone, Copy, Debug)]
@@ -84,33 +75,9 @@ pub fn install_interrupt_handler() {
     });
 }
 
-/// Why `--backend auto` should render on the CPU without trying a Vulkan device: the best
-/// usable device is itself a CPU implementation (lavapipe/llvmpipe runs the same kernel on the
-/// same cores, about 3x slower than the native backend). None when a real GPU is usable, or a
-/// device was named with `--device`, or no device is usable (then opening one reports why).
-fn auto_prefers_cpu(device: Option<usize>) -> Option<String> {
-    if device.is_some() {
-        return None;
-    }
-    let devices = crate::vulkan::device::list_devices().ok()?;
-    let usable: Vec<_> = devices.iter().filter(|d| d.usable()).collect();
-    if !usable.is_empty()
-        && usable
-            .iter()
-            .all(|d| d.device_type == ash::vk::PhysicalDeviceType::CPU)
-    {
-        Some(format!(
-            "the only ray-tracing Vulkan device is a CPU implementation ({}; --backend gpu uses it)",
-            usable[0].name
-        ))
-    } else {
-        None
-    }
-}
-
 /// Renders `scene.render.spp` samples per pixel, or the range `opts.samples` of them.
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
-    if let (Some(range), true) = (opts.samples, scene.render.adaptive_target > 0.0) {
+    if let (Some(range), true) = (opts.samples, scene.render.adaptive()) {
         bail!(
             "adaptive sampling (--target-error) cannot be split into parts (samples {range}): \
              which samples a pixel takes depends on all its earlier ones (docs/parts.md)"
@@ -118,27 +85,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
     }
     let range = opts.samples.unwrap_or(SampleRange::all(scene.render.spp));
     let t0 = Instant::now();
-    let gpu = match opts.backend {
-        Backend::Cpu => None,
-        Backend::Gpu => Some(GpuRenderer::new(scene, opts.device, opts.validation)?),
-        Backend::Auto => match auto_prefers_cpu(opts.device) {
-            Some(reason) => {
-                eprintln!("twinpath: --backend auto: {reason}; using the CPU backend");
-                None
-            }
-            None => match GpuRenderer::new(scene, opts.device, opts.validation) {
-                Ok(g) => Some(g),
-                Err(e) => {
-                    eprintln!("twinpath: --backend auto: no usable GPU ({e:#}); using the CPU");
-                    None
-                }
-            },
-        },
-    };
-    let (mut backend, kind): (Box<dyn SampleBackend>, Backend) = match gpu {
-        Some(g) => (Box::new(g), Backend::Gpu),
-        None => (Box::new(CpuBackend::new(scene)), Backend::Cpu),
-    };
+    let (mut backend, kind) = open(opts.backend, scene, opts.device, opts.validation)?;
     let setup = t0.elapsed();
     let spp = range.len();
     let progress = opts

@@ -173,6 +173,12 @@ pub const SETTINGS: &[(&str, &str)] = &[
 const ALIASES: &[(&str, &str)] = &[("rr", "russian_roulette"), ("adaptive", "adaptive_target")];
 
 impl RenderSettings {
+    /// Whether the render samples adaptively (a target error is set): the one place the host
+    /// decides it; the kernel reads it from the launch parameters (`kernel::adaptive`).
+    pub fn adaptive(&self) -> bool {
+        self.adaptive_target > 0.0
+    }
+
     /// Sets `key` (a name of [`SETTINGS`] or an alias) to the value written `value`. The error
     /// says what is wrong with the value, or lists the keys; callers add where it came from.
     pub fn set(&mut self, key: &str, value: &str) -> Result<(), String> {

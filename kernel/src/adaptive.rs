@@ -16,10 +16,17 @@
 use crate::scene::{sampler, RenderParams};
 use spirv_std::glam::Vec3;
 
+/// Whether the render samples adaptively: the one test both backends and the film ask (the
+/// host sets `pilot_period` from its settings, `RenderSettings::adaptive`).
+#[inline]
+pub fn is_adaptive(params: &RenderParams) -> bool {
+    params.pilot_period > 0
+}
+
 /// Whether sample index `sample` of a pixel is a pilot sample (see the module comment).
 #[inline]
 pub fn is_pilot_sample(params: &RenderParams, sample: u32) -> bool {
-    params.pilot_period > 0 && sample.is_multiple_of(params.pilot_period)
+    is_adaptive(params) && sample.is_multiple_of(params.pilot_period)
 }
 
 /// The sampler (`scene::sampler`) and sequence index with which sample `sample` of a pixel

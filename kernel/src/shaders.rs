@@ -15,9 +15,9 @@
 //! instanced triangles (closest hit), each present only where the scene has that geometry.
 //! Miss shader 0 serves both kinds of ray.
 
-use crate::adaptive::{is_pilot_sample, luminance, pixel_converged};
+use crate::adaptive::{is_adaptive, luminance, pixel_converged};
 use crate::features::Dynamic;
-use crate::film_sample::summable;
+use crate::film_sample::{classify, sample_use};
 use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::hit::SurfaceHit;
 use crate::path::{render_sample, Tracer};
@@ -136,7 +136,7 @@ impl Tracer for RayTracer<'_> {
 /// M2 (sum of squared deviations) of the accumulation images: Welford's update within the
 /// launch, Chan, Golub and LeVeque's pairwise combination with the earlier launches. Both stay
 /// accurate in f32 where a sum of squares minus n mean^2 would cancel. Samples the film does not
-/// sum (`film_sample::summable`: non-finite or huge) are not merged; they are counted in
+/// sum (`film_sample::classify`: non-finite or huge) are not merged; they are counted in
 /// `accum_m2.a`. With adaptive sampling, a converged pixel takes no samples, and pilot samples go to the pilot image instead (`crate::adaptive`).
 #[spirv(ray_generation)]
 pub fn raygen(
@@ -171,7 +171,7 @@ pub fn raygen(
     let py = launch_id.y;
     let coord = UVec2::new(px, py);
     let a: Vec4 = accum_mean.read(coord);
-    let adaptive = params.pilot_period > 0;
+    let adaptive = is_adaptive(params);
     let mut pilot = Vec4::ZERO;
     if adaptive {
         pilot = pilots.read(coord);
@@ -197,9 +197,10 @@ pub fn raygen(
     while s < params.samples_per_launch {
         let index = params.sample_offset + s;
         let l = render_sample(&mut tracer, Dynamic(features), &scene, px, py, index);
-        if !summable(l) {
+        let class = classify(params, index, l);
+        if class == sample_use::DISCARDED {
             discarded += 1.0;
-        } else if is_pilot_sample(params, index) {
+        } else if class == sample_use::PILOT {
             // Welford on the pilots' luminance, straight into the pilot record.
             let y = luminance(l);
             pilot.z += 1.0;

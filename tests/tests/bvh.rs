@@ -15,7 +15,7 @@ use glam::Vec3;
 use kernel::rng::SampleRng;
 use kernel::scene::{Sphere, Triangle, NONE};
 use twinpath::bench::rays::{knot_mesh, to_triangles};
-use twinpath::cpu::bvh::Bvh;
+use twinpath::cpu::Bvh;
 
 /// Uniform numbers from the kernel's hash (a fixed stream per test).
 struct Uniform(SampleRng);
@@ -135,7 +135,7 @@ fn check_against_brute_force(
             f32::INFINITY
         };
         let (want, want_t) = brute_force(bvh, o, d, t_max);
-        let twinpath::cpu::bvh::PrimHit {
+        let twinpath::cpu::PrimHit {
             prim: got,
             t: got_t,
             ..
@@ -367,7 +367,7 @@ fn ray_measurement_and_ray_file_hold_what_was_traced() {
         for r in &rays {
             let (prim, t) = (u32_at(take(4)), f32_at(take(4)));
             let (o, d) = (Vec3::new(r[0], r[1], r[2]), Vec3::new(r[3], r[4], r[5]));
-            let twinpath::cpu::bvh::PrimHit {
+            let twinpath::cpu::PrimHit {
                 prim: want,
                 t: want_t,
                 ..
@@ -382,7 +382,7 @@ fn ray_measurement_and_ray_file_hold_what_was_traced() {
 
 #[test]
 fn parallel_build_gives_the_one_thread_tree() {
-    use twinpath::cpu::bvh_build::{Aabb, BinaryBvh};
+    use twinpath::cpu::internals::{Aabb, BinaryBvh};
     // Large enough for several levels of parallel halves (PARALLEL_MIN = 4096).
     let tris = to_triangles(&knot_mesh(60_000, Vec3::ZERO, 4.0), 0);
     let bounds: Vec<Aabb> = tris
@@ -428,7 +428,7 @@ fn parallel_build_gives_the_one_thread_tree() {
 #[test]
 fn packets_of_sixteen_rays_match_brute_force() {
     use std::simd::Simd;
-    use twinpath::cpu::packet::{RayPacket, SmallScene, LANES, MAX_PRIMITIVES};
+    use twinpath::cpu::{RayPacket, SmallScene, LANES, MAX_PRIMITIVES};
     let mut hits = 0;
     let mut rays = 0;
     for n in 0..=MAX_PRIMITIVES {
@@ -532,7 +532,7 @@ fn bvh_packets_of_sixteen_rays_match_brute_force() {
 /// (hits where another primitive is hit at exactly the same t).
 fn check_bvh_packets(name: &str, bvh: &Bvh, stream: u32, extent: f32) -> (u32, u32, u32) {
     use std::simd::Simd;
-    use twinpath::cpu::packet::{RayPacket, LANES};
+    use twinpath::cpu::{RayPacket, LANES};
     let n = bvh.spheres.len() + bvh.triangles.len();
     let mut rng = Uniform::new(stream);
     let (mut hits, mut rays, mut ties) = (0, 0, 0);
@@ -602,7 +602,7 @@ fn check_bvh_packets(name: &str, bvh: &Bvh, stream: u32, extent: f32) -> (u32, u
 #[test]
 fn ties_on_shared_edges_give_the_smallest_id() {
     use std::simd::Simd;
-    use twinpath::cpu::packet::{RayPacket, LANES};
+    use twinpath::cpu::{RayPacket, LANES};
     let mut tris = Vec::new();
     for x in -6..6 {
         for z in -6..6 {

@@ -1,4 +1,4 @@
-//! glTF 2.0 import (`twinpath::scene::gltf_scene`), proven on files the tests write
+//! glTF 2.0 import (`twinpath::scene::gltf`), proven on files the tests write
 //! (`twinpath_tests::gltf_writer`):
 //!
 //! 1. Round trip: a mesh with normals, texture coordinates and a textured metallic-roughness
@@ -15,7 +15,7 @@ use kernel::scene::{material_kind, texture_slot, Material, NONE};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use twinpath::render::Backend;
-use twinpath::scene::gltf_scene::MAX_TRIANGLES;
+use twinpath::scene::gltf::MAX_TRIANGLES;
 use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse};
 use twinpath::scene::Scene;
 use twinpath_tests::gltf_writer::GltfWriter;
@@ -561,7 +561,7 @@ fn hostile(edit: impl Fn(&mut GltfWriter)) -> String {
     g.push("scenes", json!({ "nodes": [0] }));
     edit(&mut g);
     let bytes = g.glb();
-    match twinpath::scene::gltf_scene::load_bytes(Path::new("hostile.glb"), &bytes, None, None) {
+    match twinpath::scene::gltf::load_bytes(Path::new("hostile.glb"), &bytes, None, None) {
         Ok(_) => String::new(),
         Err(e) => e.to_string(),
     }
@@ -668,7 +668,7 @@ fn hostile_gltf_files_are_errors_naming_the_place() {
         b"{ not json".to_vec(),
         vec![0u8; 7],
     ] {
-        let e = twinpath::scene::gltf_scene::load_bytes(Path::new("x.glb"), &bytes, None, None)
+        let e = twinpath::scene::gltf::load_bytes(Path::new("x.glb"), &bytes, None, None)
             .unwrap_err()
             .to_string();
         assert!(e.contains("not a valid glTF 2.0 file"), "{e}");
@@ -695,7 +695,7 @@ fn a_million_nodes(emissive: bool) -> Result<Scene, String> {
         "scenes",
         json!({ "nodes": (0..1_000_000).collect::<Vec<_>>() }),
     );
-    twinpath::scene::gltf_scene::load_bytes(Path::new("million.glb"), &g.glb(), None, None)
+    twinpath::scene::gltf::load_bytes(Path::new("million.glb"), &g.glb(), None, None)
         .map_err(|e| e.to_string())
 }
 
@@ -843,8 +843,7 @@ fn sampler_wrap_modes_are_read_per_axis() {
     }
     g.push("scenes", json!({ "nodes": [0, 1, 2] }));
     let scene =
-        twinpath::scene::gltf_scene::load_bytes(Path::new("samplers.glb"), &g.glb(), None, None)
-            .unwrap();
+        twinpath::scene::gltf::load_bytes(Path::new("samplers.glb"), &g.glb(), None, None).unwrap();
     let modes: Vec<u32> = scene
         .textures
         .textures

@@ -21,7 +21,7 @@ use glam::{DMat4, DVec3, Vec3};
 use kernel::geometry::{intersect_triangle, offset_ray_origin};
 use kernel::sampling::sample_cosine_hemisphere;
 use std::path::{Path, PathBuf};
-use twinpath::cpu::bvh::Bvh;
+use twinpath::cpu::Bvh;
 use twinpath::render::Backend;
 use twinpath::scene::instancing::instance_record;
 use twinpath::scene::transform::Transform;
@@ -425,9 +425,8 @@ fn tori_gltf(shared: bool) -> Scene {
         g.push("nodes", node);
     }
     g.push("scenes", json!({ "nodes": [0, 1, 2] }));
-    let mut scene =
-        twinpath::scene::gltf_scene::load_bytes(Path::new("tori.glb"), &g.glb(), None, None)
-            .unwrap_or_else(|e| panic!("{e}"));
+    let mut scene = twinpath::scene::gltf::load_bytes(Path::new("tori.glb"), &g.glb(), None, None)
+        .unwrap_or_else(|e| panic!("{e}"));
     scene.camera.width = 32;
     scene.camera.height = 18;
     with_independent_samples(scene)

@@ -254,8 +254,8 @@ fn instanced_scenes_trace_one_path_at_a_time() {
 fn numbers_computed_for_sixteen_streams_are_sample_rng_numbers() {
     use kernel::rng::{pcg4d, SampleRng};
     use kernel::scene::sampler;
-    use twinpath::cpu::packet::LANES;
-    use twinpath::cpu::packet_numbers::{camera_numbers, NumberRequests, EMPTY};
+    use twinpath::cpu::internals::{camera_numbers, NumberRequests, EMPTY};
+    use twinpath::cpu::LANES;
 
     for round in 0..64u32 {
         let h = |lane: usize, k: u32| pcg4d([round, lane as u32, k, 0x7e57])[0];
@@ -333,8 +333,8 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
     use kernel::rng::{pcg4d, u32_to_unit_f32, SampleRng};
     use kernel::scene::{light_sampling, sampler};
     use kernel::vertex_samples::{VertexQuery, VertexSamples, NO_DIMENSION};
-    use twinpath::cpu::packet::LANES;
-    use twinpath::cpu::packet_vertices::fill_vertex_samples;
+    use twinpath::cpu::internals::fill_vertex_samples;
+    use twinpath::cpu::LANES;
 
     let many = small("many_lights.toml").lights;
     let one = small("cornell.toml").lights;

@@ -31,7 +31,7 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use std::hash::BuildHasher;
 use std::simd::f32x4;
-use twinpath::cpu::simd::{Ray4, Spheres4, Triangles4};
+use twinpath::cpu::internals::{Ray4, Spheres4, Triangles4};
 
 /// The seed of the cases when `TWINPATH_PROP_SEED` is unset.
 const DEFAULT_SEED: u64 = 0x7477_696e_7061_7468;

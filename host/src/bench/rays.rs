@@ -5,9 +5,9 @@
 //! extension rays and its shadow segments). Every set can be written to a file so another ray
 //! tracer (Embree, in `scripts/embree_rays.c`) traces exactly the same rays.
 
-use crate::cpu::bvh::Bvh;
-use crate::cpu::packet::{PacketTracer, RayPacket, SmallScene, LANES};
+use crate::cpu::Bvh;
 use crate::cpu::{BvhTracer, CpuRenderer};
+use crate::cpu::{PacketTracer, RayPacket, SmallScene, LANES};
 use crate::scene::Scene;
 use glam::Vec3;
 use kernel::camera::{camera_origin, camera_ray_direction};

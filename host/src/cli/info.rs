@@ -5,12 +5,25 @@ use anyhow::Result;
 /// What this build contains: the SPIR-V module and the backends.
 pub fn run() -> Result<()> {
     println!("twinpath {}", env!("CARGO_PKG_VERSION"));
+    println!("cpu backend: {} threads", rayon::current_num_threads());
+    gpu();
+    Ok(())
+}
+
+/// Without the `gpu` feature: no SPIR-V module, no Vulkan.
+#[cfg(not(feature = "gpu"))]
+fn gpu() {
+    println!("gpu backend: not built (cargo feature `gpu`)");
+}
+
+/// The SPIR-V module and the Vulkan devices.
+#[cfg(feature = "gpu")]
+fn gpu() {
     println!(
         "kernel SPIR-V module: {} bytes, {}",
         twinpath::KERNEL_SPV.len(),
         twinpath::KERNEL_ORIGIN
     );
-    println!("cpu backend: {} threads", rayon::current_num_threads());
     match twinpath::vulkan::device::list_devices() {
         Ok(devices) if devices.is_empty() => println!("gpu backend: no Vulkan devices"),
         Ok(devices) => {
@@ -32,5 +45,4 @@ pub fn run() -> Result<()> {
         }
         Err(e) => println!("gpu backend: unavailable: {e:#}"),
     }
-    Ok(())
 }

@@ -288,7 +288,7 @@ fn write_sample_counts(
     spp_map: Option<&PathBuf>,
 ) -> Result<()> {
     let spp = result.film.samples_per_pixel();
-    if scene.render.adaptive_target > 0.0 {
+    if scene.render.adaptive() {
         let mean = spp.iter().map(|&c| c as f64).sum::<f64>() / spp.len().max(1) as f64;
         eprintln!(
             "twinpath: adaptive sampling (target {}): {mean:.1} samples per pixel on average, {} of {} pixels stopped early",

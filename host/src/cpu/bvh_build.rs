@@ -76,6 +76,7 @@ impl BinaryBvh {
 
     /// The same tree built on the calling thread alone, in depth-first node order: the
     /// reference the parallel build is tested against.
+    #[cfg(feature = "test-support")]
     pub fn build_one_thread(bounds: &[Aabb]) -> BinaryBvh {
         let centroids: Vec<Vec3> = bounds.iter().map(Aabb::centroid).collect();
         let mut prims: Vec<u32> = (0..bounds.len() as u32).collect();

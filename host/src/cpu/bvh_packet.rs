@@ -86,7 +86,7 @@ fn column<const N: usize>(v: &[Simd<f32, N>; 3], j: usize) -> [Lanes; 3] {
     ]
 }
 
-/// Lane by lane, `bvh::tie_limit`: t while nothing is hit, else the next float above it.
+/// Lane by lane, `bvh::traverse::tie_limit`: t while nothing is hit, else the next float above it.
 #[inline(always)]
 fn tie_limits(hits: &PacketHits) -> Lanes {
     let next_up = Lanes::from_bits(hits.t.to_bits() + Ids::splat(1));

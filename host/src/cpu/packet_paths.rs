@@ -8,18 +8,20 @@
 //! the `arrival` at each vertex reached, the vertices' samples (here filled for sixteen at
 //! once), `vertex`.
 
+use super::bvh::Bvh;
 use super::packet::{PacketTracer, RayPacket, LANES};
 use super::packet_numbers::camera_numbers;
 use super::packet_vertices::fill_vertex_samples;
-use super::{CpuRenderer, TileSums};
+use super::tile::TileSums;
 use crate::backend::RayCounts;
 use crate::film::Film;
 use crate::film::PixelSums;
 use glam::Vec3;
 use kernel::features::FeatureSet;
 use kernel::path::{sample_rng, start_path_at, PathState};
-use kernel::scene::{Material, RenderParams, NONE};
-use kernel::SurfaceHit;
+use kernel::scene::{Material, NONE};
+use kernel::{SceneView, SurfaceHit};
+use std::ops::Range;
 use std::simd::Simd;
 
 /// The rays the paths in `slots` wait for, as two packets with their t_max: the extension rays
@@ -46,144 +48,142 @@ fn gather(slots: &[Option<(usize, Path)>; LANES]) -> [(RayPacket, [f32; LANES]);
 /// A path of the packets.
 type Path = PathState;
 
-impl CpuRenderer {
-    /// Samples `first..first + count` of each of `pixels` (skipping those `film` says have
-    /// converged, under adaptive sampling), sixteen paths at a time; returns each pixel's sums,
-    /// added in sample order as the one-path loop adds them, and the rays traced.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn tile_by_packets<F: FeatureSet, T: PacketTracer>(
-        &self,
-        features: F,
-        tracer: &T,
-        params: &RenderParams,
-        pixels: &mut dyn Iterator<Item = (u32, u32)>,
-        first: u32,
-        count: u32,
-        film: &Film,
-    ) -> TileSums {
-        let adaptive = params.pilot_period > 0;
-        let pixels: Vec<(u32, u32, bool)> = pixels
-            .map(|(px, py)| (px, py, !(adaptive && film.converged(params, px, py))))
-            .collect();
-        let work: Vec<(u32, u32)> = pixels
-            .iter()
-            .filter(|p| p.2)
-            .map(|&(px, py, _)| (px, py))
-            .collect();
-        let n = work.len() * count as usize;
-        let pixel_of = |k: usize| work[k / count as usize];
-        let mut radiance = vec![Vec3::ZERO; n];
-        let mut slots: [Option<(usize, Path)>; LANES] = [None; LANES];
-        let mut next = 0;
-        // The streams of samples next..next + 16, and their camera numbers computed together.
-        let mut batch = [None; LANES];
-        let mut batch_camera = [(0.0, 0.0); LANES];
-        let mut hits = [SurfaceHit::miss(); LANES];
-        let scene = self.view(params);
-        // The materials of this round's vertices as `PathState::arrival` gives them.
-        let mut materials = [Material::diffuse([0.0; 3]); LANES];
-        let mut rays = RayCounts::default();
-        loop {
-            for slot in slots.iter_mut().filter(|s| s.is_none()) {
-                if next == n {
-                    break;
-                }
-                if next % LANES == 0 {
-                    batch = std::array::from_fn(|i| {
-                        let k = next + i;
-                        (k < n).then(|| {
-                            let (px, py) = pixel_of(k);
-                            sample_rng(params, px, py, first + (k % count as usize) as u32)
-                        })
-                    });
-                    batch_camera = camera_numbers(&batch);
-                }
-                let rng = batch[next % LANES]
-                    .take()
-                    .expect("the batch holds sample next");
-                let (px, py) = pixel_of(next);
-                let uv = batch_camera[next % LANES];
-                *slot = Some((next, start_path_at(features, params, px, py, rng, uv)));
-                next += 1;
-            }
-            if slots.iter().all(Option::is_none) {
+/// Samples `samples` of each of `pixels` (skipping those `film` says have converged, under
+/// adaptive sampling), sixteen paths at a time, their rays traced by `tracer` and their hits
+/// made by `bvh` (which holds the scene's primitives); returns each pixel's sums, added in
+/// sample order as the one-path loop adds them, and the rays traced.
+pub(super) fn tile_by_packets<F: FeatureSet, T: PacketTracer>(
+    features: F,
+    tracer: &T,
+    scene: &SceneView,
+    bvh: &Bvh,
+    pixels: &mut dyn Iterator<Item = (u32, u32)>,
+    samples: Range<u32>,
+    film: &Film,
+) -> TileSums {
+    let (params, first) = (scene.params, samples.start);
+    let count = samples.end - samples.start;
+    let adaptive = kernel::adaptive::is_adaptive(params);
+    let pixels: Vec<(u32, u32, bool)> = pixels
+        .map(|(px, py)| (px, py, !(adaptive && film.converged(params, px, py))))
+        .collect();
+    let work: Vec<(u32, u32)> = pixels
+        .iter()
+        .filter(|p| p.2)
+        .map(|&(px, py, _)| (px, py))
+        .collect();
+    let n = work.len() * count as usize;
+    let pixel_of = |k: usize| work[k / count as usize];
+    let mut radiance = vec![Vec3::ZERO; n];
+    let mut slots: [Option<(usize, Path)>; LANES] = [None; LANES];
+    let mut next = 0;
+    // The streams of samples next..next + 16, and their camera numbers computed together.
+    let mut batch = [None; LANES];
+    let mut batch_camera = [(0.0, 0.0); LANES];
+    let mut hits = [SurfaceHit::miss(); LANES];
+    // The materials of this round's vertices as `PathState::arrival` gives them.
+    let mut materials = [Material::diffuse([0.0; 3]); LANES];
+    let mut rays = RayCounts::default();
+    loop {
+        for slot in slots.iter_mut().filter(|s| s.is_none()) {
+            if next == n {
                 break;
             }
-            let [(extension, ext_t_max), (shadow, shadow_t_max)] = gather(&slots);
-            let lanes = |t_max: &[f32; LANES]| t_max.iter().filter(|&&t| t > 0.0).count() as u64;
-            let (extensions, shadows) = (lanes(&ext_t_max), lanes(&shadow_t_max));
-            rays.closest += extensions;
-            rays.shadow += shadows;
-            let (prims, ts, us, vs) = if extensions > 0 {
-                let h = tracer.closest_hits(&extension, Simd::from_array(ext_t_max));
-                let a = |x: Simd<f32, LANES>| x.to_array();
-                (h.prim.to_array(), a(h.t), a(h.u), a(h.v))
-            } else {
-                ([NONE; LANES], [0.0; LANES], [0.0; LANES], [0.0; LANES])
-            };
-            let occluded = if shadows > 0 {
-                tracer
-                    .occluded_lanes(&shadow, Simd::from_array(shadow_t_max))
-                    .to_array()
-            } else {
-                [false; LANES]
-            };
-            // Filled in place (an array built by `from_fn` was copied each round).
-            hits.fill(SurfaceHit::miss());
-            for (lane, slot) in slots.iter().enumerate() {
-                let Some((_, path)) = slot else { continue };
-                if path.extend && prims[lane] != NONE {
-                    let (o, d) = (path.ray_origin, path.ray_dir);
-                    let uv = (us[lane], vs[lane]);
-                    hits[lane] = self.bvh.surface_with_uv(prims[lane], o, d, ts[lane], uv);
-                }
+            if next % LANES == 0 {
+                batch = std::array::from_fn(|i| {
+                    let k = next + i;
+                    (k < n).then(|| {
+                        let (px, py) = pixel_of(k);
+                        sample_rng(params, px, py, first + (k % count as usize) as u32)
+                    })
+                });
+                batch_camera = camera_numbers(&batch);
             }
-            // Each path takes its round's answers; those that reach a vertex state what it will
-            // draw, and the sixteen vertices' samples are filled together.
-            let mut queries = [None; LANES];
-            for (lane, slot) in slots.iter_mut().enumerate() {
-                let Some((_, path)) = slot else { continue };
-                let hit = &hits[lane];
-                if path.advance(features, &scene, hit, occluded[lane]) {
-                    let arrival = path.arrival(features, &scene, hit);
-                    materials[lane] = arrival.material;
-                    queries[lane] = Some((path.rng, arrival.query));
-                }
-            }
-            let samples = fill_vertex_samples(&queries, &self.lights);
-            for (lane, slot) in slots.iter_mut().enumerate() {
-                let Some((k, path)) = slot else { continue };
-                if let Some((_, query)) = &queries[lane] {
-                    let hit = &hits[lane];
-                    path.vertex(
-                        features,
-                        &scene,
-                        hit,
-                        &materials[lane],
-                        query,
-                        &samples[lane],
-                    );
-                }
-                if path.finished() {
-                    radiance[*k] = path.radiance;
-                    *slot = None;
-                }
+            let rng = batch[next % LANES]
+                .take()
+                .expect("the batch holds sample next");
+            let (px, py) = pixel_of(next);
+            let uv = batch_camera[next % LANES];
+            *slot = Some((next, start_path_at(features, params, px, py, rng, uv)));
+            next += 1;
+        }
+        if slots.iter().all(Option::is_none) {
+            break;
+        }
+        let [(extension, ext_t_max), (shadow, shadow_t_max)] = gather(&slots);
+        let lanes = |t_max: &[f32; LANES]| t_max.iter().filter(|&&t| t > 0.0).count() as u64;
+        let (extensions, shadows) = (lanes(&ext_t_max), lanes(&shadow_t_max));
+        rays.closest += extensions;
+        rays.shadow += shadows;
+        let (prims, ts, us, vs) = if extensions > 0 {
+            let h = tracer.closest_hits(&extension, Simd::from_array(ext_t_max));
+            let a = |x: Simd<f32, LANES>| x.to_array();
+            (h.prim.to_array(), a(h.t), a(h.u), a(h.v))
+        } else {
+            ([NONE; LANES], [0.0; LANES], [0.0; LANES], [0.0; LANES])
+        };
+        let occluded = if shadows > 0 {
+            tracer
+                .occluded_lanes(&shadow, Simd::from_array(shadow_t_max))
+                .to_array()
+        } else {
+            [false; LANES]
+        };
+        // Filled in place (an array built by `from_fn` was copied each round).
+        hits.fill(SurfaceHit::miss());
+        for (lane, slot) in slots.iter().enumerate() {
+            let Some((_, path)) = slot else { continue };
+            if path.extend && prims[lane] != NONE {
+                let (o, d) = (path.ray_origin, path.ray_dir);
+                let uv = (us[lane], vs[lane]);
+                hits[lane] = bvh.surface_with_uv(prims[lane], o, d, ts[lane], uv);
             }
         }
-        let mut samples = radiance.chunks(count.max(1) as usize);
-        let sums = pixels
-            .iter()
-            .map(|&(_, _, sampled)| {
-                let mut acc = PixelSums::default();
-                if sampled {
-                    let values = samples.next().unwrap_or(&[]);
-                    for (s, &l) in (first..).zip(values) {
-                        acc.add_sample(params, s, l);
-                    }
-                }
-                acc
-            })
-            .collect();
-        (sums, rays)
+        // Each path takes its round's answers; those that reach a vertex state what it will
+        // draw, and the sixteen vertices' samples are filled together.
+        let mut queries = [None; LANES];
+        for (lane, slot) in slots.iter_mut().enumerate() {
+            let Some((_, path)) = slot else { continue };
+            let hit = &hits[lane];
+            if path.advance(features, scene, hit, occluded[lane]) {
+                let arrival = path.arrival(features, scene, hit);
+                materials[lane] = arrival.material;
+                queries[lane] = Some((path.rng, arrival.query));
+            }
+        }
+        let vertex_samples = fill_vertex_samples(&queries, scene.lights);
+        for (lane, slot) in slots.iter_mut().enumerate() {
+            let Some((k, path)) = slot else { continue };
+            if let Some((_, query)) = &queries[lane] {
+                let hit = &hits[lane];
+                path.vertex(
+                    features,
+                    scene,
+                    hit,
+                    &materials[lane],
+                    query,
+                    &vertex_samples[lane],
+                );
+            }
+            if path.finished() {
+                radiance[*k] = path.radiance;
+                *slot = None;
+            }
+        }
     }
+    let mut samples = radiance.chunks(count.max(1) as usize);
+    let sums = pixels
+        .iter()
+        .map(|&(_, _, sampled)| {
+            let mut acc = PixelSums::default();
+            if sampled {
+                let values = samples.next().unwrap_or(&[]);
+                for (s, &l) in (first..).zip(values) {
+                    acc.add_sample(params, s, l);
+                }
+            }
+            acc
+        })
+        .collect();
+    (sums, rays)
 }

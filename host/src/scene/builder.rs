@@ -3,10 +3,10 @@
 //! triangle becomes the same kernel records (and a light) whichever file it came from.
 
 use super::environment::EnvironmentMap;
-use super::file::MAX_COORDINATE;
 use super::instancing::{instance_box, instance_record, instances_box, mesh_box, MAX_INSTANCES};
 use super::light_table::{assign_light_selection, place_directional_lights, triangle_light};
-use super::mesh::TriangleSoup;
+use super::limits::MAX_COORDINATE;
+use super::soup::TriangleSoup;
 use super::tangents::face_tangent;
 use super::textures::TextureTable;
 use super::transform::Transform;

@@ -223,7 +223,7 @@ impl GpuRenderer {
             pipeline_time,
             width: w,
             height: h,
-            adaptive: scene.render.adaptive_target > 0.0,
+            adaptive: scene.render.adaptive(),
             ctx,
         })
     }

@@ -10,7 +10,7 @@
 //! resolves it, to an element that the file declares (negative: counted back from the elements
 //! declared above the line; positive: at most the file's total).
 
-use super::error::SceneError;
+use crate::scene::error::SceneError;
 use std::path::Path;
 
 /// The three kinds of element a face corner may index, in the order of `v/vt/vn`.
@@ -127,7 +127,7 @@ mod tests {
 
     #[test]
     fn the_fuzz_finding_is_an_error_not_a_panic() {
-        let e = super::super::mesh::parse_obj(Path::new("t.obj"), b"v 0 0 0\nf  4//-8 //-84\n")
+        let e = crate::scene::mesh::parse_obj(Path::new("t.obj"), b"v 0 0 0\nf  4//-8 //-84\n")
             .unwrap_err();
         assert_eq!(e.line, Some(2), "{e}");
     }

@@ -1,12 +1,16 @@
 //! The `[materials]` table of a scene file: each entry checked field by field and made a
 //! kernel [`Material`] (README "Scene format"; the models in `docs/materials.md`).
 
-use super::error::SceneError;
-use super::file::{Checker, MaterialFile};
-use super::textures::{TextureTable, TextureUse};
+use super::checker::{Checker, V3};
+use crate::scene::builder::SceneTables;
+use crate::scene::limits::{IOR_RANGE, MAX_ALPHA};
+use crate::scene::textures::{TextureTable, TextureUse};
+use crate::scene::SceneError;
 use glam::Vec3;
 use kernel::scene::{material_kind, texture_slot, Material, NONE};
 use kernel::texture::wrap;
+use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::path::Path;
 use toml::Spanned;
 
@@ -36,10 +40,97 @@ pub const METALS: [(&str, [f32; 3], [f32; 3]); 4] = [
     ),
 ];
 
-/// Largest GGX roughness accepted: alpha 1 is already rougher than a Lambertian surface looks.
-pub const MAX_ALPHA: f32 = 1.0;
-/// Range of a dielectric's index of refraction (relative to the outside) accepted.
-pub const IOR_RANGE: (f32, f32) = (0.1, 10.0);
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct MaterialFile {
+    pub kd: Option<V3>,
+    pub ks: Option<V3>,
+    pub alpha: Option<Spanned<f32>>,
+    pub conductor: Option<Spanned<toml::Value>>,
+    pub dielectric: Option<Spanned<DielectricFile>>,
+    pub emission: Option<V3>,
+    /// With `emission`, on quads and meshes: both faces emit (default: the front face).
+    pub two_sided: Option<Spanned<bool>>,
+    /// Image textures multiplying kd, ks, alpha (its red channel) and emission (each factor
+    /// defaults to 1 where its map is given), relative to the scene file.
+    pub kd_map: Option<Spanned<String>>,
+    pub ks_map: Option<Spanned<String>>,
+    pub alpha_map: Option<Spanned<String>>,
+    pub emission_map: Option<Spanned<String>>,
+    /// How the maps continue outside [0, 1]: "repeat" (default), "clamp" or "mirror".
+    pub wrap: Option<Spanned<String>>,
+    /// glTF's metallic-roughness material (`material_kind::METALLIC_ROUGHNESS`): base colour,
+    /// metalness and perceptual roughness (alpha = roughness^2), each optional (defaults 1, as
+    /// in glTF), with glTF's maps: the base colour (sRGB) and the metallic-roughness map (linear;
+    /// blue metalness, green roughness).
+    pub base_color: Option<V3>,
+    pub metallic: Option<Spanned<f32>>,
+    pub roughness: Option<Spanned<f32>>,
+    pub base_color_map: Option<Spanned<String>>,
+    pub metallic_roughness_map: Option<Spanned<String>>,
+    /// A tangent-space normal map (linear; glTF's `normalTexture`, OpenGL's +y convention) and
+    /// its x/y scale (default 1), for any reflecting material on triangles.
+    pub normal_map: Option<Spanned<String>>,
+    pub normal_scale: Option<Spanned<f32>>,
+}
+
+impl MaterialFile {
+    /// Whether the entry describes glTF's metallic-roughness material.
+    pub fn is_metallic_roughness(&self) -> bool {
+        self.base_color.is_some()
+            || self.metallic.is_some()
+            || self.roughness.is_some()
+            || self.base_color_map.is_some()
+            || self.metallic_roughness_map.is_some()
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct DielectricFile {
+    pub ior: Spanned<f32>,
+}
+
+/// Adds the file's materials to `tables`, in name order, with their textures (relative to
+/// `base_dir`).
+pub(super) fn add_materials(
+    ck: &Checker,
+    materials: &BTreeMap<String, Spanned<MaterialFile>>,
+    base_dir: &Path,
+    tables: &mut SceneTables,
+) -> Result<(), SceneError> {
+    for (name, m) in materials {
+        let field = format!("materials.{name}");
+        let mut material = material(ck, &field, m)?;
+        attach_textures(ck, &field, m, base_dir, &mut tables.textures, &mut material)?;
+        tables.add_material(name.clone(), material);
+    }
+    Ok(())
+}
+
+/// The index of the material `s` names (at `field`) among `names`.
+pub(super) fn find_material(
+    ck: &Checker,
+    names: &[String],
+    s: &Spanned<String>,
+    field: &str,
+) -> Result<u32, SceneError> {
+    names
+        .iter()
+        .position(|n| n == s.get_ref())
+        .map(|i| i as u32)
+        .ok_or_else(|| {
+            ck.err(
+                s.span(),
+                field,
+                format!(
+                    "unknown material '{}' (defined: {})",
+                    s.get_ref(),
+                    names.join(", ")
+                ),
+            )
+        })
+}
 
 /// The material `field` (`materials.NAME`) of entry `m`.
 pub(super) fn material(

@@ -4,7 +4,7 @@
 //! or ignored is noted (`Scene::notes`); docs/gltf.md lists it.
 
 use super::Import;
-use crate::scene::materials::IOR_RANGE;
+use crate::scene::limits::IOR_RANGE;
 use crate::scene::textures::TextureUse;
 use crate::scene::SceneError;
 use glam::Vec3;

@@ -1,0 +1,334 @@
+//! The scene every format's load produces: the kernel's flat tables (materials, spheres,
+//! triangles, instances, lights, shading records, textures, the environment map), the camera
+//! and the render settings, and what the backends derive from them (the launch parameters, the
+//! feature bits, the light table with its selection probabilities).
+
+use super::environment;
+use super::inputs;
+use super::instancing;
+use super::light_table;
+use super::limits;
+use super::textures;
+use crate::settings::RenderSettings;
+use glam::Vec3;
+use kernel::scene::{
+    Camera, Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle,
+};
+use std::ops::Range;
+
+/// The camera as the scene file gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDesc {
+    pub eye: Vec3,
+    pub look_at: Vec3,
+    pub up: Vec3,
+    /// Full vertical field of view, degrees.
+    pub vfov_degrees: f32,
+    pub width: u32,
+    pub height: u32,
+    /// Diameter of the thin lens (0: a pinhole).
+    pub aperture: f32,
+    /// Distance along the view axis of the plane in focus.
+    pub focus_distance: f32,
+}
+
+impl CameraDesc {
+    /// The camera with image size `width` x `height` where given (the command line's
+    /// `--width`, `--height`): one alone keeps the aspect ratio (the other side rounded, at
+    /// least 1); the vertical field of view stays. Err: a side outside 1..=2^15 (the scene
+    /// file's own limit), naming the option.
+    pub fn resized(&self, width: Option<u32>, height: Option<u32>) -> Result<CameraDesc, String> {
+        let max = limits::MAX_IMAGE_SIDE as u32;
+        for (name, v) in [("--width", width), ("--height", height)] {
+            if let Some(v) = v {
+                if !(1..=max).contains(&v) {
+                    return Err(format!("{name} {v}: must be 1 to {max} pixels"));
+                }
+            }
+        }
+        let aspect = self.width as f64 / self.height as f64;
+        let side = |x: f64| (x.round() as u32).clamp(1, max);
+        let (w, h) = match (width, height) {
+            (Some(w), Some(h)) => (w, h),
+            (Some(w), None) => (w, side(w as f64 / aspect)),
+            (None, Some(h)) => (side(h as f64 * aspect), h),
+            (None, None) => (self.width, self.height),
+        };
+        Ok(CameraDesc {
+            width: w,
+            height: h,
+            ..*self
+        })
+    }
+
+    /// The kernel's camera: forward, and right/up scaled by the image plane's half-extents; the
+    /// lens radius and the focus distance in the spare fourth components (`kernel::scene::Camera`).
+    pub fn to_kernel(&self) -> Camera {
+        let forward = (self.look_at - self.eye).normalize();
+        let right = forward.cross(self.up).normalize();
+        let up = right.cross(forward);
+        let half_h = (0.5 * self.vfov_degrees.to_radians()).tan();
+        let half_w = half_h * self.width as f32 / self.height as f32;
+        let v4 = |v: Vec3| [v.x, v.y, v.z, 0.0];
+        Camera {
+            eye: [self.eye.x, self.eye.y, self.eye.z, 0.5 * self.aperture],
+            forward: [forward.x, forward.y, forward.z, self.focus_distance],
+            right: v4(right * half_w),
+            up: v4(up * half_h),
+        }
+    }
+}
+
+/// With adaptive sampling, every PILOT_PERIOD-th sample is a pilot (`kernel::adaptive`).
+pub const PILOT_PERIOD: u32 = 4;
+/// Pilot samples before a pixel may stop (16 samples in all).
+pub const MIN_PILOT_SAMPLES: u32 = 4;
+/// Samples per pixel per adaptive pass: both backends decide at the same sample indices.
+pub const ADAPTIVE_PASS: u32 = 8;
+
+/// The kernel's triangle with vertices `p` (p0 and the edges p1 - p0, p2 - p0) and `material`,
+/// not a light (`light` is set where it emits).
+pub fn triangle(p: [Vec3; 3], material: u32) -> Triangle {
+    Triangle {
+        p0: p[0].to_array(),
+        material,
+        edge1: (p[1] - p[0]).to_array(),
+        light: kernel::scene::NONE,
+        edge2: (p[2] - p[0]).to_array(),
+        shading: kernel::scene::NONE,
+    }
+}
+
+/// A contiguous run of triangles from one source (a mesh, or the scene's quads).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleGroup {
+    pub name: String,
+    pub range: Range<usize>,
+}
+
+/// A validated scene in the kernel's flat layout.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Where it came from (a file path, or the built-in scene's name).
+    pub name: String,
+    pub camera: CameraDesc,
+    pub render: RenderSettings,
+    pub background: Vec3,
+    pub materials: Vec<Material>,
+    pub material_names: Vec<String>,
+    pub spheres: Vec<Sphere>,
+    /// The world-space triangles, then the instanced meshes' object-space ones
+    /// ([`Scene::world_triangle_count`] tells them apart).
+    pub triangles: Vec<Triangle>,
+    /// Runs of world-space triangles by source.
+    pub triangle_groups: Vec<TriangleGroup>,
+    /// The instanced meshes: runs of object-space triangles, each placed by instances.
+    pub meshes: Vec<TriangleGroup>,
+    /// The placements of instanced meshes (`instancing`), and the mesh each places.
+    pub instances: Vec<Instance>,
+    pub instance_meshes: Vec<u32>,
+    pub lights: Vec<Light>,
+    /// The environment map, if `[background] map` names one (its light is the last entry of
+    /// `lights`).
+    pub environment: Option<environment::EnvironmentMap>,
+    /// Vertex normals and texture coordinates of the triangles that have them
+    /// (`Triangle::shading` indexes it).
+    pub shading: Vec<ShadingTriangle>,
+    /// The materials' textures (`Material::textures` indexes it).
+    pub textures: textures::TextureTable,
+    /// What the loader approximated or ignored (glTF features twinpath does not read yet):
+    /// shown to the user before a render.
+    pub notes: Vec<String>,
+    /// The files the scene was read from, with their hashes (`inputs`).
+    pub inputs: Vec<inputs::InputFile>,
+}
+
+impl Scene {
+    /// The kernel parameters for a launch of `samples_per_launch` samples starting at sample
+    /// index `sample_offset`.
+    pub fn params(&self, sample_offset: u32, samples_per_launch: u32) -> RenderParams {
+        let r = &self.render;
+        RenderParams {
+            camera: self.camera.to_kernel(),
+            background: [self.background.x, self.background.y, self.background.z, 0.0],
+            width: self.camera.width,
+            height: self.camera.height,
+            seed: r.seed,
+            sample_offset,
+            samples_per_launch,
+            light_count: self.lights.len() as u32,
+            rr_mode: r.roulette.code(),
+            rr_probability: r.rr_probability,
+            rr_start_depth: r.roulette_start_depth(),
+            mis_mode: r.mis.code(),
+            max_depth: r.max_depth,
+            light_sampling: r.light_sampling.code(),
+            adaptive_target: r.adaptive_target,
+            pilot_period: if r.adaptive() { PILOT_PERIOD } else { 0 },
+            min_pilot_samples: MIN_PILOT_SAMPLES,
+            sampler: r.sampler.code(),
+            env_width: self.environment.as_ref().map_or(0, |m| m.width),
+            env_height: self.environment.as_ref().map_or(0, |m| m.height),
+            env_light: if self.environment.is_some() {
+                self.lights.len() as u32 - 1
+            } else {
+                kernel::scene::NONE
+            },
+            env_scale: self.environment.as_ref().map_or(1.0, |m| m.scale),
+            env_rotation: {
+                let a = self
+                    .environment
+                    .as_ref()
+                    .map_or(0.0, |m| m.rotation_degrees)
+                    .to_radians();
+                [a.cos(), a.sin()]
+            },
+            _pad: [0; 2],
+        }
+    }
+
+    /// Number of world-space triangles: the triangle table's first entries (the instanced
+    /// meshes' follow).
+    pub fn world_triangle_count(&self) -> usize {
+        self.meshes
+            .first()
+            .map_or(self.triangles.len(), |m| m.range.start)
+    }
+
+    /// The world-space box of every instance (empty without instances).
+    pub fn instanced_box(&self) -> (Vec3, Vec3) {
+        let boxes: Vec<(Vec3, Vec3)> = self
+            .meshes
+            .iter()
+            .map(|m| instancing::mesh_box(&self.triangles[m.range.clone()]))
+            .collect();
+        instancing::instances_box(&boxes, &self.instances, &self.instance_meshes)
+    }
+
+    /// The instance table as the kernel binds it (see [`bindable`]).
+    pub fn instance_table(&self) -> Vec<Instance> {
+        bindable(&self.instances)
+    }
+
+    /// Replaces the environment map (and its light, the last entry of `lights`), keeping the
+    /// light selection up to date: scenes built in code (tests) give maps this way.
+    pub fn set_environment(&mut self, map: Option<environment::EnvironmentMap>) {
+        if self.environment.take().is_some() {
+            self.lights.pop();
+        }
+        if let Some(m) = &map {
+            let world = &self.triangles[..self.world_triangle_count()];
+            let light = m.light(&self.spheres, world, self.instanced_box());
+            self.lights.push(light);
+        }
+        self.environment = map;
+        light_table::assign_light_selection(&mut self.lights, self.render.light_selection.code());
+    }
+
+    /// The environment table (`kernel::environment`): the map's texels and CDFs, or one zero
+    /// (a storage buffer needs a number behind it) without a map.
+    pub fn environment_table(&self) -> Vec<f32> {
+        self.environment
+            .as_ref()
+            .map_or_else(|| vec![0.0], |m| m.table())
+    }
+
+    /// The shading table as the kernel binds it (see [`bindable`]).
+    pub fn shading_table(&self) -> Vec<ShadingTriangle> {
+        bindable(&self.shading)
+    }
+
+    /// Bytes of the scene's tables on either backend: triangles, spheres, shading records,
+    /// materials, lights, textures, the environment map and instances (what `twinpath info`
+    /// reports).
+    pub fn table_bytes(&self) -> [(&'static str, usize); 8] {
+        use std::mem::size_of;
+        [
+            ("triangles", self.triangles.len() * size_of::<Triangle>()),
+            ("instances", self.instances.len() * size_of::<Instance>()),
+            ("spheres", self.spheres.len() * size_of::<Sphere>()),
+            ("shading", self.shading.len() * size_of::<ShadingTriangle>()),
+            ("materials", self.materials.len() * size_of::<Material>()),
+            ("lights", self.lights.len() * size_of::<Light>()),
+            ("textures", self.textures.bytes()),
+            (
+                "environment",
+                self.environment.as_ref().map_or(0, |m| 4 * m.table_len()),
+            ),
+        ]
+    }
+
+    /// One line on the memory the scene's tables take on either backend: each non-empty table
+    /// and the total, and the textures' count and sizes.
+    pub fn memory_report(&self) -> String {
+        let size = |b: usize| {
+            if b < 1 << 20 {
+                format!("{:.1} KiB", b as f64 / 1024.0)
+            } else {
+                format!("{:.1} MiB", b as f64 / (1024.0 * 1024.0))
+            }
+        };
+        let tables = self.table_bytes();
+        let total: usize = tables.iter().map(|t| t.1).sum();
+        let mut parts: Vec<String> = tables
+            .iter()
+            .filter(|t| t.1 > 0 && (t.0 != "textures" || !self.textures.textures.is_empty()))
+            .map(|(name, b)| format!("{name} {}", size(*b)))
+            .collect();
+        if !self.textures.textures.is_empty() {
+            let sizes: Vec<String> = self
+                .textures
+                .textures
+                .iter()
+                .map(|t| format!("{}x{}", t.width, t.height))
+                .collect();
+            let noun = if sizes.len() == 1 {
+                "texture"
+            } else {
+                "textures"
+            };
+            parts.push(format!("{} {noun} ({})", sizes.len(), sizes.join(", ")));
+        }
+        format!("{} in all: {}", size(total), parts.join(", "))
+    }
+
+    /// The kernel's feature bits for this scene and its settings (`kernel::features`; 0 with
+    /// `specialize` off, the generic path).
+    pub fn features(&self) -> u32 {
+        if self.render.specialize {
+            kernel::features::scene_features(&self.params(0, 1))
+                | kernel::bsdf::material_features(&self.materials)
+                | kernel::light::light_features(&self.lights)
+                | kernel::features::surface_features(&self.materials, &self.shading)
+                | if self.instances.is_empty() {
+                    0
+                } else {
+                    kernel::features::INSTANCES
+                }
+        } else {
+            0
+        }
+    }
+
+    /// The light table with selection probabilities for `render.light_selection`.
+    pub fn light_table(&self) -> Vec<Light> {
+        let mut lights = self.lights.clone();
+        light_table::assign_light_selection(&mut lights, self.render.light_selection.code());
+        lights
+    }
+
+    /// Number of pixels.
+    pub fn pixel_count(&self) -> usize {
+        self.camera.width as usize * self.camera.height as usize
+    }
+}
+
+/// `records` as a storage buffer binds them: one zero record when empty (a buffer needs
+/// something behind it; the kernel never reads it, no index pointing there).
+fn bindable<T: bytemuck::Pod>(records: &[T]) -> Vec<T> {
+    if records.is_empty() {
+        vec![T::zeroed()]
+    } else {
+        records.to_vec()
+    }
+}

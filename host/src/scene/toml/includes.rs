@@ -1,0 +1,52 @@
+//! The `[[gltf]]` table: a glTF file's default scene as part of this one, under an optional
+//! transform (`crate::scene::gltf::include`).
+
+use super::checker::{Checker, V3};
+use super::transform::{parse_transform, transform_fields};
+use crate::scene::builder::SceneTables;
+use crate::scene::{gltf, SceneError};
+use serde::Deserialize;
+use std::path::Path;
+use toml::Spanned;
+
+/// A glTF file's default scene as part of this one (`gltf::include`): its meshes with
+/// their own materials, under an optional transform; its cameras are not used.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct GltfFile {
+    pub file: Spanned<String>,
+    pub scale: Option<Spanned<toml::Value>>,
+    pub rotate: Option<Spanned<[f32; 4]>>,
+    pub translate: Option<V3>,
+    pub matrix: Option<Spanned<[[f32; 4]; 4]>>,
+}
+
+/// Adds the meshes, materials and lights of the included files to `tables` (relative to
+/// `base_dir`); returns what the glTF loader noted.
+pub(super) fn add_gltf(
+    ck: &Checker,
+    includes: &[Spanned<GltfFile>],
+    base_dir: &Path,
+    tables: &mut SceneTables,
+) -> Result<Vec<String>, SceneError> {
+    let mut notes = Vec::new();
+    for (i, g) in includes.iter().enumerate() {
+        let gf = g.get_ref();
+        let field = format!("gltf[{i}]");
+        let gltf_path = base_dir.join(gf.file.get_ref());
+        if !gltf_path.is_file() {
+            return Err(ck.err(
+                gf.file.span(),
+                &format!("{field}.file"),
+                format!("glTF file {} does not exist", gltf_path.display()),
+            ));
+        }
+        let transform = if transform_fields!(gf).is_given() {
+            Some(parse_transform(ck, &field, &transform_fields!(gf))?)
+        } else {
+            None
+        };
+        gltf::include(tables, &gltf_path, transform.as_ref(), &mut notes)?;
+    }
+    Ok(notes)
+}

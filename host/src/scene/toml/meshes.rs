@@ -1,0 +1,133 @@
+//! The `[[mesh]]` table: OBJ and PLY meshes (`crate::scene::mesh`), placed by transforms;
+//! a mesh several entries place with the same material is read once and, when large enough
+//! and not emissive, instanced.
+
+use super::checker::{Checker, V3};
+use super::materials::find_material;
+use super::transform::{parse_transform, transform_fields};
+use crate::scene::builder::SceneTables;
+use crate::scene::closed_surface::check_closed_outward;
+use crate::scene::instancing::INSTANCE_MIN_TRIANGLES;
+use crate::scene::mesh::load_mesh;
+use crate::scene::soup::TriangleSoup;
+use crate::scene::SceneError;
+use serde::Deserialize;
+use std::collections::HashMap;
+use std::path::Path;
+use std::rc::Rc;
+use toml::Spanned;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct MeshFile {
+    pub file: Spanned<String>,
+    pub material: Spanned<String>,
+    /// Optional transform (`transform::parse_transform`): scale (a number or [x, y, z]), then
+    /// rotate ([degrees, axis x, y, z]), then translate; or a row-major 4 x 4 affine matrix.
+    pub scale: Option<Spanned<toml::Value>>,
+    pub rotate: Option<Spanned<[f32; 4]>>,
+    pub translate: Option<V3>,
+    pub matrix: Option<Spanned<[[f32; 4]; 4]>>,
+}
+
+/// Adds the file's meshes to `tables`; mesh files are relative to `base_dir`.
+pub(super) fn add_meshes(
+    ck: &Checker,
+    meshes: &[Spanned<MeshFile>],
+    base_dir: &Path,
+    tables: &mut SceneTables,
+) -> Result<(), SceneError> {
+    // A mesh file that several entries place with the same material is read once; from
+    // INSTANCE_MIN_TRIANGLES triangles on and unless it emits, it is stored once and instanced.
+    let mesh_key = |mf: &MeshFile| (mf.file.get_ref().clone(), mf.material.get_ref().clone());
+    let mut mesh_uses: HashMap<(String, String), usize> = HashMap::new();
+    for m in meshes {
+        *mesh_uses.entry(mesh_key(m.get_ref())).or_insert(0) += 1;
+    }
+    let mut loaded: HashMap<(String, String), Rc<TriangleSoup>> = HashMap::new();
+    let mut instanced: HashMap<(String, String), u32> = HashMap::new();
+    for (i, m) in meshes.iter().enumerate() {
+        let mf = m.get_ref();
+        let field = format!("mesh[{i}]");
+        let material = find_material(
+            ck,
+            &tables.material_names,
+            &mf.material,
+            &format!("{field}.material"),
+        )?;
+        let mesh_path = base_dir.join(mf.file.get_ref());
+        if !mesh_path.is_file() {
+            return Err(ck.err(
+                mf.file.span(),
+                &format!("{field}.file"),
+                format!("mesh file {} does not exist", mesh_path.display()),
+            ));
+        }
+        let transform = if transform_fields!(mf).is_given() {
+            Some(parse_transform(ck, &field, &transform_fields!(mf))?)
+        } else {
+            None
+        };
+        let key = mesh_key(mf);
+        if let Some(&mesh) = instanced.get(&key) {
+            tables
+                .add_instance(mesh, &transform.unwrap_or_default())
+                .map_err(|msg| ck.err(m.span(), &field, msg))?;
+            continue;
+        }
+        let soup = match loaded.get(&key) {
+            Some(soup) => soup.clone(),
+            None => Rc::new(load_mesh(&mesh_path)?),
+        };
+        if tables.is_dielectric(material) {
+            check_closed_outward(&soup.triangles).map_err(|msg| {
+                SceneError::new(
+                    &mesh_path,
+                    None,
+                    format!("{field} (material '{}')", mf.material.get_ref()),
+                    msg,
+                )
+            })?;
+        }
+        if tables.is_textured(material) && soup.uvs.is_empty() {
+            return Err(ck.err(
+                mf.material.span(),
+                &format!("{field}.material"),
+                format!(
+                    "'{}' has textures but {} has no texture coordinates (OBJ vt, PLY u v)",
+                    mf.material.get_ref(),
+                    mf.file.get_ref()
+                ),
+            ));
+        }
+        let triangle_err = |(k, msg): (usize, String)| {
+            ck.err(mf.file.span(), &format!("{field} triangle {k}"), msg)
+        };
+        if mesh_uses[&key] >= 2
+            && soup.triangles.len() >= INSTANCE_MIN_TRIANGLES
+            && !tables.is_emissive(material)
+        {
+            let mesh = tables.begin_instanced_mesh(mf.file.get_ref().clone());
+            tables
+                .push_mesh_part(&soup, material)
+                .map_err(triangle_err)?;
+            tables
+                .add_instance(mesh, &transform.unwrap_or_default())
+                .map_err(|msg| ck.err(m.span(), &field, msg))?;
+            instanced.insert(key, mesh);
+            continue;
+        }
+        tables
+            .push_mesh(
+                mf.file.get_ref().clone(),
+                &soup,
+                transform.as_ref(),
+                material,
+            )
+            .map_err(triangle_err)?;
+        if mesh_uses[&key] >= 2 {
+            loaded.insert(key, soup);
+        }
+    }
+    Ok(())
+}
