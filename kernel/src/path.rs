@@ -318,7 +318,13 @@ impl PathState {
         shading_normal: Vec3,
     ) -> VertexQuery {
         let lambertian = !features.materials() || bsdf::is_lambertian(material);
-        let flags = bsdf::flags(material);
+        // A Lambertian vertex reads its albedo and never chooses a lobe: only other kinds are
+        // asked for their flags.
+        let flags = if lambertian {
+            bsdf::lambert::FLAGS
+        } else {
+            bsdf::flags(material)
+        };
         let reflects = if lambertian {
             Vec3::from(material.albedo).max_element() > 0.0
         } else {

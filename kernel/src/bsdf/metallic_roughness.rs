@@ -15,9 +15,6 @@ pub const FEATURES: u32 = features::GLOSSY | features::METALLIC_ROUGHNESS;
 /// The mixture's flags: a Lambertian lobe beside the glossy one.
 pub const FLAGS: BsdfFlags = mixture::FLAGS;
 
-/// glTF's dielectric reflectance at normal incidence (index 1.5), the mixture's layer.
-pub const GLTF_DIELECTRIC_F0: f32 = LAYER_F0;
-
 /// The material in the Kd + Ks form the mixture reads, from its base colour (`albedo`),
 /// `metallic` and `roughness` as textures left them:
 ///
@@ -35,7 +32,7 @@ pub fn resolve(m: &Material) -> Material {
     let base = Vec3::from(m.albedo);
     let metallic = m.metallic;
     r.albedo = (base * (1.0 - metallic)).to_array();
-    r.specular = (Vec3::splat(GLTF_DIELECTRIC_F0) * (1.0 - metallic) + base * metallic).to_array();
+    r.specular = (Vec3::splat(LAYER_F0) * (1.0 - metallic) + base * metallic).to_array();
     r.alpha = m.roughness * m.roughness;
     r
 }

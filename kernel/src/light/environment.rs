@@ -44,8 +44,8 @@ pub fn pdf(l: &Light, mode: u32, scene: &SceneView, dir: Vec3) -> f32 {
     l.select_pmf * map::pdf(scene.params, scene.environment, mode, dir)
 }
 
-/// The radiance the map sends along light sample `ls` (toward -normal's opposite: the
-/// receiver looks along -normal).
+/// The radiance the map sends toward the receiver of light sample `ls`: the map's value in
+/// the direction the receiver looks, -normal (the sample faces back along it).
 #[inline]
 pub fn radiance(scene: &SceneView, ls: &LightSample) -> Vec3 {
     map::eval(scene.params, scene.environment, -ls.point.normal)
