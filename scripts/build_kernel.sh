@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Compiles kernel/ to SPIR-V with rust-gpu and writes the shipped module and its manifest,
-# kernel/shipped/kernel.spv and kernel/shipped/manifest.toml (what the module was compiled from:
-# every kernel source's hash, the locked packages, the toolchain, the builder's options).
+# Compiles kernel/ to SPIR-V with rust-gpu and writes the shipped modules and their manifest:
+# kernel/shipped/kernel.spv (the renderer's), kernel/shipped/probe.spv (the kernel with its feature
+# `probe`: the equivalence tests' compute probes) and kernel/shipped/manifest.toml (what they were
+# compiled from: every kernel source's hash, the locked packages, the toolchain, the builder's
+# options).
 # Run it after changing the kernel: every build checks the manifest against the sources and
 # fails, naming this script, until the module is regenerated.
 #
@@ -28,14 +30,15 @@ messages=$("${check[@]}" --message-format=json) || status=$?
 [ "$status" -eq 0 ] || "${check[@]}" >&2 || true
 out_dir=$(printf '%s\n' "$messages" | grep '"reason":"build-script-executed"' | grep '/host#twinpath@' \
   | sed -n 's/.*"out_dir":"\([^"]*\)".*/\1/p' | tail -n 1)
-if [ -z "$out_dir" ] || [ ! -f "$out_dir/kernel.spv" ] || [ ! -f "$out_dir/manifest.toml" ]; then
-  echo "build_kernel: cargo reported no build-script output with kernel.spv and manifest.toml" >&2
+if [ -z "$out_dir" ] || [ ! -f "$out_dir/kernel.spv" ] || [ ! -f "$out_dir/probe.spv" ] \
+   || [ ! -f "$out_dir/manifest.toml" ]; then
+  echo "build_kernel: cargo reported no build-script output with kernel.spv, probe.spv and manifest.toml" >&2
   exit 1
 fi
 [ "$status" -eq 0 ] || echo "build_kernel: the module was compiled, but the host's library did not check (cargo exit $status)" >&2
 if [ "$mode" = --check ]; then
   status=0
-  for f in kernel.spv manifest.toml; do
+  for f in kernel.spv probe.spv manifest.toml; do
     if cmp -s "$out_dir/$f" "kernel/shipped/$f"; then
       echo "build_kernel: kernel/shipped/$f is byte for byte what the sources compile to" >&2
     else
@@ -47,5 +50,6 @@ if [ "$mode" = --check ]; then
   exit "$status"
 fi
 mkdir -p kernel/shipped
-cp "$out_dir/kernel.spv" "$out_dir/manifest.toml" kernel/shipped/
-echo "build_kernel: wrote kernel/shipped/kernel.spv ($(wc -c < kernel/shipped/kernel.spv) bytes) and its manifest" >&2
+cp "$out_dir/kernel.spv" "$out_dir/probe.spv" "$out_dir/manifest.toml" kernel/shipped/
+echo "build_kernel: wrote kernel/shipped/kernel.spv ($(wc -c < kernel/shipped/kernel.spv) bytes)," \
+  "probe.spv ($(wc -c < kernel/shipped/probe.spv) bytes) and their manifest" >&2

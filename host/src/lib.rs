@@ -24,6 +24,12 @@ pub mod vulkan;
 #[cfg(feature = "gpu")]
 pub const KERNEL_SPV: &[u8] = include_bytes!(env!("kernel.spv"));
 
+/// The tests' module: the kernel compiled with its feature `probe` (the compute entry point
+/// `shaders::probe`, which `vulkan::compute` runs for the CPU-vs-GPU equivalence tests). Not
+/// part of the renderer: only with the feature `test-support`.
+#[cfg(all(feature = "gpu", feature = "test-support"))]
+pub const PROBE_SPV: &[u8] = include_bytes!(env!("probe.spv"));
+
 /// Where [`KERNEL_SPV`] came from, in words (shipped, or compiled from source).
 #[cfg(feature = "gpu")]
 pub const KERNEL_ORIGIN: &str = env!("TWINPATH_KERNEL_ORIGIN");

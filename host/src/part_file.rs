@@ -13,6 +13,7 @@ use crate::film::Film;
 use crate::fixed_sum::FixedSum;
 use crate::sample_range::{Part, SampleRange};
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use anyhow::{anyhow, bail, Context, Result};
 use exr::prelude::*;
 use std::collections::HashMap;
@@ -44,10 +45,14 @@ pub struct PartHeader {
 }
 
 impl PartHeader {
-    /// The header of a part of `scene`'s render holding `samples`.
-    pub fn new(scene: &Scene, backend: &str, samples: SampleRange) -> Self {
-        let mut settings: Vec<(String, String)> = scene
-            .render
+    /// The header of a part of `scene`'s render with `render` holding `samples`.
+    pub fn new(
+        scene: &Scene,
+        render: &RenderSettings,
+        backend: &str,
+        samples: SampleRange,
+    ) -> Self {
+        let mut settings: Vec<(String, String)> = render
             .entries()
             .into_iter()
             .filter(|(k, _)| *k != "spp")
@@ -63,8 +68,8 @@ impl PartHeader {
                 .map(|f| (f.path.display().to_string(), f.hash.to_hex().to_string()))
                 .collect(),
             settings,
-            seed: scene.render.seed,
-            sampler: scene.render.sampler.name().to_string(),
+            seed: render.seed,
+            sampler: render.sampler.name().to_string(),
             backend: backend.to_string(),
             samples,
             part: None,

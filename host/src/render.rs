@@ -7,6 +7,7 @@ use crate::backend::{open, RayCounts};
 use crate::film::Film;
 use crate::sample_range::SampleRange;
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -20,7 +21,7 @@ pub struct RenderOptions {
     pub device: Option<usize>,
     pub validation: bool,
     pub progress: bool,
-    /// The sample indices to render (`None`: all of `0..scene.render.spp`); a part of a
+    /// The sample indices to render (`None`: all of `0..settings.spp`); a part of a
     /// render split across processes (docs/parts.md).
     pub samples: Option<SampleRange>,
 }
@@ -75,17 +76,22 @@ pub fn install_interrupt_handler() {
     });
 }
 
-/// Renders `scene.render.spp` samples per pixel, or the range `opts.samples` of them.
-pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
-    if let (Some(range), true) = (opts.samples, scene.render.adaptive()) {
+/// Renders `scene` with `settings`: `settings.spp` samples per pixel, or the range
+/// `opts.samples` of them.
+pub fn render(
+    scene: &Scene,
+    settings: &RenderSettings,
+    opts: &RenderOptions,
+) -> Result<RenderOutput> {
+    if let (Some(range), true) = (opts.samples, settings.adaptive()) {
         bail!(
             "adaptive sampling (--target-error) cannot be split into parts (samples {range}): \
              which samples a pixel takes depends on all its earlier ones (docs/parts.md)"
         );
     }
-    let range = opts.samples.unwrap_or(SampleRange::all(scene.render.spp));
+    let range = opts.samples.unwrap_or(SampleRange::all(settings.spp));
     let t0 = Instant::now();
-    let (mut backend, kind) = open(opts.backend, scene, opts.device, opts.validation)?;
+    let (mut backend, kind) = open(opts.backend, scene, settings, opts.device, opts.validation)?;
     let setup = t0.elapsed();
     let spp = range.len();
     let progress = opts
@@ -96,7 +102,8 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput> {
     while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
         let count = backend.next_pass(spp_done, spp);
         let first = range.start + spp_done;
-        backend.add_samples(&scene.params(first, count), first, count, progress.as_ref())?;
+        let params = scene.params(settings, first, count);
+        backend.add_samples(&params, first, count, progress.as_ref())?;
         spp_done += count;
     }
     let film = backend.read_film()?;

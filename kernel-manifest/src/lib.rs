@@ -1,5 +1,7 @@
-//! The shipped kernel module's manifest: what `kernel/shipped/kernel.spv` was compiled from, and
-//! the check that the repository still holds exactly those inputs.
+//! The shipped kernel modules' manifest: what `kernel/shipped/kernel.spv` (the renderer's
+//! module) and `kernel/shipped/probe.spv` (the same sources with the kernel's feature `probe`:
+//! the equivalence tests' compute probes, which the renderer does not ship) were compiled from,
+//! and the check that the repository still holds exactly those inputs.
 //!
 //! twinpath ships the SPIR-V module rust-gpu compiles from `kernel/`, so that a build needs
 //! neither rust-gpu's compiler backend nor its toolchain components. The module is only as good
@@ -22,7 +24,12 @@ use std::path::{Path, PathBuf};
 
 /// The shipped module, relative to the repository root.
 pub const MODULE_PATH: &str = "kernel/shipped/kernel.spv";
-/// Its manifest, relative to the repository root.
+/// The tests' module: the kernel compiled with [`PROBE_FEATURES`] (the compute entry point
+/// `shaders::probe`), relative to the repository root.
+pub const PROBE_MODULE_PATH: &str = "kernel/shipped/probe.spv";
+/// The kernel's cargo features the tests' module is compiled with.
+pub const PROBE_FEATURES: &[&str] = &["probe"];
+/// The manifest of both modules, relative to the repository root.
 pub const MANIFEST_PATH: &str = "kernel/shipped/manifest.toml";
 /// The script that compiles the module from source and rewrites both files.
 pub const REGENERATE: &str = "scripts/build_kernel.sh";
@@ -118,12 +125,15 @@ fn hash_hex(bytes: &[u8]) -> String {
 }
 
 impl Manifest {
-    /// The manifest a module compiled now, from the repository at `root`, would carry; `module`
-    /// is that module's bytes.
-    pub fn describe(root: &Path, module: &[u8]) -> Result<Manifest, Error> {
+    /// The manifest modules compiled now, from the repository at `root`, would carry; `module`
+    /// is the renderer's module's bytes, `probe_module` the tests' module's.
+    pub fn describe(root: &Path, module: &[u8], probe_module: &[u8]) -> Result<Manifest, Error> {
         let mut build = BTreeMap::new();
         build.insert("module_blake3".into(), hash_hex(module));
         build.insert("module_bytes".into(), module.len().to_string());
+        build.insert("probe_module_blake3".into(), hash_hex(probe_module));
+        build.insert("probe_module_bytes".into(), probe_module.len().to_string());
+        build.insert("probe_features".into(), PROBE_FEATURES.join(" "));
         build.insert("toolchain".into(), toolchain(root)?);
         build.insert("target".into(), TARGET.into());
         build.insert("capabilities".into(), CAPABILITIES.join(" "));
@@ -142,7 +152,7 @@ impl Manifest {
     /// The manifest's text, in the shape [`Manifest::parse`] reads.
     pub fn to_text(&self) -> String {
         let mut out = String::from(
-            "# What kernel.spv, beside this file, was compiled from. Written by \
+            "# What kernel.spv and probe.spv, beside this file, were compiled from. Written by \
              scripts/build_kernel.sh;\n# every build of the host checks it against the \
              repository (kernel-manifest/src/lib.rs). Do not edit.\n",
         );
@@ -243,20 +253,32 @@ impl Manifest {
 /// manifest can tell: the CI recompiles it and compares bytes), else [`Error::Stale`].
 pub fn check_shipped(root: &Path) -> Result<Manifest, Error> {
     let module = read(&root.join(MODULE_PATH))?;
+    let probe_module = read(&root.join(PROBE_MODULE_PATH))?;
     let manifest_path = root.join(MANIFEST_PATH);
     let shipped = Manifest::parse(&read_text(&manifest_path)?, &manifest_path)?;
-    let now = Manifest::describe(root, &module)?;
+    let now = Manifest::describe(root, &module, &probe_module)?;
     let mut differences = Vec::new();
-    if now.build.get("module_blake3") != shipped.build.get("module_blake3") {
-        differences.push(format!(
-            "{MODULE_PATH} is not the module the manifest describes (its BLAKE3 hash differs)"
-        ));
+    for (path, key) in [
+        (MODULE_PATH, "module_blake3"),
+        (PROBE_MODULE_PATH, "probe_module_blake3"),
+    ] {
+        if now.build.get(key) != shipped.build.get(key) {
+            differences.push(format!(
+                "{path} is not the module the manifest describes (its BLAKE3 hash differs)"
+            ));
+        }
     }
-    // The module's own hash and size are compared above; what remains are its inputs.
+    // The modules' own hashes and sizes are compared above; what remains are their inputs.
     let inputs = |m: &Manifest| {
         let mut m = m.clone();
-        m.build.remove("module_blake3");
-        m.build.remove("module_bytes");
+        for key in [
+            "module_blake3",
+            "module_bytes",
+            "probe_module_blake3",
+            "probe_module_bytes",
+        ] {
+            m.build.remove(key);
+        }
         m
     };
     differences.extend(inputs(&now).differences(&inputs(&shipped)));

@@ -20,13 +20,13 @@ use spirv_std::glam::Vec3;
 /// host sets `pilot_period` from its settings, `RenderSettings::adaptive`).
 #[inline]
 pub fn is_adaptive(params: &RenderParams) -> bool {
-    params.pilot_period > 0
+    params.adaptive.pilot_period > 0
 }
 
 /// Whether sample index `sample` of a pixel is a pilot sample (see the module comment).
 #[inline]
 pub fn is_pilot_sample(params: &RenderParams, sample: u32) -> bool {
-    is_adaptive(params) && sample.is_multiple_of(params.pilot_period)
+    is_adaptive(params) && sample.is_multiple_of(params.adaptive.pilot_period)
 }
 
 /// The sampler (`scene::sampler`) and sequence index with which sample `sample` of a pixel
@@ -36,12 +36,15 @@ pub fn is_pilot_sample(params: &RenderParams, sample: u32) -> bool {
 /// indices of the sequence (the pilots' slots left out), so its power-of-two prefixes stay nets.
 #[inline]
 pub fn sample_stream(params: &RenderParams, sample: u32) -> (u32, u32) {
-    if params.sampler != sampler::SOBOL || params.pilot_period == 0 {
-        (params.sampler, sample)
+    if params.samples.sampler != sampler::SOBOL || params.adaptive.pilot_period == 0 {
+        (params.samples.sampler, sample)
     } else if is_pilot_sample(params, sample) {
         (sampler::INDEPENDENT, sample)
     } else {
-        (sampler::SOBOL, sample - sample / params.pilot_period - 1)
+        (
+            sampler::SOBOL,
+            sample - sample / params.adaptive.pilot_period - 1,
+        )
     }
 }
 
@@ -64,9 +67,9 @@ pub fn pixel_converged(
     pilot_samples: f32,
     image_samples: f32,
 ) -> bool {
-    let target = params.adaptive_target;
+    let target = params.adaptive.target;
     if !(target > 0.0)
-        || pilot_samples < params.min_pilot_samples as f32
+        || pilot_samples < params.adaptive.min_pilot_samples as f32
         || pilot_samples < 2.0
         || image_samples < 1.0
     {

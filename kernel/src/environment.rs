@@ -24,32 +24,32 @@ use spirv_std::glam::Vec3;
 /// Whether the render has an environment map.
 #[inline]
 pub fn has_map(params: &RenderParams) -> bool {
-    params.env_width > 0
+    params.environment.width > 0
 }
 
 /// Where the marginal CDF starts in the environment table.
 #[inline]
 fn marginal_offset(params: &RenderParams) -> u32 {
-    3 * params.env_width * params.env_height
+    3 * params.environment.width * params.environment.height
 }
 
 /// Where row `row`'s conditional CDF starts in the environment table.
 #[inline]
 fn conditional_offset(params: &RenderParams, row: u32) -> u32 {
-    marginal_offset(params) + params.env_height + 1 + row * (params.env_width + 1)
+    marginal_offset(params) + params.environment.height + 1 + row * (params.environment.width + 1)
 }
 
 /// World direction `d` in the map's frame: the map's rotation about +y undone.
 #[inline]
 fn to_map(params: &RenderParams, d: Vec3) -> Vec3 {
-    let [c, s] = params.env_rotation;
+    let [c, s] = params.environment.rotation;
     Vec3::new(c * d.x - s * d.z, d.y, s * d.x + c * d.z)
 }
 
 /// Direction `m` of the map's frame in the world: the map's rotation about +y applied.
 #[inline]
 fn to_world(params: &RenderParams, m: Vec3) -> Vec3 {
-    let [c, s] = params.env_rotation;
+    let [c, s] = params.environment.rotation;
     Vec3::new(c * m.x + s * m.z, m.y, c * m.z - s * m.x)
 }
 
@@ -67,7 +67,7 @@ fn map_coordinates(params: &RenderParams, d: Vec3) -> (f32, f32, f32) {
 /// The texel (column, row) of map coordinates (u, v).
 #[inline]
 fn texel(params: &RenderParams, u: f32, v: f32) -> (u32, u32) {
-    let (w, h) = (params.env_width, params.env_height);
+    let (w, h) = (params.environment.width, params.environment.height);
     (
         ((u * w as f32) as u32).min(w - 1),
         ((v * h as f32) as u32).min(h - 1),
@@ -80,8 +80,8 @@ fn texel(params: &RenderParams, u: f32, v: f32) -> (u32, u32) {
 pub fn eval(params: &RenderParams, table: &[f32], d: Vec3) -> Vec3 {
     let (u, v, _) = map_coordinates(params, d);
     let (i, j) = texel(params, u, v);
-    let k = (3 * (j * params.env_width + i)) as usize;
-    Vec3::new(table[k], table[k + 1], table[k + 2]) * params.env_scale
+    let k = (3 * (j * params.environment.width + i)) as usize;
+    Vec3::new(table[k], table[k + 1], table[k + 2]) * params.environment.scale
 }
 
 /// The largest k in [0, n) with cdf[base + k] <= x, for a CDF with cdf[base] = 0 <= x <
@@ -114,7 +114,7 @@ pub fn sample(params: &RenderParams, table: &[f32], mode: u32, u1: f32, u2: f32)
     if mode != light_sampling::SOLID_ANGLE {
         return sample_sphere(Vec3::ZERO, 1.0, u1, u2).normal;
     }
-    let (w, h) = (params.env_width, params.env_height);
+    let (w, h) = (params.environment.width, params.environment.height);
     let m = marginal_offset(params);
     let row = find_interval(table, m, h, u2);
     let (r0, r1) = (table[(m + row) as usize], table[(m + row + 1) as usize]);
@@ -153,6 +153,6 @@ pub fn pdf(params: &RenderParams, table: &[f32], mode: u32, d: Vec3) -> f32 {
     let c = conditional_offset(params, j);
     let p_row = table[(m + j + 1) as usize] - table[(m + j) as usize];
     let p_column = table[(c + i + 1) as usize] - table[(c + i) as usize];
-    let texels = (params.env_width * params.env_height) as f32;
+    let texels = (params.environment.width * params.environment.height) as f32;
     p_row * p_column * texels / (2.0 * PI * PI * sin_theta)
 }

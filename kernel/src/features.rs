@@ -86,28 +86,31 @@ pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> 
 #[inline]
 pub fn scene_features(params: &RenderParams) -> u32 {
     let mut f = SPECIALIZED;
-    if params.light_count > 0 {
+    if params.integrator.light_count > 0 {
         f |= LIGHTS;
     }
-    if params.light_count == 1 {
+    if params.integrator.light_count == 1 {
         f |= SINGLE_LIGHT;
     }
-    if params.background[0] != 0.0 || params.background[1] != 0.0 || params.background[2] != 0.0 {
+    if params.environment.background[0] != 0.0
+        || params.environment.background[1] != 0.0
+        || params.environment.background[2] != 0.0
+    {
         f |= BACKGROUND;
     }
-    if params.mis_mode == mis::POWER {
+    if params.integrator.mis_mode == mis::POWER {
         f |= MIS_POWER;
     }
-    if params.light_sampling == light_sampling::SOLID_ANGLE {
+    if params.integrator.light_sampling == light_sampling::SOLID_ANGLE {
         f |= LIGHT_SOLID_ANGLE;
     }
-    if params.rr_mode == roulette::THROUGHPUT {
+    if params.integrator.rr_mode == roulette::THROUGHPUT {
         f |= RR_THROUGHPUT;
     }
     if params.camera.eye[3] > 0.0 {
         f |= THIN_LENS;
     }
-    if params.env_width > 0 {
+    if params.environment.width > 0 {
         f |= ENVIRONMENT | BACKGROUND;
     }
     f
@@ -138,11 +141,11 @@ pub trait FeatureSet: Copy {
     }
     #[inline]
     fn lights(self, p: &RenderParams) -> bool {
-        self.answer(LIGHTS, p.light_count > 0)
+        self.answer(LIGHTS, p.integrator.light_count > 0)
     }
     #[inline]
     fn single_light(self, p: &RenderParams) -> bool {
-        self.answer(SINGLE_LIGHT, p.light_count == 1)
+        self.answer(SINGLE_LIGHT, p.integrator.light_count == 1)
     }
     /// The generic path adds the background whatever it is (adding black changes nothing).
     #[inline]
@@ -151,7 +154,7 @@ pub trait FeatureSet: Copy {
     }
     #[inline]
     fn mis_power(self, p: &RenderParams) -> bool {
-        self.answer(MIS_POWER, p.mis_mode == mis::POWER)
+        self.answer(MIS_POWER, p.integrator.mis_mode == mis::POWER)
     }
     /// The MIS mode (`scene::mis`): the power heuristic when specialised to it, else the
     /// run-time mode (the bit is cleared exactly when the mode is another).
@@ -160,7 +163,7 @@ pub trait FeatureSet: Copy {
         if self.mis_power(p) {
             mis::POWER
         } else {
-            p.mis_mode
+            p.integrator.mis_mode
         }
     }
     /// Whether any surface may be other than Lambertian (see [`MATERIALS`]).
@@ -187,7 +190,7 @@ pub trait FeatureSet: Copy {
     /// Whether the render may have an environment map (see [`ENVIRONMENT`]).
     #[inline]
     fn environment(self, p: &RenderParams) -> bool {
-        self.answer(ENVIRONMENT, p.env_width > 0)
+        self.answer(ENVIRONMENT, p.environment.width > 0)
     }
     /// Whether the camera may have a lens (see [`THIN_LENS`]).
     #[inline]
@@ -228,12 +231,12 @@ pub trait FeatureSet: Copy {
     fn light_solid_angle(self, p: &RenderParams) -> bool {
         self.answer(
             LIGHT_SOLID_ANGLE,
-            p.light_sampling == light_sampling::SOLID_ANGLE,
+            p.integrator.light_sampling == light_sampling::SOLID_ANGLE,
         )
     }
     #[inline]
     fn rr_throughput(self, p: &RenderParams) -> bool {
-        self.answer(RR_THROUGHPUT, p.rr_mode == roulette::THROUGHPUT)
+        self.answer(RR_THROUGHPUT, p.integrator.rr_mode == roulette::THROUGHPUT)
     }
 }
 

@@ -22,6 +22,7 @@ pub mod instance;
 pub mod intersect;
 pub mod light;
 pub mod path;
+#[cfg(feature = "probe")]
 pub mod probe;
 pub mod real;
 pub mod rng;

@@ -258,7 +258,7 @@ impl PathState {
                     self.radiance = emitted;
                 } else {
                     let pdf_l = light::environment::pdf(
-                        &lights[params.env_light as usize],
+                        &lights[params.environment.light as usize],
                         light_sampling_of(features, params),
                         scene,
                         self.ray_dir,
@@ -337,7 +337,7 @@ impl PathState {
         } else if features.single_light(params) {
             1
         } else {
-            params.light_count
+            params.integrator.light_count
         };
         let mut throughput = self.throughput;
         if features.dielectric() {
@@ -346,7 +346,7 @@ impl PathState {
         let survival = if features.rr_throughput(params) {
             throughput.max_element().min(1.0)
         } else {
-            params.rr_probability
+            params.integrator.rr_probability
         };
         let ng = hit.facing_normal();
         let smooth = features.shading_normals() && shading_normal != Vec3::ZERO;
@@ -366,8 +366,8 @@ impl PathState {
             light_count,
             mode: light_sampling_of(features, params),
             light_kinds: LightKinds::of(features, params),
-            extend: self.depth < params.max_depth,
-            roulette: self.depth >= params.rr_start_depth,
+            extend: self.depth < params.integrator.max_depth,
+            roulette: self.depth >= params.integrator.rr_start_depth,
             survival,
             lambertian,
             chooses_lobe: !lambertian && flags.chooses_lobe,
@@ -680,9 +680,9 @@ fn bsdf_strategy_weight(mode: u32) -> f32 {
 #[inline]
 fn background(params: &RenderParams) -> Vec3 {
     Vec3::new(
-        params.background[0],
-        params.background[1],
-        params.background[2],
+        params.environment.background[0],
+        params.environment.background[1],
+        params.environment.background[2],
     )
 }
 
@@ -733,7 +733,12 @@ pub fn start_sample<F: FeatureSet>(
 #[inline]
 pub fn sample_rng(params: &RenderParams, px: u32, py: u32, sample: u32) -> SampleRng {
     let (sampler, index) = sample_stream(params, sample);
-    SampleRng::with_sampler(params.seed, py * params.width + px, index, sampler)
+    SampleRng::with_sampler(
+        params.samples.seed,
+        py * params.samples.width + px,
+        index,
+        sampler,
+    )
 }
 
 /// The path of pixel (px, py) that draws its numbers from `rng`, with its camera ray waiting:
@@ -764,7 +769,15 @@ pub fn start_path_at<F: FeatureSet>(
     (u, v): (f32, f32),
 ) -> PathState {
     let camera = &params.camera;
-    let dir = camera_ray_direction(camera, params.width, params.height, px, py, u, v);
+    let dir = camera_ray_direction(
+        camera,
+        params.samples.width,
+        params.samples.height,
+        px,
+        py,
+        u,
+        v,
+    );
     if features.thin_lens() && lens_radius(camera) > 0.0 {
         rng.seek(LENS_DIMENSION);
         let (u1, u2) = rng.next_2d();

@@ -288,7 +288,7 @@ pub struct Camera {
 
 /// How Russian roulette picks the survival probability q of a path's extension.
 pub mod roulette {
-    /// The seed's constant q (`RenderParams::rr_probability`) at every vertex.
+    /// The seed's constant q (`IntegratorParams::rr_probability`) at every vertex.
     pub const CONSTANT: u32 = 0;
     /// q = min(1, max component of the path throughput), from `rr_start_depth` on.
     pub const THROUGHPUT: u32 = 1;
@@ -337,20 +337,45 @@ pub mod sampler {
     pub const SOBOL: u32 = 1;
 }
 
-/// Everything a path needs besides the scene geometry and tables. 176 bytes.
+/// Everything a launch of the kernel needs besides the scene's tables, one part per concern:
+/// the camera, which samples of which image, how a path is estimated, adaptive sampling, and
+/// what rays that leave the scene see. 176 bytes; every part is 4-byte words, so the host's
+/// `repr(C)` layout is the std430 layout the GPU reads (checked by `tests/tests/spirv_module.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
 pub struct RenderParams {
     pub camera: Camera,
-    /// Uniform environment radiance seen by rays that leave the scene.
-    pub background: [f32; 4],
+    pub samples: SampleParams,
+    pub integrator: IntegratorParams,
+    pub adaptive: AdaptiveParams,
+    pub environment: EnvironmentParams,
+}
+
+/// Which samples a launch computes: the image's size, and samples `first..first + count` of
+/// every pixel, numbered from `seed` by `sampler`. 24 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct SampleParams {
     pub width: u32,
     pub height: u32,
     pub seed: u32,
     /// Index of the first sample of this launch (progressive rendering).
-    pub sample_offset: u32,
-    pub samples_per_launch: u32,
+    pub first: u32,
+    /// Samples per pixel in this launch.
+    pub count: u32,
+    /// One of [`sampler`].
+    pub sampler: u32,
+}
+
+/// How a path is estimated: next-event estimation, its combination with BSDF sampling, Russian
+/// roulette and the depth bound. 28 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct IntegratorParams {
+    /// Entries of the light table.
     pub light_count: u32,
     /// One of [`roulette`].
     pub rr_mode: u32,
@@ -364,26 +389,39 @@ pub struct RenderParams {
     pub max_depth: u32,
     /// One of [`light_sampling`].
     pub light_sampling: u32,
-    /// Adaptive sampling: target relative standard error of a pixel's mean (0: off, every
-    /// pixel gets every sample). See `adaptive`.
-    pub adaptive_target: f32,
-    /// With adaptive sampling, every `pilot_period`-th sample index is a pilot sample: it
-    /// estimates the pixel's error and is not part of the image (0: no pilots).
+}
+
+/// Adaptive sampling's constants (see `adaptive`). 12 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct AdaptiveParams {
+    /// Target relative standard error of a pixel's mean (0: off, every pixel gets every
+    /// sample).
+    pub target: f32,
+    /// Every `pilot_period`-th sample index is a pilot sample: it estimates the pixel's error
+    /// and is not part of the image (0: no pilots).
     pub pilot_period: u32,
     /// Pilot samples a pixel needs before it may be declared converged.
     pub min_pilot_samples: u32,
-    /// One of [`sampler`].
-    pub sampler: u32,
-    /// The environment map's width and height in texels (0 x 0: none; the constant
-    /// `background` then lights the scene). Its texels and sampling tables are the
-    /// environment table (`environment`).
-    pub env_width: u32,
-    pub env_height: u32,
-    /// Index of the environment map in the light table, or [`NONE`].
-    pub env_light: u32,
+}
+
+/// What rays that leave the scene see: the uniform `background`, or the environment map
+/// (`environment`), whose texels and sampling tables are the environment table. 48 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct EnvironmentParams {
+    /// Uniform radiance seen by rays that leave the scene, where there is no map.
+    pub background: [f32; 4],
+    /// The map's width and height in texels (0 x 0: none).
+    pub width: u32,
+    pub height: u32,
+    /// Index of the map in the light table, or [`NONE`].
+    pub light: u32,
     /// Factor on every texel.
-    pub env_scale: f32,
+    pub scale: f32,
     /// Cosine and sine of the map's rotation about +y.
-    pub env_rotation: [f32; 2],
+    pub rotation: [f32; 2],
     pub _pad: [u32; 2],
 }

@@ -23,7 +23,9 @@ use crate::hit::SurfaceHit;
 use crate::path::{render_sample, Tracer};
 use crate::scene::{Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
 use crate::scene_view::SceneView;
-use spirv_std::glam::{UVec2, UVec3, UVec4, Vec2, Vec3, Vec4};
+#[cfg(feature = "probe")]
+use spirv_std::glam::UVec4;
+use spirv_std::glam::{UVec2, UVec3, Vec2, Vec3, Vec4};
 use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
 use spirv_std::spirv;
@@ -194,8 +196,8 @@ pub fn raygen(
         instances,
     };
     let mut s = 0;
-    while s < params.samples_per_launch {
-        let index = params.sample_offset + s;
+    while s < params.samples.count {
+        let index = params.samples.first + s;
         let l = render_sample(&mut tracer, Dynamic(features), &scene, px, py, index);
         let class = classify(params, index, l);
         if class == sample_use::DISCARDED {
@@ -334,7 +336,8 @@ pub fn closest_hit_sphere(
     ));
 }
 
-/// Push constants of [`probe`].
+/// Push constants of [`probe`] (feature `probe`: tests only).
+#[cfg(feature = "probe")]
 #[derive(Clone, Copy)]
 #[repr(C)]
 pub struct ProbeArgs {
@@ -345,7 +348,9 @@ pub struct ProbeArgs {
 }
 
 /// Compute entry point for the equivalence tests: record i of `input` (four `UVec4`) through
-/// [`crate::probe::evaluate`] into record i of `output` (two `UVec4`).
+/// [`crate::probe::evaluate`] into record i of `output` (two `UVec4`). Only in the tests'
+/// module (feature `probe`).
+#[cfg(feature = "probe")]
 #[spirv(compute(threads(64)))]
 pub fn probe(
     #[spirv(global_invocation_id)] id: UVec3,

@@ -135,10 +135,9 @@ pub fn uses_solid_angle(omega: f32) -> bool {
 /// q = cos b' = ((v cos phi - u sin phi) cos alpha - v) / ((v sin phi + u cos phi) sin alpha).
 ///
 /// As written it cancels catastrophically for thin or grazing spherical triangles (u is a
-/// difference of nearly equal cosines when alpha and A' are small; measured: a triangle seen
-/// 1e-5 above its plane failed its chi-square test by 2e7). With s = sin(A'/2), psi =
-/// A'/2 - alpha and m = 1 - cos c, the sum-to-product identities give u = -2 s sin psi,
-/// sin phi + sin alpha = 2 s cos psi, 1 - cos alpha cos phi = s^2 + sin^2 psi and
+/// difference of nearly equal cosines when alpha and A' are small: docs/lights.md). With
+/// s = sin(A'/2), psi = A'/2 - alpha and m = 1 - cos c, the sum-to-product identities give
+/// u = -2 s sin psi, sin phi + sin alpha = 2 s cos psi, 1 - cos alpha cos phi = s^2 + sin^2 psi and
 /// sin alpha sin phi + s^2 + sin^2 psi = 2 s^2, and with them (sin alpha cancels)
 /// 1 - q = 2 s^2 (1 + cos c) / (2 s^2 - m sin alpha sin phi): a product and a quotient of
 /// quantities without cancellation, so 1 - q and sin b' = sqrt((1 - q)(1 + q)) keep their

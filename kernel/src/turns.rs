@@ -4,8 +4,8 @@
 //! environment for SPIR-V (1.0, appendix A.4) leaves the precision of GLSL.std.450's
 //! trigonometric functions undefined. Both backends run the same arithmetic (on lavapipe
 //! `sample_sphere` and `sample_brdf` are now bit-exact against the CPU; with libm and the
-//! driver's sin/cos they differed by up to 1.2e-7). Speed on the CPU is unchanged: the
-//! polynomials cost what libm's `sincosf` did (4.4% of a Cornell render).
+//! driver's sin/cos they differed by up to 1.2e-7). Their cost on the CPU is libm's `sincosf`'s
+//! (docs/gpu.md).
 
 use crate::real::Real;
 use crate::word::Word;

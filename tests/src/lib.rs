@@ -2,7 +2,7 @@
 //! programmatic scenes.
 
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
-use twinpath::scene::{parse_scene, Scene};
+use twinpath::scene::{parse_scene, Scene, SceneFile};
 
 /// Two-sided critical |z| for a family of `tests` z-tests at family-wise error rate `alpha`
 /// (Bonferroni): a correct estimator fails any of them with probability at most `alpha`.
@@ -54,7 +54,7 @@ pub fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, usize, f64) {
 }
 
 /// Parses scene text as if it were the file `name` in the `scenes/` folder.
-pub fn scene_from_toml(text: &str) -> Scene {
+pub fn scene_from_toml(text: &str) -> SceneFile {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/test.toml");
     parse_scene(text, &path).unwrap_or_else(|e| panic!("test scene invalid: {e}"))
 }
@@ -62,8 +62,8 @@ pub fn scene_from_toml(text: &str) -> Scene {
 /// The scene with independent samples. Tests whose z-scores take a pixel's error from the
 /// spread of its own samples need them: Sobol points (the default) are stratified, so that
 /// spread overstates their error and such a test would lose power, not validity.
-pub fn with_independent_samples(mut scene: Scene) -> Scene {
-    scene.render.sampler = twinpath::settings::Sampler::Independent;
+pub fn with_independent_samples(mut scene: SceneFile) -> SceneFile {
+    scene.settings.sampler = twinpath::settings::Sampler::Independent;
     scene
 }
 
@@ -127,6 +127,7 @@ pub fn shade_at(
 
 pub mod cubature;
 pub mod gltf_writer;
+#[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod reference_bsdf;
 pub mod spirv;
@@ -134,7 +135,7 @@ pub mod stats;
 
 /// Renders `scene` at `spp` on `backend` (the GPU with validation layers on).
 pub fn render_film(
-    scene: &Scene,
+    scene: &SceneFile,
     backend: twinpath::render::Backend,
     spp: u32,
 ) -> twinpath::film::Film {
@@ -144,12 +145,12 @@ pub fn render_film(
 /// What [`render_film`]'s render produced: the film, and the rays where the backend counts
 /// them.
 pub fn render_output(
-    scene: &Scene,
+    scene: &SceneFile,
     backend: twinpath::render::Backend,
     spp: u32,
 ) -> twinpath::render::RenderOutput {
     let mut s = scene.clone();
-    s.render.spp = spp;
+    s.settings.spp = spp;
     let opts = twinpath::render::RenderOptions {
         backend,
         device: None,
@@ -157,7 +158,7 @@ pub fn render_output(
         progress: false,
         samples: None,
     };
-    let out = twinpath::render::render(&s, &opts).expect("render");
+    let out = twinpath::render::render(&s.scene, &s.settings, &opts).expect("render");
     assert_eq!(out.backend, backend);
     assert_eq!(out.spp_done, spp);
     out
@@ -199,11 +200,12 @@ pub fn image_mean_z(a: &twinpath::film::Film, b: &twinpath::film::Film) -> f64 {
 
 /// The scene scaled by `scale` about the origin, then translated by `translate`: positions,
 /// radii, edges and the camera. Radiance is scale-invariant, so the image must not change.
-pub fn transform_scene(scene: &Scene, scale: f32, translate: glam::Vec3) -> Scene {
+pub fn transform_scene(scene: &SceneFile, scale: f32, translate: glam::Vec3) -> SceneFile {
     use glam::Vec3;
     let p = |v: [f32; 3]| (Vec3::from(v) * scale + translate).to_array();
     let e = |v: [f32; 3]| (Vec3::from(v) * scale).to_array();
-    let mut s = scene.clone();
+    let mut file = scene.clone();
+    let s = &mut file.scene;
     s.camera.eye = s.camera.eye * scale + translate;
     s.camera.look_at = s.camera.look_at * scale + translate;
     for sp in &mut s.spheres {
@@ -229,7 +231,7 @@ pub fn transform_scene(scene: &Scene, scale: f32, translate: glam::Vec3) -> Scen
         t.edge1 = e(t.edge1);
         t.edge2 = e(t.edge2);
     }
-    s
+    file
 }
 
 /// splitmix64: the tests' own input generator, independent of the kernel's RNG under test.
@@ -267,7 +269,7 @@ pub fn variance_of_mean_from(
 /// The closed-form test scene: a diffuse plane y = 0 of albedo `kd` (200 x 200 units) under a
 /// sphere light of radius `r` and radiance `l` centred at height `h` above the origin, with the
 /// given `[camera]` and `[render]` table bodies.
-pub fn plane_under_light(camera: &str, render: &str, kd: f32, h: f32, r: f32, l: f32) -> Scene {
+pub fn plane_under_light(camera: &str, render: &str, kd: f32, h: f32, r: f32, l: f32) -> SceneFile {
     plane_under_lamps(
         camera,
         render,
@@ -290,7 +292,7 @@ pub struct Lamp {
 
 /// The diffuse plane y = 0 of albedo `kd` (200 x 200 units) under several sphere lights, with
 /// independent samples unless `render` names a sampler (the z-tests on it need them).
-pub fn plane_under_lamps(camera: &str, render: &str, kd: f32, lamps: &[Lamp]) -> Scene {
+pub fn plane_under_lamps(camera: &str, render: &str, kd: f32, lamps: &[Lamp]) -> SceneFile {
     let mut text = format!(
         r#"
         [camera]

@@ -133,9 +133,20 @@ impl Module {
         }
     }
 
-    /// The layout of the data behind the storage buffer at (set, binding): the block's only
-    /// member, or the element of the runtime array it holds.
-    pub fn binding_layout(&self, set: u32, binding: u32) -> StructLayout {
+    /// The layout of the struct that is member `member` of the struct behind the storage
+    /// buffer at (set, binding) (a part of `RenderParams`, say).
+    pub fn member_layout(&self, set: u32, binding: u32, member: u32) -> StructLayout {
+        let outer = self.binding_struct(set, binding);
+        let inner = self.structs[&outer][member as usize];
+        assert!(
+            self.structs.contains_key(&inner),
+            "member {member} of the struct at binding {binding} is not a struct"
+        );
+        self.layout_of(inner, None)
+    }
+
+    /// The type behind the storage buffer at (set, binding): a struct, or a runtime array.
+    fn binding_struct(&self, set: u32, binding: u32) -> u32 {
         let var = self
             .variables
             .keys()
@@ -147,7 +158,13 @@ impl Module {
         let block = self.pointers[&self.variables[var]];
         let members = &self.structs[&block];
         assert_eq!(members.len(), 1, "buffer block with one member");
-        let inner = members[0];
+        members[0]
+    }
+
+    /// The layout of the data behind the storage buffer at (set, binding): the block's only
+    /// member, or the element of the runtime array it holds.
+    pub fn binding_layout(&self, set: u32, binding: u32) -> StructLayout {
+        let inner = self.binding_struct(set, binding);
         if let Some(&elem) = self.runtime_arrays.get(&inner) {
             self.layout_of(elem, self.strides.get(&inner).copied())
         } else {

@@ -3,20 +3,21 @@
 use twinpath::bench::{run_bench, write_csv, write_plot, BenchConfig, Variant};
 use twinpath::film::{diff_images, RgbImage};
 use twinpath::render::{render, Backend, RenderOptions};
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 
 #[test]
 fn bench_sweeps_writes_csv_and_plot() {
-    let mut scene = Scene::builtin_default();
-    scene.camera.width = 32;
-    scene.camera.height = 32;
+    let mut scene = SceneFile::builtin_default();
+    scene.scene.camera.width = 32;
+    scene.scene.camera.height = 32;
     // A reference for the test: 256 spp of the same small scene.
     let mut r = scene.clone();
-    r.render.spp = 256;
-    r.render.seed = 999;
+    r.settings.spp = 256;
+    r.settings.seed = 999;
     let reference = RgbImage::from_film(
         &render(
-            &r,
+            &r.scene,
+            &r.settings,
             &RenderOptions {
                 backend: Backend::Cpu,
                 ..Default::default()
@@ -26,11 +27,11 @@ fn bench_sweeps_writes_csv_and_plot() {
         .film,
     );
     let variants = vec![
-        Variant::parse("seed:mis=half,light_sampling=area", &scene.render).unwrap(),
-        Variant::parse("default", &scene.render).unwrap(),
+        Variant::parse("seed:mis=half,light_sampling=area", &scene.settings).unwrap(),
+        Variant::parse("default", &scene.settings).unwrap(),
     ];
-    assert!(Variant::parse("x:mis=sometimes", &scene.render).is_err());
-    assert!(Variant::parse("x:rr=1.5", &scene.render).is_err());
+    assert!(Variant::parse("x:mis=sometimes", &scene.settings).is_err());
+    assert!(Variant::parse("x:rr=1.5", &scene.settings).is_err());
     let cfg = BenchConfig {
         variants,
         backends: vec![Backend::Cpu],
@@ -38,7 +39,7 @@ fn bench_sweeps_writes_csv_and_plot() {
         max_seconds: 1e9,
         seeds: 2,
     };
-    let rows = run_bench(&scene, &reference, &cfg, |_| {}).unwrap();
+    let rows = run_bench(&scene.scene, &reference, &cfg, |_| {}).unwrap();
     // 2 variants x spp 1, 2, 4, 8 x 2 seeds.
     assert_eq!(rows.len(), 2 * 4 * 2);
     for row in &rows {
@@ -48,11 +49,12 @@ fn bench_sweeps_writes_csv_and_plot() {
     // The error is the one `twinpath diff` reports, for the same render.
     let first = &rows[0];
     let mut s = scene.clone();
-    s.render = cfg.variants[0].settings;
-    s.render.spp = first.spp;
-    s.render.seed = first.seed;
+    s.settings = cfg.variants[0].settings;
+    s.settings.spp = first.spp;
+    s.settings.seed = first.seed;
     let again = render(
-        &s,
+        &s.scene,
+        &s.settings,
         &RenderOptions {
             backend: Backend::Cpu,
             ..Default::default()

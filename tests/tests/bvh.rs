@@ -297,23 +297,27 @@ fn memory_grows_linearly_with_the_triangle_count() {
 #[test]
 fn ray_measurement_and_ray_file_hold_what_was_traced() {
     use twinpath::bench::rays::{add_knot_mesh, measure};
-    let mut scene = twinpath::scene::Scene::builtin_default();
-    add_knot_mesh(&mut scene, 3000);
-    assert!(scene.name.ends_with("+knot3k"), "{}", scene.name);
+    let mut scene = twinpath::scene::SceneFile::builtin_default();
+    add_knot_mesh(&mut scene.scene, 3000);
+    assert!(
+        scene.scene.name.ends_with("+knot3k"),
+        "{}",
+        scene.scene.name
+    );
     let dir = std::env::temp_dir().join(format!("twinpath-rays-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("small.rays");
-    let report = measure(&scene, 48, 32, 1, Some(&path)).unwrap();
-    assert_eq!(report.triangles, scene.triangles.len());
-    assert_eq!(report.spheres, scene.spheres.len());
+    let report = measure(&scene.scene, &scene.settings, 48, 32, 1, Some(&path)).unwrap();
+    assert_eq!(report.triangles, scene.scene.triangles.len());
+    assert_eq!(report.spheres, scene.scene.spheres.len());
     assert_eq!(report.sets.len(), 4);
     assert_eq!(report.sets[0].rays, 48 * 32);
     // One bounce ray per camera ray that hit.
     assert_eq!(report.sets[1].rays, report.sets[0].hits);
     // The paths' rays are those the renderer counts at 1 spp of the same image.
     let mut image = scene.clone();
-    (image.camera.width, image.camera.height) = (48, 32);
-    image.render.packets = false;
+    (image.scene.camera.width, image.scene.camera.height) = (48, 32);
+    image.settings.packets = false;
     let rendered = twinpath_tests::render_output(&image, twinpath::render::Backend::Cpu, 1)
         .rays
         .unwrap();
@@ -341,20 +345,20 @@ fn ray_measurement_and_ray_file_hold_what_was_traced() {
     let (ntri, nsph, nsets) = (u32_at(take(4)), u32_at(take(4)), u32_at(take(4)));
     assert_eq!(
         (ntri as usize, nsph as usize, nsets),
-        (scene.triangles.len(), scene.spheres.len(), 4)
+        (scene.scene.triangles.len(), scene.scene.spheres.len(), 4)
     );
-    for t in &scene.triangles {
+    for t in &scene.scene.triangles {
         let v: Vec<f32> = (0..9).map(|_| f32_at(take(4))).collect();
         let p0 = Vec3::from(t.p0);
         assert_eq!(&v[0..3], &p0.to_array());
         assert_eq!(&v[3..6], &(p0 + Vec3::from(t.edge1)).to_array());
         assert_eq!(&v[6..9], &(p0 + Vec3::from(t.edge2)).to_array());
     }
-    for s in &scene.spheres {
+    for s in &scene.scene.spheres {
         let v: Vec<f32> = (0..4).map(|_| f32_at(take(4))).collect();
         assert_eq!(v, [s.center[0], s.center[1], s.center[2], s.radius]);
     }
-    let bvh = Bvh::build(scene.spheres.clone(), scene.triangles.clone());
+    let bvh = Bvh::build(scene.scene.spheres.clone(), scene.scene.triangles.clone());
     for set in &report.sets {
         let name = take(32);
         assert!(name.starts_with(set.name.as_bytes()));

@@ -13,7 +13,7 @@ use kernel::camera::{camera_ray_direction, lens_radius, thin_lens_ray};
 use kernel::scene::Camera;
 use twinpath::film::Film;
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{render_film, scene_from_toml, SplitMix};
 
@@ -27,7 +27,7 @@ fn pixels_per_unit() -> f64 {
 
 /// A camera at the origin looking down -z with a lens of diameter `aperture` focused at `focus`,
 /// and one emissive square of side `side` facing it, centred on the axis at depth `depth`.
-fn square_scene(aperture: f32, focus: f32, side: f32, depth: f32, seed: u32) -> Scene {
+fn square_scene(aperture: f32, focus: f32, side: f32, depth: f32, seed: u32) -> SceneFile {
     let h = side / 2.0;
     scene_from_toml(&format!(
         r#"
@@ -57,7 +57,7 @@ fn square_scene(aperture: f32, focus: f32, side: f32, depth: f32, seed: u32) -> 
 #[test]
 fn lens_rays_meet_in_the_plane_of_focus() {
     let scene = square_scene(0.8, 2.5, 0.1, 4.0, 1);
-    let camera: Camera = scene.camera.to_kernel();
+    let camera: Camera = scene.scene.camera.to_kernel();
     let r = lens_radius(&camera);
     assert_eq!(r, 0.4);
     let eye = Vec3::ZERO;
@@ -85,9 +85,9 @@ fn lens_rays_meet_in_the_plane_of_focus() {
 }
 
 /// Films of `scene` rendered with the lens and with a pinhole, same seed and spp.
-fn with_and_without_lens(scene: &Scene, backend: Backend, spp: u32) -> (Film, Film) {
+fn with_and_without_lens(scene: &SceneFile, backend: Backend, spp: u32) -> (Film, Film) {
     let mut pinhole = scene.clone();
-    pinhole.camera.aperture = 0.0;
+    pinhole.scene.camera.aperture = 0.0;
     (
         render_film(scene, backend, spp),
         render_film(&pinhole, backend, spp),
@@ -195,7 +195,7 @@ fn depth_of_field_matches_the_circle_of_confusion_on_both_backends() {
         // each pixel, whose edges fall inside pixels, so the exact expectation is the sum over
         // pixel centres c of coverage(c) |c|^2, separable in x and y.
         let mut pinhole = square_scene(aperture, focus, side, depth, 7);
-        pinhole.camera.aperture = 0.0;
+        pinhole.scene.camera.aperture = 0.0;
         let (m, _) = second_moment(&render_film(&pinhole, backend, 64));
         let half = square / 2.0;
         let (mut w, mut wc2) = (0.0, 0.0);

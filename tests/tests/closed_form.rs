@@ -13,7 +13,7 @@ use kernel::rng::SampleRng;
 use rayon::prelude::*;
 use twinpath::cpu::{BvhTracer, CpuRenderer};
 use twinpath::film::Film;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath::settings::{Mis, Roulette};
 use twinpath_tests::stats::mean_and_variance_of_mean;
 use twinpath_tests::{scene_from_toml, z_critical};
@@ -34,7 +34,7 @@ const TINY_LAMP: Lamp = Lamp { r: 2e-4, l: 2.5e7 };
 const BATCH: u32 = 1_000_000;
 const MAX_BATCHES: u32 = 32;
 
-fn plane_scene(mis_mode: &str, roulette: &str, lamp: Lamp) -> Scene {
+fn plane_scene(mis_mode: &str, roulette: &str, lamp: Lamp) -> SceneFile {
     let Lamp { r, l } = lamp;
     let mut s = twinpath_tests::plane_under_light(
         "eye = [0, 5, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 8\nheight = 8",
@@ -45,14 +45,14 @@ fn plane_scene(mis_mode: &str, roulette: &str, lamp: Lamp) -> Scene {
         l,
     );
     // Roulette from the first vertex on, so its division is exercised at every step.
-    s.render.rr_start_depth = Some(1);
+    s.settings.rr_start_depth = Some(1);
     s
 }
 
 /// Radiance estimates leaving plane point `x`, seen along a ray arriving from `view_dir` (unit,
 /// pointing from the viewer to x).
-fn estimate_at(scene: &Scene, x: Vec3, view_dir: Vec3, stream: u32, batch: u32) -> Vec<f64> {
-    let cpu = CpuRenderer::new(scene);
+fn estimate_at(scene: &SceneFile, x: Vec3, view_dir: Vec3, stream: u32, batch: u32) -> Vec<f64> {
+    let cpu = CpuRenderer::new(&scene.scene, &scene.settings);
     let params = scene.params(0, 1);
     let origin = x - 3.0 * view_dir;
     // The viewing ray must reach x itself (not the light sphere).
@@ -66,7 +66,7 @@ fn estimate_at(scene: &Scene, x: Vec3, view_dir: Vec3, stream: u32, batch: u32) 
         .into_par_iter()
         .map(|s| {
             let mut tracer = BvhTracer::new(&cpu.bvh);
-            let mut rng = SampleRng::new(params.seed, stream, s);
+            let mut rng = SampleRng::new(params.samples.seed, stream, s);
             rng.seek(kernel::vertex_samples::CAMERA_DIMENSIONS);
             let l = trace_path(
                 &mut tracer,
@@ -124,11 +124,11 @@ fn plane_under_sphere_light_matches_closed_form() {
     for (k, &(name, m, rr, lamp)) in VARIANTS.iter().enumerate() {
         let scene = plane_scene(m, rr, lamp);
         assert_eq!(
-            scene.render.mis,
+            scene.settings.mis,
             if m == "half" { Mis::Half } else { Mis::Power }
         );
         assert_eq!(
-            scene.render.roulette,
+            scene.settings.roulette,
             if rr == "constant" {
                 Roulette::Constant
             } else {
@@ -188,7 +188,7 @@ fn plane_under_sphere_light_matches_closed_form() {
     }
 }
 
-fn furnace_scene(roulette: &str, q: f32) -> Scene {
+fn furnace_scene(roulette: &str, q: f32) -> SceneFile {
     let mut text =
         std::fs::read_to_string(twinpath_tests::repo_root().join("scenes/cornell.toml")).unwrap();
     // Every albedo 1, no light (the light sphere becomes a white diffuse sphere), background Lb.
@@ -211,7 +211,7 @@ fn furnace_scene(roulette: &str, q: f32) -> Scene {
     text.push_str("\n[background]\nradiance = [0.7, 0.7, 0.7]\n");
     // Independent samples: the constant-roulette test takes its variance from the samples.
     let s = twinpath_tests::with_independent_samples(scene_from_toml(&text));
-    assert!(s.lights.is_empty());
+    assert!(s.scene.lights.is_empty());
     s
 }
 
@@ -220,8 +220,8 @@ fn white_furnace_is_exact_with_throughput_roulette() {
     // Throughput stays exactly 1 (Kd = 1), so roulette never ends a path: every path bounces
     // until it leaves through the open side and reads Lb. Exact, not statistical.
     let scene = furnace_scene("throughput", 1.0);
-    let cpu = CpuRenderer::new(&scene);
-    let mut film = Film::new(scene.camera.width, scene.camera.height);
+    let cpu = CpuRenderer::new(&scene.scene, &scene.settings);
+    let mut film = Film::new(scene.scene.camera.width, scene.scene.camera.height);
     cpu.render_into(&scene.params(0, 16), 0, 16, &mut film, None);
     assert_eq!(film.discarded, 0);
     for (i, p) in film.mean().iter().enumerate() {
@@ -237,9 +237,9 @@ fn white_furnace_z_test_with_constant_roulette() {
     // noisy. q = 0.95 keeps the variance finite here (the per-bounce chance of staying in the
     // box, about 5/6, is below q^3, so even the fourth moment is finite).
     let scene = furnace_scene("constant", 0.95);
-    let cpu = CpuRenderer::new(&scene);
+    let cpu = CpuRenderer::new(&scene.scene, &scene.settings);
     let spp = 256;
-    let mut film = Film::new(scene.camera.width, scene.camera.height);
+    let mut film = Film::new(scene.scene.camera.width, scene.scene.camera.height);
     cpu.render_into(&scene.params(0, spp), 0, spp, &mut film, None);
     assert_eq!(film.discarded, 0);
     let mean = film.mean();

@@ -15,7 +15,7 @@ use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
 use twinpath::film::Film;
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::cubature::integrate;
 use twinpath_tests::reference_bsdf::RefMaterial;
 use twinpath_tests::{render_film, scene_from_toml, z_critical};
@@ -23,7 +23,7 @@ use twinpath_tests::{render_film, scene_from_toml, z_critical};
 const L: f32 = 0.7;
 const SIZE: u32 = 24;
 
-fn sphere_in_environment(material: &str) -> Scene {
+fn sphere_in_environment(material: &str) -> SceneFile {
     scene_from_toml(&format!(
         r#"
 [camera]
@@ -56,9 +56,9 @@ radiance = [{L}, {L}, {L}]
 
 /// The renders of a scene the closed forms are checked on: CPU by packets and one path at a
 /// time, and the GPU, each at `spp`.
-fn renders(scene: &Scene, spp: u32) -> Vec<(&'static str, Film)> {
+fn renders(scene: &SceneFile, spp: u32) -> Vec<(&'static str, Film)> {
     let mut one_path = scene.clone();
-    one_path.render.packets = false;
+    one_path.settings.packets = false;
     vec![
         ("cpu packets", render_film(scene, Backend::Cpu, spp)),
         ("cpu one path", render_film(&one_path, Backend::Cpu, spp)),
@@ -132,7 +132,7 @@ fn rough_mirror_sphere_shows_the_directional_albedo() {
         a_of(0.5),
         a_of(0.087)
     );
-    let camera = scene.camera.to_kernel();
+    let camera = scene.scene.camera.to_kernel();
     let eye = Vec3::from_slice(&camera.eye[..3]).as_dvec3();
     let exact: Vec<Option<f64>> = (0..SIZE * SIZE)
         .map(|i| {

@@ -3,11 +3,11 @@
 
 use twinpath::cpu::CpuRenderer;
 use twinpath::film::Film;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 
-fn render(scene: &Scene, passes: &[u32]) -> Film {
-    let cpu = CpuRenderer::new(scene);
-    let mut film = Film::new(scene.camera.width, scene.camera.height);
+fn render(scene: &SceneFile, passes: &[u32]) -> Film {
+    let cpu = CpuRenderer::new(&scene.scene, &scene.settings);
+    let mut film = Film::new(scene.scene.camera.width, scene.scene.camera.height);
     let mut first = 0;
     for &n in passes {
         cpu.render_into(&scene.params(first, n), first, n, &mut film, None);
@@ -18,9 +18,9 @@ fn render(scene: &Scene, passes: &[u32]) -> Film {
 
 #[test]
 fn same_image_for_any_thread_count_and_pass_split() {
-    let mut scene = Scene::builtin_default();
-    scene.camera.width = 64;
-    scene.camera.height = 48;
+    let mut scene = SceneFile::builtin_default();
+    scene.scene.camera.width = 64;
+    scene.scene.camera.height = 48;
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -36,7 +36,7 @@ fn same_image_for_any_thread_count_and_pass_split() {
     // Summation in f64 of the same samples in the same order per pixel: identical.
     assert_eq!(a.mean(), c.mean());
     // And a different seed gives a different image.
-    scene.render.seed += 1;
+    scene.settings.seed += 1;
     let d = render(&scene, &[4]);
     assert_ne!(a.mean(), d.mean());
 }

@@ -3,7 +3,7 @@
 //! acceleration structure, the top-level instances. Checked against made-up limits, and the
 //! real device's limits (lavapipe here) hold the shipped instancing scene.
 
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath::vulkan::limits::{check_scene_fits, DeviceLimits};
 use twinpath_tests::repo_root;
 
@@ -15,9 +15,13 @@ const ROOMY: DeviceLimits = DeviceLimits {
 
 #[test]
 fn each_limit_is_checked_and_named() {
-    let scene = Scene::load(&repo_root().join("scenes/instances.toml")).unwrap();
-    check_scene_fits(&scene, &ROOMY).unwrap();
-    let err = |limits: DeviceLimits| check_scene_fits(&scene, &limits).unwrap_err().to_string();
+    let scene = SceneFile::load(&repo_root().join("scenes/instances.toml")).unwrap();
+    check_scene_fits(&scene.scene, &ROOMY).unwrap();
+    let err = |limits: DeviceLimits| {
+        check_scene_fits(&scene.scene, &limits)
+            .unwrap_err()
+            .to_string()
+    };
     // The environment map's table (2.0 MiB) is the largest.
     let e = err(DeviceLimits {
         max_storage_buffer_range: 1 << 20,
@@ -49,6 +53,6 @@ fn the_devices_own_limits_are_read_and_hold_the_instancing_scene() {
     assert!(ctx.limits.max_storage_buffer_range >= 1 << 20);
     assert!(ctx.limits.max_primitive_count >= 1 << 16);
     assert!(ctx.limits.max_instance_count >= 1 << 16);
-    let scene = Scene::load(&repo_root().join("scenes/instances.toml")).unwrap();
-    check_scene_fits(&scene, &ctx.limits).unwrap();
+    let scene = SceneFile::load(&repo_root().join("scenes/instances.toml")).unwrap();
+    check_scene_fits(&scene.scene, &ctx.limits).unwrap();
 }

@@ -15,7 +15,7 @@ use kernel::scene::{light_sampling, RenderParams};
 use std::f64::consts::PI;
 use twinpath::render::Backend;
 use twinpath::scene::environment::EnvironmentMap;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{assert_film_matches, chi_square, render_film, scene_from_toml, SplitMix};
 
@@ -42,9 +42,9 @@ material = "plane"
 "#;
 
 /// The plane scene under `map`.
-fn plane_under(map: &EnvironmentMap) -> Scene {
+fn plane_under(map: &EnvironmentMap) -> SceneFile {
     let mut scene = scene_from_toml(PLANE);
-    scene.set_environment(Some(map.clone()));
+    scene.scene.set_environment(Some(map.clone()));
     scene
 }
 
@@ -201,10 +201,10 @@ fn plane_under_one_bright_texel_matches_its_closed_form_on_both_backends() {
     for mode in ["solid_angle", "area"] {
         let mut scene = plane_under(&one_texel_map());
         scene
-            .render
+            .settings
             .set("light_sampling", mode)
             .expect("a light_sampling value");
-        let exact = vec![Some(want); scene.pixel_count()];
+        let exact = vec![Some(want); scene.scene.pixel_count()];
         for backend in [Backend::Cpu, Backend::Gpu] {
             let film = render_film(&scene, backend, 256);
             assert_eq!(film.discarded, 0);
@@ -222,7 +222,7 @@ fn plane_under_one_bright_texel_matches_its_closed_form_on_both_backends() {
 fn a_constant_map_lights_like_the_constant_background_on_both_backends() {
     let want = KD as f64 * 0.5;
     let mut uniform = scene_from_toml(PLANE);
-    uniform.background = Vec3::splat(0.5);
+    uniform.scene.background = Vec3::splat(0.5);
     let film = render_film(&uniform, Backend::Cpu, 16);
     assert!(
         film.mean()
@@ -231,7 +231,7 @@ fn a_constant_map_lights_like_the_constant_background_on_both_backends() {
         "the uniform background is not exactly kd L"
     );
     let map = plane_under(&EnvironmentMap::constant(32, 16, [0.5; 3]));
-    let exact = vec![Some(want); map.pixel_count()];
+    let exact = vec![Some(want); map.scene.pixel_count()];
     for backend in [Backend::Cpu, Backend::Gpu] {
         let film = render_film(&map, backend, 64);
         assert_eq!(film.discarded, 0);

@@ -19,7 +19,7 @@
 
 use twinpath::film::Film;
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{render_film, scene_from_toml, white_cornell_toml};
 
@@ -34,7 +34,7 @@ const GPU_SPP: u32 = 4096;
 
 /// The Cornell room (five quads, two diffuse spheres) with every albedo 1 and the light sphere
 /// made a third white sphere; background Lb; throughput roulette.
-fn furnace(sampler: &str, seed: u32) -> Scene {
+fn furnace(sampler: &str, seed: u32) -> SceneFile {
     let mut text = white_cornell_toml();
     for (from, to) in [
         (
@@ -49,9 +49,9 @@ fn furnace(sampler: &str, seed: u32) -> Scene {
     }
     text.push_str(&format!("\n[background]\nradiance = [{LB}, {LB}, {LB}]\n"));
     let scene = scene_from_toml(&text);
-    assert!(scene.lights.is_empty());
-    assert_eq!(scene.spheres.len(), 3);
-    assert_eq!(scene.triangles.len(), 10);
+    assert!(scene.scene.lights.is_empty());
+    assert_eq!(scene.scene.spheres.len(), 3);
+    assert_eq!(scene.scene.triangles.len(), 10);
     scene
 }
 

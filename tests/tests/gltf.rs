@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use twinpath::render::Backend;
 use twinpath::scene::gltf::MAX_TRIANGLES;
 use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse};
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gltf_writer::GltfWriter;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{assert_films_identical, render_film};
@@ -125,10 +125,10 @@ fn round_trip_files(dir: &Path) {
     std::fs::write(dir.join("terrain.glb"), g.glb()).unwrap();
 }
 
-fn load(dir: &Path, name: &str, text: &str) -> Scene {
+fn load(dir: &Path, name: &str, text: &str) -> SceneFile {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
-    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
@@ -150,20 +150,31 @@ fn a_scene_as_toml_and_as_gltf_renders_the_same_bits_on_both_backends() {
             "{head}[materials]\na_lamp = {{ emission = [4, 4, 4] }}\n{LAMP}[[gltf]]\nfile = \"terrain.glb\"\n"
         ),
     );
-    assert_eq!(toml.triangles.len(), 10);
-    assert_eq!(toml.triangles, gltf.triangles, "triangles");
+    assert_eq!(toml.scene.triangles.len(), 10);
+    assert_eq!(toml.scene.triangles, gltf.scene.triangles, "triangles");
     assert_eq!(
-        toml.shading, gltf.shading,
+        toml.scene.shading, gltf.scene.shading,
         "shading records and tangent frames"
     );
     // The mesh's 8 triangles have a record and a tangent frame each.
-    assert_eq!(toml.shading.len(), 16);
-    assert!(toml.shading.iter().step_by(2).all(|s| s.has_normals == 1));
-    assert_eq!(toml.materials[1].normal_scale, 0.8);
-    assert_eq!(toml.materials, gltf.materials, "materials");
-    assert_eq!(toml.materials[1].kind, material_kind::METALLIC_ROUGHNESS);
-    assert_eq!(toml.lights, gltf.lights, "lights");
-    assert_eq!(toml.textures.words, gltf.textures.words, "texture table");
+    assert_eq!(toml.scene.shading.len(), 16);
+    assert!(toml
+        .scene
+        .shading
+        .iter()
+        .step_by(2)
+        .all(|s| s.has_normals == 1));
+    assert_eq!(toml.scene.materials[1].normal_scale, 0.8);
+    assert_eq!(toml.scene.materials, gltf.scene.materials, "materials");
+    assert_eq!(
+        toml.scene.materials[1].kind,
+        material_kind::METALLIC_ROUGHNESS
+    );
+    assert_eq!(toml.scene.lights, gltf.scene.lights, "lights");
+    assert_eq!(
+        toml.scene.textures.words, gltf.scene.textures.words,
+        "texture table"
+    );
     assert_eq!(toml.features(), gltf.features());
     let mr = kernel::features::METALLIC_ROUGHNESS
         | kernel::features::GLOSSY
@@ -247,9 +258,9 @@ fn camera_file(dir: &Path) -> PathBuf {
 fn a_gltf_file_is_a_scene_with_its_camera_hierarchy_and_default_material() {
     let dir = temp_dir("camera");
     let path = camera_file(&dir);
-    let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let scene = SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"));
     // The first camera in the walk: node 3 (camera "main"), under the parent's T S.
-    let c = scene.camera;
+    let c = scene.scene.camera;
     assert_eq!(
         (c.width, c.height),
         (1080, 720),
@@ -268,9 +279,9 @@ fn a_gltf_file_is_a_scene_with_its_camera_hierarchy_and_default_material() {
     );
     assert!((c.up - Vec3::Y).length() < 1e-6);
     // Fan and strip: two triangles each, the square scaled by 2 at x = 3 and x = 7.
-    assert_eq!(scene.triangles.len(), 4);
+    assert_eq!(scene.scene.triangles.len(), 4);
     let corners = |k: usize| {
-        let t = scene.triangles[k];
+        let t = scene.scene.triangles[k];
         let p0 = Vec3::from(t.p0);
         [p0, p0 + Vec3::from(t.edge1), p0 + Vec3::from(t.edge2)]
     };
@@ -303,23 +314,26 @@ fn a_gltf_file_is_a_scene_with_its_camera_hierarchy_and_default_material() {
     );
     // Every front face points +z (counter-clockwise seen from +z, as the file winds them).
     for k in 0..4 {
-        let t = scene.triangles[k];
+        let t = scene.scene.triangles[k];
         assert!(
             Vec3::from(t.edge1).cross(Vec3::from(t.edge2)).z > 0.0,
             "triangle {k} winding"
         );
     }
     // No material: the specification's default, white, metallic 1, roughness 1.
-    assert_eq!(scene.materials.len(), 1);
-    let m = scene.materials[0];
+    assert_eq!(scene.scene.materials.len(), 1);
+    let m = scene.scene.materials[0];
     assert_eq!(m.kind, material_kind::METALLIC_ROUGHNESS);
     assert_eq!((m.albedo, m.metallic, m.roughness), ([1.0; 3], 1.0, 1.0));
-    assert_eq!(scene.background, Vec3::ONE, "a white sky");
+    assert_eq!(scene.scene.background, Vec3::ONE, "a white sky");
     // The other camera by name; an unknown name lists the cameras.
-    let side = Scene::load_with_camera(&path, Some("side")).unwrap();
-    assert_eq!((side.camera.width, side.camera.height), (1280, 720));
-    assert!((side.camera.eye - Vec3::ZERO).length() < 1e-6);
-    let e = Scene::load_with_camera(&path, Some("nope"))
+    let side = SceneFile::load_with_camera(&path, Some("side")).unwrap();
+    assert_eq!(
+        (side.scene.camera.width, side.scene.camera.height),
+        (1280, 720)
+    );
+    assert!((side.scene.camera.eye - Vec3::ZERO).length() < 1e-6);
+    let e = SceneFile::load_with_camera(&path, Some("nope"))
         .unwrap_err()
         .to_string();
     assert!(
@@ -329,8 +343,8 @@ fn a_gltf_file_is_a_scene_with_its_camera_hierarchy_and_default_material() {
     // It renders on both backends (the sky around two grey squares).
     for backend in [Backend::Cpu, Backend::Gpu] {
         let mut s = scene.clone();
-        s.camera.width = 24;
-        s.camera.height = 16;
+        s.scene.camera.width = 24;
+        s.scene.camera.height = 16;
         let film = render_film(&s, backend, 2);
         let mean = film.mean();
         assert!(mean
@@ -369,9 +383,9 @@ fn material_file(dir: &Path, name: &str, material: serde_json::Value, used: &[&s
 #[test]
 fn appendix_b_rules_each_hold() {
     let dir = temp_dir("appendix-b");
-    let one = |name: &str, material: serde_json::Value, used: &[&str]| -> Scene {
+    let one = |name: &str, material: serde_json::Value, used: &[&str]| -> SceneFile {
         let path = material_file(&dir, name, material, used);
-        Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+        SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
     };
     // Factors as stored, glTF's defaults for what is absent.
     let s = one(
@@ -380,7 +394,7 @@ fn appendix_b_rules_each_hold() {
         "baseColorFactor": [0.5, 0.25, 0.125, 1.0], "metallicFactor": 0.2 } }),
         &[],
     );
-    let m = s.materials[0];
+    let m = s.scene.materials[0];
     assert_eq!(m.kind, material_kind::METALLIC_ROUGHNESS);
     assert_eq!(
         (m.albedo, m.metallic, m.roughness),
@@ -405,13 +419,13 @@ fn appendix_b_rules_each_hold() {
         "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4.0 } } }),
         &["KHR_materials_emissive_strength"],
     );
-    assert_eq!(s.materials[0].emission, [4.0, 2.0, 1.0]);
-    assert_eq!(s.materials[0].two_sided, 1);
-    assert_eq!(s.lights.len(), 4, "each triangle a light");
+    assert_eq!(s.scene.materials[0].emission, [4.0, 2.0, 1.0]);
+    assert_eq!(s.scene.materials[0].two_sided, 1);
+    assert_eq!(s.scene.lights.len(), 4, "each triangle a light");
     assert!(
-        s.notes.iter().any(|n| n.contains("reflects nothing")),
+        s.scene.notes.iter().any(|n| n.contains("reflects nothing")),
         "{:?}",
-        s.notes
+        s.scene.notes
     );
     // KHR_materials_transmission + KHR_materials_ior: the dielectric, alpha = roughness^2.
     let s = one(
@@ -421,16 +435,20 @@ fn appendix_b_rules_each_hold() {
                         "KHR_materials_ior": { "ior": 1.33 } } }),
         &["KHR_materials_transmission", "KHR_materials_ior"],
     );
-    assert_eq!(s.materials[0].kind, material_kind::DIELECTRIC);
-    assert_eq!((s.materials[0].ior, s.materials[0].alpha), (1.33, 0.25));
+    assert_eq!(s.scene.materials[0].kind, material_kind::DIELECTRIC);
+    assert_eq!(
+        (s.scene.materials[0].ior, s.scene.materials[0].alpha),
+        (1.33, 0.25)
+    );
     // An extension that is not read is noted once; one that is required is an error.
     let s = one("ignored.glb", json!({}), &["KHR_materials_sheen"]);
     assert!(
-        s.notes
+        s.scene
+            .notes
             .iter()
             .any(|n| n.contains("extensions ignored: KHR_materials_sheen")),
         "{:?}",
-        s.notes
+        s.scene.notes
     );
     // Factors outside [0, 1] name the material.
     let path = material_file(
@@ -439,7 +457,7 @@ fn appendix_b_rules_each_hold() {
         json!({ "pbrMetallicRoughness": { "metallicFactor": 1.5 } }),
         &[],
     );
-    let e = Scene::load(&path).unwrap_err().to_string();
+    let e = SceneFile::load(&path).unwrap_err().to_string();
     assert!(
         e.contains("materials[0]") && e.contains("metallicFactor 1.5"),
         "{e}"
@@ -677,7 +695,7 @@ fn hostile_gltf_files_are_errors_naming_the_place() {
 
 /// A glTF file whose default scene has 10^6 nodes using one 100-triangle mesh (of an emissive
 /// material where `emissive`), loaded.
-fn a_million_nodes(emissive: bool) -> Result<Scene, String> {
+fn a_million_nodes(emissive: bool) -> Result<SceneFile, String> {
     let mut g = GltfWriter::new();
     let positions: Vec<[f32; 3]> = (0..300)
         .map(|i| {
@@ -696,6 +714,10 @@ fn a_million_nodes(emissive: bool) -> Result<Scene, String> {
         json!({ "nodes": (0..1_000_000).collect::<Vec<_>>() }),
     );
     twinpath::scene::gltf::load_bytes(Path::new("million.glb"), &g.glb(), None, None)
+        .map(|scene| SceneFile {
+            scene,
+            settings: Default::default(),
+        })
         .map_err(|e| e.to_string())
 }
 
@@ -703,9 +725,9 @@ fn a_million_nodes(emissive: bool) -> Result<Scene, String> {
 fn a_million_instances_are_stored_once_or_refused_before_they_are_flattened() {
     // 10^6 nodes instancing a 100-triangle mesh: the mesh is stored once, placed 10^6 times.
     let scene = a_million_nodes(false).expect("loads");
-    assert_eq!(scene.meshes.len(), 1);
-    assert_eq!(scene.instances.len(), 1_000_000);
-    assert_eq!(scene.triangles.len(), 100);
+    assert_eq!(scene.scene.meshes.len(), 1);
+    assert_eq!(scene.scene.instances.len(), 1_000_000);
+    assert_eq!(scene.scene.triangles.len(), 100);
     // An emissive mesh is flattened (its lights are world-space records): 10^8 triangles,
     // beyond MAX_TRIANGLES; refused from the declared counts, without reading or allocating
     // the copies.
@@ -720,7 +742,7 @@ fn a_million_instances_are_stored_once_or_refused_before_they_are_flattened() {
 fn toml_includes_a_gltf_file_under_a_transform() {
     let dir = temp_dir("include");
     let path = camera_file(&dir);
-    let plain = Scene::load(&path).unwrap();
+    let plain = SceneFile::load(&path).unwrap();
     let include = |transform: &str| {
         load(
             &dir,
@@ -735,8 +757,8 @@ fn toml_includes_a_gltf_file_under_a_transform() {
         DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2),
         DVec3::new(0.0, 0.0, -4.0),
     );
-    assert_eq!(moved.triangles.len(), plain.triangles.len());
-    for (a, b) in moved.triangles.iter().zip(&plain.triangles) {
+    assert_eq!(moved.scene.triangles.len(), plain.scene.triangles.len());
+    for (a, b) in moved.scene.triangles.iter().zip(&plain.scene.triangles) {
         let want = m.transform_point3(Vec3::from(b.p0).as_dvec3());
         assert!(
             (Vec3::from(a.p0).as_dvec3() - want).length() < 1e-5,
@@ -745,7 +767,7 @@ fn toml_includes_a_gltf_file_under_a_transform() {
         );
     }
     // The TOML camera stays; a missing file names the field.
-    assert_eq!(moved.camera.width, 24);
+    assert_eq!(moved.scene.camera.width, 24);
     let e = twinpath::scene::parse_scene(
         &format!("{CAMERA}[[gltf]]\nfile = \"nope.glb\"\n"),
         &dir.join("x.toml"),
@@ -762,19 +784,19 @@ fn toml_includes_a_gltf_file_under_a_transform() {
 fn the_shipped_showcase_loads_and_renders_alike_on_both_backends() {
     let root = twinpath_tests::repo_root();
     let alone =
-        Scene::load(&root.join("scenes/gltf/showcase.glb")).unwrap_or_else(|e| panic!("{e}"));
+        SceneFile::load(&root.join("scenes/gltf/showcase.glb")).unwrap_or_else(|e| panic!("{e}"));
     assert!(
-        alone.notes.iter().all(|n| !n.contains("ignored")),
+        alone.scene.notes.iter().all(|n| !n.contains("ignored")),
         "{:?}",
-        alone.notes
+        alone.scene.notes
     );
     assert_eq!(
-        (alone.camera.width, alone.camera.height),
+        (alone.scene.camera.width, alone.scene.camera.height),
         (960, 720),
         "its own camera"
     );
     let mut scene =
-        Scene::load(&root.join("scenes/gltf_showcase.toml")).unwrap_or_else(|e| panic!("{e}"));
+        SceneFile::load(&root.join("scenes/gltf_showcase.toml")).unwrap_or_else(|e| panic!("{e}"));
     let f = scene.features();
     for (bit, name) in [
         (kernel::features::METALLIC_ROUGHNESS, "metallic-roughness"),
@@ -786,8 +808,8 @@ fn the_shipped_showcase_loads_and_renders_alike_on_both_backends() {
     ] {
         assert!(f & bit != 0, "the showcase lacks {name}");
     }
-    scene.camera.width = 32;
-    scene.camera.height = 24;
+    scene.scene.camera.width = 32;
+    scene.scene.camera.height = 24;
     let cpu = render_film(&scene, Backend::Cpu, 16);
     let gpu = render_film(&scene, Backend::Gpu, 16);
     let z = twinpath_tests::image_mean_z(&cpu, &gpu);

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
     assert_film_matches, image_mean_z, plane_exact, plane_under_lamps, render_film, repo_root,
@@ -15,12 +15,12 @@ use twinpath_tests::{
 /// hit and miss at an edge (the GPU intersects triangles with its own watertight test, the CPU
 /// with Moller-Trumbore).
 fn assert_backends_agree(path: &str, spp: u32, tolerance: f32) {
-    let scene = Scene::load(&repo_root().join(path)).unwrap();
+    let scene = SceneFile::load(&repo_root().join(path)).unwrap();
     assert_scene_backends_agree(&scene, path, spp, tolerance);
 }
 
 /// [`assert_backends_agree`] on a scene already loaded (`path` labels it).
-fn assert_scene_backends_agree(scene: &Scene, path: &str, spp: u32, tolerance: f32) {
+fn assert_scene_backends_agree(scene: &SceneFile, path: &str, spp: u32, tolerance: f32) {
     let scene = scene.clone();
     let cpu = render_film(&scene, Backend::Cpu, spp);
     let gpu = render_film(&scene, Backend::Gpu, spp);
@@ -32,8 +32,8 @@ fn assert_scene_backends_agree(scene: &Scene, path: &str, spp: u32, tolerance: f
         let close = (0..3).all(|c| (x[c] - y[c]).abs() <= tolerance * x[c].abs().max(y[c].abs()));
         if !close {
             differing.push((
-                i % scene.camera.width as usize,
-                i / scene.camera.width as usize,
+                i % scene.scene.camera.width as usize,
+                i / scene.scene.camera.width as usize,
                 *x,
                 *y,
             ));
@@ -58,13 +58,13 @@ fn assert_scene_backends_agree(scene: &Scene, path: &str, spp: u32, tolerance: f
     // samples, so each image's noise is known from its own samples).
     let independent = with_independent_samples(scene.clone());
     let mut other = independent.clone();
-    other.render.seed = scene.render.seed.wrapping_add(1000);
+    other.settings.seed = scene.settings.seed.wrapping_add(1000);
     let cpu = render_film(&independent, Backend::Cpu, spp);
     let gpu2 = render_film(&other, Backend::Gpu, spp);
     let z = image_mean_z(&cpu, &gpu2);
     println!(
         "{path}: cpu (seed {}) vs gpu (seed {}) image means: z = {z:+.2}",
-        scene.render.seed, other.render.seed
+        scene.settings.seed, other.settings.seed
     );
     assert!(
         z.abs() < z_critical(1e-3, 1),
@@ -116,9 +116,9 @@ fn mesh_scene_same_image_on_cpu_and_gpu() {
 #[test]
 fn textures_and_smooth_normals_same_image_on_cpu_and_gpu() {
     let path = "scenes/textures.toml";
-    let mut scene = Scene::load(&repo_root().join(path)).unwrap();
-    scene.camera.width /= 2;
-    scene.camera.height /= 2;
+    let mut scene = SceneFile::load(&repo_root().join(path)).unwrap();
+    scene.scene.camera.width /= 2;
+    scene.scene.camera.height /= 2;
     assert_scene_backends_agree(&scene, path, 8, 1e-3);
 }
 
@@ -137,7 +137,7 @@ fn plane_lamp((r, l): (f32, f32)) -> Lamp {
     }
 }
 
-fn plane_scene(lamp: Lamp) -> Scene {
+fn plane_scene(lamp: Lamp) -> SceneFile {
     plane_under_lamps(
         "eye = [0, 9, 9]\nlook_at = [0, 0, -1]\nup = [0, 1, 0]\nvfov = 70\nwidth = 48\nheight = 48",
         "seed = 3",
@@ -152,7 +152,7 @@ fn plane_under_sphere_light_closed_form_on_both_backends() {
     // is tiny, so each has a variance and the z-test applies.
     for lamp in LAMPS.map(plane_lamp) {
         let scene = plane_scene(lamp);
-        let exact = plane_exact(&scene, KD, &[lamp]);
+        let exact = plane_exact(&scene.scene, KD, &[lamp]);
         assert!(exact.iter().filter(|e| e.is_some()).count() > 1500);
         for backend in [Backend::Cpu, Backend::Gpu] {
             let film = render_film(&scene, backend, 256);
@@ -182,7 +182,7 @@ fn white_furnace_exact_on_gpu() {
     }
     text.push_str("\n[background]\nradiance = [0.7, 0.7, 0.7]\n");
     let scene = scene_from_toml(&text);
-    assert!(scene.lights.is_empty());
+    assert!(scene.scene.lights.is_empty());
     let spp = 16;
     let film = render_film(&scene, Backend::Gpu, spp);
     assert_eq!(film.discarded, 0);

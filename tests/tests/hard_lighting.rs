@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{image_mean_z, render_film, repo_root, scene_from_toml, z_critical};
 
@@ -36,7 +36,7 @@ fn with_light(center: Vec3, radius: f32, emission: f32) -> String {
     )
 }
 
-fn cases() -> Vec<(&'static str, Scene)> {
+fn cases() -> Vec<(&'static str, SceneFile)> {
     let r = 0.3;
     // Light 1e-3 of its radius in front of the back wall (z = -1).
     let touching = with_light(Vec3::new(0.0, 1.0, -1.0 + r * (1.0 + 1e-3)), r, 10.0);
@@ -73,7 +73,7 @@ fn hard_lighting_is_finite_and_the_same_on_both_backends() {
     for (label, scene) in cases() {
         let cpu = render_film(&scene, Backend::Cpu, spp);
         let mut other = scene.clone();
-        other.render.seed += 1000;
+        other.settings.seed += 1000;
         let gpu = render_film(&other, Backend::Gpu, spp);
         for (name, film) in [("cpu", &cpu), ("gpu", &gpu)] {
             assert_eq!(

@@ -29,8 +29,8 @@ fn a_million_spheres_load_and_build() {
         ));
     }
     let scene = parse_scene(&text, Path::new("many.toml")).unwrap();
-    assert_eq!(scene.spheres.len(), 1_000_000);
-    let cpu = twinpath::cpu::CpuRenderer::new(&scene);
+    assert_eq!(scene.scene.spheres.len(), 1_000_000);
+    let cpu = twinpath::cpu::CpuRenderer::new(&scene.scene, &scene.settings);
     assert!(cpu.bvh.node_count() > 1000);
     let mut film = twinpath::film::Film::new(8, 8);
     cpu.render_into(&scene.params(0, 1), 0, 1, &mut film, None);

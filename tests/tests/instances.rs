@@ -25,7 +25,7 @@ use twinpath::cpu::Bvh;
 use twinpath::render::Backend;
 use twinpath::scene::instancing::instance_record;
 use twinpath::scene::transform::Transform;
-use twinpath::scene::{parse_scene, Scene};
+use twinpath::scene::{parse_scene, SceneFile};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
     assert_noiseless_pixels, pixel_quadrature, render_film, with_independent_samples, z_critical,
@@ -110,7 +110,7 @@ fn grid_obj(n: usize) -> String {
     s
 }
 
-fn load(dir: &Path, text: &str) -> Scene {
+fn load(dir: &Path, text: &str) -> SceneFile {
     parse_scene(text, &dir.join("scene.toml")).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -124,7 +124,7 @@ const PLACEMENTS: [&str; 4] = [
 
 /// Test 1's scene: a floor, a sphere light, and the torus placed four times, from the files
 /// `files` (one name four times: instanced; four names: flattened), with `placements`.
-fn tori_scene(dir: &Path, files: [&str; 4], placements: [&str; 4]) -> Scene {
+fn tori_scene(dir: &Path, files: [&str; 4], placements: [&str; 4]) -> SceneFile {
     let mut text = String::from(
         "[camera]\neye = [0, 3.5, 5.5]\nlook_at = [0, 0.5, 0]\nup = [0, 1, 0]\nvfov = 45\nwidth = 32\nheight = 24\n\
          [render]\nseed = 3\n[materials]\nfloor = { kd = [0.6, 0.6, 0.6] }\n\
@@ -176,30 +176,40 @@ fn an_instanced_mesh_renders_as_its_flattened_copies_on_both_backends() {
     }
     let instanced = tori_scene(&dir, ["torus.obj"; 4], PLACEMENTS);
     let flattened = tori_scene(&dir, ["a.obj", "b.obj", "c.obj", "d.obj"], PLACEMENTS);
-    assert_eq!((instanced.meshes.len(), instanced.instances.len()), (1, 4));
-    assert_eq!(instanced.triangles.len(), 2 + 16 * 8 * 2, "the torus once");
-    assert!(flattened.instances.is_empty());
-    assert_eq!(flattened.triangles.len(), 2 + 4 * 16 * 8 * 2);
+    assert_eq!(
+        (
+            instanced.scene.meshes.len(),
+            instanced.scene.instances.len()
+        ),
+        (1, 4)
+    );
+    assert_eq!(
+        instanced.scene.triangles.len(),
+        2 + 16 * 8 * 2,
+        "the torus once"
+    );
+    assert!(flattened.scene.instances.is_empty());
+    assert_eq!(flattened.scene.triangles.len(), 2 + 4 * 16 * 8 * 2);
     assert_ne!(instanced.features() & kernel::features::INSTANCES, 0);
     assert_eq!(flattened.features() & kernel::features::INSTANCES, 0);
     // The first torus turned 10 degrees further: a placement the test must tell apart.
     let mut off = PLACEMENTS;
     off[0] = "rotate = [45, 1, 0.3, 0]\ntranslate = [-1.3, 0.6, 0]";
     let wrong = tori_scene(&dir, ["a.obj", "b.obj", "c.obj", "d.obj"], off);
-    let pixels = (instanced.camera.width * instanced.camera.height) as usize;
+    let pixels = (instanced.scene.camera.width * instanced.scene.camera.height) as usize;
     let bound = z_critical(1e-3, pixels);
     for backend in [Backend::Cpu, Backend::Gpu] {
         let spp = 256;
         let a = render_film(&instanced, backend, spp);
         let mut b_scene = flattened.clone();
-        b_scene.render.seed = 11;
+        b_scene.settings.seed = 11;
         let b = render_film(&b_scene, backend, spp);
         let z = max_pair_z(&a, &b);
         println!("{backend:?}: instanced vs flattened: max |z| {z:.2} over {pixels} pixels (bound {bound:.2})");
         assert!(z < bound, "{backend:?}: max |z| {z:.2} >= {bound:.2}");
         if backend == Backend::Cpu {
             let mut w_scene = wrong.clone();
-            w_scene.render.seed = 11;
+            w_scene.settings.seed = 11;
             let w = render_film(&w_scene, backend, spp);
             let zw = max_pair_z(&a, &w);
             println!("{backend:?}: instanced vs a torus 10 degrees off: max |z| {zw:.2}");
@@ -252,12 +262,12 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
         "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 4\nheight = 4\n\
          [materials]\nwhite = { kd = [0.5, 0.5, 0.5] }\n[[mesh]]\nfile = \"torus.obj\"\nmaterial = \"white\"\n",
     );
-    let mesh = base.triangles.clone();
+    let mesh = base.scene.triangles.clone();
     let mut scene = base.clone();
-    scene.triangles.clear();
-    scene.triangle_groups.clear();
-    scene.triangles.extend(&mesh);
-    scene.meshes = vec![twinpath::scene::TriangleGroup {
+    scene.scene.triangles.clear();
+    scene.scene.triangle_groups.clear();
+    scene.scene.triangles.extend(&mesh);
+    scene.scene.meshes = vec![twinpath::scene::TriangleGroup {
         name: "torus".into(),
         range: 0..mesh.len(),
     }];
@@ -265,16 +275,17 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
     let mut scales = Vec::new();
     for _ in 0..400 {
         let (t, s) = random_transform(&mut g);
-        scene.instances.push(instance_record(&t, 0));
-        scene.instance_meshes.push(0);
+        scene.scene.instances.push(instance_record(&t, 0));
+        scene.scene.instance_meshes.push(0);
         scales.push(s);
     }
-    let bvh = Bvh::build_scene(&scene);
+    let bvh = Bvh::build_scene(&scene.scene);
     let cases = 200_000;
     let (mut tested, mut outside, mut returned, mut worst) = (0, 0, 0, 0.0f64);
     for _ in 0..cases {
-        let k = (g.unit() * scene.instances.len() as f32) as usize % scene.instances.len();
-        let inst = scene.instances[k];
+        let k =
+            (g.unit() * scene.scene.instances.len() as f32) as usize % scene.scene.instances.len();
+        let inst = scene.scene.instances[k];
         let tri = mesh[(g.unit() * mesh.len() as f32) as usize % mesh.len()];
         let (a, b) = (g.unit(), g.unit());
         let (a, b) = if a + b > 1.0 {
@@ -294,7 +305,7 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
         tested += 1;
         let record = bvh.surface(hit, origin, dir);
         // The exact plane of the hit triangle under the exact map of the stored matrix.
-        let h_inst = scene.instances[hit.instance as usize];
+        let h_inst = scene.scene.instances[hit.instance as usize];
         let t = mesh[hit.prim as usize];
         let m = |p: Vec3| -> DVec3 {
             let r = &h_inst.object_to_world;
@@ -374,13 +385,16 @@ fn a_far_mirrored_instanced_floor_is_exact_under_a_directional_light_on_both_bac
         place(-100.0, 100.0)
     );
     let scene = with_independent_samples(load(&dir, &text));
-    assert_eq!((scene.meshes.len(), scene.instances.len()), (1, 2));
-    assert_eq!(scene.instances[1].handedness, -1.0);
+    assert_eq!(
+        (scene.scene.meshes.len(), scene.scene.instances.len()),
+        (1, 2)
+    );
+    assert_eq!(scene.scene.instances[1].handedness, -1.0);
     let toward = -travel.as_dvec3().normalize();
     let lit = kd as f64 / std::f64::consts::PI * e * toward.y;
     // Pixels whose every quadrature ray meets the floor away from the seam between the two
     // instances (a ray through the seam may meet either or, between their roundings, neither).
-    let want = pixel_quadrature(&scene, 8, |eye, d| {
+    let want = pixel_quadrature(&scene.scene, 8, |eye, d| {
         if d.y >= 0.0 {
             return None;
         }
@@ -403,7 +417,7 @@ fn a_far_mirrored_instanced_floor_is_exact_under_a_directional_light_on_both_bac
 
 /// A glTF file of the torus placed by three nodes: one mesh the nodes share (`shared`), or a
 /// copy of it per node. Seen by the framing camera under the default white sky.
-fn tori_gltf(shared: bool) -> Scene {
+fn tori_gltf(shared: bool) -> SceneFile {
     use serde_json::json;
     let mut g = twinpath_tests::gltf_writer::GltfWriter::new();
     let (p, n, uv, idx) = torus(16, 8);
@@ -429,26 +443,32 @@ fn tori_gltf(shared: bool) -> Scene {
         .unwrap_or_else(|e| panic!("{e}"));
     scene.camera.width = 32;
     scene.camera.height = 18;
-    with_independent_samples(scene)
+    with_independent_samples(SceneFile {
+        scene,
+        settings: Default::default(),
+    })
 }
 
 #[test]
 fn gltf_meshes_shared_by_nodes_are_instanced_and_render_as_their_copies() {
     let mut shared = tori_gltf(true);
     let copies = tori_gltf(false);
-    assert_eq!((shared.meshes.len(), shared.instances.len()), (1, 3));
-    assert_eq!(shared.triangles.len(), 16 * 8 * 2);
-    assert!(copies.instances.is_empty());
+    assert_eq!(
+        (shared.scene.meshes.len(), shared.scene.instances.len()),
+        (1, 3)
+    );
+    assert_eq!(shared.scene.triangles.len(), 16 * 8 * 2);
+    assert!(copies.scene.instances.is_empty());
     // The framing camera frames the instances' boxes (the mesh box's corners mapped), which
     // hold the copies' exact box: it stands a little farther back. Both are seen through the
     // copies' camera here.
-    assert!(shared.camera.focus_distance >= copies.camera.focus_distance);
-    shared.camera = copies.camera;
+    assert!(shared.scene.camera.focus_distance >= copies.scene.camera.focus_distance);
+    shared.scene.camera = copies.scene.camera;
     let bound = z_critical(1e-3, (32 * 18) as usize);
     for backend in [Backend::Cpu, Backend::Gpu] {
         let a = render_film(&shared, backend, 64);
         let mut c = copies.clone();
-        c.render.seed = 9;
+        c.settings.seed = 9;
         let b = render_film(&c, backend, 64);
         let z = max_pair_z(&a, &b);
         println!("{backend:?}: glTF instances vs copies: max |z| {z:.2} (bound {bound:.2})");
@@ -472,10 +492,13 @@ fn emissive_and_small_shared_meshes_are_flattened() {
     );
     // The lamp torus (16 triangles, emissive) twice and the tiny grid (8 triangles) twice are
     // flattened; the white torus, shared by two entries, is instanced.
-    assert_eq!((scene.meshes.len(), scene.instances.len()), (1, 2));
-    assert_eq!(scene.world_triangle_count(), 2 * 16 + 2 * 8);
-    assert_eq!(scene.lights.len(), 2 * 16);
-    assert_eq!(scene.triangles.len(), 2 * 16 + 2 * 8 + 16);
+    assert_eq!(
+        (scene.scene.meshes.len(), scene.scene.instances.len()),
+        (1, 2)
+    );
+    assert_eq!(scene.scene.world_triangle_count(), 2 * 16 + 2 * 8);
+    assert_eq!(scene.scene.lights.len(), 2 * 16);
+    assert_eq!(scene.scene.triangles.len(), 2 * 16 + 2 * 8 + 16);
 }
 
 #[test]
@@ -495,16 +518,20 @@ fn a_thousand_instances_of_a_100k_triangle_mesh_store_it_once_on_both_backends()
     }
     let mut scene = load(&dir, &text);
     let triangles = 224 * 224 * 2;
-    assert_eq!(scene.triangles.len(), triangles);
-    assert_eq!((scene.meshes.len(), scene.instances.len()), (1, 1000));
-    scene.render.spp = 2;
+    assert_eq!(scene.scene.triangles.len(), triangles);
+    assert_eq!(
+        (scene.scene.meshes.len(), scene.scene.instances.len()),
+        (1, 1000)
+    );
+    scene.settings.spp = 2;
     // Flattened, the triangles alone would take 1000 x 100352 x 48 bytes = 4.5 GiB.
     let flattened = (1000 * triangles * 48) as f64;
-    let tables: usize = scene.table_bytes().iter().map(|t| t.1).sum();
-    println!("scene tables: {}", scene.memory_report());
+    let tables: usize = scene.scene.table_bytes().iter().map(|t| t.1).sum();
+    println!("scene tables: {}", scene.scene.memory_report());
     for backend in [Backend::Cpu, Backend::Gpu] {
         let out = twinpath::render::render(
-            &scene,
+            &scene.scene,
+            &scene.settings,
             &twinpath::render::RenderOptions {
                 backend,
                 device: None,
@@ -535,8 +562,12 @@ fn a_thousand_instances_of_a_100k_triangle_mesh_store_it_once_on_both_backends()
 
 #[test]
 fn the_shipped_instances_scene_stores_its_two_meshes_once() {
-    let scene = Scene::load(&twinpath_tests::repo_root().join("scenes/instances.toml")).unwrap();
-    assert_eq!((scene.meshes.len(), scene.instances.len()), (2, 15));
-    assert_eq!(scene.world_triangle_count(), 2, "the ground alone");
-    assert_eq!(scene.triangles.len(), 2 + 2304 + 1280);
+    let scene =
+        SceneFile::load(&twinpath_tests::repo_root().join("scenes/instances.toml")).unwrap();
+    assert_eq!(
+        (scene.scene.meshes.len(), scene.scene.instances.len()),
+        (2, 15)
+    );
+    assert_eq!(scene.scene.world_triangle_count(), 2, "the ground alone");
+    assert_eq!(scene.scene.triangles.len(), 2 + 2304 + 1280);
 }

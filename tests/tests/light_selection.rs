@@ -151,13 +151,13 @@ fn plane_under_three_lights_matches_closed_form_with_either_selection_on_both_ba
             KD,
             &lamps(),
         );
-        assert_eq!(scene.lights.len(), 3);
-        let exact = plane_exact(&scene, KD, &lamps());
+        assert_eq!(scene.scene.lights.len(), 3);
+        let exact = plane_exact(&scene.scene, KD, &lamps());
         assert!(exact.iter().filter(|e| e.is_some()).count() > 1500);
         // Per-sample variances from an independent render: the rare light's pixels are heavy
         // tailed under power selection (see assert_film_matches_with_variance).
         let mut other = scene.clone();
-        other.render.seed += 1000;
+        other.settings.seed += 1000;
         let variance_source = render_film(&other, Backend::Cpu, 2048);
         for backend in [Backend::Cpu, Backend::Gpu] {
             let film = render_film(&scene, backend, 256);

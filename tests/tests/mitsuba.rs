@@ -9,7 +9,7 @@
 use statrs::distribution::{ContinuousCDF, StudentsT};
 use twinpath::cpu::CpuRenderer;
 use twinpath::film::{diff_images, Film, RgbImage};
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::stats::pixel_z_test;
 use twinpath_tests::{repo_root, with_independent_samples, z_critical};
 
@@ -46,9 +46,9 @@ fn agrees_with_mitsuba(scene_file: &str, reference_dir: &std::path::Path) {
         .map(|(a, b)| std::array::from_fn(|c| (a[c] - b[c]) * (a[c] - b[c]) / 4.0))
         .collect();
 
-    let scene = with_independent_samples(Scene::load(&repo_root().join(scene_file)).unwrap());
+    let scene = with_independent_samples(SceneFile::load(&repo_root().join(scene_file)).unwrap());
     assert_eq!(
-        (scene.camera.width, scene.camera.height),
+        (scene.scene.camera.width, scene.scene.camera.height),
         (reference.width, reference.height)
     );
     // BATCHES independent renders of SPP / BATCHES samples (consecutive sample ranges of the
@@ -56,11 +56,11 @@ fn agrees_with_mitsuba(scene_file: &str, reference_dir: &std::path::Path) {
     // image mean's error (batch means). A render's own per-pixel variances understate the
     // heavy tails of caustics (light through the glass sphere, found only by BSDF sampling):
     // summed, they made a correct image's mean read z = +3.6.
-    let cpu = CpuRenderer::new(&scene);
+    let cpu = CpuRenderer::new(&scene.scene, &scene.settings);
     let per = SPP / BATCHES;
     let films: Vec<Film> = (0..BATCHES)
         .map(|k| {
-            let mut film = Film::new(scene.camera.width, scene.camera.height);
+            let mut film = Film::new(scene.scene.camera.width, scene.scene.camera.height);
             cpu.render_into(&scene.params(k * per, per), k * per, per, &mut film, None);
             assert_eq!(film.discarded, 0, "non-finite samples");
             film
@@ -70,8 +70,8 @@ fn agrees_with_mitsuba(scene_file: &str, reference_dir: &std::path::Path) {
     let means: Vec<Vec<[f32; 3]>> = films.iter().map(Film::mean).collect();
     let vars: Vec<Vec<[f32; 3]>> = films.iter().map(Film::variance_of_mean).collect();
     let image = RgbImage {
-        width: scene.camera.width,
-        height: scene.camera.height,
+        width: scene.scene.camera.width,
+        height: scene.scene.camera.height,
         pixels: (0..reference.pixels.len())
             .map(|i| std::array::from_fn(|c| means.iter().map(|m| m[i][c]).sum::<f32>() / b))
             .collect(),

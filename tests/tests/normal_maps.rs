@@ -7,14 +7,14 @@
 //! 2. A diffuse plane with a constant normal map under a point light matches its closed form,
 //!    kd I max(0, n.l) / (pi d^2) with n the mapped normal, per pixel on both backends; the
 //!    unmapped normal, a flipped bitangent and an ignored scale are each rejected.
-//! 3. Scene-file errors name the field.
+//! 3. SceneFile-file errors name the field.
 
 use glam::{DVec3, Vec2, Vec3};
 use kernel::scene::{texture_slot, Material, ShadingTriangle};
 use std::path::{Path, PathBuf};
 use twinpath::render::Backend;
 use twinpath::scene::textures::{TextureTable, TextureUse};
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
     assert_film_matches, max_abs_z, pixel_quadrature, render_film, scene_from_toml,
@@ -169,7 +169,7 @@ const SCALE: f64 = 1.5;
 /// The plane y = 0 (a quad: u along +x, v along -z, so T = +x, B = -z, sign +1) with a
 /// constant normal map under a point light; black background, so the light's NEE sample is
 /// all a pixel gets.
-fn mapped_plane(dir: &Path) -> Scene {
+fn mapped_plane(dir: &Path) -> SceneFile {
     let map = constant_png(dir, TEXEL);
     let text = format!(
         "[camera]\neye = [0, 3, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 50\nwidth = 24\nheight = 18\n\
@@ -185,14 +185,14 @@ fn mapped_plane(dir: &Path) -> Scene {
     std::fs::write(&path, text).unwrap();
     // Independent samples: a z-test's variance assumes them (Sobol points are stratified, and
     // their error is far below what their sample variance says: max |z| 0.02 with them).
-    with_independent_samples(Scene::load(&path).unwrap_or_else(|e| panic!("{e}")))
+    with_independent_samples(SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}")))
 }
 
 /// Each pixel's exact value with shading normal `n` at every point; `None` for pixels any of
 /// whose quadrature points sees the light or the camera near or below the shading plane
 /// (there the kernel's rule for disagreeing normals applies, tested elsewhere).
-fn exact(scene: &Scene, n: DVec3) -> Vec<Option<f64>> {
-    pixel_quadrature(scene, 16, |eye, d| {
+fn exact(scene: &SceneFile, n: DVec3) -> Vec<Option<f64>> {
+    pixel_quadrature(&scene.scene, 16, |eye, d| {
         if d.y >= 0.0 {
             return None;
         }
@@ -212,7 +212,7 @@ fn a_normal_mapped_plane_under_a_point_light_matches_its_closed_form_on_both_bac
     let dir = temp_dir("plane");
     let scene = mapped_plane(&dir);
     assert_eq!(
-        scene.shading.len(),
+        scene.scene.shading.len(),
         4,
         "a record and a tangent frame per triangle"
     );
@@ -262,7 +262,7 @@ fn normal_map_errors_name_the_field() {
         );
         let path = dir.join("bad.toml");
         std::fs::write(&path, text).unwrap();
-        Scene::load(&path).unwrap_err().to_string()
+        SceneFile::load(&path).unwrap_err().to_string()
     };
     let m = map.display();
     for (material, field, says) in [
@@ -333,11 +333,14 @@ fn gltf_tangents_are_read_and_transformed() {
         g.push("scenes", json!({ "nodes": [0] }));
         let path = dir.join(name);
         std::fs::write(&path, g.glb()).unwrap();
-        Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
+        SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
     };
-    let frame = |s: &Scene| {
-        assert_eq!(s.shading.len(), 2, "a record and its tangent frame");
-        (Vec3::from(s.shading[1].normal0), s.shading[1].uv0[0])
+    let frame = |s: &SceneFile| {
+        assert_eq!(s.scene.shading.len(), 2, "a record and its tangent frame");
+        (
+            Vec3::from(s.scene.shading[1].normal0),
+            s.scene.shading[1].uv0[0],
+        )
     };
     let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-6;
     // No TANGENT: the coordinates' frame.

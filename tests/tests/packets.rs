@@ -7,36 +7,36 @@
 
 use twinpath::cpu::{CpuRenderer, TileStrategy};
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath::settings::{LightSampling, Mis, Roulette, Sampler};
 use twinpath_tests::{assert_films_identical, render_film, repo_root};
 
-fn small(name: &str) -> Scene {
-    let mut s = Scene::load(&repo_root().join("scenes").join(name)).unwrap();
-    s.camera.width = 48;
-    s.camera.height = 48;
+fn small(name: &str) -> SceneFile {
+    let mut s = SceneFile::load(&repo_root().join("scenes").join(name)).unwrap();
+    s.scene.camera.width = 48;
+    s.scene.camera.height = 48;
     s
 }
 
-fn scenes() -> Vec<(&'static str, Scene)> {
+fn scenes() -> Vec<(&'static str, SceneFile)> {
     let mut half = small("cornell.toml");
-    half.render.mis = Mis::Half;
-    half.render.light_sampling = LightSampling::Area;
+    half.settings.mis = Mis::Half;
+    half.settings.light_sampling = LightSampling::Area;
     let mut constant = small("cornell.toml");
-    constant.render.roulette = Roulette::Constant;
+    constant.settings.roulette = Roulette::Constant;
     let mut throughput = small("cornell.toml");
-    throughput.render.rr_start_depth = Some(3);
+    throughput.settings.rr_start_depth = Some(3);
     let mut generic = small("cornell.toml");
-    generic.render.specialize = false;
+    generic.settings.specialize = false;
     let mut independent = small("cornell.toml");
-    independent.render.sampler = Sampler::Independent;
+    independent.settings.sampler = Sampler::Independent;
     let mut adaptive = small("cornell.toml");
-    adaptive.render.adaptive_target = 0.05;
+    adaptive.settings.adaptive_target = 0.05;
     let mut lens = small("cornell.toml");
-    lens.camera.aperture = 0.2;
-    lens.camera.focus_distance = 3.5;
+    lens.scene.camera.aperture = 0.2;
+    lens.scene.camera.focus_distance = 3.5;
     let mut sky = small("many_lights.toml");
-    sky.background = glam::Vec3::new(0.2, 0.3, 0.5);
+    sky.scene.background = glam::Vec3::new(0.2, 0.3, 0.5);
     vec![
         ("cornell", small("cornell.toml")),
         ("cornell, constant roulette", constant),
@@ -63,7 +63,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
 /// A scene small enough for packets with every texture slot and a smooth mesh: a checkered
 /// floor, a wall of textured roughness, a panel of textured emission, an octahedron with vertex
 /// normals (written to a temporary file).
-fn small_textured() -> Scene {
+fn small_textured() -> SceneFile {
     let dir = std::env::temp_dir().join(format!("twinpath-packets-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let obj = dir.join("octahedron.obj");
@@ -121,7 +121,7 @@ fn small_textured() -> Scene {
         "#,
         obj.display()
     ));
-    s.background = glam::Vec3::splat(0.1);
+    s.scene.background = glam::Vec3::splat(0.1);
     s
 }
 
@@ -129,7 +129,10 @@ fn small_textured() -> Scene {
 fn packets_of_paths_give_the_one_path_images() {
     for (name, scene) in scenes() {
         assert!(
-            matches!(CpuRenderer::new(&scene).tiles, TileStrategy::Packets(_)),
+            matches!(
+                CpuRenderer::new(&scene.scene, &scene.settings).tiles,
+                TileStrategy::Packets(_)
+            ),
             "{name}: small enough for packets, yet the renderer would not use them"
         );
         assert_packets_give_the_one_path_image(name, &scene);
@@ -138,14 +141,14 @@ fn packets_of_paths_give_the_one_path_images() {
 
 /// Renders `scene` as it is (with packets) and with `packets` off (one path at a time), 8 spp
 /// or 32 under adaptive sampling, and asserts the films identical, sample for sample.
-fn assert_packets_give_the_one_path_image(name: &str, scene: &Scene) {
+fn assert_packets_give_the_one_path_image(name: &str, scene: &SceneFile) {
     let mut one_path = scene.clone();
-    one_path.render.packets = false;
+    one_path.settings.packets = false;
     assert!(matches!(
-        CpuRenderer::new(&one_path).tiles,
+        CpuRenderer::new(&one_path.scene, &one_path.settings).tiles,
         TileStrategy::OnePath
     ));
-    let spp = if scene.render.adaptive_target > 0.0 {
+    let spp = if scene.settings.adaptive_target > 0.0 {
         32
     } else {
         8
@@ -158,7 +161,7 @@ fn assert_packets_give_the_one_path_image(name: &str, scene: &Scene) {
 
 /// The Cornell room with a generated torus knot of about 12k triangles in place of the left
 /// sphere (`bench::rays::knot_mesh`, written to a temporary OBJ file), 48x48.
-fn knot_room(lights: &str) -> Scene {
+fn knot_room(lights: &str) -> SceneFile {
     let dir = std::env::temp_dir().join(format!("twinpath-bvh-packets-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let obj = dir.join("knot.obj");
@@ -182,8 +185,8 @@ fn knot_room(lights: &str) -> Scene {
         "{room}\n[[mesh]]\nfile = \"{}\"\ntranslate = [-0.3, 0.6, -0.2]\nmaterial = \"white\"\n{lights}",
         obj.display()
     ));
-    s.camera.width = 48;
-    s.camera.height = 48;
+    s.scene.camera.width = 48;
+    s.scene.camera.height = 48;
     s
 }
 
@@ -194,9 +197,9 @@ fn knot_room(lights: &str) -> Scene {
 #[test]
 fn packets_through_the_bvh_give_the_one_path_images() {
     let mut independent = knot_room("");
-    independent.render.sampler = Sampler::Independent;
+    independent.settings.sampler = Sampler::Independent;
     let mut adaptive = knot_room("");
-    adaptive.render.adaptive_target = 0.05;
+    adaptive.settings.adaptive_target = 0.05;
     let lamps = r#"
         [[sphere]]
         center = [0.6, 1.5, -0.5]
@@ -228,7 +231,10 @@ fn packets_through_the_bvh_give_the_one_path_images() {
     ];
     for (name, scene) in scenes {
         assert!(
-            matches!(CpuRenderer::new(&scene).tiles, TileStrategy::BvhPackets),
+            matches!(
+                CpuRenderer::new(&scene.scene, &scene.settings).tiles,
+                TileStrategy::BvhPackets
+            ),
             "{name}: a larger scene without instances, yet no packets through the BVH"
         );
         assert_packets_give_the_one_path_image(name, &scene);
@@ -239,9 +245,9 @@ fn packets_through_the_bvh_give_the_one_path_images() {
 #[test]
 fn instanced_scenes_trace_one_path_at_a_time() {
     let scene = small("instances.toml");
-    assert!(!scene.instances.is_empty());
+    assert!(!scene.scene.instances.is_empty());
     assert!(matches!(
-        CpuRenderer::new(&scene).tiles,
+        CpuRenderer::new(&scene.scene, &scene.settings).tiles,
         TileStrategy::OnePath
     ));
 }
@@ -336,9 +342,9 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
     use twinpath::cpu::internals::fill_vertex_samples;
     use twinpath::cpu::LANES;
 
-    let many = small("many_lights.toml").lights;
-    let one = small("cornell.toml").lights;
-    let panel = small("cornell_panel.toml").lights;
+    let many = small("many_lights.toml").scene.lights;
+    let one = small("cornell.toml").scene.lights;
+    let panel = small("cornell_panel.toml").scene.lights;
     // No environment map in these light tables: its parameters stay unread.
     let params = small("cornell.toml").params(0, 1);
     assert!(many.len() > 1 && one.len() == 1 && panel.len() == 2);

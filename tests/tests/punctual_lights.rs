@@ -12,7 +12,7 @@
 use glam::Vec3;
 use serde_json::json;
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gltf_writer::GltfWriter;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
@@ -27,7 +27,7 @@ const CAMERA: &str =
 
 /// The plane y = 0 under `lights` (TOML `[[light]]` and `[[sphere]]` entries): direct light
 /// only, as nothing but the plane reflects and the background is black.
-fn plane(lights: &str, render: &str) -> Scene {
+fn plane(lights: &str, render: &str) -> SceneFile {
     with_independent_samples(scene_from_toml(&format!(
         "[camera]\n{CAMERA}\n[render]\n{render}\n[materials]\nplane = {{ kd = [{KD}, {KD}, {KD}] }}\nlamp = {{ emission = [5, 5, 5] }}\n[[quad]]\ncorner = [-100, 0, 100]\nedge1 = [200, 0, 0]\nedge2 = [0, 0, -200]\nmaterial = \"plane\"\n{lights}"
     )))
@@ -35,8 +35,8 @@ fn plane(lights: &str, render: &str) -> Scene {
 
 /// Each pixel's exact value: `radiance_at(x)` at the plane point x each quadrature ray meets
 /// (`None` for a pixel any of whose rays misses the plane or sees the sphere light).
-fn exact(scene: &Scene, radiance_at: impl Fn(glam::DVec3) -> Option<f64>) -> Vec<Option<f64>> {
-    pixel_quadrature(scene, 16, |eye, d| {
+fn exact(scene: &SceneFile, radiance_at: impl Fn(glam::DVec3) -> Option<f64>) -> Vec<Option<f64>> {
+    pixel_quadrature(&scene.scene, 16, |eye, d| {
         let t =
             kernel::geometry::intersect_sphere(eye, d, SPHERE, SPHERE_R as f32, 0.0, f32::INFINITY);
         if d.y >= 0.0 || t >= 0.0 {
@@ -87,7 +87,7 @@ fn a_plane_under_a_point_and_a_sphere_light_matches_its_closed_form_on_both_back
             point.clone()
         };
         let scene = plane(&lights, render);
-        assert_eq!(scene.lights.len(), 1 + with_sphere as usize);
+        assert_eq!(scene.scene.lights.len(), 1 + with_sphere as usize);
         let sphere_part = |x: glam::DVec3| if with_sphere { sphere_term(x) } else { 0.0 };
         let want = exact(&scene, |x| Some(point_term(x, 2) + sphere_part(x)));
         let wrong = exact(&scene, |x| Some(point_term(x, 1) + sphere_part(x)));
@@ -95,7 +95,7 @@ fn a_plane_under_a_point_and_a_sphere_light_matches_its_closed_form_on_both_back
         // half its light): heavy-tailed, so each pixel's variance comes from an independent
         // render with 16 times the samples.
         let mut other = scene.clone();
-        other.render.seed = 977;
+        other.settings.seed = 977;
         let source = render_film(&other, Backend::Cpu, 4096);
         for (backend, spp) in [(Backend::Cpu, 256), (Backend::Gpu, 256)] {
             let film = render_film(&scene, backend, spp);
@@ -205,7 +205,7 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
         g.push("scenes", json!({ "nodes": [0, 1] }));
         let path = dir.join(name);
         std::fs::write(&path, g.glb()).unwrap();
-        Scene::load(&path)
+        SceneFile::load(&path)
     };
     let scene = file(
         json!([
@@ -216,8 +216,8 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
         "lights.glb",
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(scene.lights.len(), 2);
-    let (spot, point) = (scene.lights[0], scene.lights[1]);
+    assert_eq!(scene.scene.lights.len(), 2);
+    let (spot, point) = (scene.scene.lights[0], scene.scene.lights[1]);
     assert_eq!(spot.kind, kernel::scene::light_kind::PUNCTUAL);
     assert!((Vec3::from(spot.position) - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-6);
     assert!(
@@ -238,14 +238,22 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
         "a point light: no falloff"
     );
     assert!(
-        scene.notes.iter().any(|n| n.contains("range ignored")),
+        scene
+            .scene
+            .notes
+            .iter()
+            .any(|n| n.contains("range ignored")),
         "{:?}",
-        scene.notes
+        scene.scene.notes
     );
     assert!(
-        !scene.notes.iter().any(|n| n.contains("extensions ignored")),
+        !scene
+            .scene
+            .notes
+            .iter()
+            .any(|n| n.contains("extensions ignored")),
         "KHR_lights_punctual is read: {:?}",
-        scene.notes
+        scene.scene.notes
     );
     assert!(scene.features() & kernel::features::PUNCTUAL_LIGHTS != 0);
     // Bad cones and intensities name the light.
@@ -261,8 +269,8 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
         "dir.glb",
     )
     .unwrap();
-    assert_eq!(s.lights.len(), 2);
-    let d = s.lights[0];
+    assert_eq!(s.scene.lights.len(), 2);
+    let d = s.scene.lights[0];
     assert_eq!(d.kind, kernel::scene::light_kind::DIRECTIONAL);
     assert!((Vec3::from(d.edge1) - Vec3::new(0.0, -1.0, 0.0)).length() < 1e-6);
     assert_eq!(d.radiance, [3.0, 1.5, 1.5]);
@@ -273,9 +281,9 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
         d.radius
     );
     assert!(
-        !s.notes.iter().any(|n| n.contains("directional")),
+        !s.scene.notes.iter().any(|n| n.contains("directional")),
         "{:?}",
-        s.notes
+        s.scene.notes
     );
 }
 
@@ -292,8 +300,8 @@ fn a_directional_light_and_its_shadow_match_the_closed_form_on_both_backends() {
         "[camera]\n{CAMERA}\n[render]\nmax_depth = 1\n[materials]\nplane = {{ kd = [{KD}, {KD}, {KD}] }}\n[[quad]]\ncorner = [-100, 0, 100]\nedge1 = [200, 0, 0]\nedge2 = [0, 0, -200]\nmaterial = \"plane\"\n[[sphere]]\ncenter = [0, 1, 0]\nradius = {OCCLUDER_R}\nmaterial = \"plane\"\n[[light]]\ndirection = [{}, {}, {}]\nirradiance = [{E}, {E}, {E}]\n",
         TRAVEL.x, TRAVEL.y, TRAVEL.z
     )));
-    assert_eq!(scene.lights.len(), 1);
-    assert!(scene.lights[0].radius >= 100.0, "bounds the plane");
+    assert_eq!(scene.scene.lights.len(), 1);
+    assert!(scene.scene.lights[0].radius >= 100.0, "bounds the plane");
     let toward = -TRAVEL.as_dvec3().normalize();
     let lit = KD as f64 / std::f64::consts::PI * E * toward.y;
     // Per quadrature point: the plane point, whether the sphere shadows it, or None where the
@@ -311,7 +319,9 @@ fn a_directional_light_and_its_shadow_match_the_closed_form_on_both_backends() {
         let disc = b * b - (oc.length_squared() - (OCCLUDER_R as f64).powi(2));
         Some(disc > 0.0 && -b + disc.sqrt() > 0.0)
     };
-    let shadowed = pixel_quadrature(&scene, 16, |eye, d| at(eye, d).map(|s| s as u8 as f64));
+    let shadowed = pixel_quadrature(&scene.scene, 16, |eye, d| {
+        at(eye, d).map(|s| s as u8 as f64)
+    });
     let want: Vec<Option<f64>> = shadowed
         .iter()
         .map(|f| f.filter(|&f| f == 0.0).map(|_| lit))

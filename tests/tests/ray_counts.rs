@@ -11,7 +11,7 @@
 
 use twinpath::backend::RayCounts;
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::{render_output, scene_from_toml, with_independent_samples, z_critical};
 
 const Q: f64 = 0.5;
@@ -20,7 +20,7 @@ const SIDE: u32 = 32;
 
 /// The camera at the centre of a closed sphere of albedo 0.5, constant roulette `Q` from the
 /// first vertex, and `light` (TOML) inside it.
-fn closed_sphere(light: &str) -> Scene {
+fn closed_sphere(light: &str) -> SceneFile {
     with_independent_samples(scene_from_toml(&format!(
         "[camera]\neye = [0, 0, 0]\nlook_at = [0, 0, -1]\nup = [0, 1, 0]\nvfov = 60\nwidth = {SIDE}\nheight = {SIDE}\n\
          [render]\nroulette = \"constant\"\nrussian_roulette = {Q}\nrr_start_depth = 1\n\
@@ -30,7 +30,7 @@ fn closed_sphere(light: &str) -> Scene {
 }
 
 /// Renders `scene` at `spp` on the CPU; its ray counts and sample count.
-fn rays_of(scene: &Scene, spp: u32) -> (RayCounts, u64) {
+fn rays_of(scene: &SceneFile, spp: u32) -> (RayCounts, u64) {
     let out = render_output(scene, Backend::Cpu, spp);
     let rays = out.rays.expect("the CPU backend counts rays");
     (rays, out.film.total_samples())
@@ -77,11 +77,11 @@ fn packets_trace_the_rays_of_the_one_path_loop() {
     // meshes.toml: BVH packets; cornell.toml: the small scene's packets.
     for name in ["meshes.toml", "cornell.toml"] {
         let path = twinpath_tests::repo_root().join("scenes").join(name);
-        let mut scene = Scene::load(&path).expect("scene");
-        scene.camera.width = 48;
-        scene.camera.height = 48;
+        let mut scene = SceneFile::load(&path).expect("scene");
+        scene.scene.camera.width = 48;
+        scene.scene.camera.height = 48;
         let mut one_path = scene.clone();
-        one_path.render.packets = false;
+        one_path.settings.packets = false;
         let (packets, n) = rays_of(&scene, 4);
         let (paths, m) = rays_of(&one_path, 4);
         println!("{name}: {packets:?} in packets, {paths:?} one path at a time ({n} samples)");

@@ -1,7 +1,7 @@
 //! Bad input of every class is an error naming the file, the line and the field; never a panic.
 
 use std::path::{Path, PathBuf};
-use twinpath::scene::{mesh::parse_ply, parse_scene, Scene, SceneError};
+use twinpath::scene::{mesh::parse_ply, parse_scene, SceneError, SceneFile};
 use twinpath::settings::{LightSampling, LightSelection, Mis, Roulette, Sampler};
 
 const GOOD: &str = r#"
@@ -76,20 +76,21 @@ fn assert_error(text: &str, line_needle: &str, field: &str, message_part: &str) 
 #[test]
 fn good_scene_parses() {
     let s = parse_scene(GOOD, &scene_path()).unwrap();
-    assert_eq!(s.spheres.len(), 1);
-    assert_eq!(s.triangles.len(), 2);
-    assert!(s.lights.is_empty());
+    assert_eq!(s.scene.spheres.len(), 1);
+    assert_eq!(s.scene.triangles.len(), 2);
+    assert!(s.scene.lights.is_empty());
 }
 
 #[test]
 fn builtin_scene_is_the_shipped_cornell_file() {
-    let builtin = Scene::builtin_default();
+    let builtin = SceneFile::builtin_default();
     let file =
-        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell.toml")).unwrap();
-    assert_eq!(builtin.spheres, file.spheres);
-    assert_eq!(builtin.triangles, file.triangles);
-    assert_eq!(builtin.lights.len(), 1);
-    assert_eq!(builtin.triangles.len(), 10);
+        SceneFile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell.toml"))
+            .unwrap();
+    assert_eq!(builtin.scene.spheres, file.scene.spheres);
+    assert_eq!(builtin.scene.triangles, file.scene.triangles);
+    assert_eq!(builtin.scene.lights.len(), 1);
+    assert_eq!(builtin.scene.triangles.len(), 10);
 }
 
 #[test]
@@ -209,15 +210,20 @@ fn emissive_quads_and_two_sided_emitters() {
         "edge2 = [0, 0, -2]\nmaterial = \"lamp\"",
     );
     let s = parse_scene(&t, &scene_path()).unwrap();
-    assert_eq!(s.lights.len(), 2);
+    assert_eq!(s.scene.lights.len(), 2);
     assert!(s
+        .scene
         .lights
         .iter()
         .all(|l| l.kind == kernel::scene::light_kind::TRIANGLE
             && l.two_sided == 0
             && (l.area - 2.0).abs() < 1e-6));
     assert_eq!(
-        s.triangles.iter().map(|t| t.light).collect::<Vec<_>>(),
+        s.scene
+            .triangles
+            .iter()
+            .map(|t| t.light)
+            .collect::<Vec<_>>(),
         vec![0, 1]
     );
     let two = t.replace(
@@ -225,7 +231,7 @@ fn emissive_quads_and_two_sided_emitters() {
         "lamp = { emission = [4, 4, 4], two_sided = true }",
     );
     let s = parse_scene(&two, &scene_path()).unwrap();
-    assert!(s.lights.iter().all(|l| l.two_sided == 1));
+    assert!(s.scene.lights.iter().all(|l| l.two_sided == 1));
     assert_error(
         &with(
             "white = { kd = [0.5, 0.5, 0.5] }",
@@ -336,8 +342,8 @@ fn good_meshes_load() {
         "{GOOD}\n[[mesh]]\nfile = \"tri.obj\"\nmaterial = \"white\"\n[[mesh]]\nfile = \"tri.ply\"\nmaterial = \"white\"\n"
     );
     let s = parse_scene(&scene, &dir.join("s.toml")).unwrap();
-    assert_eq!(s.triangles.len(), 2 + 2 + 1);
-    assert_eq!(s.triangle_groups.len(), 3);
+    assert_eq!(s.scene.triangles.len(), 2 + 2 + 1);
+    assert_eq!(s.scene.triangle_groups.len(), 3);
 }
 
 #[test]
@@ -390,10 +396,10 @@ fn not_utf8_scene_file() {
     let dir = temp_dir("utf8");
     let path = dir.join("bin.toml");
     std::fs::write(&path, b"[camera]\neye = [0, 1, 4]\n\xff\xfe\n").unwrap();
-    let e = Scene::load(&path).unwrap_err();
+    let e = SceneFile::load(&path).unwrap_err();
     println!("{e}");
     assert_eq!(e.line, Some(3));
-    let e = Scene::load(&dir.join("missing.toml")).unwrap_err();
+    let e = SceneFile::load(&dir.join("missing.toml")).unwrap_err();
     assert!(e.message.contains("cannot read"));
 }
 
@@ -419,29 +425,29 @@ fn render_keywords_name_their_choices() {
         |extra: &str| parse_scene(&format!("{GOOD}\n[render]\n{extra}"), &scene_path()).unwrap();
     let s = parse("");
     assert_eq!(
-        (s.render.roulette, s.render.roulette_start_depth()),
+        (s.settings.roulette, s.settings.roulette_start_depth()),
         (Roulette::Throughput, 5)
     );
     let s = parse("roulette = \"constant\"\n");
     assert_eq!(
-        (s.render.roulette, s.render.roulette_start_depth()),
+        (s.settings.roulette, s.settings.roulette_start_depth()),
         (Roulette::Constant, 1)
     );
     let s = parse("rr_start_depth = 2\nroulette = \"constant\"\n");
-    assert_eq!(s.render.roulette_start_depth(), 2);
+    assert_eq!(s.settings.roulette_start_depth(), 2);
     let s = parse("mis = \"half\"\nlight_sampling = \"area\"\nlight_selection = \"uniform\"\n");
     assert_eq!(
         (
-            s.render.mis,
-            s.render.light_sampling,
-            s.render.light_selection
+            s.settings.mis,
+            s.settings.light_sampling,
+            s.settings.light_selection
         ),
         (Mis::Half, LightSampling::Area, LightSelection::Uniform)
     );
     // Sobol points unless the scene asks for independent numbers.
-    assert_eq!(parse("").render.sampler, Sampler::Sobol);
+    assert_eq!(parse("").settings.sampler, Sampler::Sobol);
     let s = parse("sampler = \"independent\"\n");
-    assert_eq!(s.render.sampler, Sampler::Independent);
+    assert_eq!(s.settings.sampler, Sampler::Independent);
 }
 
 /// The good scene with material `white` replaced by `white_def`.
@@ -490,7 +496,12 @@ fn every_material_kind_parses() {
             "[materials]\nfloor = { kd = [0.5, 0.5, 0.5] }\n",
         );
         let s = parse_scene(&text, &scene_path()).unwrap_or_else(|e| panic!("{def}: {e}"));
-        let m = s.materials[s.material_names.iter().position(|n| n == "white").unwrap()];
+        let m = s.scene.materials[s
+            .scene
+            .material_names
+            .iter()
+            .position(|n| n == "white")
+            .unwrap()];
         assert_eq!(m.kind, kind, "{def}");
     }
 }
@@ -619,7 +630,7 @@ fn dielectric_needs_a_closed_outward_surface() {
         ) + &format!("\n[[mesh]]\nfile = \"{file}\"\nmaterial = \"glass\"\n")
     };
     let s = parse_scene(&scene("out.obj"), &dir.join("s.toml")).unwrap();
-    assert_eq!(s.triangles.len(), 2 + 4);
+    assert_eq!(s.scene.triangles.len(), 2 + 4);
     for (file, message) in [
         ("in.obj", "signed volume"),
         ("open.obj", "not a closed"),
@@ -653,10 +664,16 @@ fn thin_lens_settings() {
         &scene_path(),
     )
     .unwrap();
-    assert_eq!((s.camera.aperture, s.camera.focus_distance), (0.1, 2.5));
+    assert_eq!(
+        (s.scene.camera.aperture, s.scene.camera.focus_distance),
+        (0.1, 2.5)
+    );
     // The default focus is the look-at point's distance; the default aperture a pinhole.
     let s = parse_scene(GOOD, &scene_path()).unwrap();
-    assert_eq!((s.camera.aperture, s.camera.focus_distance), (0.0, 4.0));
+    assert_eq!(
+        (s.scene.camera.aperture, s.scene.camera.focus_distance),
+        (0.0, 4.0)
+    );
     assert_error(
         &with("height = 24", "height = 24\naperture = -0.1"),
         "aperture",
@@ -683,14 +700,14 @@ fn environment_map_settings() {
         &scene_path(),
     )
     .unwrap();
-    let map = s.environment.as_ref().unwrap();
+    let map = s.scene.environment.as_ref().unwrap();
     assert_eq!(
         (map.width, map.height, map.scale, map.rotation_degrees),
         (512, 256, 0.5, 90.0)
     );
     // The map is a light: the last entry of the light table.
     assert_eq!(
-        s.lights.last().unwrap().kind,
+        s.scene.lights.last().unwrap().kind,
         kernel::scene::light_kind::ENVIRONMENT
     );
     assert_error(

@@ -11,7 +11,7 @@
 use glam::Vec3;
 use twinpath::render::Backend;
 use twinpath::scene::mesh::{load_mesh, parse_obj};
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{render_film, repo_root, scene_from_toml, with_independent_samples};
 
@@ -63,7 +63,7 @@ fn obj_and_ply_vertex_normals_and_texture_coordinates_are_read() {
 
 /// The scene: a unit sphere (`shape`) of albedo 0.6 at the origin under a sphere light and a
 /// dim sky, seen from the front.
-fn sphere_scene(shape: &str) -> Scene {
+fn sphere_scene(shape: &str) -> SceneFile {
     let text = format!(
         r#"
         [camera]
@@ -102,9 +102,9 @@ fn mesh(path: &std::path::Path) -> String {
 /// Pixels whose 4 x 4 quadrature rays all meet the analytic sphere facing the camera
 /// (|n . d| > 0.3) at points the lamp lights at more than 0.3 cosine: away from the silhouette
 /// (where polygon and circle differ) and the terminator (where shadow rays graze the facets).
-fn interior_pixels(scene: &Scene) -> Vec<bool> {
+fn interior_pixels(scene: &SceneFile) -> Vec<bool> {
     let lamp = Vec3::new(1.5, 2.5, 4.0);
-    twinpath_tests::pixel_quadrature(scene, 4, |eye, d| {
+    twinpath_tests::pixel_quadrature(&scene.scene, 4, |eye, d| {
         let t = kernel::geometry::intersect_sphere(eye, d, Vec3::ZERO, 1.0, 0.0, f32::INFINITY);
         if t < 0.0 {
             return None;
@@ -178,10 +178,10 @@ fn smooth_mesh_sphere_converges_to_the_analytic_sphere_on_both_backends() {
     for (backend, spp) in [(Backend::Cpu, 1024), (Backend::Gpu, 256)] {
         let reference = render_film(&analytic, backend, spp);
         let mut smooth = sphere_scene(&mesh(&smooth_path));
-        smooth.render.seed += 1;
+        smooth.settings.seed += 1;
         let smooth = render_film(&smooth, backend, spp);
         let mut flat = sphere_scene(&mesh(&flat_path));
-        flat.render.seed += 2;
+        flat.settings.seed += 2;
         let flat = render_film(&flat, backend, spp);
         let (smooth_out, smooth_rel) = compare(&reference, &smooth, &mask);
         let (flat_out, flat_rel) = compare(&reference, &flat, &mask);

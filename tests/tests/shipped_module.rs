@@ -1,10 +1,13 @@
-//! The shipped kernel module (kernel/shipped/kernel.spv) is the one the kernel's sources compile
-//! to, as far as its manifest can tell, and the host runs exactly it: a kernel edit without
+//! The shipped kernel modules (kernel/shipped/kernel.spv, the renderer's, and probe.spv, the
+//! tests') are the ones the kernel's sources compile to, as far as their manifest can tell, and
+//! the host runs exactly them: a kernel edit without
 //! `scripts/build_kernel.sh` fails here (and fails every build, by host/build.rs), naming the
 //! file that changed and the script. CI recompiles the module and compares bytes
 //! (`scripts/build_kernel.sh --check`).
 
-use kernel_manifest::{check_shipped, Error, Manifest, MANIFEST_PATH, MODULE_PATH, REGENERATE};
+use kernel_manifest::{
+    check_shipped, Error, Manifest, MANIFEST_PATH, MODULE_PATH, PROBE_MODULE_PATH, REGENERATE,
+};
 use std::path::{Path, PathBuf};
 use twinpath_tests::repo_root;
 
@@ -29,6 +32,12 @@ fn the_host_runs_the_module_the_manifest_describes() {
         manifest.build["module_bytes"],
         twinpath::KERNEL_SPV.len().to_string()
     );
+    assert_eq!(
+        manifest.build["probe_module_blake3"],
+        blake3::hash(twinpath::PROBE_SPV).to_hex().to_string(),
+        "twinpath::PROBE_SPV is not the shipped tests' module"
+    );
+    assert_eq!(manifest.build["probe_features"], "probe");
     // The manifest names every kernel source and rust-gpu's compiler backend.
     assert!(manifest.sources.contains_key("kernel/src/path.rs"));
     assert!(manifest.sources.contains_key("kernel/Cargo.toml"));
@@ -142,17 +151,19 @@ fn a_changed_locked_package_toolchain_or_profile_is_an_error_naming_it() {
 
 #[test]
 fn a_module_that_is_not_the_manifests_is_an_error() {
-    let dir = copy_of_inputs("module");
-    let module = dir.join(MODULE_PATH);
-    let mut bytes = std::fs::read(&module).unwrap();
-    let last = bytes.len() - 1;
-    bytes[last] ^= 1;
-    std::fs::write(&module, bytes).unwrap();
-    let message = stale_message(&dir);
-    assert!(
-        message.contains("is not the module the manifest describes"),
-        "{message}"
-    );
+    for (name, path) in [("module", MODULE_PATH), ("probe", PROBE_MODULE_PATH)] {
+        let dir = copy_of_inputs(name);
+        let module = dir.join(path);
+        let mut bytes = std::fs::read(&module).unwrap();
+        let last = bytes.len() - 1;
+        bytes[last] ^= 1;
+        std::fs::write(&module, bytes).unwrap();
+        let message = stale_message(&dir);
+        assert!(
+            message.contains(&format!("{path} is not the module the manifest describes")),
+            "{message}"
+        );
+    }
 }
 
 #[test]

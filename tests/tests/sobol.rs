@@ -11,7 +11,7 @@ use kernel::sobol::{
     sobol_single,
 };
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{chi_square, plane_exact, plane_under_light, render_film, z_critical};
 
@@ -167,12 +167,12 @@ fn points_are_uniform_across_pixels_and_dimensions_are_independent() {
 const KD: f32 = 0.6;
 const SEEDS: u32 = 8;
 
-fn plane_scene(sampler: &str, seed: u32) -> Scene {
+fn plane_scene(sampler: &str, seed: u32) -> SceneFile {
     plane_scene_with(sampler, seed, "")
 }
 
 /// The plane scene with extra `[render]` lines.
-fn plane_scene_with(sampler: &str, seed: u32, render: &str) -> Scene {
+fn plane_scene_with(sampler: &str, seed: u32, render: &str) -> SceneFile {
     plane_under_light(
         "eye = [0, 9, 9]\nlook_at = [0, 0, -1]\nup = [0, 1, 0]\nvfov = 70\nwidth = 48\nheight = 48",
         &format!("seed = {seed}\nsampler = \"{sampler}\"\n{render}"),
@@ -232,7 +232,7 @@ fn image_z(mean: &[f64], var: &[f64], exact: &[Option<f64>]) -> (f64, f64, f64) 
 fn sobol_images_are_unbiased_and_less_noisy_on_both_backends() {
     let scene = plane_scene("sobol", 0);
     let exact = plane_exact(
-        &scene,
+        &scene.scene,
         KD,
         &[twinpath_tests::Lamp {
             center: Vec3::new(0.0, 2.0, 0.0),
@@ -276,7 +276,7 @@ fn adaptive_sampling_with_sobol_points_stays_unbiased_on_both_backends() {
         radius: 0.5,
         radiance: 5.0,
     };
-    let exact = plane_exact(&plane_scene("sobol", 0), KD, &[lamp]);
+    let exact = plane_exact(&plane_scene("sobol", 0).scene, KD, &[lamp]);
     let max_spp = 256;
     for backend in [Backend::Cpu, Backend::Gpu] {
         let mut stopped_early = 0;

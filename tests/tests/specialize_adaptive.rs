@@ -5,7 +5,7 @@
 use glam::Vec3;
 use kernel::features;
 use twinpath::render::Backend;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath::settings::{LightSampling, Mis, Roulette};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
@@ -13,59 +13,59 @@ use twinpath_tests::{
     render_film, repo_root, variance_of_mean_from, z_critical, Lamp,
 };
 
-fn small(mut s: Scene) -> Scene {
-    s.camera.width = 48;
-    s.camera.height = 48;
+fn small(mut s: SceneFile) -> SceneFile {
+    s.scene.camera.width = 48;
+    s.scene.camera.height = 48;
     s
 }
 
-fn cornell() -> Scene {
-    small(Scene::load(&repo_root().join("scenes/cornell.toml")).unwrap())
+fn cornell() -> SceneFile {
+    small(SceneFile::load(&repo_root().join("scenes/cornell.toml")).unwrap())
 }
 
 /// Triangles only, no lights, a background: the "no spheres, no lights" case.
-fn sky_meshes() -> Scene {
-    small(Scene::load(&repo_root().join("scenes/sky_meshes.toml")).unwrap())
+fn sky_meshes() -> SceneFile {
+    small(SceneFile::load(&repo_root().join("scenes/sky_meshes.toml")).unwrap())
 }
 
 /// Spheres only, several lights of different power.
-fn many_lights() -> Scene {
-    small(Scene::load(&repo_root().join("scenes/many_lights.toml")).unwrap())
+fn many_lights() -> SceneFile {
+    small(SceneFile::load(&repo_root().join("scenes/many_lights.toml")).unwrap())
 }
 
 /// Every material kind.
-fn materials() -> Scene {
-    small(Scene::load(&repo_root().join("scenes/materials.toml")).unwrap())
+fn materials() -> SceneFile {
+    small(SceneFile::load(&repo_root().join("scenes/materials.toml")).unwrap())
 }
 
 /// Cornell with a rough gold and a glass sphere: conductor and dielectric bits, no Kd + Ks.
-fn cornell_materials() -> Scene {
-    small(Scene::load(&repo_root().join("scenes/cornell_materials.toml")).unwrap())
+fn cornell_materials() -> SceneFile {
+    small(SceneFile::load(&repo_root().join("scenes/cornell_materials.toml")).unwrap())
 }
 
 /// Cornell lit by a ceiling panel: triangle lights.
-fn cornell_panel() -> Scene {
-    small(Scene::load(&repo_root().join("scenes/cornell_panel.toml")).unwrap())
+fn cornell_panel() -> SceneFile {
+    small(SceneFile::load(&repo_root().join("scenes/cornell_panel.toml")).unwrap())
 }
 
 /// Textured floor, wall and light; smooth meshes (shading normals).
-fn textures() -> Scene {
-    small(Scene::load(&repo_root().join("scenes/textures.toml")).unwrap())
+fn textures() -> SceneFile {
+    small(SceneFile::load(&repo_root().join("scenes/textures.toml")).unwrap())
 }
 
 /// `scene` through a lens of diameter 0.2 focused on its spheres (3.5 from the eye).
-fn thin_lens(mut scene: Scene) -> Scene {
-    scene.camera.aperture = 0.2;
-    scene.camera.focus_distance = 3.5;
+fn thin_lens(mut scene: SceneFile) -> SceneFile {
+    scene.scene.camera.aperture = 0.2;
+    scene.scene.camera.focus_distance = 3.5;
     scene
 }
 
-fn scenes() -> Vec<(&'static str, Scene)> {
+fn scenes() -> Vec<(&'static str, SceneFile)> {
     let mut half = cornell();
-    half.render.mis = Mis::Half;
-    half.render.light_sampling = LightSampling::Area;
+    half.settings.mis = Mis::Half;
+    half.settings.light_sampling = LightSampling::Area;
     let mut constant = cornell();
-    constant.render.roulette = Roulette::Constant;
+    constant.settings.roulette = Roulette::Constant;
     vec![
         ("cornell", cornell()),
         ("cornell, constant roulette", constant),
@@ -78,7 +78,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("cornell through a thin lens", thin_lens(cornell())),
         (
             "an environment map",
-            small(Scene::load(&repo_root().join("scenes/sky.toml")).unwrap()),
+            small(SceneFile::load(&repo_root().join("scenes/sky.toml")).unwrap()),
         ),
         ("textures and smooth meshes", textures()),
     ]
@@ -127,7 +127,7 @@ fn scene_analysis_finds_the_features_present() {
         materials().features() & (features::TEXTURES | features::SHADING_NORMALS),
         0
     );
-    let sky = small(Scene::load(&repo_root().join("scenes/sky.toml")).unwrap());
+    let sky = small(SceneFile::load(&repo_root().join("scenes/sky.toml")).unwrap());
     assert_eq!(
         sky.features() & (features::ENVIRONMENT | features::BACKGROUND | features::LIGHTS),
         features::ENVIRONMENT | features::BACKGROUND | features::LIGHTS
@@ -137,7 +137,7 @@ fn scene_analysis_finds_the_features_present() {
         features::THIN_LENS
     );
     let mut generic = cornell();
-    generic.render.specialize = false;
+    generic.settings.specialize = false;
     assert_eq!(generic.features(), 0);
 }
 
@@ -145,7 +145,7 @@ fn scene_analysis_finds_the_features_present() {
 fn assert_specialized_matches_generic(backend: Backend, spp: u32) {
     for (name, scene) in scenes() {
         let mut generic = scene.clone();
-        generic.render.specialize = false;
+        generic.settings.specialize = false;
         let a = render_film(&scene, backend, spp);
         let b = render_film(&generic, backend, spp);
         assert_films_identical(&a, &b, name);
@@ -178,7 +178,7 @@ fn lamp() -> Lamp {
 }
 
 /// The plane under one lamp, with adaptive sampling at `target`.
-fn adaptive_plane(target: f32) -> Scene {
+fn adaptive_plane(target: f32) -> SceneFile {
     plane_under_lamps(
         "eye = [0, 9, 9]\nlook_at = [0, 0, -1]\nup = [0, 1, 0]\nvfov = 70\nwidth = 48\nheight = 48",
         &format!("seed = 11\nadaptive_target = {target}"),
@@ -191,12 +191,12 @@ fn adaptive_plane(target: f32) -> Scene {
 fn adaptive_sampling_is_unbiased_on_the_closed_form_plane_on_both_backends() {
     let target = 0.004;
     let scene = adaptive_plane(target);
-    let exact = plane_exact(&scene, KD, &[lamp()]);
+    let exact = plane_exact(&scene.scene, KD, &[lamp()]);
     let max_spp = 512;
     // Per-sample variances from an independent uniform render (another seed): a pixel that
     // stopped after few samples estimates its own variance poorly.
     let mut uniform = adaptive_plane(0.0);
-    uniform.render.seed += 1000;
+    uniform.settings.seed += 1000;
     let variance_source = render_film(&uniform, Backend::Cpu, 1024);
     let mut maps = Vec::new();
     for backend in [Backend::Cpu, Backend::Gpu] {
@@ -265,7 +265,7 @@ fn scene_without_spheres_and_lights_renders_on_both_backends() {
     // No sphere hit group, no sphere BLAS, no light sampling: a furnace-like check that the
     // specialized GPU pipeline still sees the triangles (same image as the CPU's).
     let scene = sky_meshes();
-    assert!(scene.spheres.is_empty() && scene.lights.is_empty());
+    assert!(scene.scene.spheres.is_empty() && scene.scene.lights.is_empty());
     let cpu = render_film(&scene, Backend::Cpu, 4);
     let gpu = render_film(&scene, Backend::Gpu, 4);
     let (a, b) = (cpu.mean(), gpu.mean());

@@ -1,8 +1,13 @@
 //! The SPIR-V module rust-gpu builds from `kernel/`: valid for Vulkan 1.2 (spirv-val), holding
 //! exactly the entry points the Vulkan backend binds (rust-gpu can silently drop one), and laying
-//! out every shared struct exactly as the host does.
+//! out every shared struct exactly as the host does. The tests' module (`PROBE_SPV`, the kernel
+//! with its feature `probe`) holds the same entry points and the compute probe; the renderer's
+//! holds no probe.
 
-use kernel::scene::{Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
+use kernel::scene::{
+    AdaptiveParams, Camera, EnvironmentParams, Instance, IntegratorParams, Light, Material,
+    RenderParams, SampleParams, ShadingTriangle, Sphere, Triangle,
+};
 use std::collections::BTreeSet;
 use std::mem::{offset_of, size_of};
 use std::process::Command;
@@ -10,24 +15,30 @@ use twinpath::vulkan::pipeline::binding;
 use twinpath_tests::spirv::{Module, StructLayout};
 
 #[test]
-fn module_has_the_ray_tracing_and_probe_entry_points() {
+fn module_has_the_ray_tracing_entry_points_and_the_tests_module_the_probe() {
     // Execution models: GLCompute 5, RayGenerationKHR 5313, IntersectionKHR 5314,
     // ClosestHitKHR 5316, MissKHR 5317.
-    let want: BTreeSet<(u32, String)> = [
+    let mut want: BTreeSet<(u32, String)> = [
         (5313, "shaders::raygen"),
         (5317, "shaders::miss"),
         (5316, "shaders::closest_hit_triangle"),
         (5316, "shaders::closest_hit_sphere"),
         (5316, "shaders::closest_hit_instance"),
         (5314, "shaders::intersect_sphere_shader"),
-        (5, "shaders::probe"),
     ]
     .into_iter()
     .map(|(m, n)| (m, n.to_string()))
     .collect();
     let got = Module::parse(twinpath::KERNEL_SPV).entry_points;
     println!("entry points: {got:?}");
-    assert_eq!(got, want);
+    assert_eq!(got, want, "the renderer's module");
+    want.insert((5, "shaders::probe".to_string()));
+    let probe = Module::parse(twinpath::PROBE_SPV).entry_points;
+    println!("the tests' module's entry points: {probe:?}");
+    assert_eq!(probe, want, "the tests' module");
+    assert!(probe
+        .iter()
+        .any(|(_, n)| n.as_bytes() == twinpath::vulkan::compute::PROBE.to_bytes()));
     // The names the host binds are the module's.
     use twinpath::vulkan::pipeline as p;
     for name in [
@@ -37,7 +48,6 @@ fn module_has_the_ray_tracing_and_probe_entry_points() {
         p::CLOSEST_HIT_SPHERE,
         p::CLOSEST_HIT_INSTANCE,
         p::INTERSECT_SPHERE,
-        twinpath::vulkan::compute::PROBE,
     ] {
         assert!(
             got.iter().any(|(_, n)| n.as_bytes() == name.to_bytes()),
@@ -77,9 +87,18 @@ fn module_needs_ray_tracing_pipelines_and_not_ray_queries() {
 }
 
 #[test]
-fn module_passes_spirv_val() {
-    let path = std::env::temp_dir().join(format!("twinpath-kernel-{}.spv", std::process::id()));
-    std::fs::write(&path, twinpath::KERNEL_SPV).unwrap();
+fn modules_pass_spirv_val() {
+    for (name, module) in [
+        ("kernel", twinpath::KERNEL_SPV),
+        ("probe", twinpath::PROBE_SPV),
+    ] {
+        spirv_val(name, module);
+    }
+}
+
+fn spirv_val(name: &str, module: &[u8]) {
+    let path = std::env::temp_dir().join(format!("twinpath-{name}-{}.spv", std::process::id()));
+    std::fs::write(&path, module).unwrap();
     let out = Command::new("spirv-val")
         .args(["--target-env", "vulkan1.2"])
         .arg(&path)
@@ -112,32 +131,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
             binding::PARAMS,
             host_layout!(
                 RenderParams,
-                [
-                    camera,
-                    background,
-                    width,
-                    height,
-                    seed,
-                    sample_offset,
-                    samples_per_launch,
-                    light_count,
-                    rr_mode,
-                    rr_probability,
-                    rr_start_depth,
-                    mis_mode,
-                    max_depth,
-                    light_sampling,
-                    adaptive_target,
-                    pilot_period,
-                    min_pilot_samples,
-                    sampler,
-                    env_width,
-                    env_height,
-                    env_light,
-                    env_scale,
-                    env_rotation,
-                    _pad
-                ],
+                [camera, samples, integrator, adaptive, environment],
                 false
             ),
         ),
@@ -232,4 +226,64 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
         assert_eq!(host, device, "{name} differs between host and device");
     }
     assert_eq!(size_of::<RenderParams>() % 16, 0);
+    // The parts of RenderParams, member by member.
+    let parts = [
+        (
+            "Camera",
+            0,
+            host_layout!(Camera, [eye, forward, right, up], false),
+        ),
+        (
+            "SampleParams",
+            1,
+            host_layout!(
+                SampleParams,
+                [width, height, seed, first, count, sampler],
+                false
+            ),
+        ),
+        (
+            "IntegratorParams",
+            2,
+            host_layout!(
+                IntegratorParams,
+                [
+                    light_count,
+                    rr_mode,
+                    rr_probability,
+                    rr_start_depth,
+                    mis_mode,
+                    max_depth,
+                    light_sampling
+                ],
+                false
+            ),
+        ),
+        (
+            "AdaptiveParams",
+            3,
+            host_layout!(
+                AdaptiveParams,
+                [target, pilot_period, min_pilot_samples],
+                false
+            ),
+        ),
+        (
+            "EnvironmentParams",
+            4,
+            host_layout!(
+                EnvironmentParams,
+                [background, width, height, light, scale, rotation, _pad],
+                false
+            ),
+        ),
+    ];
+    for (name, member, host) in parts {
+        let device = m.member_layout(0, binding::PARAMS, member);
+        println!("RenderParams.{name}: host {host:?}, device {device:?}");
+        assert_eq!(
+            host, device,
+            "RenderParams.{name} differs between host and device"
+        );
+    }
 }

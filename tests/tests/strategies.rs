@@ -15,7 +15,7 @@ use statrs::distribution::{ContinuousCDF, StudentsT};
 use twinpath::film::Film;
 use twinpath::render::Backend;
 use twinpath::scene::environment::EnvironmentMap;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath::settings::{LightSampling, Mis};
 use twinpath_tests::{render_film, scene_from_toml};
 
@@ -130,17 +130,17 @@ struct Variant {
 }
 
 fn render(text: &str, map: Option<&EnvironmentMap>, v: Variant, batch: u32) -> Film {
-    let mut scene: Scene = scene_from_toml(text);
+    let mut scene: SceneFile = scene_from_toml(text);
     if let Some(m) = map {
-        scene.set_environment(Some(m.clone()));
+        scene.scene.set_environment(Some(m.clone()));
     }
-    scene.render.mis = v.mis;
+    scene.settings.mis = v.mis;
     if v.area {
-        scene.render.light_sampling = LightSampling::Area;
+        scene.settings.light_sampling = LightSampling::Area;
     }
-    scene.render.seed = 1000 * (v.mis as u32 + 1) + 100 * v.area as u32 + batch;
+    scene.settings.seed = 1000 * (v.mis as u32 + 1) + 100 * v.area as u32 + batch;
     // The specialised path and the generic one must agree too: only power runs specialised.
-    scene.render.specialize = v.mis == Mis::Power;
+    scene.settings.specialize = v.mis == Mis::Power;
     render_film(&scene, Backend::Cpu, SPP)
 }
 

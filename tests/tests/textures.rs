@@ -17,7 +17,7 @@ use kernel::texture::{flags, lookup, wrap, LINEAR_TABLE, SRGB_TABLE};
 use std::path::{Path, PathBuf};
 use twinpath::render::Backend;
 use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse};
-use twinpath::scene::{parse_scene, Scene};
+use twinpath::scene::{parse_scene, SceneFile};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
     assert_film_matches, max_abs_z, pixel_quadrature, render_film, scene_from_toml,
@@ -276,7 +276,7 @@ fn checker_png(dir: &Path) -> PathBuf {
     path
 }
 
-fn checker_scene(png: &Path) -> Scene {
+fn checker_scene(png: &Path) -> SceneFile {
     let text = format!(
         r#"
         [camera]
@@ -311,10 +311,10 @@ fn checker_scene(png: &Path) -> Scene {
 /// pixel, averaged; `None` where a point sees the lamp, leaves the quad, or lies within 0.6
 /// texel of a square's edge (where bilinear filtering blends the two colours). `swap` exchanges
 /// the squares' colours.
-fn checker_exact(scene: &Scene, swap: bool) -> Vec<Option<f64>> {
+fn checker_exact(scene: &SceneFile, swap: bool) -> Vec<Option<f64>> {
     let lamp = Vec3::new(0.0, LAMP_H, 0.0);
     let kd = |b: u8| KD_FACTOR * srgb_to_linear(b) as f32 as f64;
-    pixel_quadrature(scene, 16, |eye, d| {
+    pixel_quadrature(&scene.scene, 16, |eye, d| {
         if d.y >= 0.0
             || kernel::geometry::intersect_sphere(eye, d, lamp, LAMP_R, 0.0, f32::INFINITY) >= 0.0
         {
@@ -471,11 +471,11 @@ fn texture_errors_name_the_field_and_the_reason() {
 /// texture once (two materials sharing a file as the same use share its texels).
 #[test]
 fn memory_report_lists_tables_and_textures() {
-    let scene = Scene::load(&twinpath_tests::repo_root().join("scenes/textures.toml")).unwrap();
-    let bytes: std::collections::BTreeMap<_, _> = scene.table_bytes().into_iter().collect();
-    assert_eq!(bytes["textures"], 4 * scene.textures.words.len());
-    assert_eq!(bytes["shading"], 64 * scene.shading.len());
-    let report = scene.memory_report();
+    let scene = SceneFile::load(&twinpath_tests::repo_root().join("scenes/textures.toml")).unwrap();
+    let bytes: std::collections::BTreeMap<_, _> = scene.scene.table_bytes().into_iter().collect();
+    assert_eq!(bytes["textures"], 4 * scene.scene.textures.words.len());
+    assert_eq!(bytes["shading"], 64 * scene.scene.shading.len());
+    let report = scene.scene.memory_report();
     println!("{report}");
     assert!(
         report.contains("3 textures (64x64, 32x16, 64x64)"),
@@ -492,5 +492,5 @@ fn memory_report_lists_tables_and_textures() {
     );
     let scene = parse_scene(&text, &dir.join("scene.toml")).unwrap();
     // a, b and c read it as colour and repeat; d clamps: two records.
-    assert_eq!(scene.textures.textures.len(), 2);
+    assert_eq!(scene.scene.textures.textures.len(), 2);
 }

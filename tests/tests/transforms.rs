@@ -9,12 +9,12 @@
 //!    field.
 
 use glam::{DMat3, DVec3, Vec3};
-use twinpath::scene::{parse_scene, Scene};
+use twinpath::scene::{parse_scene, SceneFile};
 use twinpath_tests::{repo_root, scene_from_toml};
 
 const CAMERA: &str = "[camera]\neye = [0, 1, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 8\nheight = 8\n";
 
-fn scene(body: &str) -> Scene {
+fn scene(body: &str) -> SceneFile {
     scene_from_toml(&format!(
         "{CAMERA}[materials]\nwhite = {{ kd = [0.5, 0.5, 0.5] }}\nlamp = {{ emission = [1, 1, 1] }}\nglass = {{ dielectric = {{ ior = 1.5 }} }}\n{body}"
     ))
@@ -29,8 +29,9 @@ fn error(body: &str) -> String {
 }
 
 /// The triangles' vertices, in world space.
-fn vertices(s: &Scene) -> Vec<[Vec3; 3]> {
-    s.triangles
+fn vertices(s: &SceneFile) -> Vec<[Vec3; 3]> {
+    s.scene
+        .triangles
         .iter()
         .map(|t| {
             let p0 = Vec3::from(t.p0);
@@ -133,7 +134,7 @@ fn mirroring_keeps_front_faces_and_normals_follow_the_inverse_transpose() {
         let s = scene(&format!(
             "[[quad]]\ncorner = [-0.5, 1, -0.5]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, 1]\nmaterial = \"lamp\"\n{transform}\n"
         ));
-        for t in &s.triangles {
+        for t in &s.scene.triangles {
             let n = Vec3::from(t.edge1).cross(Vec3::from(t.edge2));
             assert!(
                 n.y < 0.0 && n.x.abs() < 1e-6 && n.z.abs() < 1e-6,
@@ -161,8 +162,8 @@ fn mirroring_keeps_front_faces_and_normals_follow_the_inverse_transpose() {
         "[[mesh]]\nfile = \"meshes/uv_sphere.obj\"\nmaterial = \"white\"\nscale = [2, 1, 0.5]\n",
     );
     let mut checked = 0;
-    for (t, p) in s.triangles.iter().zip(vertices(&s)) {
-        let r = &s.shading[t.shading as usize];
+    for (t, p) in s.scene.triangles.iter().zip(vertices(&s)) {
+        let r = &s.scene.shading[t.shading as usize];
         for (q, n) in p.iter().zip([r.normal0, r.normal1, r.normal2]) {
             let want = Vec3::new(q.x / 4.0, q.y, q.z / 0.25).normalize();
             let got = Vec3::from(n).normalize();
@@ -181,9 +182,9 @@ fn spheres_take_uniform_scales_and_bad_transforms_are_errors() {
     let s = scene(
         "[[sphere]]\ncenter = [1, 0, 0]\nradius = 0.5\nmaterial = \"white\"\nscale = 2\nrotate = [90, 0, 0, 1]\ntranslate = [0, 1, 0]\n",
     );
-    let c = Vec3::from(s.spheres[0].center);
+    let c = Vec3::from(s.scene.spheres[0].center);
     assert!((c - Vec3::new(0.0, 3.0, 0.0)).length() < 1e-6, "centre {c}");
-    assert!((s.spheres[0].radius - 1.0).abs() < 1e-6);
+    assert!((s.scene.spheres[0].radius - 1.0).abs() < 1e-6);
 
     let sphere = "[[sphere]]\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"white\"\n";
     let quad = "[[quad]]\ncorner = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, -1]\nmaterial = \"white\"\n";

@@ -24,7 +24,7 @@ use kernel::spherical_triangle::{
 use std::f64::consts::PI;
 use twinpath::render::Backend;
 use twinpath::scene::light_table::triangle_light;
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{assert_film_matches, chi_square, render_film, scene_from_toml, z_critical};
 
@@ -465,7 +465,7 @@ const A: f64 = 0.8;
 const B: f64 = 0.5;
 const L: f64 = 3.0;
 
-fn panel_scene(light_sampling: &str) -> Scene {
+fn panel_scene(light_sampling: &str) -> SceneFile {
     let text = format!(
         r#"
         [camera]
@@ -522,14 +522,14 @@ fn polygon_irradiance(x: DVec3, v: &[DVec3]) -> f64 {
 /// Exact pixel values of [`panel_scene`]: kd / pi times the panel's irradiance at the plane
 /// point each camera ray meets, averaged over the pixel by a 16 x 16 midpoint quadrature (the
 /// box filter); `None` where a quadrature ray meets the panel or misses the plane.
-fn panel_exact(scene: &Scene) -> Vec<Option<f64>> {
+fn panel_exact(scene: &SceneFile) -> Vec<Option<f64>> {
     let panel = [
         DVec3::new(-A, H, -B),
         DVec3::new(A, H, -B),
         DVec3::new(A, H, B),
         DVec3::new(-A, H, B),
     ];
-    twinpath_tests::pixel_quadrature(scene, 16, |eye, d| {
+    twinpath_tests::pixel_quadrature(&scene.scene, 16, |eye, d| {
         let (eye, d) = (eye.as_dvec3(), d.as_dvec3());
         if d.y >= 0.0 {
             return None;
@@ -547,7 +547,7 @@ fn panel_exact(scene: &Scene) -> Vec<Option<f64>> {
 fn plane_under_rectangular_light_closed_form_on_both_backends() {
     for sampling in ["solid_angle", "area"] {
         let scene = panel_scene(sampling);
-        assert_eq!(scene.lights.len(), 2);
+        assert_eq!(scene.scene.lights.len(), 2);
         let exact = panel_exact(&scene);
         assert!(exact.iter().filter(|e| e.is_some()).count() > 1000);
         for backend in [Backend::Cpu, Backend::Gpu] {

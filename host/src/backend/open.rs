@@ -5,6 +5,7 @@
 use super::SampleBackend;
 use crate::cpu::CpuBackend;
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 #[cfg(not(feature = "gpu"))]
 use anyhow::bail;
 use anyhow::Result;
@@ -18,25 +19,27 @@ pub enum Backend {
     Gpu,
 }
 
-/// The backend `kind` asks for, prepared for `scene`, and the kind it is (never `Auto`):
+/// The backend `kind` asks for, prepared for `scene` rendered with `settings`, and the kind it
+/// is (never `Auto`):
 /// `Gpu` opens Vulkan device `device` (or the best usable one), with the validation layers
 /// if `validation`; `Auto` the GPU where one is usable and not itself a CPU implementation,
 /// else the CPU (saying why on stderr); `Cpu` the CPU.
 pub fn open(
     kind: Backend,
     scene: &Scene,
+    settings: &RenderSettings,
     device: Option<usize>,
     validation: bool,
 ) -> Result<(Box<dyn SampleBackend>, Backend)> {
     let gpu = match kind {
         Backend::Cpu => None,
-        Backend::Gpu => Some(open_gpu(scene, device, validation)?),
+        Backend::Gpu => Some(open_gpu(scene, settings, device, validation)?),
         Backend::Auto => match auto_prefers_cpu(device) {
             Some(reason) => {
                 eprintln!("twinpath: --backend auto: {reason}; using the CPU backend");
                 None
             }
-            None => match open_gpu(scene, device, validation) {
+            None => match open_gpu(scene, settings, device, validation) {
                 Ok(g) => Some(g),
                 Err(e) => {
                     eprintln!("twinpath: --backend auto: no usable GPU ({e:#}); using the CPU");
@@ -47,7 +50,7 @@ pub fn open(
     };
     Ok(match gpu {
         Some(g) => (g, Backend::Gpu),
-        None => (Box::new(CpuBackend::new(scene)), Backend::Cpu),
+        None => (Box::new(CpuBackend::new(scene, settings)), Backend::Cpu),
     })
 }
 
@@ -55,11 +58,12 @@ pub fn open(
 #[cfg(feature = "gpu")]
 fn open_gpu(
     scene: &Scene,
+    settings: &RenderSettings,
     device: Option<usize>,
     validation: bool,
 ) -> Result<Box<dyn SampleBackend>> {
     Ok(Box::new(crate::vulkan::GpuRenderer::new(
-        scene, device, validation,
+        scene, settings, device, validation,
     )?))
 }
 
@@ -67,6 +71,7 @@ fn open_gpu(
 #[cfg(not(feature = "gpu"))]
 fn open_gpu(
     _scene: &Scene,
+    _settings: &RenderSettings,
     _device: Option<usize>,
     _validation: bool,
 ) -> Result<Box<dyn SampleBackend>> {

@@ -72,7 +72,8 @@ pub struct BenchRow {
     pub efficiency: f64,
 }
 
-/// Runs the sweep; `progress` is told about every render.
+/// Runs the sweep over `scene` (each variant's settings replace the scene file's); `progress`
+/// is told about every render.
 pub fn run_bench(
     scene: &Scene,
     reference: &RgbImage,
@@ -96,22 +97,21 @@ pub fn run_bench(
                 let seeds = if spp <= 8 { cfg.seeds.max(1) } else { 1 };
                 let mut slowest: f64 = 0.0;
                 for k in 0..seeds {
-                    let mut s = scene.clone();
-                    s.render = variant.settings;
-                    s.render.spp = spp;
-                    s.render.seed = variant.settings.seed.wrapping_add(1 + k);
+                    let mut settings = variant.settings;
+                    settings.spp = spp;
+                    settings.seed = variant.settings.seed.wrapping_add(1 + k);
                     let opts = RenderOptions {
                         backend,
                         ..Default::default()
                     };
-                    let out = render(&s, &opts)?;
+                    let out = render(scene, &settings, &opts)?;
                     let d = diff_images(&RgbImage::from_film(&out.film), reference)?;
                     let render_s = out.render.as_secs_f64();
                     let row = BenchRow {
                         variant: variant.name.clone(),
                         backend: out.backend,
                         spp,
-                        seed: s.render.seed,
+                        seed: settings.seed,
                         setup_s: out.setup.as_secs_f64(),
                         render_s,
                         relmse: d.relmse,

@@ -9,6 +9,7 @@ use crate::cpu::Bvh;
 use crate::cpu::{BvhTracer, CpuRenderer};
 use crate::cpu::{PacketTracer, RayPacket, SmallScene, LANES};
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use glam::Vec3;
 use kernel::camera::{camera_origin, camera_ray_direction};
 use kernel::features::Dynamic;
@@ -313,10 +314,12 @@ pub struct RaySetReport {
 }
 
 /// Builds the BVH over `scene` (timed), makes the camera rays of a `width` x `height` image,
-/// their diffuse bounces and the rays of one path per pixel ([`path_rays`]), and times
+/// their diffuse bounces (seeded by `settings.seed`) and the rays of one path per pixel
+/// rendered with `settings` ([`path_rays`]), and times
 /// closest-hit and any-hit traversal of each set on one thread. With `ray_file`, also writes the rays and our hits for `scripts/embree_rays.c`.
 pub fn measure(
     scene: &Scene,
+    settings: &RenderSettings,
     width: u32,
     height: u32,
     repeats: u32,
@@ -325,11 +328,11 @@ pub fn measure(
     let start = Instant::now();
     let bvh = Bvh::build_scene(scene);
     let build_seconds = start.elapsed().as_secs_f64();
-    let renderer = CpuRenderer::with_bvh(scene, bvh);
+    let renderer = CpuRenderer::with_bvh(scene, settings, bvh);
     let bvh = &renderer.bvh;
     let camera = camera_rays(scene, width, height);
-    let bounce = bounce_rays(bvh, &camera, scene.render.seed);
-    let (path_ext, path_shadow) = path_rays(&renderer, scene, width, height);
+    let bounce = bounce_rays(bvh, &camera, settings.seed);
+    let (path_ext, path_shadow) = path_rays(&renderer, scene, settings, width, height);
     let mut sets = Vec::new();
     let mut results = Vec::new();
     for rays in [&camera, &bounce, &path_ext, &path_shadow] {
@@ -406,12 +409,19 @@ pub fn add_knot_mesh(scene: &mut Scene, n: usize) {
 }
 
 /// The rays a render traces: one path per pixel of a `width` x `height` image of `scene`
-/// (sample 0, the scene's settings, the one-path loop of `cpu`, built over `scene`), its extension rays (the camera ray
+/// (sample 0, `settings`, the one-path loop of `cpu`, built over `scene` with them), its
+/// extension rays (the camera ray
 /// first) and its shadow segments (from + t (to - from), t_max 1), each set ordered by depth,
 /// then pixel, so that sixteen consecutive rays are those of neighbouring pixels' paths at the
 /// same depth. Deeper bounces start anywhere in the scene, unlike [`bounce_rays`]'s from the
 /// camera's hits; this is the distribution the renderer's traversal meets.
-pub fn path_rays(cpu: &CpuRenderer, scene: &Scene, width: u32, height: u32) -> (RaySet, RaySet) {
+pub fn path_rays(
+    cpu: &CpuRenderer,
+    scene: &Scene,
+    settings: &RenderSettings,
+    width: u32,
+    height: u32,
+) -> (RaySet, RaySet) {
     /// A tracer that records each ray with its path's depth and pixel, then traces it.
     struct Recorder<'a> {
         inner: BvhTracer<'a>,
@@ -434,7 +444,7 @@ pub fn path_rays(cpu: &CpuRenderer, scene: &Scene, width: u32, height: u32) -> (
     let mut sized = scene.clone();
     sized.camera.width = width;
     sized.camera.height = height;
-    let params = sized.params(0, 1);
+    let params = sized.params(settings, 0, 1);
     let mut recorder = Recorder {
         inner: BvhTracer::new(&cpu.bvh),
         key: (0, 0),

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use twinpath::bench::{run_bench, write_csv, write_plot, BenchConfig, Variant};
 use twinpath::film::RgbImage;
 use twinpath::render::{install_interrupt_handler, Backend};
+use twinpath::scene::SceneFile;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum BenchBackends {
@@ -46,17 +47,17 @@ pub struct BenchArgs {
 
 pub fn run(a: BenchArgs) -> Result<()> {
     install_interrupt_handler();
-    let scene = load_scene(a.scene.as_deref())?;
+    let SceneFile { scene, settings } = load_scene(a.scene.as_deref())?;
     let reference_image = RgbImage::read(&a.reference)?;
     let variants = if a.variants.is_empty() {
         vec![Variant {
             name: "scene".into(),
-            settings: scene.render,
+            settings,
         }]
     } else {
         a.variants
             .iter()
-            .map(|v| Variant::parse(v, &scene.render))
+            .map(|v| Variant::parse(v, &settings))
             .collect::<Result<_>>()?
     };
     let backends = match a.backend {

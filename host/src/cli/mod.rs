@@ -11,7 +11,7 @@ mod render;
 use anyhow::{anyhow, Result};
 use clap::{Args, Parser, Subcommand};
 use std::path::Path;
-use twinpath::scene::{Scene, DEFAULT_SCENE_NAME};
+use twinpath::scene::{SceneFile, DEFAULT_SCENE_NAME};
 use twinpath::settings::{LightSampling, LightSelection, Mis, RenderSettings, Roulette, Sampler};
 
 #[derive(Parser)]
@@ -157,10 +157,10 @@ impl SettingFlags {
 }
 
 /// The scene file, or the built-in Cornell scene.
-pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
+pub fn load_scene(path: Option<&Path>) -> Result<SceneFile> {
     Ok(match path {
-        Some(p) => Scene::load(p)?,
-        None => Scene::builtin_default(),
+        Some(p) => SceneFile::load(p)?,
+        None => SceneFile::builtin_default(),
     })
 }
 

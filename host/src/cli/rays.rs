@@ -5,6 +5,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
+use twinpath::scene::SceneFile;
 
 /// Ray throughput of the CPU traversal on one thread (camera rays, diffuse bounce rays and the
 /// rays of one path per pixel), one ray at a time and in packets of 16 as the renderer traces
@@ -32,7 +33,10 @@ pub struct RaysArgs {
 }
 
 pub fn run(a: RaysArgs) -> Result<()> {
-    let mut scene = load_scene(a.scene.as_deref())?;
+    let SceneFile {
+        mut scene,
+        settings,
+    } = load_scene(a.scene.as_deref())?;
     if let Some(n) = a.mesh_triangles {
         twinpath::bench::rays::add_knot_mesh(&mut scene, n);
     }
@@ -41,9 +45,15 @@ pub fn run(a: RaysArgs) -> Result<()> {
     }
     let height =
         ((a.width as u64 * scene.camera.height as u64) / scene.camera.width as u64).max(1) as u32;
-    let r =
-        twinpath::bench::rays::measure(&scene, a.width, height, a.repeats, a.ray_file.as_deref())
-            .context("writing the ray file")?;
+    let r = twinpath::bench::rays::measure(
+        &scene,
+        &settings,
+        a.width,
+        height,
+        a.repeats,
+        a.ray_file.as_deref(),
+    )
+    .context("writing the ray file")?;
     println!(
         "{}: {} triangles, {} spheres; BVH build {:.3} s ({} threads), {} nodes, {:.1} MiB hierarchy + {:.1} MiB primitives",
         scene.name, r.triangles, r.spheres, r.build_seconds, rayon::current_num_threads(), r.nodes,

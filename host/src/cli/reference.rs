@@ -7,6 +7,7 @@ use clap::Args;
 use std::path::PathBuf;
 use twinpath::film::{diff_images, RgbImage};
 use twinpath::render::{install_interrupt_handler, render, Backend, RenderOptions};
+use twinpath::scene::SceneFile;
 
 /// Render a converged reference as the mean of two independent halves, and estimate its noise.
 #[derive(Args)]
@@ -27,8 +28,11 @@ pub fn run(a: ReferenceArgs) -> Result<()> {
     if a.spp < 2 {
         bail!("--spp must be at least 2 (two halves)");
     }
-    let mut scene = load_scene(a.scene.as_deref())?;
-    scene.render.spp = a.spp / 2;
+    let SceneFile {
+        scene,
+        mut settings,
+    } = load_scene(a.scene.as_deref())?;
+    settings.spp = a.spp / 2;
     let opts = RenderOptions {
         backend: a.backend,
         device: None,
@@ -36,9 +40,9 @@ pub fn run(a: ReferenceArgs) -> Result<()> {
         progress: true,
         samples: None,
     };
-    let first = render(&scene, &opts)?;
-    scene.render.seed = scene.render.seed.wrapping_add(0x9e37_79b9);
-    let second = render(&scene, &opts)?;
+    let first = render(&scene, &settings, &opts)?;
+    settings.seed = settings.seed.wrapping_add(0x9e37_79b9);
+    let second = render(&scene, &settings, &opts)?;
     if first.interrupted || second.interrupted {
         bail!("interrupted: no reference written");
     }

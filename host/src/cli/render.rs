@@ -8,7 +8,8 @@ use twinpath::film::RgbImage;
 use twinpath::part_file::{write_part, PartHeader};
 use twinpath::render::{install_interrupt_handler, render, Backend, RenderOptions, RenderOutput};
 use twinpath::sample_range::{Part, SampleRange};
-use twinpath::scene::Scene;
+use twinpath::scene::SceneFile;
+use twinpath::settings::RenderSettings;
 
 /// Render a scene (default: the built-in Cornell scene) to EXR and/or PNG.
 #[derive(Args)]
@@ -67,12 +68,15 @@ pub fn run(a: RenderArgs) -> Result<()> {
             .build_global()
             .context("cannot set the thread count")?;
     }
-    let mut scene = match (&a.scene, &a.camera) {
-        (Some(path), Some(name)) => Scene::load_with_camera(path, Some(name))?,
+    let SceneFile {
+        mut scene,
+        mut settings,
+    } = match (&a.scene, &a.camera) {
+        (Some(path), Some(name)) => SceneFile::load_with_camera(path, Some(name))?,
         (None, Some(_)) => bail!("--camera selects a glTF file's camera: give the file"),
         (path, None) => load_scene(path.as_deref())?,
     };
-    a.settings.apply(&mut scene.render)?;
+    a.settings.apply(&mut settings)?;
     scene.camera = scene
         .camera
         .resized(a.width, a.height)
@@ -83,7 +87,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         }
         check_writable(m).with_context(|| format!("--spp-map {}", m.display()))?;
     }
-    let share = PartShare::of(&a, &scene)?;
+    let share = PartShare::of(&a, &settings)?;
     let outputs = if let Some(share) = &share {
         let out = match a.out.as_slice() {
             [] => PathBuf::from(share.file_name(&scene_stem(scene.name.as_str()))),
@@ -125,7 +129,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     };
     let samples = match &share {
         Some(s) => s.describe(),
-        None => format!("{} spp", scene.render.spp),
+        None => format!("{} spp", settings.spp),
     };
     eprintln!(
         "twinpath: {} ({}x{}, {} spheres, {} triangles{instances}, {} lights), {samples}, seed {}",
@@ -135,7 +139,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         scene.spheres.len(),
         scene.triangles.len(),
         scene.lights.len(),
-        scene.render.seed
+        settings.seed
     );
     eprintln!("twinpath: scene memory: {}", scene.memory_report());
     for note in &scene.notes {
@@ -148,13 +152,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
         progress: !a.quiet,
         samples: share.as_ref().map(|s| s.samples),
     };
-    let result = render(&scene, &opts)?;
+    let result = render(&scene, &settings, &opts)?;
     log_costs(&result, a.backend);
     if result.interrupted {
         eprintln!(
             "twinpath: interrupted: writing the image so far, {} of {} samples per pixel",
             result.spp_done,
-            opts.samples.map_or(scene.render.spp, |s| s.len())
+            opts.samples.map_or(settings.spp, |s| s.len())
         );
     }
     if let Some(share) = &share {
@@ -162,8 +166,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
             Backend::Gpu => "gpu",
             _ => "cpu",
         };
-        let mut header = PartHeader::new(&scene, backend, result.samples);
-        header.part = share.part.map(|p| (p, SampleRange::all(scene.render.spp)));
+        let mut header = PartHeader::new(&scene, &settings, backend, result.samples);
+        header.part = share.part.map(|p| (p, SampleRange::all(settings.spp)));
         write_part(&outputs[0], &header, &result.film)?;
         eprintln!(
             "twinpath: wrote part file {} (samples {})",
@@ -177,7 +181,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         image.write(o)?;
         eprintln!("twinpath: wrote {}", o.display());
     }
-    write_sample_counts(&scene, &result, a.spp_map.as_ref())
+    write_sample_counts(&settings, &result, a.spp_map.as_ref())
 }
 
 /// The samples of a render split into parts: `--part I/N` or `--samples A..B`.
@@ -188,11 +192,11 @@ struct PartShare {
 
 impl PartShare {
     /// The share the flags ask for (`None`: the whole render).
-    fn of(a: &RenderArgs, scene: &Scene) -> Result<Option<Self>> {
+    fn of(a: &RenderArgs, settings: &RenderSettings) -> Result<Option<Self>> {
         Ok(Some(match (&a.part, &a.samples) {
             (Some(text), _) => {
                 let part = Part::parse(text).with_context(|| format!("--part {text}"))?;
-                let spp = scene.render.spp;
+                let spp = settings.spp;
                 if part.count > spp {
                     bail!(
                         "--part {text}: {} parts of {spp} samples per pixel would leave parts empty",
@@ -283,16 +287,16 @@ fn log_costs(result: &RenderOutput, asked: Backend) {
 
 /// Adaptive sampling's summary, and the sample-count image if asked for.
 fn write_sample_counts(
-    scene: &Scene,
+    settings: &RenderSettings,
     result: &RenderOutput,
     spp_map: Option<&PathBuf>,
 ) -> Result<()> {
     let spp = result.film.samples_per_pixel();
-    if scene.render.adaptive() {
+    if settings.adaptive() {
         let mean = spp.iter().map(|&c| c as f64).sum::<f64>() / spp.len().max(1) as f64;
         eprintln!(
             "twinpath: adaptive sampling (target {}): {mean:.1} samples per pixel on average, {} of {} pixels stopped early",
-            scene.render.adaptive_target,
+            settings.adaptive_target,
             spp.iter().filter(|&&c| c < result.spp_done).count(),
             spp.len()
         );

@@ -5,6 +5,7 @@ use super::CpuRenderer;
 use crate::backend::{RayCounts, SampleBackend};
 use crate::film::Film;
 use crate::scene::{Scene, ADAPTIVE_PASS};
+use crate::settings::RenderSettings;
 use anyhow::Result;
 use indicatif::ProgressBar;
 use kernel::scene::RenderParams;
@@ -22,14 +23,15 @@ pub struct CpuBackend {
 }
 
 impl CpuBackend {
-    pub fn new(scene: &Scene) -> Self {
+    /// The CPU backend for `scene` rendered with `settings`.
+    pub fn new(scene: &Scene, settings: &RenderSettings) -> Self {
         let t = Instant::now();
-        let renderer = CpuRenderer::new(scene);
+        let renderer = CpuRenderer::new(scene, settings);
         Self {
             renderer,
             film: Film::new(scene.camera.width, scene.camera.height),
             build_time: t.elapsed(),
-            adaptive: scene.render.adaptive(),
+            adaptive: settings.adaptive(),
             rays: RayCounts::default(),
         }
     }

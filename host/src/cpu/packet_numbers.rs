@@ -1,7 +1,7 @@
 //! The random numbers of sixteen sample streams at once: the kernel's samplers (`kernel::rng`,
 //! `kernel::sobol`, written over `kernel::word::Word`) run on SIMD lanes, one stream per lane,
 //! at the dimensions each lane asks for. Each lane computes exactly what `SampleRng` gives at
-//! that dimension (computing them one at a time cost 18% of a Cornell render).
+//! that dimension (one at a time they were a large share of a render: docs/performance.md).
 
 use super::packet::LANES;
 use super::simd::widest_simd;

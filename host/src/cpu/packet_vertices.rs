@@ -6,7 +6,8 @@
 //! other sample (area sampling, a receiver inside its light) is left to the vertex, which
 //! computes it from the numbers with the scalar sampler. Each lane's numbers are exactly what
 //! `VertexSamples::draw` gives, and each sample given exactly what the vertex would compute
-//! (one at a time, a chain of divisions and square roots, they cost 20% of a Cornell render).
+//! (one at a time, a chain of divisions and square roots, they were a large share of a render:
+//! docs/performance.md).
 
 use super::packet::LANES;
 use super::packet_numbers::NumberRequests;

@@ -3,13 +3,14 @@
 //! scene's feature bits as a const generic (one monomorphised path per common combination).
 
 use super::bvh::Bvh;
+use super::bvh_tracer::BvhTracer;
 use super::packet::SmallScene;
 use super::packet_paths::tile_by_packets;
 use super::tile::{TileSums, TILE};
-use super::BvhTracer;
 use crate::backend::RayCounts;
 use crate::film::{Film, PixelSums};
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use glam::Vec3;
 use indicatif::ProgressBar;
 use kernel::features::{self, Dynamic, FeatureSet, Static};
@@ -114,16 +115,16 @@ fn with_all_extended(bits: u32) -> u32 {
 impl CpuRenderer {
     /// Builds the BVH over the scene's spheres, triangles and instances (and, for a small
     /// scene without instances, the packets' copy of its primitives), and picks the
-    /// [`TileStrategy`].
-    pub fn new(scene: &Scene) -> Self {
-        Self::with_bvh(scene, Bvh::build_scene(scene))
+    /// [`TileStrategy`] for `settings`.
+    pub fn new(scene: &Scene, settings: &RenderSettings) -> Self {
+        Self::with_bvh(scene, settings, Bvh::build_scene(scene))
     }
 
     /// [`Self::new`] over `bvh`, already built over `scene` by [`Bvh::build_scene`] (for
     /// `bench::rays`, which times the build apart).
-    pub fn with_bvh(scene: &Scene, bvh: Bvh) -> Self {
+    pub fn with_bvh(scene: &Scene, settings: &RenderSettings, bvh: Bvh) -> Self {
         // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).
-        let tiles = if !(scene.render.packets && scene.instances.is_empty()) {
+        let tiles = if !(settings.packets && scene.instances.is_empty()) {
             TileStrategy::OnePath
         } else if let Some(small) = SmallScene::if_small(&bvh.spheres, &bvh.triangles) {
             TileStrategy::Packets(small)
@@ -133,11 +134,11 @@ impl CpuRenderer {
         Self {
             bvh,
             materials: scene.materials.clone(),
-            lights: scene.light_table(),
+            lights: scene.light_table(settings),
             environment: scene.environment_table(),
             shading: scene.shading_table(),
             textures: scene.textures.words.clone(),
-            features: with_all_extended(scene.features()),
+            features: with_all_extended(scene.features(settings)),
             tiles,
         }
     }
@@ -249,7 +250,7 @@ impl CpuRenderer {
     where
         T: Fn(&mut dyn Iterator<Item = (u32, u32)>, &Film) -> TileSums + Sync,
     {
-        let (w, h) = (params.width, params.height);
+        let (w, h) = (params.samples.width, params.samples.height);
         let tile_pixels = move |tx: u32, ty: u32| {
             (ty * TILE..((ty + 1) * TILE).min(h))
                 .flat_map(move |py| (tx * TILE..((tx + 1) * TILE).min(w)).map(move |px| (px, py)))

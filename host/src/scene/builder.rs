@@ -4,14 +4,13 @@
 
 use super::environment::EnvironmentMap;
 use super::instancing::{instance_box, instance_record, instances_box, mesh_box, MAX_INSTANCES};
-use super::light_table::{assign_light_selection, place_directional_lights, triangle_light};
+use super::light_table::{place_directional_lights, triangle_light};
 use super::limits::MAX_COORDINATE;
 use super::soup::TriangleSoup;
 use super::tangents::face_tangent;
 use super::textures::TextureTable;
 use super::transform::Transform;
 use super::{CameraDesc, Scene, TriangleGroup};
-use crate::settings::RenderSettings;
 use bytemuck::Zeroable;
 use glam::Vec3;
 use kernel::scene::{
@@ -308,14 +307,13 @@ impl SceneTables {
         Ok(())
     }
 
-    /// The scene: the tables with the environment map's light last and the light selection
-    /// assigned for `render.light_selection`; the instanced meshes' triangles follow the
-    /// world-space ones in the triangle table.
+    /// The scene: the tables with the environment map's light last (the light selection is
+    /// the settings', assigned by `Scene::light_table`); the instanced meshes' triangles follow
+    /// the world-space ones in the triangle table.
     pub fn finish(
         mut self,
         name: String,
         camera: CameraDesc,
-        render: RenderSettings,
         background: Vec3,
         environment: Option<EnvironmentMap>,
     ) -> Scene {
@@ -334,11 +332,9 @@ impl SceneTables {
             let light = map.light(&self.spheres, world_triangles, instanced);
             self.lights.push(light);
         }
-        assign_light_selection(&mut self.lights, render.light_selection.code());
         Scene {
             name,
             camera,
-            render,
             background,
             materials: self.materials,
             material_names: self.material_names,

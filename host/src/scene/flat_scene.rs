@@ -1,7 +1,9 @@
 //! The scene every format's load produces: the kernel's flat tables (materials, spheres,
-//! triangles, instances, lights, shading records, textures, the environment map), the camera
-//! and the render settings, and what the backends derive from them (the launch parameters, the
-//! feature bits, the light table with its selection probabilities).
+//! triangles, instances, lights, shading records, textures, the environment map) and the
+//! camera, and what the backends derive from them with the render settings they are handed
+//! (the launch parameters, the feature bits, the light table with its selection
+//! probabilities). The settings are not part of the scene: a file's `[render]` table is read
+//! beside it (`super::SceneFile`).
 
 use super::environment;
 use super::inputs;
@@ -12,7 +14,8 @@ use super::textures;
 use crate::settings::RenderSettings;
 use glam::Vec3;
 use kernel::scene::{
-    Camera, Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle,
+    AdaptiveParams, Camera, EnvironmentParams, Instance, IntegratorParams, Light, Material,
+    RenderParams, SampleParams, ShadingTriangle, Sphere, Triangle,
 };
 use std::ops::Range;
 
@@ -112,7 +115,6 @@ pub struct Scene {
     /// Where it came from (a file path, or the built-in scene's name).
     pub name: String,
     pub camera: CameraDesc,
-    pub render: RenderSettings,
     pub background: Vec3,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
@@ -127,6 +129,8 @@ pub struct Scene {
     /// The placements of instanced meshes (`instancing`), and the mesh each places.
     pub instances: Vec<Instance>,
     pub instance_meshes: Vec<u32>,
+    /// The lights, their selection fields unset (`select_pmf`, `alias_threshold`, `alias`):
+    /// [`Scene::light_table`] fills them for the settings' selection policy.
     pub lights: Vec<Light>,
     /// The environment map, if `[background] map` names one (its light is the last entry of
     /// `lights`).
@@ -143,47 +147,58 @@ pub struct Scene {
     pub inputs: Vec<inputs::InputFile>,
 }
 
+/// What a scene file gives: the scene, and the render settings its `[render]` table sets over
+/// the defaults (a glTF file: the defaults). The two travel apart from here on: the settings
+/// are handed to the backend beside the scene, never read out of it.
+#[derive(Clone, Debug)]
+pub struct SceneFile {
+    pub scene: Scene,
+    pub settings: RenderSettings,
+}
+
 impl Scene {
-    /// The kernel parameters for a launch of `samples_per_launch` samples starting at sample
-    /// index `sample_offset`.
-    pub fn params(&self, sample_offset: u32, samples_per_launch: u32) -> RenderParams {
-        let r = &self.render;
+    /// The kernel parameters for a launch of `count` samples per pixel starting at sample
+    /// index `first`, rendered with settings `r`.
+    pub fn params(&self, r: &RenderSettings, first: u32, count: u32) -> RenderParams {
+        let map = self.environment.as_ref();
+        let rotation = map.map_or(0.0, |m| m.rotation_degrees).to_radians();
         RenderParams {
             camera: self.camera.to_kernel(),
-            background: [self.background.x, self.background.y, self.background.z, 0.0],
-            width: self.camera.width,
-            height: self.camera.height,
-            seed: r.seed,
-            sample_offset,
-            samples_per_launch,
-            light_count: self.lights.len() as u32,
-            rr_mode: r.roulette.code(),
-            rr_probability: r.rr_probability,
-            rr_start_depth: r.roulette_start_depth(),
-            mis_mode: r.mis.code(),
-            max_depth: r.max_depth,
-            light_sampling: r.light_sampling.code(),
-            adaptive_target: r.adaptive_target,
-            pilot_period: if r.adaptive() { PILOT_PERIOD } else { 0 },
-            min_pilot_samples: MIN_PILOT_SAMPLES,
-            sampler: r.sampler.code(),
-            env_width: self.environment.as_ref().map_or(0, |m| m.width),
-            env_height: self.environment.as_ref().map_or(0, |m| m.height),
-            env_light: if self.environment.is_some() {
-                self.lights.len() as u32 - 1
-            } else {
-                kernel::scene::NONE
+            samples: SampleParams {
+                width: self.camera.width,
+                height: self.camera.height,
+                seed: r.seed,
+                first,
+                count,
+                sampler: r.sampler.code(),
             },
-            env_scale: self.environment.as_ref().map_or(1.0, |m| m.scale),
-            env_rotation: {
-                let a = self
-                    .environment
-                    .as_ref()
-                    .map_or(0.0, |m| m.rotation_degrees)
-                    .to_radians();
-                [a.cos(), a.sin()]
+            integrator: IntegratorParams {
+                light_count: self.lights.len() as u32,
+                rr_mode: r.roulette.code(),
+                rr_probability: r.rr_probability,
+                rr_start_depth: r.roulette_start_depth(),
+                mis_mode: r.mis.code(),
+                max_depth: r.max_depth,
+                light_sampling: r.light_sampling.code(),
             },
-            _pad: [0; 2],
+            adaptive: AdaptiveParams {
+                target: r.adaptive_target,
+                pilot_period: if r.adaptive() { PILOT_PERIOD } else { 0 },
+                min_pilot_samples: MIN_PILOT_SAMPLES,
+            },
+            environment: EnvironmentParams {
+                background: [self.background.x, self.background.y, self.background.z, 0.0],
+                width: map.map_or(0, |m| m.width),
+                height: map.map_or(0, |m| m.height),
+                light: if map.is_some() {
+                    self.lights.len() as u32 - 1
+                } else {
+                    kernel::scene::NONE
+                },
+                scale: map.map_or(1.0, |m| m.scale),
+                rotation: [rotation.cos(), rotation.sin()],
+                _pad: [0; 2],
+            },
         }
     }
 
@@ -210,8 +225,8 @@ impl Scene {
         bindable(&self.instances)
     }
 
-    /// Replaces the environment map (and its light, the last entry of `lights`), keeping the
-    /// light selection up to date: scenes built in code (tests) give maps this way.
+    /// Replaces the environment map (and its light, the last entry of `lights`): scenes built
+    /// in code (tests) give maps this way.
     pub fn set_environment(&mut self, map: Option<environment::EnvironmentMap>) {
         if self.environment.take().is_some() {
             self.lights.pop();
@@ -222,7 +237,6 @@ impl Scene {
             self.lights.push(light);
         }
         self.environment = map;
-        light_table::assign_light_selection(&mut self.lights, self.render.light_selection.code());
     }
 
     /// The environment table (`kernel::environment`): the map's texels and CDFs, or one zero
@@ -292,11 +306,11 @@ impl Scene {
         format!("{} in all: {}", size(total), parts.join(", "))
     }
 
-    /// The kernel's feature bits for this scene and its settings (`kernel::features`; 0 with
-    /// `specialize` off, the generic path).
-    pub fn features(&self) -> u32 {
-        if self.render.specialize {
-            kernel::features::scene_features(&self.params(0, 1))
+    /// The kernel's feature bits for this scene rendered with `settings` (`kernel::features`;
+    /// 0 with `specialize` off, the generic path).
+    pub fn features(&self, settings: &RenderSettings) -> u32 {
+        if settings.specialize {
+            kernel::features::scene_features(&self.params(settings, 0, 1))
                 | kernel::bsdf::material_features(&self.materials)
                 | kernel::light::light_features(&self.lights)
                 | kernel::features::surface_features(&self.materials, &self.shading)
@@ -310,10 +324,11 @@ impl Scene {
         }
     }
 
-    /// The light table with selection probabilities for `render.light_selection`.
-    pub fn light_table(&self) -> Vec<Light> {
+    /// The light table as the kernel reads it: [`Scene::lights`] with the selection
+    /// probabilities of `settings.light_selection`.
+    pub fn light_table(&self, settings: &RenderSettings) -> Vec<Light> {
         let mut lights = self.lights.clone();
-        light_table::assign_light_selection(&mut lights, self.render.light_selection.code());
+        light_table::assign_light_selection(&mut lights, settings.light_selection.code());
         lights
     }
 

@@ -1,5 +1,6 @@
-//! Runs the kernel's `shaders::probe` compute entry point over buffers of records, so tests
-//! can compare every kernel function between the GPU and the CPU on the same inputs.
+//! Runs the tests' module's `shaders::probe` compute entry point (`crate::PROBE_SPV`) over
+//! buffers of records, so tests can compare every kernel function between the GPU and the CPU
+//! on the same inputs. Test support only (feature `test-support`): the renderer has no probes.
 
 use super::device::Context;
 use super::pipeline::shader_module;
@@ -21,7 +22,7 @@ pub struct ProbeRunner {
 
 impl ProbeRunner {
     pub fn new(ctx: &Context) -> Result<ProbeRunner> {
-        let module = shader_module(ctx, crate::KERNEL_SPV)?;
+        let module = shader_module(ctx, crate::PROBE_SPV)?;
         let bindings = [0, 1].map(|b| {
             vk::DescriptorSetLayoutBinding::default()
                 .binding(b)

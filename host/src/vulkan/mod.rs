@@ -2,6 +2,7 @@
 //! `vkCmdTraceRaysKHR`, accumulating progressively in float storage images.
 
 pub mod accel;
+#[cfg(feature = "test-support")]
 pub mod compute;
 pub mod device;
 pub mod limits;
@@ -12,6 +13,7 @@ use crate::backend::SampleBackend;
 use crate::film::Film;
 use crate::fixed_sum::FixedSum;
 use crate::scene::{Scene, ADAPTIVE_PASS};
+use crate::settings::RenderSettings;
 use accel::SceneAccel;
 use anyhow::{Context as _, Result};
 use ash::vk;
@@ -57,13 +59,19 @@ struct Resources {
 const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
 
 impl GpuRenderer {
-    /// Opens a device (see [`Context::new`]) and uploads `scene`.
-    pub fn new(scene: &Scene, device: Option<usize>, validation: bool) -> Result<GpuRenderer> {
+    /// Opens a device (see [`Context::new`]) and uploads `scene`, to be rendered with
+    /// `settings`.
+    pub fn new(
+        scene: &Scene,
+        settings: &RenderSettings,
+        device: Option<usize>,
+        validation: bool,
+    ) -> Result<GpuRenderer> {
         let ctx = Context::new(device, validation)?;
         limits::check_scene_fits(scene, &ctx.limits)?;
         let (w, h) = (scene.camera.width, scene.camera.height);
-        let features = scene.features();
-        let hit_groups = if scene.render.specialize {
+        let features = scene.features(settings);
+        let hit_groups = if settings.specialize {
             HitGroups {
                 triangles: scene.world_triangle_count() > 0,
                 spheres: !scene.spheres.is_empty(),
@@ -90,7 +98,7 @@ impl GpuRenderer {
             ctx.upload_buffer("materials", bytemuck::cast_slice(&scene.materials), STORAGE)?,
             ctx.upload_buffer(
                 "lights",
-                bytemuck::cast_slice(&scene.light_table()),
+                bytemuck::cast_slice(&scene.light_table(settings)),
                 STORAGE,
             )?,
             ctx.upload_buffer("triangles", bytemuck::cast_slice(&scene.triangles), STORAGE)?,
@@ -223,7 +231,7 @@ impl GpuRenderer {
             pipeline_time,
             width: w,
             height: h,
-            adaptive: scene.render.adaptive(),
+            adaptive: settings.adaptive(),
             ctx,
         })
     }
@@ -232,8 +240,8 @@ impl GpuRenderer {
         self.resources.as_ref().expect("resources live until drop")
     }
 
-    /// One dispatch: `params.samples_per_launch` samples per pixel starting at
-    /// `params.sample_offset`, added to the accumulation images.
+    /// One dispatch: `params.samples.count` samples per pixel starting at
+    /// `params.samples.first`, added to the accumulation images.
     pub fn dispatch(&mut self, params: &RenderParams) -> Result<()> {
         let (w, h) = (self.width, self.height);
         let res = self.resources.as_mut().expect("resources live until drop");

@@ -294,7 +294,7 @@ impl Bvh {
 
     /// Starts loading the node or first triangle block of reference `r` into the cache: a
     /// pushed child is usually popped soon, and incoherent rays on large meshes wait on memory
-    /// (measured on the 1M-triangle mesh: 10-19% more closest-hit rays per second).
+    /// (its effect is measured in docs/performance.md).
     #[inline(always)]
     pub(in crate::cpu) fn prefetch(&self, r: u32) {
         #[cfg(target_arch = "x86_64")]

@@ -1,11 +1,16 @@
 //! A glTF node's perspective camera, and the camera that frames a file without one.
 
-use super::{Import, IMAGE_HEIGHT, IMAGE_WIDTH};
+use super::import::Import;
 use crate::scene::builder::SceneTables;
 use crate::scene::instancing::instances_box;
 use crate::scene::limits::MAX_IMAGE_SIDE;
 use crate::scene::{CameraDesc, SceneError};
 use glam::{DMat4, DVec4, Vec3};
+
+/// Image height of a scene whose glTF camera gives an aspect ratio (width follows from it), and
+/// the 1280 x 720 of one that gives none.
+pub const IMAGE_HEIGHT: u32 = 720;
+pub const IMAGE_WIDTH: u32 = 1280;
 
 /// A perspective camera of the file, placed by its node.
 #[derive(Clone, Debug)]

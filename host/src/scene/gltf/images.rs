@@ -1,7 +1,7 @@
 //! A glTF image (in a buffer view, a data URI or a file beside the scene) decoded into the
 //! texture table.
 
-use super::Import;
+use super::import::Import;
 use crate::scene::textures::TextureUse;
 use crate::scene::SceneError;
 use std::path::PathBuf;

@@ -1,6 +1,6 @@
 //! A glTF node's `KHR_lights_punctual` light: point, spot or directional, in twinpath's units.
 
-use super::Import;
+use super::import::Import;
 use crate::scene::SceneError;
 use glam::{DMat4, DVec4, Vec3};
 

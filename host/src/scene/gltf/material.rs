@@ -3,7 +3,7 @@
 //! `KHR_materials_transmission` with `KHR_materials_ior` as the dielectric. What is approximated
 //! or ignored is noted (`Scene::notes`); docs/gltf.md lists it.
 
-use super::Import;
+use super::import::Import;
 use crate::scene::limits::IOR_RANGE;
 use crate::scene::textures::TextureUse;
 use crate::scene::SceneError;

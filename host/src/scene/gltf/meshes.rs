@@ -2,7 +2,7 @@
 //! space, or stored once and instanced where several nodes use it), with their materials.
 
 use super::accessor::{read_floats, read_indices, read_uv};
-use super::{Import, MAX_TRIANGLES};
+use super::import::{Import, MAX_TRIANGLES};
 use crate::scene::closed_surface::check_closed_outward;
 use crate::scene::instancing::INSTANCE_MIN_TRIANGLES;
 use crate::scene::soup::TriangleSoup;

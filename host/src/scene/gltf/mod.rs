@@ -9,13 +9,16 @@
 mod accessor;
 mod camera;
 mod images;
+mod import;
 mod lights;
 mod material;
 mod meshes;
 
-pub use camera::GltfCamera;
+pub use camera::{GltfCamera, IMAGE_HEIGHT, IMAGE_WIDTH};
+pub use import::MAX_TRIANGLES;
 
 use camera::framing_camera;
+use import::Import;
 use meshes::declared_triangles;
 
 use super::builder::SceneTables;
@@ -23,14 +26,9 @@ use super::inputs;
 use super::instancing::INSTANCE_MIN_TRIANGLES;
 use super::transform::Transform;
 use super::{Scene, SceneError};
-use crate::settings::RenderSettings;
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
-
-/// Most triangles a scene may flatten its glTF meshes into (48 bytes each on either backend,
-/// 3 GiB): a file that instances a large mesh many times is refused before it is expanded.
-pub const MAX_TRIANGLES: usize = 1 << 26;
+use std::path::Path;
 
 /// The extensions read (docs/gltf.md); any other a file uses is noted, and one it requires is
 /// an error.
@@ -40,30 +38,6 @@ pub const SUPPORTED_EXTENSIONS: [&str; 4] = [
     "KHR_materials_ior",
     "KHR_lights_punctual",
 ];
-
-/// Image height of a scene whose glTF camera gives an aspect ratio (width follows from it), and
-/// the 1280 x 720 of one that gives none.
-pub const IMAGE_HEIGHT: u32 = 720;
-pub const IMAGE_WIDTH: u32 = 1280;
-
-/// One glTF file being read into `tables`.
-pub(super) struct Import<'a> {
-    path: PathBuf,
-    /// Where external images are read from (none: refused).
-    base: Option<PathBuf>,
-    document: gltf::Document,
-    buffers: Vec<gltf::buffer::Data>,
-    tables: &'a mut SceneTables,
-    notes: &'a mut Vec<String>,
-    /// Kernel material of each glTF material index (`None`: the default material).
-    materials: HashMap<Option<usize>, u32>,
-    /// How many nodes of the scene use each mesh (by glTF index).
-    mesh_uses: HashMap<usize, usize>,
-    /// [`Import::instanceable`]'s answer for each mesh asked about (asked once per node).
-    instanceable: HashMap<usize, bool>,
-    /// The instanced mesh (`SceneTables::begin_instanced_mesh`) of each glTF mesh stored once.
-    instanced: HashMap<usize, u32>,
-}
 
 /// Reads the document and its buffers (external ones relative to `base`, refused without
 /// one), checks the extensions it requires, notes those it uses that are not read.
@@ -145,7 +119,7 @@ fn parse_document(
 }
 
 /// Loads glTF file `path` as a whole scene: its default scene's meshes under a uniform white
-/// sky, default render settings, seen through the perspective camera named `camera` (default:
+/// sky, seen through the perspective camera named `camera` (default:
 /// the first; without any, a camera framing the scene).
 pub fn load(path: &Path, camera: Option<&str>) -> Result<Scene, SceneError> {
     let bytes = inputs::read(path)
@@ -201,13 +175,7 @@ pub fn load_bytes(
             }
         },
     };
-    let mut scene = tables.finish(
-        path.display().to_string(),
-        desc,
-        RenderSettings::default(),
-        Vec3::ONE,
-        None,
-    );
+    let mut scene = tables.finish(path.display().to_string(), desc, Vec3::ONE, None);
     scene.notes = notes;
     Ok(scene)
 }
@@ -281,14 +249,6 @@ fn local_matrix(path: &Path, node: &gltf::Node) -> Result<DMat4, SceneError> {
 }
 
 impl Import<'_> {
-    /// Records `note` once.
-    fn note(&mut self, note: String) {
-        let note = format!("{}: {note}", self.path.display());
-        if !self.notes.contains(&note) {
-            self.notes.push(note);
-        }
-    }
-
     /// Walks the default scene's node forest (every root node when the file has no scene)
     /// under `root`, adding each mesh instance; the perspective cameras.
     fn walk(&mut self, root: DMat4) -> Result<Vec<GltfCamera>, SceneError> {

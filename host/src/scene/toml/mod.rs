@@ -19,7 +19,7 @@ pub use materials::METALS;
 
 use super::builder::SceneTables;
 use super::error::{line_of, SceneError};
-use super::Scene;
+use super::flat_scene::SceneFile;
 use checker::Checker;
 use glam::Vec3;
 use serde::Deserialize;
@@ -34,7 +34,7 @@ pub const DEFAULT_SCENE_NAME: &str = "cornell.toml";
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct SceneFile {
+struct TomlScene {
     camera: Spanned<camera::CameraFile>,
     /// Settings by name (`crate::settings`), each value with its place in the file.
     #[serde(default)]
@@ -57,8 +57,8 @@ struct SceneFile {
 
 /// Parses and validates scene text; `path` names the file in errors and anchors the paths of
 /// the files it names (meshes, textures, glTF files, maps).
-pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
-    let file: SceneFile = toml::from_str(text).map_err(|e| {
+pub fn parse_scene(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+    let file: TomlScene = toml::from_str(text).map_err(|e| {
         let line = e.span().map(|s| line_of(text, s.start));
         let field = "syntax";
         SceneError::new(path, line, field, e.message().trim().to_string())
@@ -66,7 +66,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let ck = Checker { path, text };
     let base_dir = path.parent().unwrap_or(Path::new("."));
     let camera = camera::camera(&ck, &file.camera)?;
-    let render = settings::render_settings(&ck, &file.render)?;
+    let settings = settings::render_settings(&ck, &file.render)?;
     let mut tables = SceneTables::default();
     materials::add_materials(&ck, &file.materials, base_dir, &mut tables)?;
     shapes::add_spheres(&ck, &file.sphere, &mut tables)?;
@@ -78,13 +78,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
         Some(b) => background::background(&ck, b, base_dir)?,
         None => (Vec3::ZERO, None),
     };
-    let mut scene = tables.finish(
-        path.display().to_string(),
-        camera,
-        render,
-        background,
-        environment,
-    );
+    let mut scene = tables.finish(path.display().to_string(), camera, background, environment);
     scene.notes = notes;
-    Ok(scene)
+    Ok(SceneFile { scene, settings })
 }
