@@ -23,28 +23,20 @@ struct CrateFiles {
 impl CrateFiles {
     fn read(src: &Path) -> CrateFiles {
         let mut files = BTreeMap::new();
-        let mut stack = vec![src.to_path_buf()];
-        while let Some(dir) = stack.pop() {
-            for entry in std::fs::read_dir(&dir).unwrap() {
-                let p = entry.unwrap().path();
-                if p.is_dir() {
-                    stack.push(p);
-                } else if p.extension().is_some_and(|e| e == "rs") {
-                    let rel = p.strip_prefix(src).unwrap();
-                    let mut module: Vec<String> = rel
-                        .iter()
-                        .map(|s| s.to_str().unwrap().trim_end_matches(".rs").to_string())
-                        .collect();
-                    if matches!(
-                        module.last().map(String::as_str),
-                        Some("mod" | "lib" | "main")
-                    ) {
-                        module.pop();
-                    }
-                    let text = std::fs::read_to_string(&p).unwrap();
-                    files.insert(module, without_tests_and_comments(&text));
-                }
+        for p in rust_files(src) {
+            let rel = p.strip_prefix(src).unwrap();
+            let mut module: Vec<String> = rel
+                .iter()
+                .map(|s| s.to_str().unwrap().trim_end_matches(".rs").to_string())
+                .collect();
+            if matches!(
+                module.last().map(String::as_str),
+                Some("mod" | "lib" | "main")
+            ) {
+                module.pop();
             }
+            let text = std::fs::read_to_string(&p).unwrap();
+            files.insert(module, without_tests_and_comments(&text));
         }
         CrateFiles { files }
     }
@@ -320,6 +312,23 @@ fn circles(graph: &Graph) -> Vec<Vec<String>> {
     s.found
 }
 
+/// Every `.rs` file below `dir`.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let p = entry.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|e| e == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
 fn src(dir: &str) -> PathBuf {
     twinpath_tests::repo_root().join(dir)
 }
@@ -392,21 +401,15 @@ fn the_circle_finder_finds_a_circle() {
 
 #[test]
 fn no_host_file_over_600_lines() {
-    let mut long = Vec::new();
-    let mut stack = vec![src("host/src")];
-    while let Some(dir) = stack.pop() {
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let p = entry.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|e| e == "rs") {
-                let lines = std::fs::read_to_string(&p).unwrap().lines().count();
-                if lines > 600 {
-                    long.push(format!("{} ({lines} lines)", p.display()));
-                }
-            }
-        }
-    }
+    let files = rust_files(&src("host/src"));
+    assert!(files.len() > 20, "too few files seen");
+    let long: Vec<String> = files
+        .iter()
+        .filter_map(|p| {
+            let lines = std::fs::read_to_string(p).unwrap().lines().count();
+            (lines > 600).then(|| format!("{} ({lines} lines)", p.display()))
+        })
+        .collect();
     assert!(long.is_empty(), "files over 600 lines: {long:?}");
 }
 
