@@ -781,6 +781,106 @@ fn toml_includes_a_gltf_file_under_a_transform() {
 }
 
 #[test]
+fn a_toml_scene_renders_through_its_gltf_files_camera() {
+    let dir = temp_dir("toml_camera");
+    let path = camera_file(&dir);
+    let main = SceneFile::load_with_camera(&path, Some("main")).unwrap();
+    let side = SceneFile::load_with_camera(&path, Some("side")).unwrap();
+    let include = |camera: &str, transform: &str| {
+        twinpath::scene::parse_scene(
+            &format!("[camera]\n{camera}\n[[gltf]]\nfile = \"camera.glb\"\n{transform}"),
+            &dir.join("x.toml"),
+        )
+    };
+    // Without a transform: exactly the file's camera.
+    let same = include("gltf = \"main\"", "").unwrap();
+    assert_eq!(same.scene.camera, main.scene.camera);
+    // Under the include's transform: moved with the meshes, the view unchanged otherwise.
+    let moved = include("gltf = \"main\"", "translate = [1, 2, 3]\n").unwrap();
+    let d = Vec3::new(1.0, 2.0, 3.0);
+    let (a, b) = (moved.scene.camera, main.scene.camera);
+    assert!((a.eye - (b.eye + d)).length() < 1e-5, "{a:?} vs {b:?}");
+    assert!(
+        (a.look_at - (b.look_at + d)).length() < 1e-5,
+        "{a:?} vs {b:?}"
+    );
+    assert!((a.up - b.up).length() < 1e-6 && a.vfov_degrees == b.vfov_degrees);
+    // The table's size (one side alone keeps the aspect ratio, 1.5 here) and lens.
+    let sized = include(
+        "gltf = \"main\"\nwidth = 300\naperture = 0.1\nfocus_distance = 2",
+        "",
+    )
+    .unwrap();
+    let c = sized.scene.camera;
+    assert_eq!(
+        (c.width, c.height, c.aperture, c.focus_distance),
+        (300, 200, 0.1, 2.0)
+    );
+    assert_eq!((c.eye, c.vfov_degrees), (b.eye, b.vfov_degrees));
+    // --camera on a TOML scene: the named camera as its file states it, replacing [camera].
+    let toml_path = dir.join("with_camera.toml");
+    std::fs::write(
+        &toml_path,
+        format!("{CAMERA}[[gltf]]\nfile = \"camera.glb\"\n"),
+    )
+    .unwrap();
+    let by_flag = SceneFile::load_with_camera(&toml_path, Some("side")).unwrap();
+    assert_eq!(by_flag.scene.camera, side.scene.camera);
+    assert_eq!(SceneFile::load(&toml_path).unwrap().scene.camera.width, 24);
+    // Errors name the field (and line) and list the cameras there are.
+    let errors = [
+        (
+            "gltf = \"nope\"",
+            "x.toml:2: camera.gltf: no perspective camera named 'nope'",
+        ),
+        (
+            "gltf = \"main\"\neye = [0, 0, 1]",
+            "x.toml:3: camera.eye: not with camera.gltf",
+        ),
+        (
+            "gltf = \"main\"\naperture = 0.1",
+            "camera.focus_distance: missing",
+        ),
+        (
+            "eye = [0, 0, 1]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 8",
+            "camera.height: missing",
+        ),
+        (
+            "gltf = \"main\"\nheight = 0",
+            "x.toml:3: camera.height: 0 is outside",
+        ),
+    ];
+    for (camera, want) in errors {
+        let e = include(camera, "").unwrap_err().to_string();
+        assert!(e.contains(want), "{camera}: {e}");
+    }
+    let e = include("gltf = \"nope\"", "").unwrap_err().to_string();
+    assert!(e.contains("'main' (") && e.contains("'side' ("), "{e}");
+    let e = SceneFile::load_with_camera(&toml_path, Some("nope"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("camera: no perspective camera named 'nope'") && e.contains("'main'"),
+        "{e}"
+    );
+    // The image: the TOML scene under the glTF file's white sky renders through the included
+    // camera exactly what the file alone renders through its own.
+    let through = include(
+        "gltf = \"main\"\nwidth = 24\n[background]\nradiance = [1, 1, 1]",
+        "",
+    )
+    .unwrap();
+    let mut alone = main.clone();
+    alone.scene.camera = alone.scene.camera.resized(Some(24), None).unwrap();
+    assert_eq!(through.scene.camera, alone.scene.camera);
+    assert_films_identical(
+        &render_film(&through, Backend::Cpu, 4),
+        &render_film(&alone, Backend::Cpu, 4),
+        "TOML through the glTF camera vs the glTF file",
+    );
+}
+
+#[test]
 fn the_shipped_showcase_loads_and_renders_alike_on_both_backends() {
     let root = twinpath_tests::repo_root();
     let alone =

@@ -16,7 +16,8 @@ use twinpath::settings::RenderSettings;
 pub struct RenderArgs {
     /// Scene file: TOML, or glTF 2.0 (.gltf, .glb). Without it, the built-in Cornell scene.
     scene: Option<PathBuf>,
-    /// glTF: the perspective camera to render through, by name (default: the first).
+    /// A perspective camera to render through, by name: of the glTF file (default: its first),
+    /// or of a TOML scene's [[gltf]] files (instead of its [camera] table).
     #[arg(long)]
     camera: Option<String>,
     /// Image width in pixels, instead of the scene's (alone: the height follows the scene's

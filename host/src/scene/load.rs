@@ -3,7 +3,7 @@
 
 use super::error::{self, SceneError};
 use super::flat_scene::SceneFile;
-use super::toml::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
+use super::toml::{parse_scene, parse_scene_with_camera, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
 use super::{gltf, inputs};
 use crate::settings::RenderSettings;
 use kernel::scene::RenderParams;
@@ -16,7 +16,8 @@ impl SceneFile {
         Self::load_with_camera(path, None)
     }
 
-    /// [`SceneFile::load`], a glTF file seen through its perspective camera named `camera`.
+    /// [`SceneFile::load`] seen through the perspective camera named `camera`: of the glTF
+    /// file, or of a TOML scene's `[[gltf]]` files (instead of its `[camera]` table).
     pub fn load_with_camera(path: &Path, camera: Option<&str>) -> Result<SceneFile, SceneError> {
         let (file, files) = inputs::recording(|| Self::read(path, camera));
         let mut file = file?;
@@ -36,14 +37,6 @@ impl SceneFile {
                 settings: RenderSettings::default(),
             });
         }
-        if let Some(name) = camera {
-            return Err(SceneError::new(
-                path,
-                None,
-                "camera",
-                format!("a camera name ('{name}') selects among a glTF file's cameras; a TOML scene has one"),
-            ));
-        }
         let text = inputs::read(path)
             .map_err(|e| SceneError::new(path, None, "file", format!("cannot read: {e}")))?;
         let text = String::from_utf8(text).map_err(|e| {
@@ -53,7 +46,7 @@ impl SceneFile {
             );
             SceneError::new(path, Some(line), "file", "not valid UTF-8 text")
         })?;
-        parse_scene(&text, path)
+        parse_scene_with_camera(&text, path, camera)
     }
 
     /// [`super::Scene::params`] with the file's settings.

@@ -27,4 +27,4 @@ pub use flat_scene::{
     triangle, CameraDesc, Scene, SceneFile, TriangleGroup, ADAPTIVE_PASS, MIN_PILOT_SAMPLES,
     PILOT_PERIOD,
 };
-pub use toml::{parse_scene, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
+pub use toml::{parse_scene, parse_scene_with_camera, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};

@@ -4,13 +4,15 @@
 use super::checker::{Checker, V3};
 use super::transform::{parse_transform, transform_fields};
 use crate::scene::builder::SceneTables;
-use crate::scene::{gltf, SceneError};
+use crate::scene::gltf::{self, GltfCamera};
+use crate::scene::SceneError;
 use serde::Deserialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 /// A glTF file's default scene as part of this one (`gltf::include`): its meshes with
-/// their own materials, under an optional transform; its cameras are not used.
+/// their own materials, under an optional transform; its perspective cameras, placed by the
+/// same transform, are the ones `[camera] gltf = "NAME"` and `--camera NAME` choose from.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct GltfFile {
@@ -21,15 +23,23 @@ pub(super) struct GltfFile {
     pub matrix: Option<Spanned<[[f32; 4]; 4]>>,
 }
 
+/// A perspective camera of an included glTF file, placed in the scene, and the file.
+pub(super) struct IncludedCamera {
+    pub camera: GltfCamera,
+    pub file: PathBuf,
+}
+
 /// Adds the meshes, materials and lights of the included files to `tables` (relative to
-/// `base_dir`); returns what the glTF loader noted.
+/// `base_dir`); returns what the glTF loader noted and the files' perspective cameras, each
+/// with the file it came from.
 pub(super) fn add_gltf(
     ck: &Checker,
     includes: &[Spanned<GltfFile>],
     base_dir: &Path,
     tables: &mut SceneTables,
-) -> Result<Vec<String>, SceneError> {
+) -> Result<(Vec<String>, Vec<IncludedCamera>), SceneError> {
     let mut notes = Vec::new();
+    let mut cameras = Vec::new();
     for (i, g) in includes.iter().enumerate() {
         let gf = g.get_ref();
         let field = format!("gltf[{i}]");
@@ -46,7 +56,12 @@ pub(super) fn add_gltf(
         } else {
             None
         };
-        gltf::include(tables, &gltf_path, transform.as_ref(), &mut notes)?;
+        for camera in gltf::include(tables, &gltf_path, transform.as_ref(), &mut notes)? {
+            cameras.push(IncludedCamera {
+                camera,
+                file: gltf_path.clone(),
+            });
+        }
     }
-    Ok(notes)
+    Ok((notes, cameras))
 }

@@ -58,6 +58,16 @@ struct TomlScene {
 /// Parses and validates scene text; `path` names the file in errors and anchors the paths of
 /// the files it names (meshes, textures, glTF files, maps).
 pub fn parse_scene(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+    parse_scene_with_camera(text, path, None)
+}
+
+/// [`parse_scene`] seen through the perspective camera named `camera` of the scene's `[[gltf]]`
+/// files (`--camera NAME`) instead of its `[camera]` table.
+pub fn parse_scene_with_camera(
+    text: &str,
+    path: &Path,
+    camera: Option<&str>,
+) -> Result<SceneFile, SceneError> {
     let file: TomlScene = toml::from_str(text).map_err(|e| {
         let line = e.span().map(|s| line_of(text, s.start));
         let field = "syntax";
@@ -65,7 +75,6 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     })?;
     let ck = Checker { path, text };
     let base_dir = path.parent().unwrap_or(Path::new("."));
-    let camera = camera::camera(&ck, &file.camera)?;
     let settings = settings::render_settings(&ck, &file.render)?;
     let mut tables = SceneTables::default();
     materials::add_materials(&ck, &file.materials, base_dir, &mut tables)?;
@@ -73,7 +82,11 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     shapes::add_quads(&ck, &file.quad, &mut tables)?;
     meshes::add_meshes(&ck, &file.mesh, base_dir, &mut tables)?;
     lights::add_lights(&ck, &file.light, &mut tables)?;
-    let notes = includes::add_gltf(&ck, &file.gltf, base_dir, &mut tables)?;
+    let (notes, gltf_cameras) = includes::add_gltf(&ck, &file.gltf, base_dir, &mut tables)?;
+    let camera = match camera {
+        Some(name) => camera::gltf_camera(&ck, None, name, &gltf_cameras)?,
+        None => camera::camera(&ck, &file.camera, &gltf_cameras)?,
+    };
     let (background, environment) = match &file.background {
         Some(b) => background::background(&ck, b, base_dir)?,
         None => (Vec3::ZERO, None),
