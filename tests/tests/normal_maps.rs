@@ -378,3 +378,75 @@ fn gltf_tangents_are_read_and_transformed() {
     let (t, sign) = frame(&load(Some([0.0, 0.0, 0.0, 1.0]), json!({}), "zero.glb"));
     assert!(close(t, Vec3::X) && sign == 1.0, "{t} {sign}");
 }
+
+/// A normal-mapped glTF mesh without `TANGENT` gets MikkTSpace's vertex tangents (glTF 2.0,
+/// "Meshes"), as Blender computes them: on a cylinder of 16 segments (u around it, v along its
+/// axis), each corner's tangent is the direction of increasing u at that vertex, (-sin phi, 0,
+/// -cos phi), not the facet's (one tangent per triangle is off by half a segment, 0.19); the
+/// seam's corners, whose coordinates differ on either side, are the facet's.
+#[test]
+fn gltf_meshes_without_tangents_get_mikktspace_vertex_tangents() {
+    use serde_json::json;
+    use twinpath_tests::gltf_writer::GltfWriter;
+    const SEGMENTS: u32 = 16;
+    let dir = temp_dir("mikktspace");
+    let mut g = GltfWriter::new();
+    let png = {
+        let img = image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]));
+        let mut out = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+        out.into_inner()
+    };
+    let tex = g.png_texture(&png);
+    let material = g.push("materials", json!({ "normalTexture": { "index": tex } }));
+    let (mut p, mut n, mut uv, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for k in 0..=SEGMENTS {
+        let phi = std::f32::consts::TAU * k as f32 / SEGMENTS as f32;
+        for y in [0.0, 1.0] {
+            p.push([phi.cos(), y, -phi.sin()]);
+            n.push([phi.cos(), 0.0, -phi.sin()]);
+            // glTF's v grows down the image: the image's up is +y.
+            uv.push([k as f32 / SEGMENTS as f32, 1.0 - y]);
+        }
+    }
+    for k in 0..SEGMENTS {
+        let (a, c, b, d) = (2 * k, 2 * k + 1, 2 * k + 2, 2 * k + 3);
+        idx.extend([a, b, d, a, d, c]);
+    }
+    let mesh = g.mesh(&p, Some(&n), Some(&uv), &idx, Some(material));
+    g.push("nodes", json!({ "mesh": mesh }));
+    g.push("scenes", json!({ "nodes": [0] }));
+    let path = dir.join("cylinder.glb");
+    std::fs::write(&path, g.glb()).unwrap();
+    let s = SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.scene.triangles.len(), 2 * SEGMENTS as usize);
+    let (mut checked, mut seam) = (0, 0);
+    for t in &s.scene.triangles {
+        let frame = &s.scene.shading[t.shading as usize + 1];
+        assert_eq!(
+            frame.uv0[0], 1.0,
+            "the bitangent's sign: v grows along +y = N x T"
+        );
+        let p0 = Vec3::from(t.p0);
+        let corners = [p0, p0 + Vec3::from(t.edge1), p0 + Vec3::from(t.edge2)];
+        let tangents = [frame.normal0, frame.normal1, frame.normal2].map(Vec3::from);
+        for (c, tangent) in corners.iter().zip(tangents) {
+            let phi = (-c.z).atan2(c.x);
+            let want = Vec3::new(-phi.sin(), 0.0, -phi.cos());
+            if (c.z.abs() < 1e-6) && c.x > 0.0 {
+                // The seam: the coordinates differ on its two sides, so MikkTSpace welds
+                // nothing there and the corner keeps its facet's tangent.
+                seam += 1;
+                assert!((tangent - want).length() < 0.25, "{c}: {tangent} vs {want}");
+                continue;
+            }
+            assert!(
+                (tangent - want).length() < 1e-4,
+                "corner {c}: tangent {tangent}, the vertex's direction of u {want}"
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(seam, 6, "three corners on each side of the seam");
+    assert_eq!(checked, 6 * SEGMENTS as usize - 6);
+}

@@ -7,7 +7,7 @@ use super::instancing::{instance_box, instance_record, instances_box, mesh_box, 
 use super::light_table::{place_directional_lights, triangle_light};
 use super::limits::MAX_COORDINATE;
 use super::soup::TriangleSoup;
-use super::tangents::face_tangent;
+use super::tangents::{face_tangent, mikktspace_tangents};
 use super::textures::TextureTable;
 use super::transform::Transform;
 use super::{CameraDesc, Scene, TriangleGroup};
@@ -243,6 +243,14 @@ impl SceneTables {
     ) -> Result<(), (usize, String)> {
         let mirror = transform.is_some_and(|t| t.mirrors());
         let textured = self.is_textured(material);
+        // A normal-mapped mesh with vertex normals and texture coordinates but no tangents of
+        // its own gets MikkTSpace's (glTF 2.0, "Meshes"; Blender's), whatever its format.
+        let normal_mapped =
+            self.materials[material as usize].textures[texture_slot::NORMAL] != NONE;
+        let generated = (normal_mapped && soup.tangents.is_empty())
+            .then(|| mikktspace_tangents(soup))
+            .flatten();
+        let file_tangents = generated.as_deref().unwrap_or(&soup.tangents);
         for (k, t) in soup.triangles.iter().enumerate() {
             let p = t.map(|v| match transform {
                 Some(m) => m.point(Vec3::from(v)),
@@ -275,7 +283,7 @@ impl SceneTables {
             // A file's tangents (glTF TANGENT) map as directions, T' = M T; their sign flips
             // where M mirrors: (N' x T') . (M B) = det(M) w |M^-T N| for B = w N x T and
             // N' along M^-T N (docs/materials.md, "Normal maps").
-            let tangents = soup.tangents.get(k).filter(|_| textured).map(|t| {
+            let tangents = file_tangents.get(k).filter(|_| textured).map(|t| {
                 let mapped = wound(
                     t.map(|c| {
                         let v = Vec3::new(c[0], c[1], c[2]);

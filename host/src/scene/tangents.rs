@@ -11,12 +11,55 @@
 //! (N x dp/du) . dp/dv > 0 (v grows toward N x T, the image's up: glTF's bitangent with
 //! `TANGENT.w` = +1), else -1 (a mirrored parametrisation).
 //!
-//! One tangent per triangle: MikkTSpace, which glTF names for files without `TANGENT`, averages
-//! it over the triangles sharing a vertex. The two agree on flat and uniformly parametrised
-//! surfaces; on curved meshes the per-triangle frame can show the facets in the mapped normal
-//! (docs/gltf.md).
+//! That is one tangent per triangle, for meshes without vertex normals or texture coordinates.
+//! A normal-mapped mesh that has both but no tangents of its own (a glTF mesh without
+//! `TANGENT`, any OBJ or PLY mesh) gets MikkTSpace's vertex tangents instead
+//! ([`mikktspace_tangents`]), as the glTF specification asks and Blender computes them: the tangents of the triangles around a vertex, averaged (Mikkelsen 2008,
+//! "Simulation of Wrinkled Surfaces Revisited"), so a curved mesh's mapped normal shows no
+//! facets (docs/gltf.md).
 
+use super::soup::TriangleSoup;
 use kernel::frame::orthonormal_basis;
+
+/// MikkTSpace tangents of `soup`'s triangles, one per corner, as glTF's `TANGENT` holds them (xyz
+/// along increasing u, w the bitangent's sign), from its positions, vertex normals and texture
+/// coordinates (the soup's, v up, so the sign is the one [`face_tangent`] would give). None
+/// where the soup lacks normals or coordinates, or the generator fails.
+pub fn mikktspace_tangents(soup: &TriangleSoup) -> Option<Vec<[[f32; 4]; 3]>> {
+    struct Corners<'a> {
+        soup: &'a TriangleSoup,
+        tangents: Vec<[[f32; 4]; 3]>,
+    }
+    impl mikktspace::Geometry for Corners<'_> {
+        fn num_faces(&self) -> usize {
+            self.soup.triangles.len()
+        }
+        fn num_vertices_of_face(&self, _face: usize) -> usize {
+            3
+        }
+        fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.soup.triangles[face][vert]
+        }
+        fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.soup.normals[face][vert]
+        }
+        fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+            self.soup.uvs[face][vert]
+        }
+        fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
+            self.tangents[face][vert] = tangent;
+        }
+    }
+    let n = soup.triangles.len();
+    if n == 0 || soup.normals.len() != n || soup.uvs.len() != n {
+        return None;
+    }
+    let mut corners = Corners {
+        soup,
+        tangents: vec![[[0.0; 4]; 3]; n],
+    };
+    mikktspace::generate_tangents(&mut corners).then_some(corners.tangents)
+}
 
 /// The unit tangent dp/du of the triangle `p` with texture coordinates `uv`, and the
 /// bitangent sign, for geometric normal `normal` (unit). Where (u, v) does not span the
