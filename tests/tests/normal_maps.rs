@@ -297,6 +297,18 @@ fn normal_map_errors_name_the_field() {
     assert_eq!(plain.features() & kernel::features::NORMAL_MAPS, 0);
 }
 
+/// A glTF material whose normal map is flat (every texel the unperturbed normal): its index.
+fn flat_normal_map_material(g: &mut twinpath_tests::gltf_writer::GltfWriter) -> usize {
+    let img = image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]));
+    let mut png = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut png, image::ImageFormat::Png).unwrap();
+    let tex = g.png_texture(&png.into_inner());
+    g.push(
+        "materials",
+        serde_json::json!({ "normalTexture": { "index": tex } }),
+    )
+}
+
 /// The tangent frame a glTF file's own `TANGENT` gives, under no transform, a mirroring one and
 /// a rotation; and the per-triangle frame where the file has none or a degenerate one.
 #[test]
@@ -308,14 +320,7 @@ fn gltf_tangents_are_read_and_transformed() {
     // from the coordinates is T = +x, sign +1. The file says T = (0, 0, 2), w = -1 instead.
     let load = |tangent: Option<[f32; 4]>, node: serde_json::Value, name: &str| {
         let mut g = GltfWriter::new();
-        let png = {
-            let img = image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]));
-            let mut out = std::io::Cursor::new(Vec::new());
-            img.write_to(&mut out, image::ImageFormat::Png).unwrap();
-            out.into_inner()
-        };
-        let tex = g.png_texture(&png);
-        let material = g.push("materials", json!({ "normalTexture": { "index": tex } }));
+        let material = flat_normal_map_material(&mut g);
         let mesh = g.mesh(
             &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]],
             Some(&[[0.0, 1.0, 0.0]; 3]),
@@ -391,14 +396,7 @@ fn gltf_meshes_without_tangents_get_mikktspace_vertex_tangents() {
     const SEGMENTS: u32 = 16;
     let dir = temp_dir("mikktspace");
     let mut g = GltfWriter::new();
-    let png = {
-        let img = image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]));
-        let mut out = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut out, image::ImageFormat::Png).unwrap();
-        out.into_inner()
-    };
-    let tex = g.png_texture(&png);
-    let material = g.push("materials", json!({ "normalTexture": { "index": tex } }));
+    let material = flat_normal_map_material(&mut g);
     let (mut p, mut n, mut uv, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for k in 0..=SEGMENTS {
         let phi = std::f32::consts::TAU * k as f32 / SEGMENTS as f32;
