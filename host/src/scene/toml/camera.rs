@@ -39,35 +39,12 @@ pub(super) fn camera(
     if let Some(name) = &cam.gltf {
         return gltf_camera(ck, Some(camera), name.get_ref(), gltf_cameras);
     }
-    let missing = |field: &str| {
-        ck.err(
-            camera.span(),
-            &format!("camera.{field}"),
-            "missing (give eye, look_at, up, vfov, width and height, or gltf = \"NAME\" for a \
-             camera of the [[gltf]] files)",
-        )
-    };
-    let (Some(eye), Some(look_at), Some(up), Some(vfov_s)) =
-        (&cam.eye, &cam.look_at, &cam.up, &cam.vfov)
-    else {
-        let field = [
-            ("eye", cam.eye.is_none()),
-            ("look_at", cam.look_at.is_none()),
-            ("up", cam.up.is_none()),
-            ("vfov", cam.vfov.is_none()),
-        ]
-        .into_iter()
-        .find(|f| f.1)
-        .map_or("eye", |f| f.0);
-        return Err(missing(field));
-    };
-    let (Some(width), Some(height)) = (&cam.width, &cam.height) else {
-        return Err(missing(if cam.width.is_none() {
-            "width"
-        } else {
-            "height"
-        }));
-    };
+    let eye = required(ck, camera, &cam.eye, "eye")?;
+    let look_at = required(ck, camera, &cam.look_at, "look_at")?;
+    let up = required(ck, camera, &cam.up, "up")?;
+    let vfov_s = required(ck, camera, &cam.vfov, "vfov")?;
+    let width = required(ck, camera, &cam.width, "width")?;
+    let height = required(ck, camera, &cam.height, "height")?;
     let eye = ck.vec3(eye, "camera.eye")?;
     let look_at_v = ck.vec3(look_at, "camera.look_at")?;
     let up_v = ck.vec3(up, "camera.up")?;
@@ -97,7 +74,7 @@ pub(super) fn camera(
             "is zero or parallel to the viewing direction",
         ));
     }
-    let (aperture, focus_distance) = lens(ck, cam, Some(forward.length()))?;
+    let (aperture, focus_distance) = lens(ck, cam)?;
     Ok(CameraDesc {
         eye,
         look_at: look_at_v,
@@ -106,7 +83,24 @@ pub(super) fn camera(
         width,
         height,
         aperture,
-        focus_distance,
+        focus_distance: focus_distance.unwrap_or(forward.length()),
+    })
+}
+
+/// The table's `field`, or an error naming it as missing.
+fn required<'a, T>(
+    ck: &Checker,
+    table: &Spanned<CameraFile>,
+    value: &'a Option<T>,
+    field: &str,
+) -> Result<&'a T, SceneError> {
+    value.as_ref().ok_or_else(|| {
+        ck.err(
+            table.span(),
+            &format!("camera.{field}"),
+            "missing (give eye, look_at, up, vfov, width and height, or gltf = \"NAME\" for a \
+             camera of the [[gltf]] files)",
+        )
     })
 }
 
@@ -119,10 +113,6 @@ pub(super) fn gltf_camera(
     name: &str,
     gltf_cameras: &[IncludedCamera],
 ) -> Result<CameraDesc, SceneError> {
-    let (span, field) = match table.and_then(|t| t.get_ref().gltf.as_ref()) {
-        Some(g) => (g.span(), "camera.gltf"),
-        None => (0..0, "camera"),
-    };
     let Some(found) = gltf_cameras.iter().find(|c| c.camera.name == name) else {
         let names: Vec<String> = gltf_cameras
             .iter()
@@ -136,9 +126,9 @@ pub(super) fn gltf_camera(
                 names.join(", ")
             }
         );
-        return Err(match table {
-            Some(_) => ck.err(span, field, msg),
-            None => SceneError::new(ck.path, None, field, msg),
+        return Err(match table.and_then(|t| t.get_ref().gltf.as_ref()) {
+            Some(g) => ck.err(g.span(), "camera.gltf", msg),
+            None => SceneError::new(ck.path, None, "camera", msg),
         });
     };
     let mut desc = found.camera.desc;
@@ -171,21 +161,24 @@ pub(super) fn gltf_camera(
     desc = desc
         .resized(width, height)
         .map_err(|m| ck.err(table.span(), "camera", m))?;
-    let (aperture, focus_distance) = lens(ck, cam, None)?;
+    let (aperture, focus_distance) = lens(ck, cam)?;
     desc.aperture = aperture;
-    if cam.focus_distance.is_some() {
-        desc.focus_distance = focus_distance;
+    match (focus_distance, &cam.aperture) {
+        (Some(d), _) => desc.focus_distance = d,
+        (None, Some(a)) if aperture > 0.0 => {
+            return Err(ck.err(
+                a.span(),
+                "camera.focus_distance",
+                "missing: a thin lens on a glTF camera needs the distance in focus",
+            ))
+        }
+        (None, _) => {}
     }
     Ok(desc)
 }
 
-/// The lens: aperture (default 0) and focus distance (default `default_focus`; without one, a
-/// thin lens needs the table's).
-fn lens(
-    ck: &Checker,
-    cam: &CameraFile,
-    default_focus: Option<f32>,
-) -> Result<(f32, f32), SceneError> {
+/// The lens: the aperture (default 0) and the table's focus distance, if it gives one.
+fn lens(ck: &Checker, cam: &CameraFile) -> Result<(f32, Option<f32>), SceneError> {
     let aperture = match &cam.aperture {
         Some(a) => {
             let x = *a.get_ref();
@@ -210,19 +203,9 @@ fn lens(
                     format!("{x} is not a distance in (0, {MAX_COORDINATE:e}]"),
                 ));
             }
-            x
+            Some(x)
         }
-        None => match (default_focus, &cam.aperture) {
-            (Some(d), _) => d,
-            (None, Some(a)) if *a.get_ref() > 0.0 => {
-                return Err(ck.err(
-                    a.span(),
-                    "camera.focus_distance",
-                    "missing: a thin lens on a glTF camera needs the distance in focus",
-                ))
-            }
-            (None, _) => 1.0,
-        },
+        None => None,
     };
     Ok((aperture, focus_distance))
 }
