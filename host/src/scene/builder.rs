@@ -80,6 +80,11 @@ impl SceneTables {
             .any(|&t| t != NONE)
     }
 
+    /// Whether material `m` has a normal map (its triangles then carry a tangent frame).
+    fn is_normal_mapped(&self, m: u32) -> bool {
+        self.materials[m as usize].textures[texture_slot::NORMAL] != NONE
+    }
+
     /// Appends the triangle with vertices `p` and `material`, its shading record `attributes`
     /// if it has one, and its light if the material emits. A triangle whose material has a
     /// normal map always gets a record (texture coordinates 0 where it has none), followed by
@@ -107,7 +112,7 @@ impl SceneTables {
     ) {
         let mut tri = super::triangle(p, material);
         let m = self.materials[material as usize];
-        let normal_mapped = m.textures[texture_slot::NORMAL] != NONE;
+        let normal_mapped = self.is_normal_mapped(material);
         let attributes = match attributes {
             None if normal_mapped => Some(ShadingTriangle::zeroed()),
             a => a,
@@ -245,9 +250,7 @@ impl SceneTables {
         let textured = self.is_textured(material);
         // A normal-mapped mesh with vertex normals and texture coordinates but no tangents of
         // its own gets MikkTSpace's (glTF 2.0, "Meshes"; Blender's), whatever its format.
-        let normal_mapped =
-            self.materials[material as usize].textures[texture_slot::NORMAL] != NONE;
-        let generated = (normal_mapped && soup.tangents.is_empty())
+        let generated = (self.is_normal_mapped(material) && soup.tangents.is_empty())
             .then(|| mikktspace_tangents(soup))
             .flatten();
         let file_tangents = generated.as_deref().unwrap_or(&soup.tangents);
