@@ -19,38 +19,44 @@ fn small(mut s: SceneFile) -> SceneFile {
     s
 }
 
+/// `scenes/NAME.toml` at 48 x 48.
+fn shipped(name: &str) -> SceneFile {
+    let path = repo_root().join("scenes").join(format!("{name}.toml"));
+    small(SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}")))
+}
+
 fn cornell() -> SceneFile {
-    small(SceneFile::load(&repo_root().join("scenes/cornell.toml")).unwrap())
+    shipped("cornell")
 }
 
 /// Triangles only, no lights, a background: the "no spheres, no lights" case.
 fn sky_meshes() -> SceneFile {
-    small(SceneFile::load(&repo_root().join("scenes/sky_meshes.toml")).unwrap())
+    shipped("sky_meshes")
 }
 
 /// Spheres only, several lights of different power.
 fn many_lights() -> SceneFile {
-    small(SceneFile::load(&repo_root().join("scenes/many_lights.toml")).unwrap())
+    shipped("many_lights")
 }
 
 /// Every material kind.
 fn materials() -> SceneFile {
-    small(SceneFile::load(&repo_root().join("scenes/materials.toml")).unwrap())
+    shipped("materials")
 }
 
 /// Cornell with a rough gold and a glass sphere: conductor and dielectric bits, no Kd + Ks.
 fn cornell_materials() -> SceneFile {
-    small(SceneFile::load(&repo_root().join("scenes/cornell_materials.toml")).unwrap())
+    shipped("cornell_materials")
 }
 
 /// Cornell lit by a ceiling panel: triangle lights.
 fn cornell_panel() -> SceneFile {
-    small(SceneFile::load(&repo_root().join("scenes/cornell_panel.toml")).unwrap())
+    shipped("cornell_panel")
 }
 
 /// Textured floor, wall and light; smooth meshes (shading normals).
 fn textures() -> SceneFile {
-    small(SceneFile::load(&repo_root().join("scenes/textures.toml")).unwrap())
+    shipped("textures")
 }
 
 /// `scene` through a lens of diameter 0.2 focused on its spheres (3.5 from the eye).
@@ -76,10 +82,7 @@ fn scenes() -> Vec<(&'static str, SceneFile)> {
         ("cornell with gold and glass", cornell_materials()),
         ("cornell lit by a panel (triangle lights)", cornell_panel()),
         ("cornell through a thin lens", thin_lens(cornell())),
-        (
-            "an environment map",
-            small(SceneFile::load(&repo_root().join("scenes/sky.toml")).unwrap()),
-        ),
+        ("an environment map", shipped("sky")),
         ("textures and smooth meshes", textures()),
     ]
 }
@@ -127,7 +130,7 @@ fn scene_analysis_finds_the_features_present() {
         materials().features() & (features::TEXTURES | features::SHADING_NORMALS),
         0
     );
-    let sky = small(SceneFile::load(&repo_root().join("scenes/sky.toml")).unwrap());
+    let sky = shipped("sky");
     assert_eq!(
         sky.features() & (features::ENVIRONMENT | features::BACKGROUND | features::LIGHTS),
         features::ENVIRONMENT | features::BACKGROUND | features::LIGHTS
