@@ -18,7 +18,8 @@ cargo test --workspace -- --nocapture "$@" 2>&1 | tee target/test.log
 bash scripts/slurm/test_cluster.sh target/debug/twinpath 2>&1 | tee -a target/test.log
 # The CPU-only build: without the `gpu` feature the workspace still builds the whole CLI, which
 # renders on the CPU backend and says the GPU backend is not built. Then the default build again,
-# so target/debug/twinpath is the full binary (both builds are cached: seconds).
+# so target/debug/twinpath is the full binary (the CPU-only twinpath compiles once, ~2 minutes on
+# two cores; the second build only relinks the cached default one).
 cargo build --workspace --no-default-features
 target/debug/twinpath info | grep -q '^gpu backend: not built'
 target/debug/twinpath render --backend auto --spp 2 --width 32 --quiet -o target/cpu_only.exr
