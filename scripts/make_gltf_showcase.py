@@ -160,10 +160,11 @@ for axis in range(3):
         bt += [base, base + 1, base + 2, base, base + 2, base + 3]
 box = mesh("box", bp, bn, None, bt, box_mat)
 
-# Spot light straight down from y = 3 (a node's -z, rotated -90 degrees about x).
+# Spot light straight down from y = 3 (a node's -z, rotated -90 degrees about x): 6 W/sr, in
+# the extension's candela (x 683 lm/W, as Blender's exporter writes them).
 h = math.sqrt(0.5)
 doc["extensions"] = {"KHR_lights_punctual": {"lights": [
-    {"type": "spot", "name": "warm spot", "color": [1.0, 0.85, 0.6], "intensity": 6.0,
+    {"type": "spot", "name": "warm spot", "color": [1.0, 0.85, 0.6], "intensity": 6.0 * 683,
      "spot": {"innerConeAngle": 0.25, "outerConeAngle": 0.5}}]}}
 doc["cameras"].append({"name": "front", "type": "perspective",
                        "perspective": {"yfov": 0.7, "aspectRatio": 4 / 3, "znear": 0.05}})

@@ -57,13 +57,22 @@ pub const NORMAL_MAPS: u32 = 1 << 17;
 /// The scene has instances (`scene::Instance`): a hit may carry object-space shading records
 /// whose normals and tangents `surface::shade` maps to world space.
 pub const INSTANCES: u32 = 1 << 18;
+/// Some light's material also reflects (`Material::reflects`): a path that finds it goes on.
+pub const REFLECTING_LIGHTS: u32 = 1 << 19;
 
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
 /// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals,
-/// [`NORMAL_MAPS`] and [`SHADING_NORMALS`] if a material has a normal map.
+/// [`NORMAL_MAPS`] and [`SHADING_NORMALS`] if a material has a normal map,
+/// [`REFLECTING_LIGHTS`] if an emitting material reflects.
 #[inline]
 pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> u32 {
     let mut f = 0;
+    if materials
+        .iter()
+        .any(|m| m.emission.iter().any(|&e| e > 0.0) && m.reflects())
+    {
+        f |= REFLECTING_LIGHTS;
+    }
     if materials
         .iter()
         .any(|m| m.textures.iter().any(|&t| t != NONE))
@@ -226,6 +235,11 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn triangle_lights(self) -> bool {
         self.answer(TRIANGLE_LIGHTS, true)
+    }
+    /// The generic path asks each light's material (`Material::reflects`).
+    #[inline]
+    fn reflecting_lights(self) -> bool {
+        self.answer(REFLECTING_LIGHTS, true)
     }
     #[inline]
     fn light_solid_angle(self, p: &RenderParams) -> bool {

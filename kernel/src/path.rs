@@ -282,7 +282,7 @@ impl PathState {
             let emission = emission_at(features, scene, material, hit);
             let emitted = eval_radiance(emission, hit.arrived_behind, two_sided);
             if self.depth == 0 {
-                // 1: a light seen directly (it reflects nothing, so the path ends).
+                // 1: a light seen directly.
                 self.radiance = emitted;
             } else {
                 // 2(b): the extension found a light.
@@ -298,7 +298,12 @@ impl PathState {
                 let weight = self.found_light_weight(features, params, pdf_l);
                 self.radiance += self.throughput * emitted * weight;
             }
-            return false;
+            // A light that reflects nothing ends the path; one that also reflects (glTF's
+            // emissive materials, TOML's emission + kd) goes on as any surface: its emission
+            // is counted here, once, and its reflection by the vertex like any other.
+            if !(features.reflecting_lights() && material.reflects()) {
+                return false;
+            }
         }
         self.depth += 1;
         true

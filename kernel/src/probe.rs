@@ -111,7 +111,8 @@ fn v3(v: Vec3) -> Vec4 {
 /// The material of the BSDF probes: kind `kind` with roughness `alpha` and, for a dielectric,
 /// index `eta`; Kd (0.5, 0.4, 0.3) and Ks (0.2, 0.3, 0.4) for the Kd + Ks mixture; gold's RGB
 /// index (`complex` 1) or reflectance (0.9, 0.8, 0.7) for a conductor; for glTF's
-/// metallic-roughness material base colour (0.5, 0.4, 0.3), metallic 0.3 (`complex` 0) or 0.9,
+/// metallic-roughness material base colour (0.5, 0.4, 0.3), metallic 0.3 with a coloured,
+/// weakened dielectric layer (`complex` 0; `KHR_materials_specular`) or 0.9 with the default one,
 /// roughness sqrt(alpha), resolved as `surface::shade` resolves it.
 #[inline]
 pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material {
@@ -131,6 +132,11 @@ pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material
         m.specular = [0.0; 3];
         m.metallic = if complex != 0 { 0.9 } else { 0.3 };
         m.roughness = alpha.sqrt();
+        if complex == 0 {
+            // A coloured, weakened layer (KHR_materials_specular, KHR_materials_ior).
+            m.layer_f0 = [0.06, 0.02, 0.1];
+            m.layer_f90 = 0.7;
+        }
         m = crate::bsdf::metallic_roughness::resolve(&m);
     }
     m

@@ -178,6 +178,13 @@ pub struct Material {
     pub roughness: f32,
     /// The normal map's x and y scale (glTF's `normalTexture.scale`; 1 without a map).
     pub normal_scale: f32,
+    /// METALLIC_ROUGHNESS: the dielectric layer's reflectance at normal incidence per channel,
+    /// min(((ior - 1) / (ior + 1))^2 x specularColorFactor, 1) x specularFactor (glTF's
+    /// `KHR_materials_ior` and `KHR_materials_specular`; 0.04 without them).
+    pub layer_f0: [f32; 3],
+    /// METALLIC_ROUGHNESS: the layer's reflectance at grazing incidence, `KHR_materials_specular`'s
+    /// specularFactor (1 without it). Every other kind: 1.
+    pub layer_f90: f32,
 }
 
 impl Material {
@@ -198,6 +205,8 @@ impl Material {
             metallic: 0.0,
             roughness: 0.0,
             normal_scale: 1.0,
+            layer_f0: [LAYER_F0; 3],
+            layer_f90: 1.0,
         }
     }
 
@@ -207,7 +216,23 @@ impl Material {
         m.emission = radiance;
         m
     }
+
+    /// Whether the surface reflects at all: any kind but the Lambertian, which reflects when
+    /// its albedo is not black (a light's own surface, [`Material::emitter`], is a black
+    /// Lambertian). A path that finds a light on a reflecting surface goes on.
+    #[inline]
+    pub fn reflects(&self) -> bool {
+        self.kind != material_kind::DIFFUSE
+            || self.albedo[0] > 0.0
+            || self.albedo[1] > 0.0
+            || self.albedo[2] > 0.0
+    }
 }
+
+/// The dielectric layer's reflectance at normal incidence of glTF's metallic-roughness material
+/// without `KHR_materials_specular` and `KHR_materials_ior`: ((1 - 1.5) / (1 + 1.5))^2 (glTF
+/// 2.0, Appendix B, "dielectric_brdf", index 1.5); [`Material::layer_f0`]'s default.
+pub const LAYER_F0: f32 = 0.04;
 
 /// The shapes a [`Light`] can have (`Light::kind`).
 pub mod light_kind {

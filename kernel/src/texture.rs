@@ -6,8 +6,10 @@
 //! - word 0: the number of textures T;
 //! - words [`SRGB_TABLE`]..+256: the sRGB-decoded value of each byte (f32 bits; the host
 //!   computes the IEC 61966-2-1 curve in f64), words [`LINEAR_TABLE`]..+256: byte / 255;
-//! - words [`RECORDS`] + 4k..+4: texture k's record: first texel word, width, height, flags
-//!   ([`flags`]);
+//! - words [`RECORDS`] + 10k..+10: texture k's record: first texel word, width, height, flags
+//!   ([`flags`]), then an affine map of the texture coordinates (f32 bits, row-major a b c /
+//!   d e f: u' = a u + b v + c, v' = d u + e v + f), read where `flags::TRANSFORM` is set
+//!   (glTF's `KHR_texture_transform`); several records may share one image's texels;
 //! - the texels: an 8-bit texture one word per texel (r | g << 8 | b << 16 | a << 24), a float
 //!   texture three words (f32 bits of r, g, b); rows from the image's top, texels left to right.
 //!
@@ -29,7 +31,9 @@ pub const LINEAR_TABLE: usize = SRGB_TABLE + 256;
 /// Word of texture 0's record.
 pub const RECORDS: usize = LINEAR_TABLE + 256;
 /// Words per texture record.
-pub const RECORD_WORDS: usize = 4;
+pub const RECORD_WORDS: usize = 10;
+/// Word of a record's texture-coordinate map (six words).
+pub const RECORD_TRANSFORM: usize = 4;
 
 /// Bits of a texture record's flags word.
 pub mod flags {
@@ -40,6 +44,8 @@ pub mod flags {
     /// Bits 2-3: how u continues outside [0, 1] (one of `super::wrap`); bits 4-5: how v does.
     pub const WRAP_U_SHIFT: u32 = 2;
     pub const WRAP_V_SHIFT: u32 = 4;
+    /// The record's texture-coordinate map applies (else the coordinates are used as given).
+    pub const TRANSFORM: u32 = 1 << 6;
 
     /// The flag bits of wrap modes `u` and `v` (`super::wrap`).
     pub const fn wrap(u: u32, v: u32) -> u32 {
@@ -203,11 +209,29 @@ fn decoded(table: &[u32], base: usize, word: u32) -> f32 {
     f32::from_bits(table[base + (word & 0xff) as usize])
 }
 
-/// Texture `texture` of `table` at coordinates `uv`, bilinearly filtered (RGB; linear values).
+/// Texture coordinates `uv` through the map of the record at word `r`:
+/// (a u + b v + c, d u + e v + f).
+#[inline]
+fn transformed(table: &[u32], r: usize, uv: Vec2) -> Vec2 {
+    let t = r + RECORD_TRANSFORM;
+    let w = |k: usize| f32::from_bits(table[t + k]);
+    Vec2::new(
+        w(0) * uv.x + w(1) * uv.y + w(2),
+        w(3) * uv.x + w(4) * uv.y + w(5),
+    )
+}
+
+/// Texture `texture` of `table` at coordinates `uv` (through the record's map where it has
+/// one), bilinearly filtered (RGB; linear values).
 #[inline]
 pub fn lookup(table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
     let r = RECORDS + RECORD_WORDS * texture as usize;
     let (offset, width, height, tex_flags) = (table[r], table[r + 1], table[r + 2], table[r + 3]);
+    let uv = if tex_flags & flags::TRANSFORM != 0 {
+        transformed(table, r, uv)
+    } else {
+        uv
+    };
     let f = footprint(
         uv,
         width,

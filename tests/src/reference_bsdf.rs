@@ -91,12 +91,18 @@ pub enum RefMaterial {
     Dielectric { eta: f64, alpha: f64 },
     /// glTF 2.0's metallic-roughness material, written from the specification's Appendix B
     /// as it stands: mix(dielectric_brdf, metal_brdf, metallic) with
-    /// dielectric_brdf = fresnel_mix(ior 1.5, diffuse(base), specular) and
-    /// metal_brdf = specular * conductor_fresnel(f0 = base); alpha = roughness^2.
+    /// dielectric_brdf = fresnel_mix(ior, diffuse(base), specular) and
+    /// metal_brdf = specular * conductor_fresnel(f0 = base); alpha = roughness^2; with
+    /// `KHR_materials_specular`'s fresnel_mix(f0_color = `specular_color`, ior,
+    /// weight = `specular`, base, layer) (`KHR_materials_ior`: `ior`; 1.5, 1 and white
+    /// without the extensions).
     MetallicRoughness {
         base: DVec3,
         metallic: f64,
         roughness: f64,
+        ior: f64,
+        specular: f64,
+        specular_color: DVec3,
     },
 }
 
@@ -143,11 +149,17 @@ impl RefMaterial {
                 base,
                 metallic,
                 roughness,
+                ior,
+                specular,
+                specular_color,
             } => {
                 let mut m = Material::diffuse(f(base));
                 m.kind = material_kind::METALLIC_ROUGHNESS;
                 m.metallic = metallic as f32;
                 m.roughness = roughness as f32;
+                let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+                m.layer_f0 = f((specular_color * f0).min(DVec3::ONE) * specular);
+                m.layer_f90 = specular as f32;
                 m
             }
         }
@@ -161,6 +173,16 @@ impl RefMaterial {
             kernel::bsdf::metallic_roughness::resolve(&m)
         } else {
             m
+        }
+    }
+
+    /// The GGX alpha of the material's glossy lobe.
+    pub fn alpha(&self) -> f64 {
+        match *self {
+            RefMaterial::Glossy { alpha, .. }
+            | RefMaterial::Conductor { alpha, .. }
+            | RefMaterial::Dielectric { alpha, .. } => alpha,
+            RefMaterial::MetallicRoughness { roughness, .. } => roughness * roughness,
         }
     }
 
@@ -183,6 +205,9 @@ impl RefMaterial {
                 base,
                 metallic,
                 roughness,
+                ior,
+                specular: weight,
+                specular_color,
             } => {
                 if ci < 0.0 {
                     return DVec3::ZERO;
@@ -193,10 +218,13 @@ impl RefMaterial {
                 let specular = ggx_d(n.dot(h), alpha) * ggx_g1(co, alpha) * ggx_g1(ci, alpha)
                     / (4.0 * co * ci);
                 let diffuse = base / PI;
-                // fresnel_mix(ior 1.5, base, layer) = mix(base, layer, F0 + (1 - F0)(1 - |VdotH|)^5).
-                let f0 = ((1.0f64 - 1.5) / (1.0 + 1.5)).powi(2);
-                let fr = f0 + (1.0 - f0) * (1.0 - voh).powi(5);
-                let dielectric_brdf = diffuse * (1.0 - fr) + DVec3::splat(specular * fr);
+                // fresnel_mix(f0_color, ior, weight, base, layer) =
+                // (1 - weight max(fr)) base + weight fr layer, fr = f0 + (1 - f0)(1 - |VdotH|)^5,
+                // f0 = min(((1 - ior) / (1 + ior))^2 f0_color, 1).
+                let f0 = (specular_color * ((1.0 - ior) / (1.0 + ior)).powi(2)).min(DVec3::ONE);
+                let fr = f0 + (DVec3::ONE - f0) * (1.0 - voh).powi(5);
+                let dielectric_brdf =
+                    diffuse * (1.0 - weight * fr.max_element()) + fr * (weight * specular);
                 let metal_brdf = specular * (base + (DVec3::ONE - base) * (1.0 - voh).powi(5));
                 dielectric_brdf * (1.0 - metallic) + metal_brdf * metallic
             }
@@ -289,15 +317,22 @@ impl RefMaterial {
                 base,
                 metallic,
                 roughness,
+                ior,
+                specular,
+                specular_color,
             } => {
                 if ci <= 0.0 {
                     return 0.0;
                 }
-                // The kernel samples it as the Kd + Ks mixture of Kd = (1 - metallic) base and
-                // F0 = lerp(0.04, base, metallic).
+                // The kernel samples it as the Kd + Ks mixture of Kd = (1 - metallic) base,
+                // F0 = lerp(layer F0, base, metallic) and F90 = lerp(specular, 1, metallic).
                 let kd = base * (1.0 - metallic);
-                let ks = DVec3::splat(0.04 * (1.0 - metallic)) + base * metallic;
-                let fs = schlick(ks, co).element_sum();
+                let layer_f0 = (specular_color * ((ior - 1.0) / (ior + 1.0)).powi(2))
+                    .min(DVec3::ONE)
+                    * specular;
+                let ks = layer_f0 * (1.0 - metallic) + base * metallic;
+                let f90 = specular * (1.0 - metallic) + metallic;
+                let fs = (ks + (DVec3::splat(f90) - ks) * (1.0 - co).powi(5)).element_sum();
                 let p = fs / (fs + kd.element_sum());
                 (1.0 - p) * ci / PI + p * reflected(roughness * roughness)
             }

@@ -42,6 +42,22 @@ fn metallic_roughness(metallic: f64, roughness: f64) -> RefMaterial {
         base: DVec3::new(0.8, 0.5, 0.2),
         metallic,
         roughness,
+        ior: 1.5,
+        specular: 1.0,
+        specular_color: DVec3::ONE,
+    }
+}
+
+/// [`metallic_roughness`] with `KHR_materials_specular`'s weight and a coloured F0 (clamped to
+/// 1 in its blue channel) and `KHR_materials_ior`'s index 2.
+fn specular_layered(metallic: f64, roughness: f64, specular: f64) -> RefMaterial {
+    RefMaterial::MetallicRoughness {
+        base: DVec3::new(0.8, 0.5, 0.2),
+        metallic,
+        roughness,
+        ior: 2.0,
+        specular,
+        specular_color: DVec3::new(1.0, 0.5, 12.0),
     }
 }
 
@@ -58,6 +74,14 @@ fn rough_materials() -> Vec<(String, RefMaterial)> {
         v.push((
             format!("glTF metallic {metallic} roughness {roughness}"),
             metallic_roughness(metallic, roughness),
+        ));
+    }
+    for (metallic, roughness, specular) in [(0.0, 0.3, 0.6), (0.4, 0.5, 0.0)] {
+        v.push((
+            format!(
+                "glTF metallic {metallic} roughness {roughness} specular {specular}, coloured, ior 2"
+            ),
+            specular_layered(metallic, roughness, specular),
         ));
     }
     for eta in [1.5, 1.0 / 1.5] {
@@ -203,9 +227,10 @@ fn unit(g: &mut SplitMix) -> Vec3 {
 /// (where f32 keeps the lobes' shape; `properties.rs` covers the edges for finiteness).
 fn random_material(g: &mut SplitMix) -> RefMaterial {
     let alpha = 10f64.powf(-2.0 + 2.0 * g.unit() as f64);
-    match g.u64() % 5 {
+    match g.u64() % 6 {
         0 => glossy(alpha),
         4 => metallic_roughness(g.unit() as f64, alpha.sqrt()),
+        5 => specular_layered(g.unit() as f64, alpha.sqrt(), g.unit() as f64),
         1 => conductor(alpha),
         2 => RefMaterial::Conductor {
             eta: DVec3::ZERO,
@@ -252,9 +277,15 @@ fn values_and_densities_match_the_f64_reference() {
         // Values below 1e-4 (the lobes' peaks reach 1e4) are compared absolutely: there, near
         // total internal reflection, the transmittance changes steeply with the angle, and the
         // f32 rounding of the inputs moves it by a few 1e-3 of itself.
+        // Relative differences are scaled to the bound of the lobe's roughness: GGX's
+        // denominator 1 - (n.h)^2 (1 - alpha^2) >= alpha^2 is computed from n.h in f32, whose
+        // rounding (a few eps) it carries absolutely, so D (squared denominator) and with it f
+        // and the pdf may be off by 4 eps / alpha^2 relative (3.1e-3 at alpha 0.0125, where
+        // 1.4e-3 was measured; 1e-3 holds from alpha 0.022 on). The worst ratio must stay <= 1.
+        let bound = 1e-3f64.max(4.0 * f32::EPSILON as f64 / (m.alpha() * m.alpha()));
         let mut compare = |a: f64, b: f64, worst: &mut f64| {
             if a.abs().max(b.abs()) > 1e-4 {
-                *worst = worst.max(rel(a, b));
+                *worst = worst.max(rel(a, b) / bound);
             } else {
                 worst_abs = worst_abs.max((a - b).abs());
             }
@@ -266,12 +297,12 @@ fn values_and_densities_match_the_f64_reference() {
         compared += 1;
     }
     println!(
-        "{compared} directions: worst relative difference f cos {worst_f:.2e}, pdf {worst_pdf:.2e} \
-         (values below 1e-4: worst absolute difference {worst_abs:.2e})"
+        "{compared} directions: worst relative difference over its bound f cos {worst_f:.2e}, pdf \
+         {worst_pdf:.2e} (values below 1e-4: worst absolute difference {worst_abs:.2e})"
     );
     assert!(compared > 100_000);
     assert!(
-        worst_f < 1e-3 && worst_pdf < 1e-3 && worst_abs < 1e-7,
+        worst_f < 1.0 && worst_pdf < 1.0 && worst_abs < 1e-7,
         "f cos {worst_f:.2e}, pdf {worst_pdf:.2e}, absolute {worst_abs:.2e}"
     );
 }

@@ -88,6 +88,7 @@ fn the_mapped_normal_is_gltfs_formula() {
                 TextureUse {
                     colour: false,
                     wrap: [kernel::texture::wrap::REPEAT; 2],
+                    transform: None,
                 },
                 "n",
             )

@@ -209,9 +209,9 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
     };
     let scene = file(
         json!([
-            { "type": "spot", "color": [1.0, 0.5, 0.25], "intensity": 8.0,
+            { "type": "spot", "color": [1.0, 0.5, 0.25], "intensity": 8.0 * 683.0,
               "spot": { "innerConeAngle": 0.2, "outerConeAngle": 0.6 } },
-            { "type": "point", "intensity": 2.0, "range": 10.0 }
+            { "type": "point", "intensity": 2.0 * 683.0, "range": 10.0 }
         ]),
         "lights.glb",
     )
@@ -261,11 +261,11 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("KHR_lights_punctual.lights[0]"), "{e}");
-    // A directional light shines down its node's -z (here -y), colour x intensity its
-    // irradiance, from beyond the scene's bounding sphere (the triangle's: centre
+    // A directional light shines down its node's -z (here -y), colour x intensity / 683 its
+    // irradiance (lux to W/m^2), from beyond the scene's bounding sphere (the triangle's: centre
     // (0.5, 0, -0.5), radius sqrt(1/2)).
     let s = file(
-        json!([{ "type": "directional", "color": [1.0, 0.5, 0.5], "intensity": 3.0 }, { "type": "point" }]),
+        json!([{ "type": "directional", "color": [1.0, 0.5, 0.5], "intensity": 3.0 * 683.0 }, { "type": "point" }]),
         "dir.glb",
     )
     .unwrap();
@@ -284,6 +284,41 @@ fn gltf_lights_are_placed_by_their_nodes_and_checked() {
         !s.scene.notes.iter().any(|n| n.contains("directional")),
         "{:?}",
         s.scene.notes
+    );
+
+    // The other conventions of Blender's exporter, chosen by a TOML include: "unitless" takes
+    // the values as W/sr and W/m^2, "raw" takes a point light's as Blender's watts (W / 4 pi
+    // per steradian); a name outside the list is an error naming the field.
+    let include = |glb: &str, units: &str| {
+        let toml =
+            format!("[camera]\n{CAMERA}\n[[gltf]]\nfile = \"{glb}\"\nlight_units = \"{units}\"\n");
+        twinpath::scene::parse_scene(&toml, &dir.join("units.toml"))
+    };
+    let pi4 = 4.0 * std::f32::consts::PI;
+    for (name, spot_i, directional_e) in [
+        ("standard", 8.0, None),
+        ("unitless", 8.0 * 683.0, None),
+        ("raw", 8.0 * 683.0 / pi4, None),
+        ("raw", 0.0, Some(3.0 * 683.0)),
+    ] {
+        let glb = if directional_e.is_some() {
+            "dir.glb"
+        } else {
+            "lights.glb"
+        };
+        let s = include(glb, name).unwrap_or_else(|e| panic!("{e}"));
+        let l = s.scene.lights[0];
+        let expected = directional_e.unwrap_or(spot_i);
+        assert!(
+            (l.radiance[0] - expected).abs() <= 1e-6 * expected,
+            "{name}: {} against {expected}",
+            l.radiance[0]
+        );
+    }
+    let e = include("lights.glb", "lumens").unwrap_err().to_string();
+    assert!(
+        e.contains("gltf[0].light_units") && e.contains("standard, unitless, raw"),
+        "{e}"
     );
 }
 

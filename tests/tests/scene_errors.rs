@@ -591,9 +591,14 @@ fn bad_materials_name_their_field() {
             "unknown field",
         ),
         (
-            "{ kd = [0.5, 0.5, 0.5], emission = [1, 1, 1] }",
+            "{ kd = [0.5, 0.5, 0.5], ks = [0.1, 0.1, 0.1], alpha = 0.2, emission = [1, 1, 1] }",
             "materials.white",
-            "emission and reflection",
+            "more than one of",
+        ),
+        (
+            "{ kd = [0.5, 0.5, 0.5], alpha = 0.2, emission = [1, 1, 1] }",
+            "materials.white",
+            "emission and a glossy lobe",
         ),
         ("{ }", "materials.white", "needs kd"),
     ] {

@@ -154,7 +154,9 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     textures,
                     metallic,
                     roughness,
-                    normal_scale
+                    normal_scale,
+                    layer_f0,
+                    layer_f90
                 ],
                 true
             ),

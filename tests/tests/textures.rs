@@ -8,7 +8,9 @@
 //! 3. A checkered plane under a sphere light matches the closed form kd(square) L (r/D)^2 cos in
 //!    every pixel inside a square, on both backends; the same images against the squares'
 //!    colours swapped fail by far (the test's power).
-//! 4. PNG, JPEG and EXR maps load; scene errors: a texture on a sphere, on a mesh without
+//! 4. A record's coordinate map (glTF's `KHR_texture_transform`) applies before the lookup,
+//!    (a u + b v + c, d u + e v + f), and the records of one image share its texels.
+//! 5. PNG, JPEG and EXR maps load; scene errors: a texture on a sphere, on a mesh without
 //!    texture coordinates, on metal, a missing file, an unknown wrap, maps that would reflect more
 //!    than they receive.
 
@@ -16,7 +18,7 @@ use glam::{Vec2, Vec3};
 use kernel::texture::{flags, lookup, wrap, LINEAR_TABLE, SRGB_TABLE};
 use std::path::{Path, PathBuf};
 use twinpath::render::Backend;
-use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse};
+use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse, UvTransform};
 use twinpath::scene::{parse_scene, SceneFile};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
@@ -174,6 +176,7 @@ fn lookup_is_bilinear_between_texel_centres_repeated_clamped_or_mirrored() {
         let usage = TextureUse {
             colour: srgb,
             wrap: mode,
+            transform: None,
         };
         table.push(
             Path::new("generated"),
@@ -493,4 +496,46 @@ fn memory_report_lists_tables_and_textures() {
     let scene = parse_scene(&text, &dir.join("scene.toml")).unwrap();
     // a, b and c read it as colour and repeat; d clamps: two records.
     assert_eq!(scene.scene.textures.textures.len(), 2);
+}
+
+#[test]
+fn a_coordinate_map_applies_before_the_lookup_and_shares_the_texels() {
+    let mut g = SplitMix(0x7e48);
+    let bytes: Vec<u8> = (0..5 * 3 * 4).map(|_| g.u64() as u8).collect();
+    let image = image::DynamicImage::ImageRgba8(image::RgbaImage::from_raw(5, 3, bytes).unwrap());
+    let path = Path::new("generated.png");
+    let usage = |transform| TextureUse {
+        colour: true,
+        wrap: [wrap::REPEAT, wrap::MIRROR],
+        transform,
+    };
+    let mut table = TextureTable::new();
+    let plain = table
+        .add_image(path, image.clone(), usage(None), "map")
+        .unwrap();
+    let size = table.words.len();
+    let map = [0.8f32, -1.2, 0.3, 0.6, 0.4, -0.7];
+    let mapped = table
+        .add_image(path, image, usage(Some(UvTransform(map))), "map")
+        .unwrap();
+    assert_ne!(plain, mapped);
+    assert_eq!(
+        table.words.len(),
+        size + kernel::texture::RECORD_WORDS,
+        "a second record, no second copy of the texels"
+    );
+    assert!(table.textures[mapped as usize].flags & flags::TRANSFORM != 0);
+    assert!(table.textures[plain as usize].flags & flags::TRANSFORM == 0);
+    for _ in 0..10_000 {
+        let uv = Vec2::new(g.unit() * 6.0 - 3.0, g.unit() * 6.0 - 3.0);
+        let moved = Vec2::new(
+            map[0] * uv.x + map[1] * uv.y + map[2],
+            map[3] * uv.x + map[4] * uv.y + map[5],
+        );
+        assert_eq!(
+            lookup(&table.words, mapped, uv),
+            lookup(&table.words, plain, moved),
+            "at {uv}"
+        );
+    }
 }

@@ -30,12 +30,39 @@ pub struct TextureInfo {
     pub height: u32,
 }
 
-/// How a texture is read: as colour (sRGB-encoded 8-bit images) or as linear data, and how
-/// coordinates outside [0, 1] wrap along u and v (`kernel::texture::wrap`).
+/// How a texture is read: as colour (sRGB-encoded 8-bit images) or as linear data, how
+/// coordinates outside [0, 1] wrap along u and v (`kernel::texture::wrap`), and the map the
+/// coordinates go through first, if any (glTF's `KHR_texture_transform`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TextureUse {
     pub colour: bool,
     pub wrap: [u32; 2],
+    pub transform: Option<UvTransform>,
+}
+
+/// An affine map of texture coordinates in the kernel's convention (v up), row-major
+/// [a, b, c, d, e, f]: (u, v) -> (a u + b v + c, d u + e v + f); equal when bit for bit equal.
+#[derive(Clone, Copy, Debug)]
+pub struct UvTransform(pub [f32; 6]);
+
+impl PartialEq for UvTransform {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.map(f32::to_bits) == other.0.map(f32::to_bits)
+    }
+}
+
+impl Eq for UvTransform {}
+
+impl UvTransform {
+    /// The map that changes nothing.
+    pub const IDENTITY: Self = Self([1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+}
+
+/// The texels of a new record: its own, or those of record k (the same image, read through
+/// another decoding table, wrap mode or coordinate map).
+enum Texels<'a> {
+    Own(&'a [u32]),
+    SharedWith(usize),
 }
 
 /// The sRGB decoding of byte `b` (IEC 61966-2-1), in f64.
@@ -87,7 +114,11 @@ impl TextureTable {
             .with_guessed_format()
             .map_err(|e| err(format!("cannot read: {e}")))?
             .decode()
-            .map_err(|e| err(format!("not a readable PNG, JPEG, EXR or HDR image: {e}")))?;
+            .map_err(|e| {
+                err(format!(
+                    "not a readable PNG, JPEG, WebP, EXR or HDR image: {e}"
+                ))
+            })?;
         self.add_image(path, image, usage, field)
     }
 
@@ -123,6 +154,9 @@ impl TextureTable {
             image::ColorType::Rgb32F | image::ColorType::Rgba32F
         );
         let mut tex_flags = flags::wrap(usage.wrap[0], usage.wrap[1]);
+        if usage.transform.is_some() {
+            tex_flags |= flags::TRANSFORM;
+        }
         let texels: Vec<u32> = if float {
             tex_flags |= flags::FLOAT;
             let rgb = image.into_rgb32f();
@@ -150,14 +184,22 @@ impl TextureTable {
                 .collect()
         };
         // Used another way that reads the same (a float image as colour and as linear data).
-        if let Some(k) = self
-            .textures
-            .iter()
-            .position(|t| t.path == path && t.flags == tex_flags)
-        {
+        if let Some(k) = self.textures.iter().position(|t| {
+            t.path == path && t.flags == tex_flags && t.usage.transform == usage.transform
+        }) {
             return Ok(k as u32);
         }
-        self.push(path, usage, tex_flags, width, height, &texels);
+        // The same texels under another decoding, wrap mode or coordinate map: shared, not
+        // copied (an 8-bit image's words are its bytes whichever table decodes them).
+        let source = match self
+            .textures
+            .iter()
+            .position(|t| t.path == path && t.flags & flags::FLOAT == tex_flags & flags::FLOAT)
+        {
+            Some(k) => Texels::SharedWith(k),
+            None => Texels::Own(&texels),
+        };
+        self.push_record(path, usage, tex_flags, width, height, source);
         Ok(self.textures.len() as u32 - 1)
     }
 
@@ -203,6 +245,19 @@ impl TextureTable {
         height: u32,
         texels: &[u32],
     ) {
+        self.push_record(path, usage, tex_flags, width, height, Texels::Own(texels));
+    }
+
+    /// [`TextureTable::push`] of a record whose texels are its own or an earlier record's.
+    fn push_record(
+        &mut self,
+        path: &Path,
+        usage: TextureUse,
+        tex_flags: u32,
+        width: u32,
+        height: u32,
+        texels: Texels,
+    ) {
         // The texels of the textures so far, after their records.
         let old_records = RECORDS + RECORD_WORDS * self.textures.len();
         let old_texels = self.words.split_off(old_records);
@@ -219,10 +274,15 @@ impl TextureTable {
         for k in 0..n - 1 {
             self.words[RECORDS + RECORD_WORDS * k] += shift;
         }
-        let first = (RECORDS + RECORD_WORDS * n + old_texels.len()) as u32;
+        let (first, own) = match texels {
+            Texels::Own(t) => ((RECORDS + RECORD_WORDS * n + old_texels.len()) as u32, t),
+            Texels::SharedWith(k) => (self.words[RECORDS + RECORD_WORDS * k], &[][..]),
+        };
+        let map = usage.transform.unwrap_or(UvTransform::IDENTITY).0;
         self.words
             .extend_from_slice(&[first, width, height, tex_flags]);
+        self.words.extend(map.map(f32::to_bits));
         self.words.extend_from_slice(&old_texels);
-        self.words.extend_from_slice(texels);
+        self.words.extend_from_slice(own);
     }
 }

@@ -10,9 +10,18 @@ use spirv_std::glam::Vec3;
 /// F0 = Ks. `cos` is clamped to [0, 1].
 #[inline]
 pub fn schlick(f0: Vec3, cos: f32) -> Vec3 {
+    schlick_f90(f0, 1.0, cos)
+}
+
+/// Schlick's approximation with reflectance `f90` at grazing incidence instead of 1,
+/// f0 + (f90 - f0) (1 - cos)^5 (`cos` clamped to [0, 1]): glTF's `KHR_materials_specular`
+/// scales a dielectric's Fresnel curve by its specularFactor this way. With `f90` = 1 it is
+/// [`schlick`] bit for bit.
+#[inline]
+pub fn schlick_f90(f0: Vec3, f90: f32, cos: f32) -> Vec3 {
     let m = 1.0 - cos.clamp(0.0, 1.0);
     let m2 = m * m;
-    f0 + (Vec3::ONE - f0) * (m2 * m2 * m)
+    f0 + (Vec3::splat(f90) - f0) * (m2 * m2 * m)
 }
 
 /// Unpolarised reflectance of a conductor of complex index of refraction eta + i k (relative to

@@ -3,7 +3,7 @@
 //! and resolved at each point ([`resolve`], after its textures) into the `mixture`'s Kd + Ks
 //! form with the dielectric layer, which evaluates and samples it.
 
-use super::mixture::{self, LAYER_F0};
+use super::mixture;
 use super::{BsdfFlags, BsdfSample};
 use crate::features;
 use crate::scene::Material;
@@ -19,20 +19,21 @@ pub const FLAGS: BsdfFlags = mixture::FLAGS;
 /// `metallic` and `roughness` as textures left them:
 ///
 /// `mix(dielectric_brdf, metal_brdf, metallic)` with
-/// `dielectric_brdf = fresnel_mix(0.04; diffuse(base), specular)` and
-/// `metal_brdf = specular * F_Schlick(F0 = base)`. The specular lobes share D and G, and
-/// Schlick's F is affine in F0, so their sum is one GGX lobe with
-/// F_Schlick(F0 = lerp(0.04, base, metallic)) (`specular`), and the diffuse part is
-/// `(1 - metallic) base / pi` (`albedo`) weighed by 1 - F_Schlick(0.04, |wo . h|) (the
-/// mixture's layer); alpha = roughness^2. The kind stays METALLIC_ROUGHNESS, which is what
-/// selects that weight.
+/// `dielectric_brdf = fresnel_mix(layer_f0, layer_f90; diffuse(base), specular)` (0.04 and 1
+/// by default; `KHR_materials_specular` and `KHR_materials_ior` set them) and
+/// `metal_brdf = specular * F_Schlick(F0 = base, F90 = 1)`. The specular lobes share D and G,
+/// and Schlick's F is affine in F0 and F90, so their sum is one GGX lobe with
+/// F0 = lerp(layer_f0, base, metallic) (`specular`) and F90 = lerp(layer_f90, 1, metallic)
+/// (`mixture::glossy_f90`), and the diffuse part is `(1 - metallic) base / pi` (`albedo`)
+/// weighed by 1 - max F_Schlick(layer_f0, layer_f90, |wo . h|) (the mixture's layer);
+/// alpha = roughness^2. The kind stays METALLIC_ROUGHNESS, which is what selects that weight.
 #[inline]
 pub fn resolve(m: &Material) -> Material {
     let mut r = *m;
     let base = Vec3::from(m.albedo);
     let metallic = m.metallic;
     r.albedo = (base * (1.0 - metallic)).to_array();
-    r.specular = (Vec3::splat(LAYER_F0) * (1.0 - metallic) + base * metallic).to_array();
+    r.specular = (Vec3::from(m.layer_f0) * (1.0 - metallic) + base * metallic).to_array();
     r.alpha = m.roughness * m.roughness;
     r
 }

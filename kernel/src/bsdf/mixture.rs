@@ -1,10 +1,12 @@
 //! The seed's Kd + Ks BRDF (`material_kind::GLOSSY`): a Lambertian lobe Kd / pi plus a GGX
-//! microfacet lobe with Schlick's Fresnel (F0 = Ks), each sampled in proportion to an estimate
-//! of its albedo. With `layered`, the Lambertian lobe lies under a dielectric layer of
-//! reflectance F0 [`LAYER_F0`] and is weighed by the share it lets through (glTF's
-//! `fresnel_mix`, which `metallic_roughness` resolves into this form).
+//! microfacet lobe with Schlick's Fresnel (F0 = Ks, F90 [`glossy_f90`]), each sampled in
+//! proportion to an estimate of its albedo. With `layered`, the Lambertian lobe lies under a
+//! dielectric layer of reflectance `layer_f0` at normal incidence and `layer_f90` at grazing
+//! (`crate::scene::LAYER_F0` and 1 by default) and is weighed by the share it lets through (glTF's
+//! `fresnel_mix` with `KHR_materials_specular`'s weight and colour, which `metallic_roughness`
+//! resolves into this form).
 
-use super::fresnel::schlick;
+use super::fresnel::schlick_f90;
 use super::lambert::sample_brdf;
 use super::microfacet::{reflection, sample_visible_normal};
 use super::{reflect, BsdfFlags, BsdfSample, DELTA_ALPHA};
@@ -22,17 +24,13 @@ pub const FLAGS: BsdfFlags = BsdfFlags {
     chooses_lobe: true,
 };
 
-/// The dielectric layer's reflectance at normal incidence, ((1 - 1.5) / (1 + 1.5))^2 (glTF 2.0,
-/// Appendix B, "dielectric_brdf", index 1.5).
-pub const LAYER_F0: f32 = 0.04;
-
 /// The probability that the mixture samples its glossy lobe from `wo` at cosine `cos_o`: each
 /// lobe in proportion to an estimate of its albedo, mean(Kd) for the diffuse and
 /// mean(F_Schlick(cos_o)) for the glossy (the masking left out); 0 when both are 0.
 #[inline]
 pub fn glossy_lobe_probability(m: &Material, cos_o: f32) -> f32 {
     let fd = Vec3::from(m.albedo).dot(Vec3::ONE);
-    let fs = schlick(Vec3::from(m.specular), cos_o).dot(Vec3::ONE);
+    let fs = schlick_f90(Vec3::from(m.specular), glossy_f90(m), cos_o).dot(Vec3::ONE);
     if fd + fs > 0.0 {
         fs / (fd + fs)
     } else {
@@ -40,14 +38,24 @@ pub fn glossy_lobe_probability(m: &Material, cos_o: f32) -> f32 {
     }
 }
 
-/// The factor on the Kd lobe for light from `wi` toward `wo`: 1 without the layer, and with it
-/// the share the layer lets through, 1 - F_Schlick(F0 = [`LAYER_F0`], |wo . h|) at the half
-/// vector h of `wo` and `wi` (Appendix B's `fresnel_mix`).
+/// The glossy lobe's reflectance at grazing incidence: the layer's `layer_f90` blended toward a
+/// metal's 1 by `metallic` (Schlick's F is affine in F0 and F90, so the dielectric's and the
+/// metal's specular terms sum to one Schlick curve); 1 for GLOSSY (`layer_f90` 1, `metallic`
+/// 0), exactly.
 #[inline]
-fn diffuse_share(layered: bool, wo: Vec3, wi: Vec3) -> f32 {
+pub fn glossy_f90(m: &Material) -> f32 {
+    m.layer_f90 + (1.0 - m.layer_f90) * m.metallic
+}
+
+/// The factor on the Kd lobe for light from `wi` toward `wo`: 1 without the layer, and with it
+/// the share the layer lets through, 1 - max over channels of F_Schlick(`layer_f0`,
+/// `layer_f90`, |wo . h|) at the half vector h of `wo` and `wi` (Appendix B's `fresnel_mix`
+/// as `KHR_materials_specular` extends it: `1 - weight * max_value(fr)`).
+#[inline]
+fn diffuse_share(m: &Material, layered: bool, wo: Vec3, wi: Vec3) -> f32 {
     if layered {
         let h = (wo + wi).normalize();
-        1.0 - schlick(Vec3::splat(LAYER_F0), wo.dot(h).abs()).x
+        1.0 - schlick_f90(Vec3::from(m.layer_f0), m.layer_f90, wo.dot(h).abs()).max_element()
     } else {
         1.0
     }
@@ -65,11 +73,11 @@ pub fn eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, layered: bool) -> (Vec3, 
     }
     let p_glossy = glossy_lobe_probability(m, cos_o);
     let c = cos_i * (1.0 / PI);
-    let mut f = Vec3::from(m.albedo) * (c * diffuse_share(layered, wo, wi));
+    let mut f = Vec3::from(m.albedo) * (c * diffuse_share(m, layered, wo, wi));
     let mut pdf = (1.0 - p_glossy) * c;
     if !(m.alpha < DELTA_ALPHA) {
         let r = reflection(n, wo, wi, cos_o, cos_i, m.alpha);
-        f += schlick(Vec3::from(m.specular), wi.dot(r.h)) * r.value;
+        f += schlick_f90(Vec3::from(m.specular), glossy_f90(m), wi.dot(r.h)) * r.value;
         pdf += p_glossy * r.pdf;
     }
     (f, pdf)
@@ -97,7 +105,7 @@ pub fn sample(
         return BsdfSample::mirror(
             n,
             reflect(wo, n),
-            schlick(Vec3::from(m.specular), cos_o) / p_glossy,
+            schlick_f90(Vec3::from(m.specular), glossy_f90(m), cos_o) / p_glossy,
         );
     }
     let wi = if glossy {
@@ -107,7 +115,7 @@ pub fn sample(
     };
     if smooth {
         // The diffuse lobe beside a delta one: (Kd/pi cos) / ((1 - p) cos/pi), exactly.
-        let weight = Vec3::from(m.albedo) * (diffuse_share(layered, wo, wi) / (1.0 - p_glossy));
+        let weight = Vec3::from(m.albedo) * (diffuse_share(m, layered, wo, wi) / (1.0 - p_glossy));
         return BsdfSample::reflected(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
     }
     let (f, pdf) = eval(m, n, wo, wi, layered);

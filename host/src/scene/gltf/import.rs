@@ -2,6 +2,7 @@
 //! (`meshes`, `material`, `images`, `camera`, `lights`) reads and adds to, and the limit on
 //! what it may add. The node walk that drives them is in `mod.rs`.
 
+use super::LightUnits;
 use crate::scene::builder::SceneTables;
 use gltf::Document;
 use std::collections::HashMap;
@@ -20,6 +21,8 @@ pub(super) struct Import<'a> {
     pub(super) buffers: Vec<gltf::buffer::Data>,
     pub(super) tables: &'a mut SceneTables,
     pub(super) notes: &'a mut Vec<String>,
+    /// How the file's light intensities read.
+    pub(super) light_units: LightUnits,
     /// Kernel material of each glTF material index (`None`: the default material).
     pub(super) materials: HashMap<Option<usize>, u32>,
     /// How many nodes of the scene use each mesh (by glTF index).

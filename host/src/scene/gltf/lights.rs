@@ -1,4 +1,5 @@
-//! A glTF node's `KHR_lights_punctual` light: point, spot or directional, in twinpath's units.
+//! A glTF node's `KHR_lights_punctual` light: point, spot or directional, converted from the
+//! file's photometric units into twinpath's radiometric ones (`super::LightUnits`).
 
 use super::import::Import;
 use crate::scene::SceneError;
@@ -6,10 +7,10 @@ use glam::{DMat4, DVec4, Vec3};
 
 impl Import<'_> {
     /// Adds `KHR_lights_punctual` light `light` of `node` at `world`: a point or spot light at
-    /// the node's origin, a spot pointing down the node's -z; colour x intensity is its radiant
-    /// intensity (the extension's candela taken as RGB watts per steradian); `range` is ignored
-    /// (physical falloff). A directional light shines down the node's -z with colour x
-    /// intensity as its irradiance (lux taken as RGB watts per square metre).
+    /// the node's origin, a spot pointing down the node's -z, of radiant intensity colour x
+    /// intensity in the import's `LightUnits`; `range` is ignored (physical falloff). A
+    /// directional light shines down the node's -z, its irradiance colour x intensity in those
+    /// units.
     pub(super) fn add_light(
         &mut self,
         node: &gltf::Node,
@@ -20,7 +21,9 @@ impl Import<'_> {
         let field = format!("KHR_lights_punctual.lights[{}]", light.index());
         let path = self.path.clone();
         let err = |msg: String| SceneError::new(&path, None, field.clone(), msg);
-        let intensity = Vec3::from(light.color()) * light.intensity();
+        let directional = matches!(light.kind(), Kind::Directional);
+        let intensity = Vec3::from(light.color())
+            * self.light_units.radiometric(light.intensity(), directional);
         if !(intensity.is_finite() && intensity.min_element() >= 0.0) {
             return Err(err(format!(
                 "colour x intensity {:?} must be finite and >= 0",

@@ -1,16 +1,15 @@
 //! glTF materials onto the kernel's: the metallic-roughness model as the specification's
-//! Appendix B defines it (`material_kind::METALLIC_ROUGHNESS`), emissive materials as lights,
+//! Appendix B defines it (`material_kind::METALLIC_ROUGHNESS`), its dielectric layer as
+//! `KHR_materials_specular` and `KHR_materials_ior` change it, emissive materials as lights,
 //! `KHR_materials_transmission` with `KHR_materials_ior` as the dielectric. What is approximated
 //! or ignored is noted (`Scene::notes`); docs/gltf.md lists it.
 
 use super::import::Import;
+use super::textures::{normal_texture, texture};
 use crate::scene::limits::IOR_RANGE;
-use crate::scene::textures::TextureUse;
 use crate::scene::SceneError;
 use glam::Vec3;
-use gltf::texture::WrappingMode;
 use kernel::scene::{material_kind, texture_slot, Material};
-use kernel::texture::wrap;
 
 /// The kernel material for glTF material `m` (`None`: the specification's default material,
 /// white, metallic 1, roughness 1), its textures loaded.
@@ -72,20 +71,14 @@ pub(super) fn material(
             emission.to_array()
         )));
     }
-    if emission.max_element() > 0.0 {
-        imp.note(format!(
-            "{label}: emits, so it is a light, which reflects nothing (its base colour is dropped)"
-        ));
-        let mut out = Material::emitter(emission.to_array());
-        out.two_sided = m.double_sided() as u32;
-        if let Some(info) = m.emissive_texture() {
-            out.textures[texture_slot::EMISSION] = texture(imp, &label, &info, true)?;
-        }
-        return Ok(out);
-    }
+    let emits = emission.max_element() > 0.0;
 
     if let Some(t) = m.transmission() {
-        if t.transmission_factor() > 0.0 {
+        if t.transmission_factor() > 0.0 && emits {
+            imp.note(format!(
+                "{label}: emits and transmits: rendered as a light on the opaque material"
+            ));
+        } else if t.transmission_factor() > 0.0 {
             let ior = m.ior().unwrap_or(1.5);
             let (lo, hi) = IOR_RANGE;
             if !(lo..=hi).contains(&ior) {
@@ -117,6 +110,16 @@ pub(super) fn material(
     out.kind = material_kind::METALLIC_ROUGHNESS;
     out.metallic = metallic;
     out.roughness = roughness;
+    (out.layer_f0, out.layer_f90) = dielectric_layer(imp, &label, &m, &err)?;
+    if emits {
+        // A light (its triangles in the light table) that reflects as its material does, as
+        // a Principled BSDF with emission does in Blender.
+        out.emission = emission.to_array();
+        out.two_sided = m.double_sided() as u32;
+        if let Some(info) = m.emissive_texture() {
+            out.textures[texture_slot::EMISSION] = texture(imp, &label, &info, true)?;
+        }
+    }
     if let Some(info) = pbr.base_color_texture() {
         out.textures[texture_slot::KD] = texture(imp, &label, &info, true)?;
     }
@@ -124,6 +127,52 @@ pub(super) fn material(
         out.textures[texture_slot::KS] = texture(imp, &label, &info, false)?;
     }
     normal_map(imp, &label, &m, out)
+}
+
+/// The dielectric layer of opaque material `m` (`Material::layer_f0`, `layer_f90`): its
+/// reflectance at normal incidence min(((ior - 1) / (ior + 1))^2 x specularColorFactor, 1) x
+/// specularFactor and at grazing incidence specularFactor (`KHR_materials_ior`, default 1.5;
+/// `KHR_materials_specular`, defaults 1 and white). The extension's two textures are noted and
+/// their factors used.
+fn dielectric_layer(
+    imp: &mut Import,
+    label: &str,
+    m: &gltf::Material,
+    err: &dyn Fn(String) -> SceneError,
+) -> Result<([f32; 3], f32), SceneError> {
+    let ior = m.ior().unwrap_or(1.5);
+    // The specification allows 0 (the specular-glossiness conversion: F0 = 1) and any index
+    // >= 1.
+    if !(ior == 0.0 || (1.0..=IOR_RANGE.1).contains(&ior)) {
+        return Err(err(format!(
+            "KHR_materials_ior {ior} of an opaque material must be 0 or within 1..={}",
+            IOR_RANGE.1
+        )));
+    }
+    let (factor, colour) = match m.specular() {
+        None => (1.0, [1.0; 3]),
+        Some(s) => {
+            if s.specular_texture().is_some() || s.specular_color_texture().is_some() {
+                imp.note(format!(
+                    "{label}: KHR_materials_specular textures ignored (its factors are used)"
+                ));
+            }
+            (s.specular_factor(), s.specular_color_factor())
+        }
+    };
+    if !(0.0..=1.0).contains(&factor) {
+        return Err(err(format!(
+            "KHR_materials_specular.specularFactor {factor} is outside 0..=1"
+        )));
+    }
+    if !colour.iter().all(|c| c.is_finite() && *c >= 0.0) {
+        return Err(err(format!(
+            "KHR_materials_specular.specularColorFactor {colour:?} must be finite and >= 0"
+        )));
+    }
+    let f0 = ((ior as f64 - 1.0) / (ior as f64 + 1.0)).powi(2);
+    let layer_f0 = colour.map(|c| ((f0 * c as f64).min(1.0) * factor as f64) as f32);
+    Ok((layer_f0, factor))
 }
 
 /// `out` with glTF material `m`'s `normalTexture` (linear) and its scale, where it has one.
@@ -144,45 +193,7 @@ fn normal_map(
             format!("{} is not finite", n.scale()),
         ));
     }
-    out.textures[texture_slot::NORMAL] = texture_of(imp, label, n.texture(), n.tex_coord(), false)?;
+    out.textures[texture_slot::NORMAL] = normal_texture(imp, label, &n)?;
     out.normal_scale = n.scale();
     Ok(out)
-}
-
-/// The texture table's index of the image behind `info`, read as colour (sRGB) or linear data,
-/// wrapping along u and v as its sampler's `wrapS` and `wrapT` say.
-fn texture(
-    imp: &mut Import,
-    label: &str,
-    info: &gltf::texture::Info,
-    colour: bool,
-) -> Result<u32, SceneError> {
-    texture_of(imp, label, info.texture(), info.tex_coord(), colour)
-}
-
-/// [`texture`] for texture `tex` read with texture coordinates `tex_coord`.
-fn texture_of(
-    imp: &mut Import,
-    label: &str,
-    tex: gltf::Texture,
-    tex_coord: u32,
-    colour: bool,
-) -> Result<u32, SceneError> {
-    if tex_coord != 0 {
-        imp.note(format!(
-            "{label}: textures[{}] names TEXCOORD_{tex_coord}; TEXCOORD_0 is used",
-            tex.index(),
-        ));
-    }
-    let sampler = tex.sampler();
-    let mode = |m: WrappingMode| match m {
-        WrappingMode::Repeat => wrap::REPEAT,
-        WrappingMode::ClampToEdge => wrap::CLAMP,
-        WrappingMode::MirroredRepeat => wrap::MIRROR,
-    };
-    let usage = TextureUse {
-        colour,
-        wrap: [mode(sampler.wrap_s()), mode(sampler.wrap_t())],
-    };
-    imp.image(tex.source().index(), usage)
 }

@@ -10,12 +10,15 @@ mod accessor;
 mod camera;
 mod images;
 mod import;
+mod light_units;
 mod lights;
 mod material;
 mod meshes;
+mod textures;
 
 pub use camera::{GltfCamera, IMAGE_HEIGHT, IMAGE_WIDTH};
 pub use import::MAX_TRIANGLES;
+pub use light_units::{LightUnits, LUMENS_PER_WATT};
 
 use camera::framing_camera;
 use import::Import;
@@ -32,10 +35,13 @@ use std::path::Path;
 
 /// The extensions read (docs/gltf.md); any other a file uses is noted, and one it requires is
 /// an error.
-pub const SUPPORTED_EXTENSIONS: [&str; 4] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 7] = [
+    "EXT_texture_webp",
     "KHR_materials_emissive_strength",
     "KHR_materials_transmission",
     "KHR_materials_ior",
+    "KHR_materials_specular",
+    "KHR_texture_transform",
     "KHR_lights_punctual",
 ];
 
@@ -84,16 +90,23 @@ fn parse_document(
             }
         }
     }
-    let document = gltf::Document::from_json(json).map_err(invalid)?;
-    if let Some(e) = document
-        .extensions_required()
-        .find(|e| !SUPPORTED_EXTENSIONS.contains(e))
+    let mut json = json;
+    image_sources(path, &mut json)?;
+    if let Some(e) = json
+        .extensions_required
+        .iter()
+        .find(|e| !SUPPORTED_EXTENSIONS.contains(&e.as_str()))
     {
         return Err(err(
             "extensionsRequired",
             format!("requires {e}, which twinpath does not read"),
         ));
     }
+    // Read here (`image_sources`) but unknown to the gltf crate, whose validation refuses an
+    // unknown required extension.
+    json.extensions_required
+        .retain(|e| e.as_str() != "EXT_texture_webp");
+    let document = gltf::Document::from_json(json).map_err(invalid)?;
     let ignored: Vec<&str> = document
         .extensions_used()
         .filter(|e| !SUPPORTED_EXTENSIONS.contains(e))
@@ -118,6 +131,38 @@ fn parse_document(
     Ok((document, buffers))
 }
 
+/// Gives each texture whose image only an extension names its image: `EXT_texture_webp`'s
+/// (which Blender's exporter writes for WebP images, without a PNG fallback unless asked).
+/// A texture only `KHR_texture_basisu` names (KTX2) is an error naming it. A texture with its
+/// own `source` keeps it (the extensions' fallback rule).
+fn image_sources(path: &Path, json: &mut gltf::json::Root) -> Result<(), SceneError> {
+    for (i, t) in json.textures.iter_mut().enumerate() {
+        if t.source.value() != u32::MAX as usize {
+            continue;
+        }
+        let named = |ext: &str| {
+            t.extensions
+                .as_ref()
+                .and_then(|e| e.others.get(ext))
+                .and_then(|v| v.get("source"))
+                .and_then(|s| s.as_u64())
+                .and_then(|s| u32::try_from(s).ok())
+        };
+        if let Some(k) = named("EXT_texture_webp") {
+            t.source = gltf::json::Index::new(k);
+        } else if named("KHR_texture_basisu").is_some() {
+            return Err(SceneError::new(
+                path,
+                None,
+                format!("textures[{i}]"),
+                "is a KTX2 (Basis Universal) image, KHR_texture_basisu, which twinpath does not \
+                 read: export the file's images as PNG, JPEG or WebP",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Loads glTF file `path` as a whole scene: its default scene's meshes under a uniform white
 /// sky, seen through the perspective camera named `camera` (default:
 /// the first; without any, a camera framing the scene).
@@ -138,7 +183,15 @@ pub fn load_bytes(
 ) -> Result<Scene, SceneError> {
     let mut tables = SceneTables::default();
     let mut notes = Vec::new();
-    let cameras = import(&mut tables, path, bytes, base, None, &mut notes)?;
+    let cameras = import(
+        &mut tables,
+        path,
+        bytes,
+        base,
+        None,
+        LightUnits::Standard,
+        &mut notes,
+    )?;
     let desc = match camera {
         Some(name) => {
             cameras
@@ -180,18 +233,27 @@ pub fn load_bytes(
     Ok(scene)
 }
 
-/// Reads glTF file `path` into `tables` under `transform` (a TOML scene's `[[gltf]]`); the
-/// file's perspective cameras, placed in the scene.
+/// Reads glTF file `path` into `tables` under `transform` (a TOML scene's `[[gltf]]`), its
+/// lights in `light_units`; the file's perspective cameras, placed in the scene.
 pub(super) fn include(
     tables: &mut SceneTables,
     path: &Path,
     transform: Option<&Transform>,
+    light_units: LightUnits,
     notes: &mut Vec<String>,
 ) -> Result<Vec<GltfCamera>, SceneError> {
     let bytes = inputs::read(path)
         .map_err(|e| SceneError::new(path, None, "file", format!("cannot read: {e}")))?;
     let base = path.parent().unwrap_or(Path::new("."));
-    import(tables, path, &bytes, Some(base), transform, notes)
+    import(
+        tables,
+        path,
+        &bytes,
+        Some(base),
+        transform,
+        light_units,
+        notes,
+    )
 }
 
 /// Reads the glTF file of `bytes` into `tables` (see [`load_bytes`] for `base`).
@@ -201,6 +263,7 @@ fn import(
     bytes: &[u8],
     base: Option<&Path>,
     transform: Option<&Transform>,
+    light_units: LightUnits,
     notes: &mut Vec<String>,
 ) -> Result<Vec<GltfCamera>, SceneError> {
     let (document, buffers) = parse_document(path, bytes, base, notes)?;
@@ -211,6 +274,7 @@ fn import(
         buffers,
         tables,
         notes,
+        light_units,
         materials: HashMap::new(),
         mesh_uses: HashMap::new(),
         instanceable: HashMap::new(),

@@ -21,6 +21,9 @@ pub(super) struct GltfFile {
     pub rotate: Option<Spanned<[f32; 4]>>,
     pub translate: Option<V3>,
     pub matrix: Option<Spanned<[[f32; 4]; 4]>>,
+    /// How the file's `KHR_lights_punctual` intensities read (`gltf::LightUnits::NAMES`;
+    /// default "standard": candela and lux).
+    pub light_units: Option<Spanned<String>>,
 }
 
 /// A perspective camera of an included glTF file, placed in the scene, and the file.
@@ -56,7 +59,28 @@ pub(super) fn add_gltf(
         } else {
             None
         };
-        for camera in gltf::include(tables, &gltf_path, transform.as_ref(), &mut notes)? {
+        let light_units = match &gf.light_units {
+            None => gltf::LightUnits::default(),
+            Some(name) => gltf::LightUnits::from_name(name.get_ref()).ok_or_else(|| {
+                ck.err(
+                    name.span(),
+                    &format!("{field}.light_units"),
+                    format!(
+                        "'{}' is not one of {}",
+                        name.get_ref(),
+                        gltf::LightUnits::NAMES.join(", ")
+                    ),
+                )
+            })?,
+        };
+        let file_cameras = gltf::include(
+            tables,
+            &gltf_path,
+            transform.as_ref(),
+            light_units,
+            &mut notes,
+        )?;
+        for camera in file_cameras {
             cameras.push(IncludedCamera {
                 camera,
                 file: gltf_path.clone(),

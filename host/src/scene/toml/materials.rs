@@ -170,16 +170,24 @@ pub(super) fn material(
         None => None,
     };
     if mf.emission.is_some() || mf.emission_map.is_some() {
-        if mf.kd.is_some() || alpha.is_some() || mf.kd_map.is_some() || mf.ks_map.is_some() {
+        if alpha.is_some() || mf.ks_map.is_some() {
             return Err(whole(
-                "has emission and reflection: a light reflects nothing, give emission alone",
+                "has emission and a glossy lobe: a light reflects as a diffuse surface (kd, \
+                 kd_map) or not at all",
             ));
         }
         let radiance = match &mf.emission {
             Some(e) => ck.color(e, &format!("{field}.emission"), None)?,
             None => Vec3::ONE,
         };
-        let mut out = Material::emitter(radiance.to_array());
+        // A light that also reflects diffusely (kd), as a Principled BSDF with emission does.
+        let kd = match &mf.kd {
+            Some(kd) => ck.color(kd, &format!("{field}.kd"), Some(1.0))?,
+            None if mf.kd_map.is_some() => Vec3::ONE,
+            None => Vec3::ZERO,
+        };
+        let mut out = Material::diffuse(kd.to_array());
+        out.emission = radiance.to_array();
         out.two_sided = mf.two_sided.as_ref().is_some_and(|t| *t.get_ref()) as u32;
         return Ok(out);
     }
@@ -488,6 +496,7 @@ pub(super) fn attach_textures(
             TextureUse {
                 colour,
                 wrap: [mode; 2],
+                transform: None,
             },
             &map_field,
         )?;
