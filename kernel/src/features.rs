@@ -8,7 +8,8 @@
 //! answer is the same (`scene_features` derives both from the same parameters).
 
 use crate::scene::{
-    light_sampling, mis, roulette, texture_slot, Material, RenderParams, ShadingTriangle, NONE,
+    light_sampling, mis, roulette, shading_flags, texture_slot, Material, RenderParams,
+    ShadingTriangle, NONE,
 };
 
 /// The bits are answers fixed before the render; without it, they are ignored.
@@ -59,11 +60,17 @@ pub const NORMAL_MAPS: u32 = 1 << 17;
 pub const INSTANCES: u32 = 1 << 18;
 /// Some light's material also reflects (`Material::reflects`): a path that finds it goes on.
 pub const REFLECTING_LIGHTS: u32 = 1 << 19;
+/// Some triangle has vertex colours (`shading_flags::VERTEX_COLOURS`): hits may read them.
+pub const VERTEX_COLOURS: u32 = 1 << 20;
+/// Some texture has a coordinate map (`texture::flags::TRANSFORM`, glTF's
+/// `KHR_texture_transform`): lookups may read it.
+pub const TEXTURE_TRANSFORMS: u32 = 1 << 21;
 
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
 /// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals,
 /// [`NORMAL_MAPS`] and [`SHADING_NORMALS`] if a material has a normal map,
-/// [`REFLECTING_LIGHTS`] if an emitting material reflects.
+/// [`REFLECTING_LIGHTS`] if an emitting material reflects, [`VERTEX_COLOURS`] if a triangle
+/// has vertex colours.
 #[inline]
 pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> u32 {
     let mut f = 0;
@@ -85,8 +92,17 @@ pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> 
     {
         f |= NORMAL_MAPS | SHADING_NORMALS;
     }
-    if shading.iter().any(|s| s.has_normals != 0) {
+    if shading
+        .iter()
+        .any(|s| s.flags & shading_flags::NORMALS != 0)
+    {
         f |= SHADING_NORMALS;
+    }
+    if shading
+        .iter()
+        .any(|s| s.flags & shading_flags::VERTEX_COLOURS != 0)
+    {
+        f |= VERTEX_COLOURS;
     }
     f
 }
@@ -235,6 +251,16 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn triangle_lights(self) -> bool {
         self.answer(TRIANGLE_LIGHTS, true)
+    }
+    /// The generic path asks each texture's record.
+    #[inline]
+    fn texture_transforms(self) -> bool {
+        self.answer(TEXTURE_TRANSFORMS, true)
+    }
+    /// The generic path asks each triangle's record.
+    #[inline]
+    fn vertex_colours(self) -> bool {
+        self.answer(VERTEX_COLOURS, true)
     }
     /// The generic path asks each light's material (`Material::reflects`).
     #[inline]

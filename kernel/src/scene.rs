@@ -43,13 +43,16 @@ pub struct Triangle {
 /// A triangle whose material has a normal map (`texture_slot::NORMAL`) has a second record
 /// right after its own, its tangent frame ([`ShadingTriangle::tangent_frame`]): the three
 /// vertex tangents in `normal0..2` (interpolated like the normals) and the bitangent's sign in
-/// `uv0[0]`, glTF's `TANGENT.w` (bitangent = sign x normal x tangent). Keeping it in the same
-/// table costs nothing to scenes without normal maps and needs no further GPU binding.
+/// `uv0[0]`, glTF's `TANGENT.w` (bitangent = sign x normal x tangent). A triangle with vertex
+/// colours (`shading_flags::VERTEX_COLOURS`, glTF's `COLOR_0`) has one more record after those,
+/// [`ShadingTriangle::vertex_colours`]: the three linear RGB colours in `normal0..2`,
+/// interpolated like the normals, multiplying the base colour. Keeping them in the same table
+/// costs nothing to scenes without them and needs no further GPU binding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
 pub struct ShadingTriangle {
-    /// Vertex normals (any length; ignored unless `has_normals`).
+    /// Vertex normals (any length; ignored without `shading_flags::NORMALS`).
     pub normal0: [f32; 3],
     pub normal1: [f32; 3],
     pub normal2: [f32; 3],
@@ -57,8 +60,18 @@ pub struct ShadingTriangle {
     pub uv0: [f32; 2],
     pub uv1: [f32; 2],
     pub uv2: [f32; 2],
-    /// 1 if the normals shade the triangle, 0 if its geometric normal does.
-    pub has_normals: u32,
+    /// [`shading_flags`]: whether the normals shade the triangle (else its geometric normal
+    /// does) and whether a vertex-colour record follows.
+    pub flags: u32,
+}
+
+/// Bits of [`ShadingTriangle::flags`].
+pub mod shading_flags {
+    /// The vertex normals shade the triangle.
+    pub const NORMALS: u32 = 1 << 0;
+    /// A vertex-colour record ([`super::ShadingTriangle::vertex_colours`]) follows the
+    /// triangle's record (and its tangent frame, where its material has a normal map).
+    pub const VERTEX_COLOURS: u32 = 1 << 1;
 }
 
 impl ShadingTriangle {
@@ -71,7 +84,21 @@ impl ShadingTriangle {
             uv0: [sign, 0.0],
             uv1: [0.0; 2],
             uv2: [0.0; 2],
-            has_normals: 0,
+            flags: 0,
+        }
+    }
+
+    /// The vertex-colour record of a triangle with vertex colours `colours` (linear RGB; see
+    /// the type's documentation).
+    pub const fn vertex_colours(colours: [[f32; 3]; 3]) -> Self {
+        Self {
+            normal0: colours[0],
+            normal1: colours[1],
+            normal2: colours[2],
+            uv0: [0.0; 2],
+            uv1: [0.0; 2],
+            uv2: [0.0; 2],
+            flags: 0,
         }
     }
 }

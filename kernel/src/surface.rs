@@ -21,9 +21,9 @@ use crate::features::FeatureSet;
 use crate::geometry::{blend2, blend3};
 use crate::hit::SurfaceHit;
 use crate::instance::{normal_to_world, vector_to_world};
-use crate::scene::{texture_slot, Material, ShadingTriangle, NONE};
+use crate::scene::{shading_flags, texture_slot, Material, ShadingTriangle, NONE};
 use crate::scene_view::SceneView;
-use crate::texture::{lookup, textured_material};
+use crate::texture::{lookup_in, textured_material};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
@@ -96,7 +96,9 @@ pub fn mapped_normal(
 
 /// The material at the vertex of `hit` (its `SurfaceHit::material`, shading record
 /// `SurfaceHit::shading` and barycentrics): a copy of its table entry in `scene`, with
-/// its textures applied where the scene has any and, for glTF's metallic-roughness material,
+/// its textures applied where the scene has any, its albedo (base colour) times the record's
+/// interpolated vertex colours where it has them (glTF's `COLOR_0`) and, for glTF's
+/// metallic-roughness material,
 /// resolved into the form `crate::bsdf` evaluates (`bsdf::at_point`); and the
 /// unit shading normal (either orientation) where the record's vertex normals or the
 /// material's normal map give one, else zero (the hit shades with its geometric normal).
@@ -115,7 +117,7 @@ pub fn shade<F: FeatureSet>(features: F, scene: &SceneView, hit: &SurfaceHit) ->
     if (features.shading_normals() || features.textures()) && record != NONE {
         let tri = shading[record as usize];
         let instanced = features.instances() && instance != NONE;
-        if features.shading_normals() && tri.has_normals != 0 {
+        if features.shading_normals() && tri.flags & shading_flags::NORMALS != 0 {
             normal = interpolated_normal(&tri, bary);
             if instanced {
                 normal = unit_or(
@@ -126,7 +128,7 @@ pub fn shade<F: FeatureSet>(features: F, scene: &SceneView, hit: &SurfaceHit) ->
         }
         if features.textures() {
             let uv = interpolated_uv(&tri, bary);
-            m = textured_material(&m, textures, uv);
+            m = textured_material(features, &m, textures, uv);
             let map = m.textures[texture_slot::NORMAL];
             if features.normal_maps() && map != NONE {
                 let base = if normal == Vec3::ZERO {
@@ -146,10 +148,29 @@ pub fn shade<F: FeatureSet>(features: F, scene: &SceneView, hit: &SurfaceHit) ->
                     base,
                     &frame,
                     bary,
-                    lookup(textures, map, uv),
+                    lookup_in(features, textures, map, uv),
                     m.normal_scale,
                 );
             }
+        }
+    }
+    if features.vertex_colours() && record != NONE {
+        let tri = shading[record as usize];
+        if tri.flags & shading_flags::VERTEX_COLOURS != 0 {
+            // After the tangent frame, where the material has a normal map.
+            let after = if m.textures[texture_slot::NORMAL] != NONE {
+                2
+            } else {
+                1
+            };
+            let colours = shading[record as usize + after];
+            let colour = blend3(
+                Vec3::from(colours.normal0),
+                Vec3::from(colours.normal1),
+                Vec3::from(colours.normal2),
+                bary,
+            );
+            m.albedo = (Vec3::from(m.albedo) * colour).to_array();
         }
     }
     (bsdf::at_point(features, &m), normal)
@@ -169,7 +190,7 @@ pub fn emission_at<F: FeatureSet>(
     let texture = material.textures[texture_slot::EMISSION];
     if features.textures() && texture != NONE && record != NONE {
         let uv = interpolated_uv(&scene.shading[record as usize], bary);
-        emission * lookup(scene.textures, texture, uv)
+        emission * lookup_in(features, scene.textures, texture, uv)
     } else {
         emission
     }

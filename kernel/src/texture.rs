@@ -19,6 +19,7 @@
 //! the point (pbrt-v4 `Image::Bilerp`, the same weights).
 
 use crate::bsdf;
+use crate::features::{Dynamic, FeatureSet};
 use crate::scene::{texture_slot, Material, NONE};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -225,9 +226,16 @@ fn transformed(table: &[u32], r: usize, uv: Vec2) -> Vec2 {
 /// one), bilinearly filtered (RGB; linear values).
 #[inline]
 pub fn lookup(table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
+    lookup_in(Dynamic(0), table, texture, uv)
+}
+
+/// [`lookup`] in a scene of feature bits `features`: the record's map is looked at only where
+/// the scene has one (`features::TEXTURE_TRANSFORMS`).
+#[inline]
+pub fn lookup_in<F: FeatureSet>(features: F, table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
     let r = RECORDS + RECORD_WORDS * texture as usize;
     let (offset, width, height, tex_flags) = (table[r], table[r + 1], table[r + 2], table[r + 3]);
-    let uv = if tex_flags & flags::TRANSFORM != 0 {
+    let uv = if features.texture_transforms() && tex_flags & flags::TRANSFORM != 0 {
         transformed(table, r, uv)
     } else {
         uv
@@ -253,21 +261,40 @@ pub fn lookup(table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
 /// by the texture's value there (alpha by its red channel; for glTF's metallic-roughness
 /// material the `KS` map's blue channel multiplies metallic and its green roughness).
 #[inline]
-pub fn textured_material(material: &Material, table: &[u32], uv: Vec2) -> Material {
+pub fn textured_material<F: FeatureSet>(
+    features: F,
+    material: &Material,
+    table: &[u32],
+    uv: Vec2,
+) -> Material {
     let mut m = *material;
     let t = material.textures;
     if t[texture_slot::KD] != NONE {
-        m.albedo = (Vec3::from(m.albedo) * lookup(table, t[texture_slot::KD], uv)).to_array();
+        let value = lookup_in(features, table, t[texture_slot::KD], uv);
+        m.albedo = (Vec3::from(m.albedo) * value).to_array();
     }
     if t[texture_slot::KS] != NONE {
-        bsdf::apply_ks_texture(&mut m, lookup(table, t[texture_slot::KS], uv));
+        bsdf::apply_ks_texture(&mut m, lookup_in(features, table, t[texture_slot::KS], uv));
     }
     if t[texture_slot::ALPHA] != NONE {
-        m.alpha *= lookup(table, t[texture_slot::ALPHA], uv).x;
+        m.alpha *= lookup_in(features, table, t[texture_slot::ALPHA], uv).x;
     }
     if t[texture_slot::EMISSION] != NONE {
-        m.emission =
-            (Vec3::from(m.emission) * lookup(table, t[texture_slot::EMISSION], uv)).to_array();
+        let value = lookup_in(features, table, t[texture_slot::EMISSION], uv);
+        m.emission = (Vec3::from(m.emission) * value).to_array();
     }
     m
+}
+
+/// The feature bits the texture table `table` asks for: [`crate::features::TEXTURE_TRANSFORMS`]
+/// if a record has a coordinate map. (Host side: the kernel reads the bits.)
+#[cfg(not(target_arch = "spirv"))]
+pub fn table_features(table: &[u32]) -> u32 {
+    let count = table.first().copied().unwrap_or(0) as usize;
+    let mapped = (0..count).any(|k| table[RECORDS + RECORD_WORDS * k + 3] & flags::TRANSFORM != 0);
+    if mapped {
+        crate::features::TEXTURE_TRANSFORMS
+    } else {
+        0
+    }
 }

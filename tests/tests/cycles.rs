@@ -26,7 +26,8 @@ use twinpath::scene::{parse_scene, SceneFile};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::stats::pixel_z_test;
 use twinpath_tests::{
-    pixel_quadrature, render_film, repo_root, with_independent_samples, z_critical,
+    assert_films_identical, pixel_quadrature, render_film, repo_root, with_independent_samples,
+    z_critical,
 };
 
 const SPP: u32 = 1024;
@@ -197,6 +198,17 @@ fn a_blender_emissive_principled_bsdf_renders_as_cycles_renders_it() {
 #[test]
 fn a_blender_texture_through_a_mapping_node_renders_as_cycles_renders_it() {
     agrees_with_cycles("mapping");
+    // The map is read under `features::TEXTURE_TRANSFORMS`: the specialized path and the
+    // generic one (which reads every record's flags) give the same bits.
+    let f = fixture("mapping");
+    assert!(f.scene.features() & kernel::features::TEXTURE_TRANSFORMS != 0);
+    let mut generic = f.scene.clone();
+    generic.settings.specialize = false;
+    assert_films_identical(
+        &render_film(&f.scene, Backend::Cpu, 16),
+        &render_film(&generic, Backend::Cpu, 16),
+        "specialized against generic",
+    );
 }
 
 #[test]

@@ -163,7 +163,7 @@ fn a_scene_as_toml_and_as_gltf_renders_the_same_bits_on_both_backends() {
         .shading
         .iter()
         .step_by(2)
-        .all(|s| s.has_normals == 1));
+        .all(|s| s.flags == kernel::scene::shading_flags::NORMALS));
     assert_eq!(toml.scene.materials[1].normal_scale, 0.8);
     assert_eq!(toml.scene.materials, gltf.scene.materials, "materials");
     assert_eq!(
@@ -511,7 +511,7 @@ fn texture_channels_srgb_and_the_metallic_roughness_map() {
         uv0: [0.5, 0.5],
         uv1: [0.5, 0.5],
         uv2: [0.5, 0.5],
-        has_normals: 0,
+        flags: 0,
     };
     let (at, _) = twinpath_tests::shade_at(
         0,

@@ -122,7 +122,7 @@ fn the_mapped_normal_is_gltfs_formula() {
             uv0: [0.1, 0.1],
             uv1: [0.9, 0.2],
             uv2: [0.4, 0.8],
-            has_normals: 1,
+            flags: kernel::scene::shading_flags::NORMALS,
         };
         let (_, got) = twinpath_tests::shade_at(
             0,
@@ -137,10 +137,7 @@ fn the_mapped_normal_is_gltfs_formula() {
         );
         close(got, "shade, vertex normals");
         // ...and on the geometric normal where the triangle has none.
-        let flat = ShadingTriangle {
-            has_normals: 0,
-            ..smooth
-        };
+        let flat = ShadingTriangle { flags: 0, ..smooth };
         let (_, got) = twinpath_tests::shade_at(
             0,
             0,

@@ -196,7 +196,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
             binding::SHADING,
             host_layout!(
                 ShadingTriangle,
-                [normal0, normal1, normal2, uv0, uv1, uv2, has_normals],
+                [normal0, normal1, normal2, uv0, uv1, uv2, flags],
                 true
             ),
         ),

@@ -14,7 +14,8 @@ use super::{CameraDesc, Scene, TriangleGroup};
 use bytemuck::Zeroable;
 use glam::Vec3;
 use kernel::scene::{
-    material_kind, texture_slot, Instance, Light, Material, ShadingTriangle, Sphere, Triangle, NONE,
+    material_kind, shading_flags, texture_slot, Instance, Light, Material, ShadingTriangle, Sphere,
+    Triangle, NONE,
 };
 
 /// The tables of a scene being loaded.
@@ -97,11 +98,13 @@ impl SceneTables {
         attributes: Option<ShadingTriangle>,
         tangents: Option<([Vec3; 3], f32)>,
     ) {
-        self.push_triangle_to(Space::World, p, material, attributes, tangents);
+        self.push_triangle_to(Space::World, p, material, attributes, tangents, None);
     }
 
     /// [`SceneTables::push_triangle`] into the world-space table or (`Space::Object`, never a
-    /// light) the instanced meshes' table.
+    /// light) the instanced meshes' table, with vertex `colours` where it has them (a record
+    /// after its own and its tangent frame: `ShadingTriangle::vertex_colours`; `attributes`
+    /// then carries `shading_flags::VERTEX_COLOURS`).
     fn push_triangle_to(
         &mut self,
         space: Space,
@@ -109,6 +112,7 @@ impl SceneTables {
         material: u32,
         attributes: Option<ShadingTriangle>,
         tangents: Option<([Vec3; 3], f32)>,
+        colours: Option<[[f32; 3]; 3]>,
     ) {
         let mut tri = super::triangle(p, material);
         let m = self.materials[material as usize];
@@ -135,6 +139,10 @@ impl SceneTables {
                     }
                 };
                 self.shading.push(frame);
+            }
+            if let Some(c) = colours {
+                debug_assert!(a.flags & shading_flags::VERTEX_COLOURS != 0);
+                self.shading.push(ShadingTriangle::vertex_colours(c));
             }
         }
         if space == Space::Object {
@@ -300,9 +308,17 @@ impl SceneTables {
                 let sign = if mirror { -t[0][3] } else { t[0][3] };
                 (mapped, sign)
             });
-            let attributes = (normals.is_some() || uvs.is_some()).then(|| {
+            let colours = soup.colours.get(k).map(|c| wound(*c, mirror));
+            let attributes = (normals.is_some() || uvs.is_some() || colours.is_some()).then(|| {
                 let n = normals.unwrap_or([[0.0; 3]; 3]);
                 let t = uvs.unwrap_or([[0.0; 2]; 3]);
+                let mut flags = 0;
+                if normals.is_some() {
+                    flags |= shading_flags::NORMALS;
+                }
+                if colours.is_some() {
+                    flags |= shading_flags::VERTEX_COLOURS;
+                }
                 ShadingTriangle {
                     normal0: n[0],
                     normal1: n[1],
@@ -310,10 +326,10 @@ impl SceneTables {
                     uv0: t[0],
                     uv1: t[1],
                     uv2: t[2],
-                    has_normals: normals.is_some() as u32,
+                    flags,
                 }
             });
-            self.push_triangle_to(space, p, material, attributes, tangents);
+            self.push_triangle_to(space, p, material, attributes, tangents, colours);
         }
         Ok(())
     }

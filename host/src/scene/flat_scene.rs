@@ -314,6 +314,7 @@ impl Scene {
                 | kernel::bsdf::material_features(&self.materials)
                 | kernel::light::light_features(&self.lights)
                 | kernel::features::surface_features(&self.materials, &self.shading)
+                | kernel::texture::table_features(&self.textures.words)
                 | if self.instances.is_empty() {
                     0
                 } else {

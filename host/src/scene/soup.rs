@@ -10,6 +10,8 @@ pub struct TriangleSoup {
     pub normals: Vec<[[f32; 3]; 3]>,
     pub uvs: Vec<[[f32; 2]; 3]>,
     pub tangents: Vec<[[f32; 4]; 3]>,
+    /// Linear RGB vertex colours (glTF's `COLOR_0`), multiplying the base colour.
+    pub colours: Vec<[[f32; 3]; 3]>,
 }
 
 impl TriangleSoup {
@@ -24,6 +26,9 @@ impl TriangleSoup {
         }
         if self.tangents.len() != self.triangles.len() {
             self.tangents.clear();
+        }
+        if self.colours.len() != self.triangles.len() {
+            self.colours.clear();
         }
         self
     }

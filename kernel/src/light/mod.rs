@@ -144,7 +144,7 @@ pub fn radiance<F: FeatureSet>(
     let l = &scene.lights[ls.light as usize];
     match l.kind {
         light_kind::TRIANGLE if kinds.triangles && features.textures() => {
-            Vec3::from(l.radiance) * triangle::emission_texture_at(scene.textures, l, ls)
+            Vec3::from(l.radiance) * triangle::emission_texture_at(features, scene.textures, l, ls)
         }
         light_kind::ENVIRONMENT if kinds.environment => environment::radiance(scene, ls),
         light_kind::PUNCTUAL if kinds.delta => punctual::radiance(l, ls),

@@ -4,6 +4,7 @@
 //! radiance at the sampled point.
 
 use super::LightSample;
+use crate::features::FeatureSet;
 use crate::geometry::{
     area_to_solid_angle_pdf, blend2, triangle_barycentrics, triangle_normal, triangle_point,
 };
@@ -130,7 +131,12 @@ fn pdf_given(l: &Light, spherical: Option<SphericalTriangle>, x: Vec3, y: Vec3, 
 /// (1 where the light has no texture): the point's barycentrics on the triangle, its texture
 /// coordinates from the light's `uv`, the texture there.
 #[inline]
-pub fn emission_texture_at(textures: &[u32], l: &Light, ls: &LightSample) -> Vec3 {
+pub fn emission_texture_at<F: FeatureSet>(
+    features: F,
+    textures: &[u32],
+    l: &Light,
+    ls: &LightSample,
+) -> Vec3 {
     if l.emission_texture == NONE {
         return Vec3::ONE;
     }
@@ -146,7 +152,7 @@ pub fn emission_texture_at(textures: &[u32], l: &Light, ls: &LightSample) -> Vec
         Vec2::new(l.uv[4], l.uv[5]),
         bary,
     );
-    texture::lookup(textures, l.emission_texture, uv)
+    texture::lookup_in(features, textures, l.emission_texture, uv)
 }
 
 /// Rounding-error bound of a point sampled on `l` (barycentrics on the triangle): what lifts

@@ -162,6 +162,61 @@ pub(super) fn read_uv(
     read_finite(path, a, buffers, read)
 }
 
+/// Vertex colours (COLOR_n): VEC3 or VEC4 (alpha dropped) of float, or of normalised
+/// unsigned bytes or shorts; linear RGB.
+pub(super) fn read_colour(
+    path: &Path,
+    a: &Accessor,
+    buffers: &[gltf::buffer::Data],
+) -> Result<Vec<[f32; 3]>, SceneError> {
+    let read: fn(&[u8], usize) -> f32 = match (a.data_type(), a.normalized()) {
+        (DataType::F32, _) => f32_at,
+        (DataType::U8, true) => |b, k| b[k] as f32 / 255.0,
+        (DataType::U16, true) => {
+            |b, k| u16::from_le_bytes([b[2 * k], b[2 * k + 1]]) as f32 / 65535.0
+        }
+        _ => {
+            return Err(accessor_error(
+                path,
+                a,
+                format!(
+                    "is {:?} {:?}{}: vertex colours are VEC3 or VEC4 of FLOAT, or of normalized \
+                     UNSIGNED_BYTE or UNSIGNED_SHORT",
+                    a.dimensions(),
+                    a.data_type(),
+                    if a.normalized() { " normalized" } else { "" }
+                ),
+            ))
+        }
+    };
+    let colours = match a.dimensions() {
+        Dimensions::Vec3 => read_finite::<3>(path, a, buffers, read)?,
+        Dimensions::Vec4 => read_finite::<4>(path, a, buffers, read)?
+            .into_iter()
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+        other => {
+            return Err(accessor_error(
+                path,
+                a,
+                format!("is {other:?}: vertex colours are VEC3 or VEC4"),
+            ))
+        }
+    };
+    if let Some((i, c)) = colours
+        .iter()
+        .enumerate()
+        .find(|(_, c)| !c.iter().all(|&x| (0.0..=1.0).contains(&x)))
+    {
+        return Err(accessor_error(
+            path,
+            a,
+            format!("element {i} is {c:?}: colours lie within 0..=1"),
+        ));
+    }
+    Ok(colours)
+}
+
 /// The N-component elements of accessor `a`, component k of an element's bytes `b` being
 /// `read(b, k)`, each component finite.
 fn read_finite<const N: usize>(

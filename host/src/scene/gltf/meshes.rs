@@ -1,7 +1,7 @@
 //! A glTF node's mesh: its triangle primitives read into the tables (flattened into world
 //! space, or stored once and instanced where several nodes use it), with their materials.
 
-use super::accessor::{read_floats, read_indices, read_uv};
+use super::accessor::{read_colour, read_floats, read_indices, read_uv};
 use super::import::{Import, MAX_TRIANGLES};
 use crate::scene::closed_surface::check_closed_outward;
 use crate::scene::instancing::INSTANCE_MIN_TRIANGLES;
@@ -161,9 +161,9 @@ impl Import<'_> {
         Ok(())
     }
 
-    /// The triangles of primitive `p` in object space, with its normals and texture
-    /// coordinates (v flipped: glTF's origin is the image's top left, the kernel's its bottom
-    /// left).
+    /// The triangles of primitive `p` in object space, with its normals, texture coordinates
+    /// (v flipped: glTF's origin is the image's top left, the kernel's its bottom left),
+    /// tangents and vertex colours.
     fn primitive(&self, p: &gltf::Primitive, field: &str) -> Result<TriangleSoup, SceneError> {
         let err = |msg: String| SceneError::new(&self.path, None, field, msg);
         let position = p
@@ -183,10 +183,15 @@ impl Import<'_> {
             Some(a) => Some(read_floats::<4>(&self.path, &a, &self.buffers)?),
             None => None,
         };
+        let colours = match p.get(&gltf::Semantic::Colors(0)) {
+            Some(a) => Some(read_colour(&self.path, &a, &self.buffers)?),
+            None => None,
+        };
         for (name, len) in [
             ("NORMAL", normals.as_ref().map(|v| v.len())),
             ("TEXCOORD_0", uvs.as_ref().map(|v| v.len())),
             ("TANGENT", tangents.as_ref().map(|v| v.len())),
+            ("COLOR_0", colours.as_ref().map(|v| v.len())),
         ] {
             if let Some(len) = len.filter(|&l| l != n) {
                 return Err(err(format!(
@@ -236,6 +241,9 @@ impl Import<'_> {
             }),
             tangents: tangents.map_or_else(Vec::new, |v| {
                 triangles.iter().map(|t| t.map(|i| v[i as usize])).collect()
+            }),
+            colours: colours.map_or_else(Vec::new, |v| {
+                triangles.iter().map(|t| corner(t, &v)).collect()
             }),
         })
     }

@@ -152,7 +152,7 @@ pub(super) fn add_quads(
         uv0: corners[0],
         uv1: corners[1],
         uv2: corners[2],
-        has_normals: 0,
+        flags: 0,
     };
     let quads_start = tables.triangles.len();
     for (i, q) in quads.iter().enumerate() {
