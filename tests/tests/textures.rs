@@ -18,7 +18,7 @@ use glam::{Vec2, Vec3};
 use kernel::texture::{flags, lookup, wrap, LINEAR_TABLE, SRGB_TABLE};
 use std::path::{Path, PathBuf};
 use twinpath::render::Backend;
-use twinpath::scene::textures::{srgb_to_linear, TextureTable, TextureUse, UvTransform};
+use twinpath::scene::textures::{srgb_to_linear, Texels, TextureTable, TextureUse, UvTransform};
 use twinpath::scene::{parse_scene, SceneFile};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
@@ -184,7 +184,7 @@ fn lookup_is_bilinear_between_texel_centres_repeated_clamped_or_mirrored() {
             tex_flags,
             width,
             height,
-            &words,
+            Texels::Own(&words),
         );
         refs.push(Reference {
             width,

@@ -60,7 +60,7 @@ impl UvTransform {
 
 /// The texels of a new record: its own, or those of record k (the same image, read through
 /// another decoding table, wrap mode or coordinate map).
-enum Texels<'a> {
+pub enum Texels<'a> {
     Own(&'a [u32]),
     SharedWith(usize),
 }
@@ -199,7 +199,7 @@ impl TextureTable {
             Some(k) => Texels::SharedWith(k),
             None => Texels::Own(&texels),
         };
-        self.push_record(path, usage, tex_flags, width, height, source);
+        self.push(path, usage, tex_flags, width, height, source);
         Ok(self.textures.len() as u32 - 1)
     }
 
@@ -234,22 +234,9 @@ impl TextureTable {
         peak
     }
 
-    /// Appends a texture of `width` x `height` texels (`texels` in the kernel's encoding for
-    /// `tex_flags`) and rebuilds the table.
+    /// Appends a texture of `width` x `height` texels (its own `texels` in the kernel's
+    /// encoding for `tex_flags`, or an earlier record's) and rebuilds the table.
     pub fn push(
-        &mut self,
-        path: &Path,
-        usage: TextureUse,
-        tex_flags: u32,
-        width: u32,
-        height: u32,
-        texels: &[u32],
-    ) {
-        self.push_record(path, usage, tex_flags, width, height, Texels::Own(texels));
-    }
-
-    /// [`TextureTable::push`] of a record whose texels are its own or an earlier record's.
-    fn push_record(
         &mut self,
         path: &Path,
         usage: TextureUse,
