@@ -215,12 +215,50 @@ def scene_mapping():
     return scene
 
 
+def scene_colour():
+    """A floor whose base colour is a Color Attribute (float, per corner: red, green, blue and
+    white at its four corners), Specular IOR Level 0, under a 300 W point light."""
+    scene = reset()
+    mat = principled("coloured")
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    attribute = nodes.new("ShaderNodeVertexColor")
+    attribute.layer_name = "Col"
+    links.new(attribute.outputs["Color"], nodes["Principled BSDF"].inputs["Base Color"])
+    plane = floor(material=mat)
+    colours = plane.data.color_attributes.new("Col", "FLOAT_COLOR", "POINT")
+    corners = [(0.9, 0.1, 0.1, 1.0), (0.1, 0.8, 0.2, 1.0), (0.2, 0.3, 0.9, 1.0), (1.0, 1.0, 1.0, 1.0)]
+    for k, value in enumerate(corners):
+        colours.data[k].color = value
+    light(scene, "POINT", 300.0, (0.3, 0.2, 2.0), shadow_soft_size=0.0)
+    camera(scene)
+    return scene
+
+
+def scene_glowing_wall():
+    """A wall whose Principled BSDF both emits (strength 1, warm) and reflects (base colour 0.7,
+    Specular IOR Level 0), beside a floor, under a 200 W point light."""
+    scene = reset()
+    floor()
+    bpy.ops.mesh.primitive_plane_add(
+        size=2.0, location=(0.0, 1.0, 1.0), rotation=(math.pi / 2, 0.0, 0.0)
+    )
+    wall = bpy.context.object
+    wall.data.materials.append(
+        principled("glowing", base=(0.7, 0.7, 0.7), emission=((1.0, 0.8, 0.6), 1.0))
+    )
+    light(scene, "POINT", 200.0, (0.5, -1.0, 2.0), shadow_soft_size=0.0)
+    camera(scene, location=(0.0, -4.0, 2.0), target=(0.0, 0.5, 0.6))
+    return scene
+
+
 SCENES = {
     "point": scene_point,
     "spot": scene_spot,
     "sun": scene_sun,
     "emission": scene_emission,
     "mapping": scene_mapping,
+    "colour": scene_colour,
+    "glowing_wall": scene_glowing_wall,
 }
 
 

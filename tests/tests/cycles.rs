@@ -18,6 +18,9 @@
 //!   the camera and lighting the floor (`KHR_materials_emissive_strength`).
 //! - `mapping`: an image texture through a Mapping node (offset, 30 degrees, scale 2 x 1.5),
 //!   which the exporter writes as `KHR_texture_transform` in `extensionsRequired`.
+//! - `colour`: a Color Attribute (float, per vertex) driving the base colour: `COLOR_0`.
+//! - `glowing_wall`: a wall whose Principled BSDF emits and reflects (base colour 0.7) beside a
+//!   lit floor: the emissive material keeps its surface, and light bounces between the two.
 
 use glam::Vec3;
 use twinpath::film::RgbImage;
@@ -209,6 +212,16 @@ fn a_blender_texture_through_a_mapping_node_renders_as_cycles_renders_it() {
         &render_film(&generic, Backend::Cpu, 16),
         "specialized against generic",
     );
+}
+
+#[test]
+fn a_blender_color_attribute_renders_as_cycles_renders_it() {
+    agrees_with_cycles("colour");
+}
+
+#[test]
+fn a_blender_surface_that_emits_and_reflects_renders_as_cycles_renders_it() {
+    agrees_with_cycles("glowing_wall");
 }
 
 #[test]
