@@ -66,11 +66,15 @@ pub const VERTEX_COLOURS: u32 = 1 << 20;
 /// `KHR_texture_transform`): lookups may read it.
 pub const TEXTURE_TRANSFORMS: u32 = 1 << 21;
 
+/// Some material has holes (`Material::opacity`, glTF's MASK or BLEND; `crate::opacity`): rays
+/// may pass through a candidate hit (the GPU traces them without the OPAQUE flag).
+pub const OPACITY: u32 = 1 << 22;
+
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
 /// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals,
 /// [`NORMAL_MAPS`] and [`SHADING_NORMALS`] if a material has a normal map,
 /// [`REFLECTING_LIGHTS`] if an emitting material reflects, [`VERTEX_COLOURS`] if a triangle
-/// has vertex colours.
+/// has vertex colours, [`OPACITY`] if a material has holes.
 #[inline]
 pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> u32 {
     let mut f = 0;
@@ -103,6 +107,9 @@ pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> 
         .any(|s| s.flags & shading_flags::VERTEX_COLOURS != 0)
     {
         f |= VERTEX_COLOURS;
+    }
+    if materials.iter().any(|m| m.opacity != 0.0) {
+        f |= OPACITY;
     }
     f
 }
@@ -261,6 +268,12 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn vertex_colours(self) -> bool {
         self.answer(VERTEX_COLOURS, true)
+    }
+    /// Whether a candidate hit may be a hole (see [`OPACITY`]; the generic path asks each
+    /// candidate's material).
+    #[inline]
+    fn opacity(self) -> bool {
+        self.answer(OPACITY, true)
     }
     /// The generic path asks each light's material (`Material::reflects`).
     #[inline]

@@ -21,6 +21,7 @@ pub mod hit;
 pub mod instance;
 pub mod intersect;
 pub mod light;
+pub mod opacity;
 pub mod path;
 #[cfg(feature = "probe")]
 pub mod probe;

@@ -212,6 +212,11 @@ pub struct Material {
     /// METALLIC_ROUGHNESS: the layer's reflectance at grazing incidence, `KHR_materials_specular`'s
     /// specularFactor (1 without it). Every other kind: 1.
     pub layer_f90: f32,
+    /// Where a triangle of this material is present (glTF's `alphaMode`, `crate::opacity`),
+    /// as one number: 0, everywhere (OPAQUE); t > 0, MASK: where the `KD` texture's alpha (1
+    /// without one) is at least t = alphaCutoff / baseColorFactor's alpha (above 1: nowhere);
+    /// t < 0, BLEND: with probability -t x that alpha, -t in (0, 1] being the factor's alpha.
+    pub opacity: f32,
 }
 
 impl Material {
@@ -234,6 +239,7 @@ impl Material {
             normal_scale: 1.0,
             layer_f0: [LAYER_F0; 3],
             layer_f90: 1.0,
+            opacity: 0.0,
         }
     }
 

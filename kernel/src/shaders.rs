@@ -12,16 +12,21 @@
 //! when there is none).
 //! Specialization constant 0: the feature bits of `crate::features` (0: generic path).
 //! Hit groups: 0 triangles (closest hit), then 1 spheres (intersection + closest hit), then
-//! instanced triangles (closest hit), each present only where the scene has that geometry.
-//! Miss shader 0 serves both kinds of ray.
+//! instanced triangles (closest hit), each present only where the scene has that geometry;
+//! where a material has holes (`crate::opacity`), the triangle groups have any-hit shaders
+//! too, which run for the triangles of BLASes built without the OPAQUE flag, and rays are
+//! traced without `RayFlags::OPAQUE`. Miss shader 0 serves both kinds of ray.
 
 use crate::adaptive::{is_adaptive, luminance, pixel_converged};
-use crate::features::Dynamic;
+use crate::features::{Dynamic, FeatureSet};
 use crate::film_sample::{classify, sample_use};
 use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::hit::SurfaceHit;
+use crate::opacity::{covers, CandidateRay};
 use crate::path::{render_sample, Tracer};
-use crate::scene::{Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle};
+use crate::scene::{
+    Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle, NONE,
+};
 use crate::scene_view::SceneView;
 #[cfg(feature = "probe")]
 use spirv_std::glam::UVec4;
@@ -85,10 +90,12 @@ impl HitPayload {
     }
 }
 
-/// [`Tracer`] over the top-level acceleration structure.
+/// [`Tracer`] over the top-level acceleration structure. `opaque` is `RayFlags::OPAQUE` in a
+/// scene without holes (no any-hit shader runs) and `RayFlags::NONE` in one with them.
 struct RayTracer<'a> {
     tlas: &'a AccelerationStructure,
     payload: &'a mut HitPayload,
+    opaque: RayFlags,
 }
 
 impl Tracer for RayTracer<'_> {
@@ -96,7 +103,7 @@ impl Tracer for RayTracer<'_> {
         self.payload.hit = 0;
         unsafe {
             self.tlas.trace_ray(
-                RayFlags::OPAQUE,
+                self.opaque,
                 0xff,
                 0,
                 1,
@@ -116,9 +123,7 @@ impl Tracer for RayTracer<'_> {
         self.payload.hit = 1;
         unsafe {
             self.tlas.trace_ray(
-                RayFlags::OPAQUE
-                    | RayFlags::TERMINATE_ON_FIRST_HIT
-                    | RayFlags::SKIP_CLOSEST_HIT_SHADER,
+                self.opaque | RayFlags::TERMINATE_ON_FIRST_HIT | RayFlags::SKIP_CLOSEST_HIT_SHADER,
                 0xff,
                 0,
                 1,
@@ -181,7 +186,16 @@ pub fn raygen(
             return;
         }
     }
-    let mut tracer = RayTracer { tlas, payload };
+    let opaque = if Dynamic(features).opacity() {
+        RayFlags::NONE
+    } else {
+        RayFlags::OPAQUE
+    };
+    let mut tracer = RayTracer {
+        tlas,
+        payload,
+        opaque,
+    };
     let mut n_b = 0.0;
     let mut mean_b = Vec3::ZERO;
     let mut m2_b = Vec3::ZERO;
@@ -294,6 +308,80 @@ pub fn closest_hit_instance(
         barycentrics.x,
         barycentrics.y,
     ));
+}
+
+/// Any hit on a triangle with holes: the candidate is ignored where `opacity::covers` says the
+/// surface is not there, as the CPU's leaf test ignores it (`instance_custom_index` is the
+/// instance's first triangle). It asks the generic path's questions (`Dynamic(0)`: the same
+/// answers), so only the ray-generation shader reads the specialization constant.
+#[spirv(any_hit)]
+pub fn any_hit_triangle(
+    #[spirv(hit_attribute)] barycentrics: &Vec2,
+    #[spirv(primitive_id)] primitive: u32,
+    #[spirv(instance_custom_index)] first: u32,
+    #[spirv(world_ray_origin)] origin: Vec3,
+    #[spirv(world_ray_direction)] dir: Vec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] materials: &[Material],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] shading: &[ShadingTriangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] textures: &[u32],
+) {
+    let index = first + primitive;
+    let ray = CandidateRay {
+        origin,
+        dir,
+        triangle: index,
+        instance: NONE,
+    };
+    let tri = &triangles[index as usize];
+    let there = covers(
+        Dynamic(0),
+        materials,
+        shading,
+        textures,
+        tri,
+        *barycentrics,
+        &ray,
+    );
+    if !there {
+        unsafe { spirv_std::arch::ignore_intersection() };
+    }
+}
+
+/// Any hit on an instanced triangle with holes: as [`any_hit_triangle`], the triangle from the
+/// instance's mesh (`instance_custom_index` is the instance's record).
+#[spirv(any_hit)]
+pub fn any_hit_instance(
+    #[spirv(hit_attribute)] barycentrics: &Vec2,
+    #[spirv(primitive_id)] primitive: u32,
+    #[spirv(instance_custom_index)] index: u32,
+    #[spirv(world_ray_origin)] origin: Vec3,
+    #[spirv(world_ray_direction)] dir: Vec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] materials: &[Material],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] shading: &[ShadingTriangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] textures: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] instances: &[Instance],
+) {
+    let ray = CandidateRay {
+        origin,
+        dir,
+        triangle: primitive,
+        instance: index,
+    };
+    let tri = &triangles[(instances[index as usize].first_triangle + primitive) as usize];
+    let there = covers(
+        Dynamic(0),
+        materials,
+        shading,
+        textures,
+        tri,
+        *barycentrics,
+        &ray,
+    );
+    if !there {
+        unsafe { spirv_std::arch::ignore_intersection() };
+    }
 }
 
 /// Intersection with a procedural sphere: the kernel's robust ray/sphere test, the same function

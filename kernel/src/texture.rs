@@ -233,6 +233,49 @@ pub fn lookup(table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
 /// the scene has one (`features::TEXTURE_TRANSFORMS`).
 #[inline]
 pub fn lookup_in<F: FeatureSet>(features: F, table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
+    let (offset, width, tex_flags, f) = located(features, table, texture, uv);
+    bilerp(
+        texel(table, offset, width, tex_flags, f.x0, f.y0),
+        texel(table, offset, width, tex_flags, f.x1, f.y0),
+        texel(table, offset, width, tex_flags, f.x0, f.y1),
+        texel(table, offset, width, tex_flags, f.x1, f.y1),
+        f.fx,
+        f.fy,
+    )
+}
+
+/// The alpha channel of texture `texture` at `uv`, bilinearly filtered as [`lookup_in`]
+/// filters the colour: an 8-bit texel's fourth byte / 255 (alpha is linear, glTF 2.0 section
+/// 3.9.2, even in an sRGB-encoded colour map); 1 for a float texture, which has none.
+#[inline]
+pub fn alpha_in<F: FeatureSet>(features: F, table: &[u32], texture: u32, uv: Vec2) -> f32 {
+    let (offset, width, tex_flags, f) = located(features, table, texture, uv);
+    if tex_flags & flags::FLOAT != 0 {
+        return 1.0;
+    }
+    let top = texel_alpha(table, offset, width, f.x0, f.y0) * (1.0 - f.fx)
+        + texel_alpha(table, offset, width, f.x1, f.y0) * f.fx;
+    let bottom = texel_alpha(table, offset, width, f.x0, f.y1) * (1.0 - f.fx)
+        + texel_alpha(table, offset, width, f.x1, f.y1) * f.fx;
+    top * (1.0 - f.fy) + bottom * f.fy
+}
+
+/// The alpha of 8-bit texel (x, y) of the texture whose first texel word is `offset`.
+#[inline]
+fn texel_alpha(table: &[u32], offset: u32, width: u32, x: u32, y: u32) -> f32 {
+    let word = table[offset as usize + y as usize * width as usize + x as usize];
+    decoded(table, LINEAR_TABLE, word >> 24)
+}
+
+/// Texture `texture`'s first texel word, width and flags, and the footprint of `uv` on it
+/// (through the record's map where it has one and the scene has maps).
+#[inline]
+fn located<F: FeatureSet>(
+    features: F,
+    table: &[u32],
+    texture: u32,
+    uv: Vec2,
+) -> (u32, u32, u32, Footprint) {
     let r = RECORDS + RECORD_WORDS * texture as usize;
     let (offset, width, height, tex_flags) = (table[r], table[r + 1], table[r + 2], table[r + 3]);
     let uv = if features.texture_transforms() && tex_flags & flags::TRANSFORM != 0 {
@@ -247,14 +290,7 @@ pub fn lookup_in<F: FeatureSet>(features: F, table: &[u32], texture: u32, uv: Ve
         (tex_flags >> flags::WRAP_U_SHIFT) & 3,
         (tex_flags >> flags::WRAP_V_SHIFT) & 3,
     );
-    bilerp(
-        texel(table, offset, width, tex_flags, f.x0, f.y0),
-        texel(table, offset, width, tex_flags, f.x1, f.y0),
-        texel(table, offset, width, tex_flags, f.x0, f.y1),
-        texel(table, offset, width, tex_flags, f.x1, f.y1),
-        f.fx,
-        f.fy,
-    )
+    (offset, width, tex_flags, f)
 }
 
 /// `material` at a point of texture coordinates `uv`: each parameter with a texture multiplied

@@ -17,7 +17,7 @@ use twinpath_tests::spirv::{Module, StructLayout};
 #[test]
 fn module_has_the_ray_tracing_entry_points_and_the_tests_module_the_probe() {
     // Execution models: GLCompute 5, RayGenerationKHR 5313, IntersectionKHR 5314,
-    // ClosestHitKHR 5316, MissKHR 5317.
+    // AnyHitKHR 5315, ClosestHitKHR 5316, MissKHR 5317.
     let mut want: BTreeSet<(u32, String)> = [
         (5313, "shaders::raygen"),
         (5317, "shaders::miss"),
@@ -25,6 +25,8 @@ fn module_has_the_ray_tracing_entry_points_and_the_tests_module_the_probe() {
         (5316, "shaders::closest_hit_sphere"),
         (5316, "shaders::closest_hit_instance"),
         (5314, "shaders::intersect_sphere_shader"),
+        (5315, "shaders::any_hit_triangle"),
+        (5315, "shaders::any_hit_instance"),
     ]
     .into_iter()
     .map(|(m, n)| (m, n.to_string()))
@@ -48,6 +50,8 @@ fn module_has_the_ray_tracing_entry_points_and_the_tests_module_the_probe() {
         p::CLOSEST_HIT_SPHERE,
         p::CLOSEST_HIT_INSTANCE,
         p::INTERSECT_SPHERE,
+        p::ANY_HIT_TRIANGLE,
+        p::ANY_HIT_INSTANCE,
     ] {
         assert!(
             got.iter().any(|(_, n)| n.as_bytes() == name.to_bytes()),
@@ -156,7 +160,8 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     roughness,
                     normal_scale,
                     layer_f0,
-                    layer_f90
+                    layer_f90,
+                    opacity
                 ],
                 true
             ),

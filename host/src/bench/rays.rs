@@ -446,7 +446,7 @@ pub fn path_rays(
     sized.camera.height = height;
     let params = sized.params(settings, 0, 1);
     let mut recorder = Recorder {
-        inner: BvhTracer::new(&cpu.bvh),
+        inner: cpu.tracer(),
         key: (0, 0),
         extensions: Vec::new(),
         shadows: Vec::new(),

@@ -14,7 +14,7 @@
 //! its own slab test (or the pop test, which is looser) rejects it, and the closest hit is the
 //! least (t, id) over the primitives reached (`bvh.rs`, `closest_in`), whatever the order.
 
-use super::bvh::{Bvh, LEAF, STACK, WIDTH};
+use super::bvh::{Bvh, Solid, LEAF, STACK, WIDTH};
 use super::packet::{PacketHits, PacketTracer, RayPacket, LANES};
 use super::simd::{
     slab_lanes, sphere_lanes, triangle_lanes, triangle_lanes_uv, widest_simd, Boxes, SLAB_PAD,
@@ -251,7 +251,8 @@ impl Bvh {
         let (origin, dir) = lane_ray(rays, lane);
         let best = (hits.prim[lane], hits.t[lane]);
         let mut no_instance = NONE;
-        let (prim, t) = self.closest_in::<false>(start, origin, dir, best, &mut no_instance);
+        let (prim, t) =
+            self.closest_in::<false, Solid>(start, origin, dir, best, &mut no_instance, Solid);
         if (prim, t) == best {
             return;
         }
@@ -288,7 +289,7 @@ impl Bvh {
                     let lane = rest.trailing_zeros() as usize;
                     rest &= rest - 1;
                     let (origin, dir) = lane_ray(rays, lane);
-                    if self.any_in::<false>(current, origin, dir, t_max[lane]) {
+                    if self.any_in::<false, Solid>(current, origin, dir, t_max[lane], Solid) {
                         occluded |= 1 << lane;
                     }
                 }

@@ -17,7 +17,7 @@ mod simd;
 mod tile;
 
 pub use backend::CpuBackend;
-pub use bvh::{Bvh, PrimHit};
+pub use bvh::{Bvh, HoleTables, PrimHit};
 pub use bvh_tracer::BvhTracer;
 pub use packet::{PacketTracer, RayPacket, SmallScene, LANES, MAX_PRIMITIVES};
 pub use renderer::{CpuRenderer, TileStrategy};

@@ -2,7 +2,7 @@
 //! (rayon), each tile one path at a time or sixteen at once (`packet_paths`), under the
 //! scene's feature bits as a const generic (one monomorphised path per common combination).
 
-use super::bvh::Bvh;
+use super::bvh::{Bvh, HoleTables};
 use super::bvh_tracer::BvhTracer;
 use super::packet::SmallScene;
 use super::packet_paths::tile_by_packets;
@@ -39,7 +39,9 @@ pub struct CpuRenderer {
 /// How the CPU renderer computes a tile's samples. All give the same image bit for bit
 /// (`tests/tests/packets.rs`); packets are faster (docs/performance.md).
 pub enum TileStrategy {
-    /// One path at a time through the BVH: scenes with instances, or `packets` off.
+    /// One path at a time through the BVH: scenes with instances or with holes (glTF's MASK
+    /// and BLEND, `kernel::opacity`, which only the one-path traversal tests), or `packets`
+    /// off.
     OnePath,
     /// Sixteen paths at a time, their rays tested against every primitive by SIMD lanes
     /// (`packet_paths.rs`): for scenes of at most `packet::MAX_PRIMITIVES` primitives unless
@@ -124,7 +126,8 @@ impl CpuRenderer {
     /// `bench::rays`, which times the build apart).
     pub fn with_bvh(scene: &Scene, settings: &RenderSettings, bvh: Bvh) -> Self {
         // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).
-        let tiles = if !(settings.packets && scene.instances.is_empty()) {
+        let holes = scene.materials.iter().any(|m| m.opacity != 0.0);
+        let tiles = if !(settings.packets && scene.instances.is_empty()) || holes {
             TileStrategy::OnePath
         } else if let Some(small) = SmallScene::if_small(&bvh.spheres, &bvh.triangles) {
             TileStrategy::Packets(small)
@@ -143,9 +146,23 @@ impl CpuRenderer {
         }
     }
 
+    /// The [`Tracer`] of one path at a time over the BVH: through the holes of materials that
+    /// have them (`kernel::opacity`).
+    pub fn tracer(&self) -> BvhTracer<'_> {
+        let mut tracer = BvhTracer::new(&self.bvh);
+        if self.materials.iter().any(|m| m.opacity != 0.0) {
+            tracer.holes = Some(HoleTables {
+                materials: &self.materials,
+                shading: &self.shading,
+                textures: &self.textures,
+            });
+        }
+        tracer
+    }
+
     /// One sample of one pixel, exactly as the GPU's ray-generation shader computes it.
     pub fn sample(&self, params: &RenderParams, px: u32, py: u32, sample: u32) -> Vec3 {
-        let mut tracer = BvhTracer::new(&self.bvh);
+        let mut tracer = self.tracer();
         with_features!(self.features, f => self.sample_with(f, &mut tracer, params, px, py, sample))
     }
 
@@ -296,7 +313,7 @@ impl CpuRenderer {
         film: &Film,
     ) -> TileSums {
         let adaptive = kernel::adaptive::is_adaptive(params);
-        let mut tracer = BvhTracer::new(&self.bvh);
+        let mut tracer = self.tracer();
         let sums = pixels
             .map(|(px, py)| {
                 let mut acc = PixelSums::default();

@@ -128,12 +128,18 @@ impl Context {
 
     /// A BLAS over `triangles` (non-indexed vertices p0, p0 + edge1, p0 + edge2 per
     /// triangle, as on the CPU); `inputs` keeps the vertex buffer until the TLAS is built.
+    /// Its geometry is OPAQUE (no any-hit shader runs for it) unless a triangle's material
+    /// has holes (`Material::opacity`, `kernel::opacity`).
     fn triangle_blas(
         &self,
         name: &str,
         triangles: &[kernel::scene::Triangle],
+        materials: &[kernel::scene::Material],
         inputs: &mut Vec<Buffer>,
     ) -> Result<AccelerationStructure> {
+        let holes = triangles
+            .iter()
+            .any(|t| materials[t.material as usize].opacity != 0.0);
         let mut vertices: Vec<[f32; 3]> = Vec::with_capacity(3 * triangles.len());
         for t in triangles {
             let p0 = glam::Vec3::from(t.p0);
@@ -154,7 +160,11 @@ impl Context {
         let geometry = vk::AccelerationStructureGeometryKHR::default()
             .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
             .geometry(vk::AccelerationStructureGeometryDataKHR { triangles: data })
-            .flags(vk::GeometryFlagsKHR::OPAQUE);
+            .flags(if holes {
+                vk::GeometryFlagsKHR::empty()
+            } else {
+                vk::GeometryFlagsKHR::OPAQUE
+            });
         self.build_accel(
             &format!("BLAS {name}"),
             vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL,
@@ -182,6 +192,7 @@ impl Context {
                 let blas = self.triangle_blas(
                     &group.name,
                     &scene.triangles[group.range.clone()],
+                    &scene.materials,
                     &mut inputs,
                 )?;
                 instances.push(instance(
@@ -197,6 +208,7 @@ impl Context {
                 let blas = self.triangle_blas(
                     &mesh.name,
                     &scene.triangles[mesh.range.clone()],
+                    &scene.materials,
                     &mut inputs,
                 )?;
                 mesh_blases.push(blas.address);

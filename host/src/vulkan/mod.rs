@@ -76,6 +76,7 @@ impl GpuRenderer {
                 triangles: scene.world_triangle_count() > 0,
                 spheres: !scene.spheres.is_empty(),
                 instances: !scene.instances.is_empty(),
+                holes: scene.materials.iter().any(|m| m.opacity != 0.0),
             }
         } else {
             HitGroups::ALL

@@ -15,6 +15,8 @@ pub const CLOSEST_HIT_TRIANGLE: &CStr = c"shaders::closest_hit_triangle";
 pub const CLOSEST_HIT_SPHERE: &CStr = c"shaders::closest_hit_sphere";
 pub const CLOSEST_HIT_INSTANCE: &CStr = c"shaders::closest_hit_instance";
 pub const INTERSECT_SPHERE: &CStr = c"shaders::intersect_sphere_shader";
+pub const ANY_HIT_TRIANGLE: &CStr = c"shaders::any_hit_triangle";
+pub const ANY_HIT_INSTANCE: &CStr = c"shaders::any_hit_instance";
 
 /// Descriptor bindings, as `kernel::shaders` declares them.
 pub mod binding {
@@ -35,12 +37,15 @@ pub mod binding {
 
 /// Which hit groups a pipeline has: a scene without world-space triangles (or spheres, or
 /// instances) gets no triangle (or sphere, or instance) hit group when specialized; the
-/// generic pipeline has all three.
+/// generic pipeline has all three. With `holes` (a material has holes, `kernel::opacity`) the
+/// triangle groups have any-hit shaders too; they run only for BLASes built without the
+/// OPAQUE flag.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HitGroups {
     pub triangles: bool,
     pub spheres: bool,
     pub instances: bool,
+    pub holes: bool,
 }
 
 impl HitGroups {
@@ -48,6 +53,7 @@ impl HitGroups {
         triangles: true,
         spheres: true,
         instances: true,
+        holes: true,
     };
 
     /// SBT record offset of the triangle hit group (instances of triangle BLASes).
@@ -108,6 +114,7 @@ impl RtPipeline {
         let module = shader_module(ctx, spv)?;
         let all = vk::ShaderStageFlags::RAYGEN_KHR
             | vk::ShaderStageFlags::CLOSEST_HIT_KHR
+            | vk::ShaderStageFlags::ANY_HIT_KHR
             | vk::ShaderStageFlags::INTERSECTION_KHR
             | vk::ShaderStageFlags::MISS_KHR;
         let b = |binding: u32, ty: vk::DescriptorType| {
@@ -180,21 +187,33 @@ impl RtPipeline {
             group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 0, unused, unused),
             group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 1, unused, unused),
         ];
-        // A triangle hit group of closest-hit shader `name` (world-space or instanced).
+        // A triangle hit group of closest-hit shader `name` (world-space or instanced), with
+        // any-hit shader `any` where the scene has holes.
         let triangle_group = |stages: &mut Vec<vk::PipelineShaderStageCreateInfo<'_>>,
                               groups: &mut Vec<vk::RayTracingShaderGroupCreateInfoKHR<'_>>,
-                              name: &'static CStr| {
+                              name: &'static CStr,
+                              any: &'static CStr| {
             stages.push(stage(vk::ShaderStageFlags::CLOSEST_HIT_KHR, name));
-            groups.push(group(
+            let mut g = group(
                 vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP,
                 unused,
                 stages.len() as u32 - 1,
                 unused,
-            ));
+            );
+            if hit_groups.holes {
+                stages.push(stage(vk::ShaderStageFlags::ANY_HIT_KHR, any));
+                g = g.any_hit_shader(stages.len() as u32 - 1);
+            }
+            groups.push(g);
         };
         // Hit groups in SBT order (HitGroups::triangle_offset, sphere_offset, instance_offset).
         if hit_groups.triangles {
-            triangle_group(&mut stages, &mut groups, CLOSEST_HIT_TRIANGLE);
+            triangle_group(
+                &mut stages,
+                &mut groups,
+                CLOSEST_HIT_TRIANGLE,
+                ANY_HIT_TRIANGLE,
+            );
         }
         if hit_groups.spheres {
             stages.push(stage(
@@ -213,7 +232,12 @@ impl RtPipeline {
             ));
         }
         if hit_groups.instances {
-            triangle_group(&mut stages, &mut groups, CLOSEST_HIT_INSTANCE);
+            triangle_group(
+                &mut stages,
+                &mut groups,
+                CLOSEST_HIT_INSTANCE,
+                ANY_HIT_INSTANCE,
+            );
         }
         let info = vk::RayTracingPipelineCreateInfoKHR::default()
             .stages(&stages)

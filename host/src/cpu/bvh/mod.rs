@@ -17,7 +17,12 @@
 //! whatever the traversal order.
 
 mod hits;
+mod holes;
 mod traverse;
+
+pub use holes::HoleTables;
+use holes::Holes;
+pub(super) use holes::{Presence, Solid};
 
 use super::bvh_build::{Aabb, BinaryBvh, SAH_MAX_DEPTH};
 use super::huge_pages;

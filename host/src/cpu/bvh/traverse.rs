@@ -44,7 +44,7 @@ impl Bvh {
             return (NONE, t_max);
         };
         let mut no_instance = NONE;
-        self.closest_in::<false>(root, origin, dir, (NONE, t_max), &mut no_instance)
+        self.closest_in::<false, Solid>(root, origin, dir, (NONE, t_max), &mut no_instance, Solid)
     }
 
     widest_simd! {
@@ -63,7 +63,8 @@ impl Bvh {
                 t: t_max,
             };
         };
-        let (prim, t) = self.closest_in::<true>(root, origin, dir, (NONE, t_max), &mut instance);
+        let (prim, t) =
+            self.closest_in::<true, Solid>(root, origin, dir, (NONE, t_max), &mut instance, Solid);
         PrimHit { prim, instance, t }
     }
 
@@ -77,13 +78,14 @@ impl Bvh {
     /// (`bvh_packet.rs`) gives the same hits. (A tie between an instance's triangle and any
     /// other primitive still depends on the order; packets are not used with instances.)
     #[inline(always)]
-    pub(in crate::cpu) fn closest_in<const INSTANCES: bool>(
+    pub(in crate::cpu) fn closest_in<const INSTANCES: bool, P: Presence>(
         &self,
         start: u32,
         origin: Vec3,
         dir: Vec3,
         (mut best, mut best_t): (u32, f32),
         best_instance: &mut u32,
+        presence: P,
     ) -> (u32, f32) {
         let ray = Ray4::new(origin, dir);
         // Not zero-filled (3 KiB per ray): entries below `sp` are always written first.
@@ -132,7 +134,10 @@ impl Bvh {
                     let t = ray.triangles(&block.triangles, 0.0, limit).to_array();
                     for (&t, &id) in t.iter().zip(&block.id) {
                         // Missed lanes are -1; hits are below `limit` as it was at the call.
-                        if t >= 0.0 && (t < best_t || (t == best_t && id < best)) {
+                        if t >= 0.0
+                            && (t < best_t || (t == best_t && id < best))
+                            && (P::SOLID || self.triangle_present(presence, id, origin, dir))
+                        {
                             best_t = t;
                             best = id;
                             if INSTANCES {
@@ -161,12 +166,13 @@ impl Bvh {
                         let mesh = &self.meshes[self.instance_meshes[i as usize] as usize];
                         let Some(mesh_root) = mesh.root else { continue };
                         let mut no_instance = NONE;
-                        let (prim, t) = mesh.closest_in::<false>(
+                        let (prim, t) = mesh.closest_in::<false, P>(
                             mesh_root,
                             o,
                             d,
                             (NONE, best_t),
                             &mut no_instance,
+                            presence.in_instance(i),
                         );
                         if prim != NONE && t < best_t {
                             best_t = t;
@@ -213,7 +219,7 @@ impl Bvh {
     fn any_one_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
         // Not `is_some_and`: a closure is not compiled with the caller's target features.
         match self.root {
-            Some(root) => self.any_in::<false>(root, origin, dir, t_max),
+            Some(root) => self.any_in::<false, Solid>(root, origin, dir, t_max, Solid),
             None => false,
         }
     }
@@ -228,7 +234,7 @@ impl Bvh {
     fn any_two_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
         // Not `is_some_and`: a closure is not compiled with the caller's target features.
         match self.root {
-            Some(root) => self.any_in::<true>(root, origin, dir, t_max),
+            Some(root) => self.any_in::<true, Solid>(root, origin, dir, t_max, Solid),
             None => false,
         }
     }
@@ -236,12 +242,13 @@ impl Bvh {
     /// [`Bvh::any_hit`] in the subtree `start`, with the instance step compiled in where
     /// `INSTANCES`.
     #[inline(always)]
-    pub(in crate::cpu) fn any_in<const INSTANCES: bool>(
+    pub(in crate::cpu) fn any_in<const INSTANCES: bool, P: Presence>(
         &self,
         start: u32,
         origin: Vec3,
         dir: Vec3,
         t_max: f32,
+        presence: P,
     ) -> bool {
         let ray = Ray4::new(origin, dir);
         let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
@@ -261,9 +268,17 @@ impl Bvh {
             } else {
                 let (blocks, spheres) = self.leaf_contents(current);
                 for block in &self.blocks[blocks] {
-                    let t = ray.triangles(&block.triangles, 0.0, t_max);
-                    if t.to_array().iter().any(|&t| t >= 0.0) {
-                        return true;
+                    let t = ray.triangles(&block.triangles, 0.0, t_max).to_array();
+                    if P::SOLID {
+                        if t.iter().any(|&t| t >= 0.0) {
+                            return true;
+                        }
+                    } else {
+                        for (&t, &id) in t.iter().zip(&block.id) {
+                            if t >= 0.0 && self.triangle_present(presence, id, origin, dir) {
+                                return true;
+                            }
+                        }
                     }
                 }
                 for block in &self.sphere_blocks[spheres] {
@@ -277,7 +292,8 @@ impl Bvh {
                         let (o, d) = ray_to_object(&self.instances[i as usize], origin, dir);
                         let mesh = &self.meshes[self.instance_meshes[i as usize] as usize];
                         let Some(mesh_root) = mesh.root else { continue };
-                        if mesh.any_in::<false>(mesh_root, o, d, t_max) {
+                        if mesh.any_in::<false, P>(mesh_root, o, d, t_max, presence.in_instance(i))
+                        {
                             return true;
                         }
                     }
@@ -289,6 +305,97 @@ impl Bvh {
             sp -= 1;
             // SAFETY: entry `sp` was written by a push (sp only grows by writing).
             current = unsafe { stack[sp].assume_init() };
+        }
+    }
+
+    /// Whether primitive `id` (a triangle: blocks hold only triangles) is there for
+    /// `presence`, met by `origin + t dir` in this tree's space.
+    #[inline(always)]
+    fn triangle_present<P: Presence>(&self, presence: P, id: u32, origin: Vec3, dir: Vec3) -> bool {
+        let index = id as usize - self.spheres.len();
+        presence.present(&self.triangles[index], index as u32, origin, dir)
+    }
+
+    /// [`Bvh::closest_hit`] where materials may have holes: candidates that `tables` say are not
+    /// there are passed through (`holes.rs`).
+    pub fn closest_hit_through(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        tables: &HoleTables<'_>,
+    ) -> SurfaceHit {
+        let hit = self.closest_through(origin, dir, t_max, tables);
+        if hit.prim == NONE {
+            return SurfaceHit::miss();
+        }
+        self.surface(hit, origin, dir)
+    }
+
+    widest_simd! {
+        /// The primitive of [`Bvh::closest_hit_through`].
+        fn closest_through(&self, origin: Vec3, dir: Vec3, t_max: f32, tables: &HoleTables<'_>)
+            -> PrimHit = closest_through_any_cpu, closest_through_avx512, closest_through_avx2
+    }
+
+    #[inline(always)]
+    fn closest_through_any_cpu(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        tables: &HoleTables<'_>,
+    ) -> PrimHit {
+        let mut instance = NONE;
+        let Some(root) = self.root else {
+            return PrimHit {
+                prim: NONE,
+                instance,
+                t: t_max,
+            };
+        };
+        let holes = Holes {
+            tables: *tables,
+            origin,
+            dir,
+            instance: NONE,
+        };
+        let best = (NONE, t_max);
+        let (prim, t) = if self.instances.is_empty() {
+            self.closest_in::<false, Holes>(root, origin, dir, best, &mut instance, holes)
+        } else {
+            self.closest_in::<true, Holes>(root, origin, dir, best, &mut instance, holes)
+        };
+        PrimHit { prim, instance, t }
+    }
+
+    widest_simd! {
+        /// [`Bvh::any_hit`] where materials may have holes (as [`Bvh::closest_hit_through`]).
+        pub fn any_hit_through(&self, origin: Vec3, dir: Vec3, t_max: f32, tables: &HoleTables<'_>)
+            -> bool = any_through_any_cpu, any_through_avx512, any_through_avx2
+    }
+
+    #[inline(always)]
+    fn any_through_any_cpu(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        tables: &HoleTables<'_>,
+    ) -> bool {
+        let Some(root) = self.root else {
+            return false;
+        };
+        let holes = Holes {
+            tables: *tables,
+            origin,
+            dir,
+            instance: NONE,
+        };
+        if self.instances.is_empty() {
+            self.any_in::<false, Holes>(root, origin, dir, t_max, holes)
+        } else {
+            self.any_in::<true, Holes>(root, origin, dir, t_max, holes)
         }
     }
 

@@ -51,12 +51,6 @@ pub(super) fn material(
             "{label}: occlusionTexture ignored (a path tracer computes occlusion)"
         ));
     }
-    if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
-        imp.note(format!(
-            "{label}: alphaMode {:?} rendered as OPAQUE",
-            m.alpha_mode()
-        ));
-    }
 
     let strength = m.emissive_strength().unwrap_or(1.0);
     if !(strength >= 0.0 && strength.is_finite()) {
@@ -98,6 +92,12 @@ pub(super) fn material(
                     "{label}: glass ignores the base colour and metalness (clear glass)"
                 ));
             }
+            if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
+                imp.note(format!(
+                    "{label}: glass ignores its alphaMode {:?} (no holes)",
+                    m.alpha_mode()
+                ));
+            }
             let mut out = Material::diffuse([0.0; 3]);
             out.kind = material_kind::DIELECTRIC;
             out.ior = ior;
@@ -111,6 +111,15 @@ pub(super) fn material(
     out.metallic = metallic;
     out.roughness = roughness;
     (out.layer_f0, out.layer_f90) = dielectric_layer(imp, &label, &m, &err)?;
+    out.opacity = opacity(&m, base[3], pbr.base_color_texture().is_some(), &err)?;
+    if emits && out.opacity != 0.0 {
+        imp.note(format!(
+            "{label}: emits, so its alphaMode {:?} is rendered as OPAQUE (a light's samples \
+             do not see holes)",
+            m.alpha_mode()
+        ));
+        out.opacity = 0.0;
+    }
     if emits {
         // A light (its triangles in the light table) that reflects as its material does, as
         // a Principled BSDF with emission does in Blender.
@@ -127,6 +136,40 @@ pub(super) fn material(
         out.textures[texture_slot::KS] = texture(imp, &label, &info, false)?;
     }
     normal_map(imp, &label, &m, out)
+}
+
+/// `Material::opacity` of material `m` (`kernel::opacity`) from its `alphaMode`, its
+/// `alphaCutoff` and its base colour's alpha `alpha` (a base colour texture's alpha multiplies
+/// it where `textured`): OPAQUE, a MASK of cutoff 0 and a BLEND of alpha 1 without a texture
+/// are 0 (present everywhere); a MASK is alphaCutoff / alpha and a BLEND -alpha, either of
+/// alpha 0 being 2 (present nowhere: no alpha reaches it).
+fn opacity(
+    m: &gltf::Material,
+    alpha: f32,
+    textured: bool,
+    err: &dyn Fn(String) -> SceneError,
+) -> Result<f32, SceneError> {
+    use gltf::material::AlphaMode;
+    const NOWHERE: f32 = 2.0;
+    Ok(match m.alpha_mode() {
+        AlphaMode::Opaque => 0.0,
+        AlphaMode::Mask => {
+            let cutoff = m.alpha_cutoff().unwrap_or(0.5);
+            if !(cutoff >= 0.0 && cutoff.is_finite()) {
+                return Err(err(format!("alphaCutoff {cutoff} must be finite and >= 0")));
+            }
+            if cutoff == 0.0 {
+                0.0
+            } else if alpha == 0.0 {
+                NOWHERE
+            } else {
+                (cutoff / alpha).min(NOWHERE)
+            }
+        }
+        AlphaMode::Blend if alpha == 1.0 && !textured => 0.0,
+        AlphaMode::Blend if alpha == 0.0 => NOWHERE,
+        AlphaMode::Blend => -alpha,
+    })
 }
 
 /// The dielectric layer of opaque material `m` (`Material::layer_f0`, `layer_f90`): its

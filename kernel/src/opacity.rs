@@ -1,0 +1,90 @@
+//! Surfaces with holes: glTF's `alphaMode` MASK (a cutout, present where the base colour's
+//! alpha reaches `alphaCutoff`) and BLEND (present with probability alpha), decided for each
+//! candidate hit while a ray traverses the scene, so that a ray's closest hit and a shadow
+//! ray's verdict are those of the surfaces present. Both backends ask [`covers`]: the GPU in
+//! the any-hit shaders of the ray-tracing pipeline (`crate::shaders`), the CPU in its BVH's
+//! leaf test. `Material::opacity` holds the mode and its number.
+//!
+//! BLEND is stochastic transparency (Enderton, Sintorn, Shirley and Luebke 2010, "Stochastic
+//! Transparency"; pbrt-v4 tests alpha the same way, `GeometricPrimitive::Intersect`, with a
+//! number hashed from the ray): a candidate of alpha a is present when a uniform number u,
+//! drawn for that candidate alone, is below a. The candidates along a ray draw independently,
+//! so the nearest present one is candidate i with probability a_i x prod over the nearer j of
+//! (1 - a_j), and a shadow ray is unoccluded with probability prod_j (1 - a_j): the layered
+//! surfaces' transmittance. An estimator that follows the traversal's answer is therefore
+//! unbiased for Blender's mix of the surface with a transparent BSDF (alpha of the surface,
+//! 1 - alpha of the scene behind), with no weight to carry. The number is a hash of the ray's
+//! bits and the candidate ([`CandidateRay::draw`]): the same in every traversal order, the same
+//! when Vulkan runs an any-hit shader twice for one candidate (it may, without
+//! `NO_DUPLICATE_ANY_HIT_INVOCATION`), the same in the CPU's scalar and packet traversals; and
+//! each ray of a path is a new ray (its bits come from the path's own random numbers), so each
+//! draws anew.
+
+use crate::features::FeatureSet;
+use crate::hash::pcg4d;
+use crate::rng::u32_to_unit_f32;
+use crate::scene::{texture_slot, Material, ShadingTriangle, Triangle, NONE};
+use crate::surface::interpolated_uv;
+use crate::texture::alpha_in;
+use spirv_std::glam::{Vec2, Vec3};
+
+/// A candidate hit: the world-space ray (as it was traced) and the triangle it met: its index
+/// in the triangle table, or in its mesh for an instanced triangle, whose instance is
+/// `instance` (`NONE` for a world-space triangle).
+#[derive(Clone, Copy, Debug)]
+pub struct CandidateRay {
+    pub origin: Vec3,
+    pub dir: Vec3,
+    pub triangle: u32,
+    pub instance: u32,
+}
+
+impl CandidateRay {
+    /// The candidate's uniform number in [0, 1): two rounds of `pcg4d`, over the origin's bits
+    /// and the triangle, then with the direction's bits and the instance mixed in.
+    #[inline]
+    pub fn draw(&self) -> f32 {
+        let (o, d) = (self.origin, self.dir);
+        let h = pcg4d([o.x.to_bits(), o.y.to_bits(), o.z.to_bits(), self.triangle]);
+        let h = pcg4d([
+            h[0] ^ d.x.to_bits(),
+            h[1] ^ d.y.to_bits(),
+            h[2] ^ d.z.to_bits(),
+            h[3] ^ self.instance,
+        ]);
+        u32_to_unit_f32(h[0])
+    }
+}
+
+/// Whether triangle `tri`, met by `ray` at barycentrics `bary`, is there (see the module's
+/// documentation): always for a material of opacity 0; for MASK when the `KD` texture's alpha
+/// at the point (1 without a texture or texture coordinates) is at least the material's
+/// number; for BLEND when the candidate's number is below the factor's alpha times the
+/// texture's.
+#[inline]
+pub fn covers<F: FeatureSet>(
+    features: F,
+    materials: &[Material],
+    shading: &[ShadingTriangle],
+    textures: &[u32],
+    tri: &Triangle,
+    bary: Vec2,
+    ray: &CandidateRay,
+) -> bool {
+    let material = &materials[tri.material as usize];
+    let t = material.opacity;
+    if t == 0.0 {
+        return true;
+    }
+    let map = material.textures[texture_slot::KD];
+    let mut alpha = 1.0;
+    if features.textures() && map != NONE && tri.shading != NONE {
+        let uv = interpolated_uv(&shading[tri.shading as usize], bary);
+        alpha = alpha_in(features, textures, map, uv);
+    }
+    if t > 0.0 {
+        alpha >= t
+    } else {
+        ray.draw() < -t * alpha
+    }
+}

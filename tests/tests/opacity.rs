@@ -1,0 +1,332 @@
+//! Surfaces with holes (glTF's `alphaMode`, `kernel::opacity`): a MASK cuts the surface where
+//! its base colour's alpha is below `alphaCutoff`, a BLEND is there with probability alpha, on
+//! camera rays, bounce rays and shadow rays, through world-space and instanced triangles, on
+//! both backends (the CPU's leaf test, the GPU's any-hit shaders).
+//!
+//! 1. The materials: each alphaMode onto `Material::opacity`, the feature bit, the notes.
+//! 2. A MASK in closed form: a black plane whose base colour texture (2 x 1 texels, alpha 0 and
+//!    200/255, clamped) fades in along u, cut at 0.3, in front of the white sky. The alpha is
+//!    linear (never sRGB-decoded) and bilinear, so the plane is there exactly right of
+//!    u* = 1/4 + 0.15 x 255/200; a pixel shows the sky on the fraction of it left of that line
+//!    (the plane faces the film, so a pixel's x maps affinely onto the plane). Pixels wholly on
+//!    one side are noiseless (0 or 1, exactly); the others are z-tested. The sRGB-decoded
+//!    alpha's line, 6 pixels to the right, is rejected.
+//! 3. A BLEND in closed form, through instances and on shadow rays: a white Lambertian floor
+//!    (albedo rho) under two black planes of alpha a (one mesh placed twice: instances), lit by
+//!    the white sky and a directional light straight down of irradiance pi: every floor pixel
+//!    is rho (1 - a)^2 (1 + pi / pi), for the layers' transmittance is (1 - a)^2 whatever the
+//!    direction (`kernel::opacity`'s derivation). One layer's (1 - a) and opaque layers' 0 are
+//!    rejected. The GPU renders it specialized and generic (every hit group with its any-hit
+//!    shader).
+
+use glam::Vec3;
+use serde_json::{json, Value};
+use std::path::PathBuf;
+use twinpath::render::Backend;
+use twinpath::scene::SceneFile;
+use twinpath_tests::gltf_writer::GltfWriter;
+use twinpath_tests::gpu::assert_validation_clean;
+use twinpath_tests::{
+    assert_film_matches, assert_noiseless_pixels, max_abs_z, render_film, with_independent_samples,
+};
+
+/// The MASK's cutoff and the texture's second alpha byte.
+const CUTOFF: f64 = 0.3;
+const ALPHA_BYTE: u8 = 200;
+
+fn load(bytes: &[u8], name: &str) -> SceneFile {
+    let dir: PathBuf =
+        std::env::temp_dir().join(format!("twinpath-opacity-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A material that reflects nothing (base colour black, metallic 0, specular factor 0) with
+/// `extra` merged in.
+fn black(extra: Value) -> Value {
+    let mut m = json!({
+        "pbrMetallicRoughness": { "baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0 },
+        "extensions": { "KHR_materials_specular": { "specularFactor": 0.0 } }
+    });
+    for (k, v) in extra.as_object().unwrap() {
+        if k == "pbrMetallicRoughness" {
+            for (k2, v2) in v.as_object().unwrap() {
+                m[k][k2] = v2.clone();
+            }
+        } else {
+            m[k] = v.clone();
+        }
+    }
+    m
+}
+
+/// A square of side 2 `half` at z = 0 facing +z, `n` x `n` quads (uv from 0 to 1 across it).
+fn square(g: &mut GltfWriter, half: f32, n: u32, material: usize) -> usize {
+    let (mut p, mut uv, mut idx) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..=n {
+        for i in 0..=n {
+            let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
+            p.push([-half + 2.0 * half * s, -half + 2.0 * half * t, 0.0]);
+            // glTF's v runs down the image.
+            uv.push([s, 1.0 - t]);
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let k = j * (n + 1) + i;
+            idx.extend([k, k + 1, k + n + 2, k, k + n + 2, k + n + 1]);
+        }
+    }
+    let normals = vec![[0.0, 0.0, 1.0]; p.len()];
+    g.mesh(&p, Some(&normals), Some(&uv), &idx, Some(material))
+}
+
+/// Adds a perspective camera node at height `z` looking down -z; its node index.
+fn camera(g: &mut GltfWriter, z: f32) -> usize {
+    let cam = g.push(
+        "cameras",
+        json!({ "type": "perspective", "perspective": { "yfov": 0.9, "aspectRatio": 1.3333, "znear": 0.01 } }),
+    );
+    g.push(
+        "nodes",
+        json!({ "camera": cam, "translation": [0.0, 0.0, z] }),
+    )
+}
+
+/// The MASK scene of the module's item 2: the plane spans [-2, 2]^2 (so the view from the
+/// camera's height 1.35, about 1.7 x 1.3 wide, lies inside it), its texture fading in along u.
+fn mask_file() -> Vec<u8> {
+    let mut g = GltfWriter::new();
+    g.json["extensionsUsed"] = json!(["KHR_materials_specular"]);
+    let img = image::RgbaImage::from_raw(2, 1, vec![0, 0, 0, 0, 0, 0, 0, ALPHA_BYTE]).unwrap();
+    let mut png = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut png, image::ImageFormat::Png).unwrap();
+    let t = g.png_texture(png.get_ref());
+    let clamp = g.push("samplers", json!({ "wrapS": 33071, "wrapT": 33071 }));
+    g.json["textures"][t]["sampler"] = json!(clamp);
+    let m = g.push(
+        "materials",
+        black(json!({
+            "pbrMetallicRoughness": { "baseColorTexture": { "index": t } },
+            "alphaMode": "MASK", "alphaCutoff": CUTOFF
+        })),
+    );
+    let mesh = square(&mut g, 2.0, 1, m);
+    let plane = g.push("nodes", json!({ "mesh": mesh }));
+    let cam = camera(&mut g, 1.35);
+    g.push("scenes", json!({ "nodes": [plane, cam] }));
+    g.glb()
+}
+
+/// The BLEND scene of the module's item 3: floor at z = 0 (albedo `RHO`), two layers of the
+/// same 18-triangle mesh (instanced) of alpha `A` at z = 1 and 1.5, all 2 x 10^4 wide, a
+/// directional light straight down of pi x 683 lux (irradiance pi W/m^2 in standard units),
+/// the camera at z = 0.5.
+const RHO: f64 = 0.5;
+const A: f64 = 0.4;
+fn blend_file() -> Vec<u8> {
+    let mut g = GltfWriter::new();
+    g.json["extensionsUsed"] = json!(["KHR_materials_specular", "KHR_lights_punctual"]);
+    let floor_m = g.push(
+        "materials",
+        black(json!({ "pbrMetallicRoughness": { "baseColorFactor": [RHO, RHO, RHO, 1.0] } })),
+    );
+    let layer_m = g.push(
+        "materials",
+        black(json!({
+            "pbrMetallicRoughness": { "baseColorFactor": [0.0, 0.0, 0.0, A] },
+            "alphaMode": "BLEND"
+        })),
+    );
+    let floor = square(&mut g, 1e4, 1, floor_m);
+    let layer = square(&mut g, 1e4, 3, layer_m);
+    g.json["extensions"] = json!({ "KHR_lights_punctual": { "lights": [
+        { "type": "directional", "intensity": std::f64::consts::PI * 683.0 }
+    ] } });
+    let mut nodes = vec![
+        g.push("nodes", json!({ "mesh": floor })),
+        g.push(
+            "nodes",
+            json!({ "mesh": layer, "translation": [0.0, 0.0, 1.0] }),
+        ),
+        g.push(
+            "nodes",
+            json!({ "mesh": layer, "translation": [0.0, 0.0, 1.5] }),
+        ),
+        // glTF's lights shine down their node's -z.
+        g.push(
+            "nodes",
+            json!({ "extensions": { "KHR_lights_punctual": { "light": 0 } } }),
+        ),
+    ];
+    nodes.push(camera(&mut g, 0.5));
+    g.push("scenes", json!({ "nodes": nodes }));
+    g.glb()
+}
+
+#[test]
+fn alpha_modes_become_the_materials_opacity() {
+    let cases = [
+        (json!({}), 0.0),
+        (json!({ "alphaMode": "OPAQUE", "alphaCutoff": 0.7 }), 0.0),
+        (json!({ "alphaMode": "MASK" }), 0.5),
+        (
+            json!({ "alphaMode": "MASK", "alphaCutoff": 0.3,
+                    "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 0.6] } }),
+            0.5,
+        ),
+        (json!({ "alphaMode": "MASK", "alphaCutoff": 0.0 }), 0.0),
+        (
+            json!({ "alphaMode": "MASK",
+                    "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 0.0] } }),
+            2.0,
+        ),
+        (
+            json!({ "alphaMode": "BLEND",
+                    "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 0.4] } }),
+            -0.4,
+        ),
+        (json!({ "alphaMode": "BLEND" }), 0.0),
+        (
+            json!({ "alphaMode": "BLEND",
+                    "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 0.0] } }),
+            2.0,
+        ),
+    ];
+    for (extra, want) in cases {
+        let mut g = GltfWriter::new();
+        g.json["extensionsUsed"] = json!(["KHR_materials_specular"]);
+        let m = g.push("materials", black(extra.clone()));
+        let mesh = square(&mut g, 1.0, 1, m);
+        let node = g.push("nodes", json!({ "mesh": mesh }));
+        g.push("scenes", json!({ "nodes": [node] }));
+        let s = load(&g.glb(), "modes.glb");
+        let got = s.scene.materials[0].opacity;
+        assert!(
+            (got - want).abs() < 1e-6,
+            "{extra}: opacity {got}, want {want}"
+        );
+        let bit = s.features() & kernel::features::OPACITY != 0;
+        assert_eq!(bit, want != 0.0, "{extra}: the OPACITY bit");
+        assert!(
+            !s.scene.notes.iter().any(|n| n.contains("alphaMode")),
+            "{extra}"
+        );
+    }
+    // An emitter keeps no holes (its light samples would not see them), and says so.
+    let mut g = GltfWriter::new();
+    let m = g.push(
+        "materials",
+        json!({ "alphaMode": "MASK", "emissiveFactor": [1.0, 1.0, 1.0] }),
+    );
+    let mesh = square(&mut g, 1.0, 1, m);
+    let node = g.push("nodes", json!({ "mesh": mesh }));
+    g.push("scenes", json!({ "nodes": [node] }));
+    let s = load(&g.glb(), "emitter.glb");
+    assert_eq!(s.scene.materials[0].opacity, 0.0);
+    assert!(
+        s.scene
+            .notes
+            .iter()
+            .any(|n| n.contains("alphaMode Mask is rendered as OPAQUE")),
+        "{:?}",
+        s.scene.notes
+    );
+}
+
+/// The plane's x where a ray from `eye` along `d` meets z = 0.
+fn plane_x(eye: Vec3, d: Vec3) -> f64 {
+    eye.x as f64 + d.x as f64 * (-eye.z as f64 / d.z as f64)
+}
+
+/// Per pixel, the fraction of its area whose ray meets the plane left of x = `x_cut` (the
+/// MASK's hole, which shows the white sky), as `(value, noiseless)`.
+fn sky_fraction(scene: &twinpath::scene::Scene, x_cut: f64) -> Vec<(f64, bool)> {
+    let cam = scene.camera.to_kernel();
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let eye = Vec3::new(cam.eye[0], cam.eye[1], cam.eye[2]);
+    (0..w * h)
+        .map(|i| {
+            let (px, py) = (i % w, i / w);
+            let x = |u: f32| {
+                plane_x(
+                    eye,
+                    kernel::camera::camera_ray_direction(&cam, w, h, px, py, u, 0.5),
+                )
+            };
+            let (x0, x1) = (x(0.0), x(1.0));
+            assert!(x1 > x0);
+            let f = ((x_cut - x0) / (x1 - x0)).clamp(0.0, 1.0);
+            (f, f == 0.0 || f == 1.0)
+        })
+        .collect()
+}
+
+#[test]
+fn a_mask_cuts_the_plane_where_the_linear_alpha_is_below_the_cutoff_on_both_backends() {
+    let mut scene = with_independent_samples(load(&mask_file(), "mask.glb"));
+    scene.scene.camera = scene.scene.camera.resized(Some(48), Some(36)).unwrap();
+    assert!(scene.features() & kernel::features::OPACITY != 0);
+    // u* along the plane (u = (x + 2) / 4): alpha(u) = clamp(2u - 1/2, 0, 1) x byte / 255.
+    let cut = |alpha: f64| 4.0 * (0.25 + 0.5 * CUTOFF / alpha) - 2.0;
+    let linear = sky_fraction(&scene.scene, cut(ALPHA_BYTE as f64 / 255.0));
+    let srgb = sky_fraction(
+        &scene.scene,
+        cut(twinpath::scene::textures::srgb_to_linear(ALPHA_BYTE)),
+    );
+    let noiseless: Vec<Option<f64>> = linear.iter().map(|&(f, n)| n.then_some(f)).collect();
+    let noisy: Vec<Option<f64>> = linear.iter().map(|&(f, n)| (!n).then_some(f)).collect();
+    let wrong: Vec<Option<f64>> = srgb.iter().map(|&(f, _)| Some(f)).collect();
+    assert!(noiseless.iter().flatten().any(|&f| f == 0.0));
+    assert!(noiseless.iter().flatten().any(|&f| f == 1.0));
+    assert!(noisy.iter().flatten().count() >= 36);
+    for backend in [Backend::Cpu, Backend::Gpu] {
+        let film = render_film(&scene, backend, 256);
+        assert_noiseless_pixels(&film, &noiseless, &format!("{backend:?}"));
+        assert_film_matches(&film, &noisy, &format!("{backend:?} boundary"));
+        let mean = film.mean();
+        let off = wrong
+            .iter()
+            .enumerate()
+            .filter(|(i, w)| (mean[*i][0] as f64 - w.unwrap()).abs() > 0.5)
+            .count();
+        assert!(
+            off >= 36 * 4,
+            "{backend:?}: sRGB-decoded alpha not rejected ({off} pixels off)"
+        );
+    }
+    assert_validation_clean();
+}
+
+#[test]
+fn blended_instanced_layers_transmit_one_minus_alpha_each_on_both_backends() {
+    let mut scene = with_independent_samples(load(&blend_file(), "blend.glb"));
+    scene.scene.camera = scene.scene.camera.resized(Some(24), Some(18)).unwrap();
+    assert_eq!(
+        scene.scene.instances.len(),
+        2,
+        "the layers are one mesh, placed twice"
+    );
+    let pixels = 24 * 18;
+    let value = |t: f64| vec![Some(RHO * t * 2.0); pixels];
+    let exact = value((1.0 - A) * (1.0 - A));
+    for (backend, specialize) in [
+        (Backend::Cpu, true),
+        (Backend::Gpu, true),
+        (Backend::Gpu, false),
+    ] {
+        let mut s = scene.clone();
+        s.settings.specialize = specialize;
+        let label = format!("{backend:?} specialize {specialize}");
+        let film = render_film(&s, backend, 512);
+        assert_film_matches(&film, &exact, &label);
+        let (mean, var) = (film.mean(), film.variance_of_mean());
+        for (wrong, what) in [(1.0 - A, "one layer"), (0.0, "opaque layers")] {
+            let z = max_abs_z(&mean, &var, &value(wrong));
+            assert!(z > 20.0, "{label}: {what} not rejected ({z})");
+        }
+    }
+    assert_validation_clean();
+}
