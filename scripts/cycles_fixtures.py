@@ -251,6 +251,58 @@ def scene_glowing_wall():
     return scene
 
 
+def alpha_checker_image(path):
+    """A 4 x 4 image of one colour, green (bytes 0 and 255: sRGB-decoded exactly to 0 and 1, so
+    the same texels in both renderers, read as linear as in the mapping scene), whose alpha
+    alternates 0 and 1 as a checkerboard, written as PNG and loaded back: the leaf texture of a
+    cut-out."""
+    image = bpy.data.images.new("leaf", 4, 4, alpha=True)
+    pixels = []
+    for j in range(4):
+        for i in range(4):
+            pixels += [0.0, 1.0, 0.0, float((i + j) % 2)]
+    image.pixels = pixels
+    image.filepath_raw = path
+    image.file_format = "PNG"
+    image.save()
+    bpy.data.images.remove(image)
+    loaded = bpy.data.images.load(path)
+    loaded.colorspace_settings.name = "Linear Rec.709"
+    return loaded
+
+
+def scene_cutout():
+    """A 2 m square 1 m above the floor whose alpha is clipped at 0.5, as a leaf texture is: the
+    image's alpha through Math "Less Than" 0.5 and "Subtract" from 1 into the Principled BSDF's
+    Alpha (the set-up Blender's exporter writes as alphaMode MASK), its colour into Base Color,
+    Specular IOR Level 0; under a 300 W point light, so the holes show the floor and let light
+    through to it."""
+    scene = reset()
+    floor()
+    mat = principled("leaf")
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    texture = nodes.new("ShaderNodeTexImage")
+    texture.image = alpha_checker_image(os.path.join(bpy.app.tempdir, "leaf.png"))
+    texture.interpolation = "Linear"
+    texture.extension = "REPEAT"
+    less = nodes.new("ShaderNodeMath")
+    less.operation = "LESS_THAN"
+    less.inputs[1].default_value = 0.5
+    one_minus = nodes.new("ShaderNodeMath")
+    one_minus.operation = "SUBTRACT"
+    one_minus.inputs[0].default_value = 1.0
+    bsdf = nodes["Principled BSDF"]
+    links.new(texture.outputs["Color"], bsdf.inputs["Base Color"])
+    links.new(texture.outputs["Alpha"], less.inputs[0])
+    links.new(less.outputs["Value"], one_minus.inputs[1])
+    links.new(one_minus.outputs["Value"], bsdf.inputs["Alpha"])
+    bpy.ops.mesh.primitive_plane_add(size=2.0, location=(0.0, 0.3, 1.0))
+    bpy.context.object.data.materials.append(mat)
+    light(scene, "POINT", 300.0, (0.3, 0.2, 2.5), shadow_soft_size=0.0)
+    camera(scene)
+    return scene
+
+
 SCENES = {
     "point": scene_point,
     "spot": scene_spot,
@@ -259,6 +311,7 @@ SCENES = {
     "mapping": scene_mapping,
     "colour": scene_colour,
     "glowing_wall": scene_glowing_wall,
+    "cutout": scene_cutout,
 }
 
 
