@@ -215,6 +215,20 @@ fn alpha_modes_become_the_materials_opacity() {
             "{extra}"
         );
     }
+    // A negative cutoff is an error naming the field.
+    let mut g = GltfWriter::new();
+    let m = g.push(
+        "materials",
+        json!({ "alphaMode": "MASK", "alphaCutoff": -0.5 }),
+    );
+    let mesh = square(&mut g, 1.0, 1, m);
+    let node = g.push("nodes", json!({ "mesh": mesh }));
+    g.push("scenes", json!({ "nodes": [node] }));
+    let dir = std::env::temp_dir().join(format!("twinpath-opacity-{}", std::process::id()));
+    let path = dir.join("negative.glb");
+    std::fs::write(&path, g.glb()).unwrap();
+    let e = SceneFile::load(&path).unwrap_err().to_string();
+    assert!(e.contains("alphaCutoff"), "{e}");
     // An emitter keeps no holes (its light samples would not see them), and says so.
     let mut g = GltfWriter::new();
     let m = g.push(
