@@ -1,6 +1,7 @@
 //! Ray/primitive intersection, the geometry factor, and where a new ray starts.
 
 use crate::intersect;
+use crate::scene::Triangle;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
@@ -115,6 +116,22 @@ pub fn intersect_triangle_uv(
             v: 0.0,
         }
     }
+}
+
+/// The barycentrics (and t) where the ray `origin + t dir`, t in (0, inf), meets triangle
+/// record `tri`: [`intersect_triangle_uv`] of its corner and edges. The CPU's hit records and
+/// its test of holes both ask it, as the GPU's hardware reports them.
+#[inline]
+pub fn triangle_record_uv(tri: &Triangle, origin: Vec3, dir: Vec3) -> TriangleHit {
+    intersect_triangle_uv(
+        origin,
+        dir,
+        Vec3::from(tri.p0),
+        Vec3::from(tri.edge1),
+        Vec3::from(tri.edge2),
+        0.0,
+        f32::INFINITY,
+    )
 }
 
 /// [`intersect_triangle_uv`]'s distance only: t in (t_min, t_max) or a negative value.

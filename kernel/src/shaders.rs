@@ -312,8 +312,8 @@ pub fn closest_hit_instance(
 
 /// Any hit on a triangle with holes: the candidate is ignored where `opacity::covers` says the
 /// surface is not there, as the CPU's leaf test ignores it (`instance_custom_index` is the
-/// instance's first triangle). It asks the generic path's questions (`Dynamic(0)`: the same
-/// answers), so only the ray-generation shader reads the specialization constant.
+/// instance's first triangle). It asks the generic path's questions, so only the
+/// ray-generation shader reads the specialization constant.
 #[spirv(any_hit)]
 pub fn any_hit_triangle(
     #[spirv(hit_attribute)] barycentrics: &Vec2,
@@ -334,18 +334,7 @@ pub fn any_hit_triangle(
         instance: NONE,
     };
     let tri = &triangles[index as usize];
-    let there = covers(
-        Dynamic(0),
-        materials,
-        shading,
-        textures,
-        tri,
-        *barycentrics,
-        &ray,
-    );
-    if !there {
-        unsafe { spirv_std::arch::ignore_intersection() };
-    }
+    ignore_unless_there(materials, shading, textures, tri, *barycentrics, &ray);
 }
 
 /// Any hit on an instanced triangle with holes: as [`any_hit_triangle`], the triangle from the
@@ -370,16 +359,22 @@ pub fn any_hit_instance(
         instance: index,
     };
     let tri = &triangles[(instances[index as usize].first_triangle + primitive) as usize];
-    let there = covers(
-        Dynamic(0),
-        materials,
-        shading,
-        textures,
-        tri,
-        *barycentrics,
-        &ray,
-    );
-    if !there {
+    ignore_unless_there(materials, shading, textures, tri, *barycentrics, &ray);
+}
+
+/// Ignores the candidate hit of `ray` on `tri` at barycentrics `bary` where `opacity::covers`
+/// says the surface is not there (the generic path's questions, `Dynamic(0)`: the same answers
+/// as specialized); what both any-hit shaders do.
+#[inline]
+fn ignore_unless_there(
+    materials: &[Material],
+    shading: &[ShadingTriangle],
+    textures: &[u32],
+    tri: &Triangle,
+    bary: Vec2,
+    ray: &CandidateRay,
+) {
+    if !covers(Dynamic(0), materials, shading, textures, tri, bary, ray) {
         unsafe { spirv_std::arch::ignore_intersection() };
     }
 }

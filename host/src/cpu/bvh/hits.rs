@@ -46,15 +46,7 @@ impl Bvh {
         let (o, d) = ray_to_object(instance, origin, dir);
         let index = hit.prim as usize;
         let tri = &mesh.triangles[index];
-        let h = intersect_triangle_uv(
-            o,
-            d,
-            Vec3::from(tri.p0),
-            Vec3::from(tri.edge1),
-            Vec3::from(tri.edge2),
-            0.0,
-            f32::INFINITY,
-        );
+        let h = triangle_record_uv(tri, o, d);
         SurfaceHit::instanced_triangle(
             tri,
             mesh.shapes[index],
@@ -81,13 +73,11 @@ impl Bvh {
         if (id as usize) < self.spheres.len() {
             return (0.0, 0.0);
         }
-        let tri = &self.triangles[id as usize - self.spheres.len()];
-        let (p0, e1, e2) = (
-            Vec3::from(tri.p0),
-            Vec3::from(tri.edge1),
-            Vec3::from(tri.edge2),
+        let h = triangle_record_uv(
+            &self.triangles[id as usize - self.spheres.len()],
+            origin,
+            dir,
         );
-        let h = intersect_triangle_uv(origin, dir, p0, e1, e2, 0.0, f32::INFINITY);
         (h.u, h.v)
     }
 

@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 use kernel::features::Dynamic;
-use kernel::geometry::intersect_triangle_uv;
+use kernel::geometry::triangle_record_uv;
 use kernel::opacity::{covers, CandidateRay};
 use kernel::scene::{Material, ShadingTriangle, Triangle};
 
@@ -63,15 +63,7 @@ impl Presence for Holes<'_> {
             return true;
         }
         // The barycentrics as the hit record computes them (`Bvh::barycentrics`).
-        let h = intersect_triangle_uv(
-            origin,
-            dir,
-            Vec3::from(tri.p0),
-            Vec3::from(tri.edge1),
-            Vec3::from(tri.edge2),
-            0.0,
-            f32::INFINITY,
-        );
+        let h = triangle_record_uv(tri, origin, dir);
         let ray = CandidateRay {
             origin: self.origin,
             dir: self.dir,

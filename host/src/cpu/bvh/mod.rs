@@ -30,9 +30,7 @@ use super::simd::{widest_simd, Boxes, Ray4, Spheres4, Triangles4, SLAB_PAD};
 use crate::scene::instancing::instance_box;
 use crate::scene::Scene;
 use glam::Vec3;
-use kernel::geometry::{
-    intersect_sphere, intersect_triangle, intersect_triangle_uv, TriangleShape,
-};
+use kernel::geometry::{intersect_sphere, intersect_triangle, triangle_record_uv, TriangleShape};
 use kernel::instance::ray_to_object;
 use kernel::scene::{Instance, Sphere, Triangle, NONE};
 use kernel::SurfaceHit;

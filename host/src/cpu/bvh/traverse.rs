@@ -55,6 +55,19 @@ impl Bvh {
 
     #[inline(always)]
     fn closest_two_level_any_cpu(&self, origin: Vec3, dir: Vec3, t_max: f32) -> PrimHit {
+        self.closest_from_root::<true, Solid>(origin, dir, t_max, Solid)
+    }
+
+    /// The closest hit from the root (a miss at `t_max` in an empty tree), with the instance
+    /// step where `INSTANCES`, counting the candidates `presence` says are there.
+    #[inline(always)]
+    fn closest_from_root<const INSTANCES: bool, P: Presence>(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        presence: P,
+    ) -> PrimHit {
         let mut instance = NONE;
         let Some(root) = self.root else {
             return PrimHit {
@@ -63,8 +76,9 @@ impl Bvh {
                 t: t_max,
             };
         };
+        let best = (NONE, t_max);
         let (prim, t) =
-            self.closest_in::<true, Solid>(root, origin, dir, (NONE, t_max), &mut instance, Solid);
+            self.closest_in::<INSTANCES, P>(root, origin, dir, best, &mut instance, presence);
         PrimHit { prim, instance, t }
     }
 
@@ -346,27 +360,17 @@ impl Bvh {
         t_max: f32,
         tables: &HoleTables<'_>,
     ) -> PrimHit {
-        let mut instance = NONE;
-        let Some(root) = self.root else {
-            return PrimHit {
-                prim: NONE,
-                instance,
-                t: t_max,
-            };
-        };
         let holes = Holes {
             tables: *tables,
             origin,
             dir,
             instance: NONE,
         };
-        let best = (NONE, t_max);
-        let (prim, t) = if self.instances.is_empty() {
-            self.closest_in::<false, Holes>(root, origin, dir, best, &mut instance, holes)
+        if self.instances.is_empty() {
+            self.closest_from_root::<false, Holes>(origin, dir, t_max, holes)
         } else {
-            self.closest_in::<true, Holes>(root, origin, dir, best, &mut instance, holes)
-        };
-        PrimHit { prim, instance, t }
+            self.closest_from_root::<true, Holes>(origin, dir, t_max, holes)
+        }
     }
 
     widest_simd! {
