@@ -28,6 +28,15 @@ use crate::surface::interpolated_uv;
 use crate::texture::alpha_in;
 use spirv_std::glam::{Vec2, Vec3};
 
+/// The tables [`covers`] reads: the scene's materials, shading records (texture coordinates)
+/// and texture table.
+#[derive(Clone, Copy)]
+pub struct HoleTables<'a> {
+    pub materials: &'a [Material],
+    pub shading: &'a [ShadingTriangle],
+    pub textures: &'a [u32],
+}
+
 /// A candidate hit: the world-space ray (as it was traced) and the triangle it met: its index
 /// in the triangle table, or in its mesh for an instanced triangle, whose instance is
 /// `instance` (`NONE` for a world-space triangle).
@@ -64,14 +73,12 @@ impl CandidateRay {
 #[inline]
 pub fn covers<F: FeatureSet>(
     features: F,
-    materials: &[Material],
-    shading: &[ShadingTriangle],
-    textures: &[u32],
+    tables: &HoleTables,
     tri: &Triangle,
     bary: Vec2,
     ray: &CandidateRay,
 ) -> bool {
-    let material = &materials[tri.material as usize];
+    let material = &tables.materials[tri.material as usize];
     let t = material.opacity;
     if t == 0.0 {
         return true;
@@ -79,8 +86,8 @@ pub fn covers<F: FeatureSet>(
     let map = material.textures[texture_slot::KD];
     let mut alpha = 1.0;
     if features.textures() && map != NONE && tri.shading != NONE {
-        let uv = interpolated_uv(&shading[tri.shading as usize], bary);
-        alpha = alpha_in(features, textures, map, uv);
+        let uv = interpolated_uv(&tables.shading[tri.shading as usize], bary);
+        alpha = alpha_in(features, tables.textures, map, uv);
     }
     if t > 0.0 {
         alpha >= t

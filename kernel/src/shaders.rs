@@ -22,7 +22,7 @@ use crate::features::{Dynamic, FeatureSet};
 use crate::film_sample::{classify, sample_use};
 use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::hit::SurfaceHit;
-use crate::opacity::{covers, CandidateRay};
+use crate::opacity::{covers, CandidateRay, HoleTables};
 use crate::path::{render_sample, Tracer};
 use crate::scene::{
     Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle, NONE,
@@ -334,7 +334,12 @@ pub fn any_hit_triangle(
         instance: NONE,
     };
     let tri = &triangles[index as usize];
-    ignore_unless_there(materials, shading, textures, tri, *barycentrics, &ray);
+    let tables = HoleTables {
+        materials,
+        shading,
+        textures,
+    };
+    ignore_unless_there(&tables, tri, *barycentrics, &ray);
 }
 
 /// Any hit on an instanced triangle with holes: as [`any_hit_triangle`], the triangle from the
@@ -359,22 +364,20 @@ pub fn any_hit_instance(
         instance: index,
     };
     let tri = &triangles[(instances[index as usize].first_triangle + primitive) as usize];
-    ignore_unless_there(materials, shading, textures, tri, *barycentrics, &ray);
+    let tables = HoleTables {
+        materials,
+        shading,
+        textures,
+    };
+    ignore_unless_there(&tables, tri, *barycentrics, &ray);
 }
 
 /// Ignores the candidate hit of `ray` on `tri` at barycentrics `bary` where `opacity::covers`
 /// says the surface is not there (the generic path's questions, `Dynamic(0)`: the same answers
 /// as specialized); what both any-hit shaders do.
 #[inline]
-fn ignore_unless_there(
-    materials: &[Material],
-    shading: &[ShadingTriangle],
-    textures: &[u32],
-    tri: &Triangle,
-    bary: Vec2,
-    ray: &CandidateRay,
-) {
-    if !covers(Dynamic(0), materials, shading, textures, tri, bary, ray) {
+fn ignore_unless_there(tables: &HoleTables, tri: &Triangle, bary: Vec2, ray: &CandidateRay) {
+    if !covers(Dynamic(0), tables, tri, bary, ray) {
         unsafe { spirv_std::arch::ignore_intersection() };
     }
 }

@@ -5,8 +5,9 @@
 use glam::{Vec2, Vec3};
 use kernel::features::Dynamic;
 use kernel::geometry::triangle_record_uv;
+pub use kernel::opacity::HoleTables;
 use kernel::opacity::{covers, CandidateRay};
-use kernel::scene::{Material, ShadingTriangle, Triangle};
+use kernel::scene::{Triangle, NONE};
 
 /// The answer for a triangle candidate of a traversal.
 pub trait Presence: Copy {
@@ -36,23 +37,26 @@ impl Presence for Solid {
     }
 }
 
-/// The tables `kernel::opacity::covers` reads: the scene's materials, shading records and
-/// texture table.
-#[derive(Clone, Copy, Debug)]
-pub struct HoleTables<'a> {
-    pub materials: &'a [Material],
-    pub shading: &'a [ShadingTriangle],
-    pub textures: &'a [u32],
-}
-
 /// The candidates of one world-space ray `origin + t dir` that the materials say are there;
 /// `instance` is the instance whose mesh the traversal is in (`NONE` at the top level).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy)]
 pub struct Holes<'a> {
     pub tables: HoleTables<'a>,
     pub origin: Vec3,
     pub dir: Vec3,
     pub instance: u32,
+}
+
+impl<'a> Holes<'a> {
+    /// The candidates of the world-space ray `origin + t dir` at the top level of the tree.
+    pub fn of_ray(tables: HoleTables<'a>, origin: Vec3, dir: Vec3) -> Self {
+        Holes {
+            tables,
+            origin,
+            dir,
+            instance: NONE,
+        }
+    }
 }
 
 impl Presence for Holes<'_> {
@@ -70,15 +74,7 @@ impl Presence for Holes<'_> {
             triangle: index,
             instance: self.instance,
         };
-        covers(
-            Dynamic(0),
-            self.tables.materials,
-            self.tables.shading,
-            self.tables.textures,
-            tri,
-            Vec2::new(h.u, h.v),
-            &ray,
-        )
+        covers(Dynamic(0), &self.tables, tri, Vec2::new(h.u, h.v), &ray)
     }
     #[inline(always)]
     fn in_instance(&self, instance: u32) -> Self {

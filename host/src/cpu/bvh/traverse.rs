@@ -360,12 +360,7 @@ impl Bvh {
         t_max: f32,
         tables: &HoleTables<'_>,
     ) -> PrimHit {
-        let holes = Holes {
-            tables: *tables,
-            origin,
-            dir,
-            instance: NONE,
-        };
+        let holes = Holes::of_ray(*tables, origin, dir);
         if self.instances.is_empty() {
             self.closest_from_root::<false, Holes>(origin, dir, t_max, holes)
         } else {
@@ -390,12 +385,7 @@ impl Bvh {
         let Some(root) = self.root else {
             return false;
         };
-        let holes = Holes {
-            tables: *tables,
-            origin,
-            dir,
-            instance: NONE,
-        };
+        let holes = Holes::of_ray(*tables, origin, dir);
         if self.instances.is_empty() {
             self.any_in::<false, Holes>(root, origin, dir, t_max, holes)
         } else {
