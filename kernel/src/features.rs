@@ -70,11 +70,16 @@ pub const TEXTURE_TRANSFORMS: u32 = 1 << 21;
 /// may pass through a candidate hit (the GPU traces them without the OPAQUE flag).
 pub const OPACITY: u32 = 1 << 22;
 
+/// Some triangle has a second set of texture coordinates (`shading_flags::SECOND_UVS`, glTF's
+/// `TEXCOORD_1`): lookups may read it.
+pub const SECOND_UVS: u32 = 1 << 23;
+
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
 /// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals,
 /// [`NORMAL_MAPS`] and [`SHADING_NORMALS`] if a material has a normal map,
 /// [`REFLECTING_LIGHTS`] if an emitting material reflects, [`VERTEX_COLOURS`] if a triangle
-/// has vertex colours, [`OPACITY`] if a material has holes.
+/// has vertex colours, [`OPACITY`] if a material has holes, [`SECOND_UVS`] if a triangle has
+/// a second set of texture coordinates.
 #[inline]
 pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> u32 {
     let mut f = 0;
@@ -110,6 +115,12 @@ pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> 
     }
     if materials.iter().any(|m| m.opacity != 0.0) {
         f |= OPACITY;
+    }
+    if shading
+        .iter()
+        .any(|s| s.flags & shading_flags::SECOND_UVS != 0)
+    {
+        f |= SECOND_UVS;
     }
     f
 }
@@ -274,6 +285,11 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn opacity(self) -> bool {
         self.answer(OPACITY, true)
+    }
+    /// The generic path asks each texture's record.
+    #[inline]
+    fn second_uvs(self) -> bool {
+        self.answer(SECOND_UVS, true)
     }
     /// The generic path asks each light's material (`Material::reflects`).
     #[inline]

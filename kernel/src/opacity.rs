@@ -24,7 +24,7 @@ use crate::features::FeatureSet;
 use crate::hash::pcg4d;
 use crate::rng::u32_to_unit_f32;
 use crate::scene::{texture_slot, Material, ShadingTriangle, Triangle, NONE};
-use crate::surface::interpolated_uv;
+use crate::surface::tex_coords;
 use crate::texture::alpha_in;
 use spirv_std::glam::{Vec2, Vec3};
 
@@ -86,8 +86,8 @@ pub fn covers<F: FeatureSet>(
     let map = material.textures[texture_slot::KD];
     let mut alpha = 1.0;
     if features.textures() && map != NONE && tri.shading != NONE {
-        let uv = interpolated_uv(&tables.shading[tri.shading as usize], bary);
-        alpha = alpha_in(features, tables.textures, map, uv);
+        let coords = tex_coords(features, tables.shading, tri.shading, material, bary);
+        alpha = alpha_in(features, tables.textures, map, coords);
     }
     if t > 0.0 {
         alpha >= t

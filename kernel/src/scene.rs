@@ -46,7 +46,8 @@ pub struct Triangle {
 /// `uv0[0]`, glTF's `TANGENT.w` (bitangent = sign x normal x tangent). A triangle with vertex
 /// colours (`shading_flags::VERTEX_COLOURS`, glTF's `COLOR_0`) has one more record after those,
 /// [`ShadingTriangle::vertex_colours`]: the three linear RGB colours in `normal0..2`,
-/// interpolated like the normals, multiplying the base colour. Keeping them in the same table
+/// interpolated like the normals, multiplying the base colour; one with a second set of texture
+/// coordinates (`shading_flags::SECOND_UVS`) one more, with them in `uv0..2`. Keeping them in the same table
 /// costs nothing to scenes without them and needs no further GPU binding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
@@ -72,6 +73,10 @@ pub mod shading_flags {
     /// A vertex-colour record ([`super::ShadingTriangle::vertex_colours`]) follows the
     /// triangle's record (and its tangent frame, where its material has a normal map).
     pub const VERTEX_COLOURS: u32 = 1 << 1;
+    /// A record of the triangle's second texture coordinates (glTF's `TEXCOORD_1`, in
+    /// `uv0..2`) follows the others (its tangent frame and vertex colours, where it has them),
+    /// for the textures that read that set (`crate::texture::flags::SECOND_SET`).
+    pub const SECOND_UVS: u32 = 1 << 2;
 }
 
 impl ShadingTriangle {

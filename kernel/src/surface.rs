@@ -23,7 +23,7 @@ use crate::hit::SurfaceHit;
 use crate::instance::{normal_to_world, vector_to_world};
 use crate::scene::{shading_flags, texture_slot, Material, ShadingTriangle, NONE};
 use crate::scene_view::SceneView;
-use crate::texture::{lookup_in, textured_material};
+use crate::texture::{lookup_at, textured_material, TexCoords};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
@@ -62,6 +62,29 @@ pub fn interpolated_uv(tri: &ShadingTriangle, bary: Vec2) -> Vec2 {
         Vec2::from(tri.uv2),
         bary,
     )
+}
+
+/// The texture coordinates of shading record `record` (of a triangle whose material is
+/// `material`) at barycentrics `bary`: its own, and the second set from the record that follows
+/// its others (tangent frame, vertex colours) where it has one (`shading_flags::SECOND_UVS`, in
+/// scenes with second sets); else the first again.
+#[inline]
+pub fn tex_coords<F: FeatureSet>(
+    features: F,
+    shading: &[ShadingTriangle],
+    record: u32,
+    material: &Material,
+    bary: Vec2,
+) -> TexCoords {
+    let tri = &shading[record as usize];
+    let mut coords = TexCoords::one(interpolated_uv(tri, bary));
+    if features.second_uvs() && tri.flags & shading_flags::SECOND_UVS != 0 {
+        let after = 1
+            + (material.textures[texture_slot::NORMAL] != NONE) as u32
+            + (tri.flags & shading_flags::VERTEX_COLOURS != 0) as u32;
+        coords.second = interpolated_uv(&shading[(record + after) as usize], bary);
+    }
+    coords
 }
 
 /// The shading normal a tangent-space normal map gives (glTF 2.0, `material.normalTexture`;
@@ -127,8 +150,8 @@ pub fn shade<F: FeatureSet>(features: F, scene: &SceneView, hit: &SurfaceHit) ->
             }
         }
         if features.textures() {
-            let uv = interpolated_uv(&tri, bary);
-            m = textured_material(features, &m, textures, uv);
+            let coords = tex_coords(features, shading, record, &m, bary);
+            m = textured_material(features, &m, textures, coords);
             let map = m.textures[texture_slot::NORMAL];
             if features.normal_maps() && map != NONE {
                 let base = if normal == Vec3::ZERO {
@@ -148,7 +171,7 @@ pub fn shade<F: FeatureSet>(features: F, scene: &SceneView, hit: &SurfaceHit) ->
                     base,
                     &frame,
                     bary,
-                    lookup_in(features, textures, map, uv),
+                    lookup_at(features, textures, map, coords),
                     m.normal_scale,
                 );
             }
@@ -189,8 +212,8 @@ pub fn emission_at<F: FeatureSet>(
     let emission = Vec3::from(material.emission);
     let texture = material.textures[texture_slot::EMISSION];
     if features.textures() && texture != NONE && record != NONE {
-        let uv = interpolated_uv(&scene.shading[record as usize], bary);
-        emission * lookup_in(features, scene.textures, texture, uv)
+        let coords = tex_coords(features, scene.shading, record, material, bary);
+        emission * lookup_at(features, scene.textures, texture, coords)
     } else {
         emission
     }

@@ -47,6 +47,9 @@ pub mod flags {
     pub const WRAP_V_SHIFT: u32 = 4;
     /// The record's texture-coordinate map applies (else the coordinates are used as given).
     pub const TRANSFORM: u32 = 1 << 6;
+    /// The lookup reads the point's second texture coordinates (glTF's `TEXCOORD_1`,
+    /// [`super::TexCoords::second`]).
+    pub const SECOND_SET: u32 = 1 << 7;
 
     /// The flag bits of wrap modes `u` and `v` (`super::wrap`).
     pub const fn wrap(u: u32, v: u32) -> u32 {
@@ -62,6 +65,26 @@ pub mod wrap {
     pub const CLAMP: u32 = 1;
     /// The image repeats mirrored every other time (MIRRORED_REPEAT).
     pub const MIRROR: u32 = 2;
+}
+
+/// A point's texture coordinates: glTF's `TEXCOORD_0` and `TEXCOORD_1` (the first again where
+/// the triangle has no second set); each texture record says which it reads
+/// ([`flags::SECOND_SET`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexCoords {
+    pub first: Vec2,
+    pub second: Vec2,
+}
+
+impl TexCoords {
+    /// One set for every texture.
+    #[inline]
+    pub fn one(uv: Vec2) -> Self {
+        Self {
+            first: uv,
+            second: uv,
+        }
+    }
 }
 
 /// The four texels around a point and the point's position between them: texel columns `x0`,
@@ -233,7 +256,19 @@ pub fn lookup(table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
 /// the scene has one (`features::TEXTURE_TRANSFORMS`).
 #[inline]
 pub fn lookup_in<F: FeatureSet>(features: F, table: &[u32], texture: u32, uv: Vec2) -> Vec3 {
-    let (offset, width, tex_flags, f) = located(features, table, texture, uv);
+    lookup_at(features, table, texture, TexCoords::one(uv))
+}
+
+/// [`lookup_in`] at a point of texture coordinates `coords`, the texture reading the set its
+/// record names (the second only in scenes with second sets, `features::SECOND_UVS`).
+#[inline]
+pub fn lookup_at<F: FeatureSet>(
+    features: F,
+    table: &[u32],
+    texture: u32,
+    coords: TexCoords,
+) -> Vec3 {
+    let (offset, width, tex_flags, f) = located(features, table, texture, coords);
     bilerp(
         texel(table, offset, width, tex_flags, f.x0, f.y0),
         texel(table, offset, width, tex_flags, f.x1, f.y0),
@@ -248,8 +283,8 @@ pub fn lookup_in<F: FeatureSet>(features: F, table: &[u32], texture: u32, uv: Ve
 /// filters the colour: an 8-bit texel's fourth byte / 255 (alpha is linear, glTF 2.0 section
 /// 3.9.2, even in an sRGB-encoded colour map); 1 for a float texture, which has none.
 #[inline]
-pub fn alpha_in<F: FeatureSet>(features: F, table: &[u32], texture: u32, uv: Vec2) -> f32 {
-    let (offset, width, tex_flags, f) = located(features, table, texture, uv);
+pub fn alpha_in<F: FeatureSet>(features: F, table: &[u32], texture: u32, coords: TexCoords) -> f32 {
+    let (offset, width, tex_flags, f) = located(features, table, texture, coords);
     if tex_flags & flags::FLOAT != 0 {
         return 1.0;
     }
@@ -267,17 +302,22 @@ fn texel_alpha(table: &[u32], offset: u32, width: u32, x: u32, y: u32) -> f32 {
     decoded(table, LINEAR_TABLE, word >> 24)
 }
 
-/// Texture `texture`'s first texel word, width and flags, and the footprint of `uv` on it
-/// (through the record's map where it has one and the scene has maps).
+/// Texture `texture`'s first texel word, width and flags, and the footprint on it of the set
+/// of `coords` it reads (through the record's map where it has one and the scene has maps).
 #[inline]
 fn located<F: FeatureSet>(
     features: F,
     table: &[u32],
     texture: u32,
-    uv: Vec2,
+    coords: TexCoords,
 ) -> (u32, u32, u32, Footprint) {
     let r = RECORDS + RECORD_WORDS * texture as usize;
     let (offset, width, height, tex_flags) = (table[r], table[r + 1], table[r + 2], table[r + 3]);
+    let uv = if features.second_uvs() && tex_flags & flags::SECOND_SET != 0 {
+        coords.second
+    } else {
+        coords.first
+    };
     let uv = if features.texture_transforms() && tex_flags & flags::TRANSFORM != 0 {
         transformed(table, r, uv)
     } else {
@@ -293,7 +333,7 @@ fn located<F: FeatureSet>(
     (offset, width, tex_flags, f)
 }
 
-/// `material` at a point of texture coordinates `uv`: each parameter with a texture multiplied
+/// `material` at a point of texture coordinates `coords`: each parameter with a texture multiplied
 /// by the texture's value there (alpha by its red channel; for glTF's metallic-roughness
 /// material the `KS` map's blue channel multiplies metallic and its green roughness).
 #[inline]
@@ -301,22 +341,25 @@ pub fn textured_material<F: FeatureSet>(
     features: F,
     material: &Material,
     table: &[u32],
-    uv: Vec2,
+    coords: TexCoords,
 ) -> Material {
     let mut m = *material;
     let t = material.textures;
     if t[texture_slot::KD] != NONE {
-        let value = lookup_in(features, table, t[texture_slot::KD], uv);
+        let value = lookup_at(features, table, t[texture_slot::KD], coords);
         m.albedo = (Vec3::from(m.albedo) * value).to_array();
     }
     if t[texture_slot::KS] != NONE {
-        bsdf::apply_ks_texture(&mut m, lookup_in(features, table, t[texture_slot::KS], uv));
+        bsdf::apply_ks_texture(
+            &mut m,
+            lookup_at(features, table, t[texture_slot::KS], coords),
+        );
     }
     if t[texture_slot::ALPHA] != NONE {
-        m.alpha *= lookup_in(features, table, t[texture_slot::ALPHA], uv).x;
+        m.alpha *= lookup_at(features, table, t[texture_slot::ALPHA], coords).x;
     }
     if t[texture_slot::EMISSION] != NONE {
-        let value = lookup_in(features, table, t[texture_slot::EMISSION], uv);
+        let value = lookup_at(features, table, t[texture_slot::EMISSION], coords);
         m.emission = (Vec3::from(m.emission) * value).to_array();
     }
     m

@@ -483,6 +483,7 @@ fn texture_channels_srgb_and_the_metallic_roughness_map() {
                 colour: true,
                 wrap: [kernel::texture::wrap::REPEAT; 2],
                 transform: None,
+                second_set: false,
             },
             "b",
         )
@@ -494,6 +495,7 @@ fn texture_channels_srgb_and_the_metallic_roughness_map() {
                 colour: false,
                 wrap: [kernel::texture::wrap::REPEAT; 2],
                 transform: None,
+                second_set: false,
             },
             "m",
         )

@@ -89,6 +89,7 @@ fn the_mapped_normal_is_gltfs_formula() {
                     colour: false,
                     wrap: [kernel::texture::wrap::REPEAT; 2],
                     transform: None,
+                    second_set: false,
                 },
                 "n",
             )

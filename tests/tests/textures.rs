@@ -177,6 +177,7 @@ fn lookup_is_bilinear_between_texel_centres_repeated_clamped_or_mirrored() {
             colour: srgb,
             wrap: mode,
             transform: None,
+            second_set: false,
         };
         table.push(
             Path::new("generated"),
@@ -508,6 +509,7 @@ fn a_coordinate_map_applies_before_the_lookup_and_shares_the_texels() {
         colour: true,
         wrap: [wrap::REPEAT, wrap::MIRROR],
         transform,
+        second_set: false,
     };
     let mut table = TextureTable::new();
     let plain = table

@@ -81,6 +81,15 @@ impl SceneTables {
             .any(|&t| t != NONE)
     }
 
+    /// Whether a texture of material `m` reads the second set of texture coordinates (its
+    /// triangles then carry a record of them: `shading_flags::SECOND_UVS`).
+    pub fn reads_second_set(&self, m: u32) -> bool {
+        self.materials[m as usize]
+            .textures
+            .iter()
+            .any(|&t| t != NONE && self.textures.reads_second_set(t))
+    }
+
     /// Whether material `m` has a normal map (its triangles then carry a tangent frame).
     fn is_normal_mapped(&self, m: u32) -> bool {
         self.materials[m as usize].textures[texture_slot::NORMAL] != NONE
@@ -98,13 +107,15 @@ impl SceneTables {
         attributes: Option<ShadingTriangle>,
         tangents: Option<([Vec3; 3], f32)>,
     ) {
-        self.push_triangle_to(Space::World, p, material, attributes, tangents, None);
+        let none = Trailing::default();
+        self.push_triangle_to(Space::World, p, material, attributes, tangents, none);
     }
 
     /// [`SceneTables::push_triangle`] into the world-space table or (`Space::Object`, never a
-    /// light) the instanced meshes' table, with vertex `colours` where it has them (a record
-    /// after its own and its tangent frame: `ShadingTriangle::vertex_colours`; `attributes`
-    /// then carries `shading_flags::VERTEX_COLOURS`).
+    /// light) the instanced meshes' table, with the `trailing` records where it has them (after
+    /// its own and its tangent frame: `ShadingTriangle::vertex_colours`, then the second
+    /// texture coordinates; `attributes` then carries `shading_flags::VERTEX_COLOURS` and
+    /// `SECOND_UVS`).
     fn push_triangle_to(
         &mut self,
         space: Space,
@@ -112,7 +123,7 @@ impl SceneTables {
         material: u32,
         attributes: Option<ShadingTriangle>,
         tangents: Option<([Vec3; 3], f32)>,
-        colours: Option<[[f32; 3]; 3]>,
+        trailing: Trailing,
     ) {
         let mut tri = super::triangle(p, material);
         let m = self.materials[material as usize];
@@ -140,9 +151,18 @@ impl SceneTables {
                 };
                 self.shading.push(frame);
             }
-            if let Some(c) = colours {
+            if let Some(c) = trailing.colours {
                 debug_assert!(a.flags & shading_flags::VERTEX_COLOURS != 0);
                 self.shading.push(ShadingTriangle::vertex_colours(c));
+            }
+            if let Some(t) = trailing.second_uvs {
+                debug_assert!(a.flags & shading_flags::SECOND_UVS != 0);
+                self.shading.push(ShadingTriangle {
+                    uv0: t[0],
+                    uv1: t[1],
+                    uv2: t[2],
+                    ..ShadingTriangle::zeroed()
+                });
             }
         }
         if space == Space::Object {
@@ -154,10 +174,13 @@ impl SceneTables {
             tri.light = self.lights.len() as u32;
             let mut light = triangle_light(&tri, m.emission, m.two_sided != 0);
             if let Some(a) = attributes {
-                light.uv = [a.uv0, a.uv1, a.uv2]
-                    .concat()
-                    .try_into()
-                    .expect("six numbers");
+                // The emission texture's own set of coordinates.
+                let emission = m.textures[texture_slot::EMISSION];
+                let uv = match trailing.second_uvs {
+                    Some(t) if emission != NONE && self.textures.reads_second_set(emission) => t,
+                    _ => [a.uv0, a.uv1, a.uv2],
+                };
+                light.uv = uv.concat().try_into().expect("six numbers");
                 light.emission_texture = m.textures[texture_slot::EMISSION];
             }
             self.lights.push(light);
@@ -256,6 +279,7 @@ impl SceneTables {
     ) -> Result<(), (usize, String)> {
         let mirror = transform.is_some_and(|t| t.mirrors());
         let textured = self.is_textured(material);
+        let second_set = self.reads_second_set(material);
         // A normal-mapped mesh with vertex normals and texture coordinates but no tangents of
         // its own gets MikkTSpace's (glTF 2.0, "Meshes"; Blender's), whatever its format.
         let generated = (self.is_normal_mapped(material) && soup.tangents.is_empty())
@@ -309,6 +333,11 @@ impl SceneTables {
                 (mapped, sign)
             });
             let colours = soup.colours.get(k).map(|c| wound(*c, mirror));
+            let second_uvs = soup
+                .uvs1
+                .get(k)
+                .filter(|_| second_set)
+                .map(|t| wound(*t, mirror));
             let attributes = (normals.is_some() || uvs.is_some() || colours.is_some()).then(|| {
                 let n = normals.unwrap_or([[0.0; 3]; 3]);
                 let t = uvs.unwrap_or([[0.0; 2]; 3]);
@@ -318,6 +347,9 @@ impl SceneTables {
                 }
                 if colours.is_some() {
                     flags |= shading_flags::VERTEX_COLOURS;
+                }
+                if second_uvs.is_some() {
+                    flags |= shading_flags::SECOND_UVS;
                 }
                 ShadingTriangle {
                     normal0: n[0],
@@ -329,7 +361,11 @@ impl SceneTables {
                     flags,
                 }
             });
-            self.push_triangle_to(space, p, material, attributes, tangents, colours);
+            let trailing = Trailing {
+                colours,
+                second_uvs,
+            };
+            self.push_triangle_to(space, p, material, attributes, tangents, trailing);
         }
         Ok(())
     }
@@ -379,4 +415,13 @@ impl SceneTables {
             inputs: Vec::new(),
         }
     }
+}
+
+/// The records that follow a triangle's shading record (after its tangent frame), where it has
+/// them: vertex colours (`shading_flags::VERTEX_COLOURS`) and a second set of texture
+/// coordinates (`shading_flags::SECOND_UVS`).
+#[derive(Clone, Copy, Debug, Default)]
+struct Trailing {
+    colours: Option<[[f32; 3]; 3]>,
+    second_uvs: Option<[[f32; 2]; 3]>,
 }

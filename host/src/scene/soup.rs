@@ -12,6 +12,8 @@ pub struct TriangleSoup {
     pub tangents: Vec<[[f32; 4]; 3]>,
     /// Linear RGB vertex colours (glTF's `COLOR_0`), multiplying the base colour.
     pub colours: Vec<[[f32; 3]; 3]>,
+    /// A second set of texture coordinates (glTF's `TEXCOORD_1`), for the textures that read it.
+    pub uvs1: Vec<[[f32; 2]; 3]>,
 }
 
 impl TriangleSoup {
@@ -29,6 +31,9 @@ impl TriangleSoup {
         }
         if self.colours.len() != self.triangles.len() {
             self.colours.clear();
+        }
+        if self.uvs1.len() != self.triangles.len() {
+            self.uvs1.clear();
         }
         self
     }

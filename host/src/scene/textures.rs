@@ -31,13 +31,15 @@ pub struct TextureInfo {
 }
 
 /// How a texture is read: as colour (sRGB-encoded 8-bit images) or as linear data, how
-/// coordinates outside [0, 1] wrap along u and v (`kernel::texture::wrap`), and the map the
-/// coordinates go through first, if any (glTF's `KHR_texture_transform`).
+/// coordinates outside [0, 1] wrap along u and v (`kernel::texture::wrap`), the map the
+/// coordinates go through first, if any (glTF's `KHR_texture_transform`), and whether it reads
+/// the second set of texture coordinates (glTF's `TEXCOORD_1`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TextureUse {
     pub colour: bool,
     pub wrap: [u32; 2],
     pub transform: Option<UvTransform>,
+    pub second_set: bool,
 }
 
 /// An affine map of texture coordinates in the kernel's convention (v up), row-major
@@ -157,6 +159,9 @@ impl TextureTable {
         if usage.transform.is_some() {
             tex_flags |= flags::TRANSFORM;
         }
+        if usage.second_set {
+            tex_flags |= flags::SECOND_SET;
+        }
         let texels: Vec<u32> = if float {
             tex_flags |= flags::FLOAT;
             let rgb = image.into_rgb32f();
@@ -232,6 +237,11 @@ impl TextureTable {
             }
         }
         peak
+    }
+
+    /// Whether texture `k` reads the second set of texture coordinates.
+    pub fn reads_second_set(&self, k: u32) -> bool {
+        self.textures[k as usize].flags & flags::SECOND_SET != 0
     }
 
     /// Appends a texture of `width` x `height` texels (its own `texels` in the kernel's

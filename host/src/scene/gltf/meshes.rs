@@ -148,6 +148,14 @@ impl Import<'_> {
                 "its material has textures but the primitive has no TEXCOORD_0",
             ));
         }
+        if self.tables.reads_second_set(material) && soup.uvs1.is_empty() {
+            return Err(SceneError::new(
+                &self.path,
+                None,
+                field,
+                "its material has a texture that reads TEXCOORD_1 but the primitive has none",
+            ));
+        }
         if self.tables.is_dielectric(material) {
             check_closed_outward(&soup.triangles).map_err(|msg| {
                 SceneError::new(
@@ -179,6 +187,10 @@ impl Import<'_> {
             Some(a) => Some(read_uv(&self.path, &a, &self.buffers)?),
             None => None,
         };
+        let uvs1 = match p.get(&gltf::Semantic::TexCoords(1)) {
+            Some(a) => Some(read_uv(&self.path, &a, &self.buffers)?),
+            None => None,
+        };
         let tangents = match p.get(&gltf::Semantic::Tangents) {
             Some(a) => Some(read_floats::<4>(&self.path, &a, &self.buffers)?),
             None => None,
@@ -190,6 +202,7 @@ impl Import<'_> {
         for (name, len) in [
             ("NORMAL", normals.as_ref().map(|v| v.len())),
             ("TEXCOORD_0", uvs.as_ref().map(|v| v.len())),
+            ("TEXCOORD_1", uvs1.as_ref().map(|v| v.len())),
             ("TANGENT", tangents.as_ref().map(|v| v.len())),
             ("COLOR_0", colours.as_ref().map(|v| v.len())),
         ] {
@@ -228,23 +241,25 @@ impl Import<'_> {
             }
         };
         let corner = |t: &[u32; 3], v: &[[f32; 3]]| t.map(|i| v[i as usize]);
+        let flipped = |v: Vec<[f32; 2]>| -> Vec<[[f32; 2]; 3]> {
+            triangles
+                .iter()
+                .map(|t| t.map(|i| [v[i as usize][0], 1.0 - v[i as usize][1]]))
+                .collect()
+        };
         Ok(TriangleSoup {
             triangles: triangles.iter().map(|t| corner(t, &positions)).collect(),
             normals: normals.map_or_else(Vec::new, |v| {
                 triangles.iter().map(|t| corner(t, &v)).collect()
             }),
-            uvs: uvs.map_or_else(Vec::new, |v| {
-                triangles
-                    .iter()
-                    .map(|t| t.map(|i| [v[i as usize][0], 1.0 - v[i as usize][1]]))
-                    .collect()
-            }),
+            uvs: uvs.map_or_else(Vec::new, flipped),
             tangents: tangents.map_or_else(Vec::new, |v| {
                 triangles.iter().map(|t| t.map(|i| v[i as usize])).collect()
             }),
             colours: colours.map_or_else(Vec::new, |v| {
                 triangles.iter().map(|t| corner(t, &v)).collect()
             }),
+            uvs1: uvs1.map_or_else(Vec::new, flipped),
         })
     }
 }

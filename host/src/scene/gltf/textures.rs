@@ -120,7 +120,7 @@ fn texture_of(
     colour: bool,
 ) -> Result<u32, SceneError> {
     let tex_coord = transform.and_then(|t| t.tex_coord).unwrap_or(tex_coord);
-    if tex_coord != 0 {
+    if tex_coord > 1 {
         imp.note(format!(
             "{label}: textures[{}] names TEXCOORD_{tex_coord}; TEXCOORD_0 is used",
             tex.index(),
@@ -152,6 +152,7 @@ fn texture_of(
         colour,
         wrap: [mode(sampler.wrap_s()), mode(sampler.wrap_t())],
         transform: map,
+        second_set: tex_coord == 1,
     };
     imp.image(tex.source().index(), usage)
 }

@@ -497,6 +497,7 @@ pub(super) fn attach_textures(
                 colour,
                 wrap: [mode; 2],
                 transform: None,
+                second_set: false,
             },
             &map_field,
         )?;
