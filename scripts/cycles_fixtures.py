@@ -303,6 +303,22 @@ def scene_cutout():
     return scene
 
 
+def scene_blend():
+    """A 2 m square 1 m above the floor whose Principled BSDF has Alpha 0.4 (base colour 0.2,
+    0.5, 0.8; Specular IOR Level 0), which Blender's exporter writes as alphaMode BLEND; under
+    a 300 W point light: the camera sees the floor through it, and light reaches the floor
+    through it, 60% of the time."""
+    scene = reset()
+    floor()
+    mat = principled("veil", base=(0.2, 0.5, 0.8))
+    mat.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = 0.4
+    bpy.ops.mesh.primitive_plane_add(size=2.0, location=(0.0, 0.3, 1.0))
+    bpy.context.object.data.materials.append(mat)
+    light(scene, "POINT", 300.0, (0.3, 0.2, 2.5), shadow_soft_size=0.0)
+    camera(scene)
+    return scene
+
+
 SCENES = {
     "point": scene_point,
     "spot": scene_spot,
@@ -312,6 +328,7 @@ SCENES = {
     "colour": scene_colour,
     "glowing_wall": scene_glowing_wall,
     "cutout": scene_cutout,
+    "blend": scene_blend,
 }
 
 

@@ -25,6 +25,9 @@
 //!   "Less Than" and "Subtract" into Alpha, as a leaf's cut-out is set up), which the exporter
 //!   writes as `alphaMode` MASK: its holes show the floor and let the light through. The same
 //!   render with the holes ignored (the square opaque) is rejected.
+//! - `blend`: a square over the floor whose Principled BSDF has Alpha 0.4, which the exporter
+//!   writes as `alphaMode` BLEND: seen and passed through 60% of the time. The same render
+//!   with the square opaque is rejected.
 
 use glam::Vec3;
 use twinpath::film::RgbImage;
@@ -252,7 +255,27 @@ fn a_blender_alpha_clipped_texture_renders_as_cycles_renders_it() {
     assert_validation_clean();
     let m = &f.scene.scene.materials;
     assert!(m.iter().any(|m| m.opacity == 0.5), "the file's MASK: {m:?}");
-    // With the holes ignored (the square opaque, as before alphaMode was read).
+    assert_opaque_rejected(&f, "cutout");
+}
+
+#[test]
+fn a_blender_alpha_blended_surface_renders_as_cycles_renders_it() {
+    let f = fixture("blend");
+    for backend in [Backend::Cpu, Backend::Gpu] {
+        compare(&f, backend, "blend", None, 0.0, true);
+    }
+    assert_validation_clean();
+    let m = &f.scene.scene.materials;
+    assert!(
+        m.iter().any(|m| (m.opacity + 0.4).abs() < 1e-6),
+        "the file's BLEND: {m:?}"
+    );
+    assert_opaque_rejected(&f, "blend");
+}
+
+/// Renders fixture `f` with every material's holes ignored (opaque, as before `alphaMode` was
+/// read) and asserts that Cycles' image rejects it: under 90% of pixels pass.
+fn assert_opaque_rejected(f: &Fixture, name: &str) {
     let mut opaque = f.scene.clone();
     for m in &mut opaque.scene.materials {
         m.opacity = 0.0;
@@ -270,12 +293,12 @@ fn a_blender_alpha_clipped_texture_renders_as_cycles_renders_it() {
         z_critical(1e-3, 3),
     );
     println!(
-        "cutout, holes ignored: {:.2}% pass",
+        "{name}, holes ignored: {:.2}% pass",
         100.0 * t.pass_fraction()
     );
     assert!(
         t.pass_fraction() < 0.9,
-        "an opaque square not rejected: {:.2}% pass",
+        "{name}: an opaque surface not rejected: {:.2}% pass",
         100.0 * t.pass_fraction()
     );
 }
