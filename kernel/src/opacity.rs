@@ -25,7 +25,7 @@ use crate::hash::pcg4d;
 use crate::rng::u32_to_unit_f32;
 use crate::scene::{texture_slot, Material, ShadingTriangle, Triangle, NONE};
 use crate::surface::tex_coords;
-use crate::texture::alpha_in;
+use crate::texture::{alpha_in, TexCoords};
 use spirv_std::glam::{Vec2, Vec3};
 
 /// The tables [`covers`] reads: the scene's materials, shading records (texture coordinates)
@@ -83,15 +83,62 @@ pub fn covers<F: FeatureSet>(
     if t == 0.0 {
         return true;
     }
-    let map = material.textures[texture_slot::KD];
     let mut alpha = 1.0;
-    if features.textures() && map != NONE && tri.shading != NONE {
+    if tri.shading != NONE {
         let coords = tex_coords(features, tables.shading, tri.shading, material, bary);
-        alpha = alpha_in(features, tables.textures, map, coords);
+        alpha = texture_alpha(features, tables.textures, material, coords);
     }
     if t > 0.0 {
         alpha >= t
     } else {
         ray.draw() < -t * alpha
+    }
+}
+
+/// The expected presence of material `material` (an index, or `NONE`: 1) at a point of
+/// texture coordinates `uv`: 1 without holes; for MASK 1 where [`covers`] says it is there,
+/// else 0; for BLEND the probability that it is there, the factor's alpha times the texture's.
+/// A triangle light's samples are weighed by it (`light::triangle`): where a ray passing the
+/// point finds the surface with probability c, a sample of the point carries c times its
+/// emission, which keeps the light's two strategies (light and BSDF samples) unbiased under
+/// the same MIS weights.
+#[inline]
+pub fn coverage<F: FeatureSet>(
+    features: F,
+    materials: &[Material],
+    textures: &[u32],
+    material: u32,
+    uv: Vec2,
+) -> f32 {
+    if material == NONE {
+        return 1.0;
+    }
+    let m = &materials[material as usize];
+    let t = m.opacity;
+    if t == 0.0 {
+        return 1.0;
+    }
+    let alpha = texture_alpha(features, textures, m, TexCoords::one(uv));
+    if t > 0.0 {
+        (alpha >= t) as u32 as f32
+    } else {
+        -t * alpha
+    }
+}
+
+/// The alpha of `material`'s `KD` texture at `coords` (1 without one, or in a scene without
+/// textures).
+#[inline]
+fn texture_alpha<F: FeatureSet>(
+    features: F,
+    textures: &[u32],
+    material: &Material,
+    coords: TexCoords,
+) -> f32 {
+    let map = material.textures[texture_slot::KD];
+    if features.textures() && map != NONE {
+        alpha_in(features, textures, map, coords)
+    } else {
+        1.0
     }
 }

@@ -120,8 +120,12 @@ pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material
     m.kind = kind;
     m.alpha = alpha;
     m.ior = eta;
-    m.complex = complex;
-    m.eta = [0.143036, 0.375307, 1.44205];
+    // Gold's index where `complex`, else none (the constant reflectance).
+    m.eta = if complex != 0 {
+        [0.143036, 0.375307, 1.44205]
+    } else {
+        [0.0; 3]
+    };
     m.k = [3.983, 2.38556, 1.60336];
     m.specular = if complex != 0 || kind != crate::scene::material_kind::CONDUCTOR {
         [0.2, 0.3, 0.4]
@@ -161,7 +165,7 @@ pub fn probe_triangle_light(p0: Vec3, e1: Vec3, e2: Vec3, two_sided: u32) -> Lig
         point_error: 0.0,
         uv: [0.0; 6],
         emission_texture: crate::scene::NONE,
-        _pad: 0,
+        material: crate::scene::NONE,
     }
 }
 

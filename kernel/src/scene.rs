@@ -185,16 +185,21 @@ pub struct Material {
     /// GGX roughness (the distribution's alpha, no remapping); below `bsdf::DELTA_ALPHA` the
     /// lobe is a perfect (delta) mirror or refraction.
     pub alpha: f32,
-    /// GLOSSY: Ks, the Schlick Fresnel's reflectance at normal incidence. CONDUCTOR without
-    /// `complex`: the constant reflectance.
+    /// GLOSSY: Ks, the Schlick Fresnel's reflectance at normal incidence. CONDUCTOR with `eta`
+    /// zero: the constant reflectance.
     pub specular: [f32; 3],
     /// DIELECTRIC: the inside's index of refraction relative to the outside.
     pub ior: f32,
-    /// CONDUCTOR with `complex`: the real part eta of the complex index of refraction.
+    /// CONDUCTOR: the real part eta of the complex index of refraction, positive in every
+    /// channel for the exact Fresnel of `eta` + i `k` (a metal's is); zero for the constant
+    /// `specular` (`Material::is_complex_conductor`).
     pub eta: [f32; 3],
-    /// CONDUCTOR: 1 for the exact Fresnel of `eta` + i `k`, 0 for the constant `specular`.
-    pub complex: u32,
-    /// CONDUCTOR with `complex`: the extinction coefficient k.
+    /// Where a triangle of this material is present (glTF's `alphaMode`, `crate::opacity`),
+    /// as one number: 0, everywhere (OPAQUE); t > 0, MASK: where the `KD` texture's alpha (1
+    /// without one) is at least t = alphaCutoff / baseColorFactor's alpha (above 1: nowhere);
+    /// t < 0, BLEND: with probability -t x that alpha, -t in (0, 1] being the factor's alpha.
+    pub opacity: f32,
+    /// CONDUCTOR with a complex index: the extinction coefficient k.
     pub k: [f32; 3],
     /// A light on triangles: 1 if both faces emit, 0 for the front face alone (copied into
     /// each of its triangles' `Light::two_sided`).
@@ -217,11 +222,6 @@ pub struct Material {
     /// METALLIC_ROUGHNESS: the layer's reflectance at grazing incidence, `KHR_materials_specular`'s
     /// specularFactor (1 without it). Every other kind: 1.
     pub layer_f90: f32,
-    /// Where a triangle of this material is present (glTF's `alphaMode`, `crate::opacity`),
-    /// as one number: 0, everywhere (OPAQUE); t > 0, MASK: where the `KD` texture's alpha (1
-    /// without one) is at least t = alphaCutoff / baseColorFactor's alpha (above 1: nowhere);
-    /// t < 0, BLEND: with probability -t x that alpha, -t in (0, 1] being the factor's alpha.
-    pub opacity: f32,
 }
 
 impl Material {
@@ -235,7 +235,7 @@ impl Material {
             specular: [0.0; 3],
             ior: 1.0,
             eta: [0.0; 3],
-            complex: 0,
+            opacity: 0.0,
             k: [0.0; 3],
             two_sided: 0,
             textures: [NONE; texture_slot::COUNT],
@@ -244,7 +244,6 @@ impl Material {
             normal_scale: 1.0,
             layer_f0: [LAYER_F0; 3],
             layer_f90: 1.0,
-            opacity: 0.0,
         }
     }
 
@@ -253,6 +252,13 @@ impl Material {
         let mut m = Self::diffuse([0.0; 3]);
         m.emission = radiance;
         m
+    }
+
+    /// Whether a CONDUCTOR reflects by the exact Fresnel of its complex index `eta` + i `k`
+    /// (its `eta` positive) rather than its constant `specular` (`eta` zero).
+    #[inline]
+    pub fn is_complex_conductor(&self) -> bool {
+        self.eta[0] > 0.0
     }
 
     /// Whether the surface reflects at all: any kind but the Lambertian, which reflects when
@@ -331,7 +337,9 @@ pub struct Light {
     /// TRIANGLE: the texture multiplying `radiance` (`Material::textures[EMISSION]`), or
     /// [`NONE`].
     pub emission_texture: u32,
-    pub _pad: u32,
+    /// TRIANGLE: its material, whose holes (`Material::opacity`) weigh its light samples
+    /// (`crate::opacity::coverage`); [`NONE`] for every other kind.
+    pub material: u32,
 }
 
 /// Pinhole or thin-lens camera: a ray through image-plane point (x, y) in [-1, 1]^2 (y up) has

@@ -202,7 +202,7 @@ pub fn bilerp(c00: Vec3, c10: Vec3, c01: Vec3, c11: Vec3, fx: f32, fy: f32) -> V
 
 /// The value of texel (x, y) of texture `record` (its first word `offset`, its `width` and
 /// `flags`): decoded through the table's sRGB or linear byte table, or read as f32.
-#[inline]
+#[inline(always)]
 fn texel(table: &[u32], offset: u32, width: u32, tex_flags: u32, x: u32, y: u32) -> Vec3 {
     let index = y as usize * width as usize + x as usize;
     if tex_flags & flags::FLOAT != 0 {
@@ -304,7 +304,7 @@ fn texel_alpha(table: &[u32], offset: u32, width: u32, x: u32, y: u32) -> f32 {
 
 /// Texture `texture`'s first texel word, width and flags, and the footprint on it of the set
 /// of `coords` it reads (through the record's map where it has one and the scene has maps).
-#[inline]
+#[inline(always)]
 fn located<F: FeatureSet>(
     features: F,
     table: &[u32],

@@ -133,7 +133,6 @@ impl RefMaterial {
                     None => {
                         m.eta = f(eta);
                         m.k = f(k);
-                        m.complex = 1;
                     }
                 }
                 m

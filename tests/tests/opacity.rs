@@ -18,6 +18,12 @@
 //!    direction (`kernel::opacity`'s derivation). One layer's (1 - a) and opaque layers' 0 are
 //!    rejected. The GPU renders it specialized and generic (every hit group with its any-hit
 //!    shader).
+//! 4. Emitters with holes: a light's samples carry its coverage (`opacity::coverage`), a hit
+//!    finds it where it is there, under the same MIS weights. A black BLEND emitter of alpha
+//!    1/2 over a white floor (no sky: a TOML scene including the file) lights the floor as an
+//!    opaque one of half its emission does; a MASK emitter whose texture's alpha cuts it at
+//!    u = 1/2 as an opaque emitter of its left half. Per-pixel z-tests of the two renders, on
+//!    both backends; the holes ignored (the full emission, the whole square) rejected.
 
 use glam::Vec3;
 use serde_json::{json, Value};
@@ -87,7 +93,8 @@ fn square(g: &mut GltfWriter, half: f32, n: u32, material: usize) -> usize {
 fn camera(g: &mut GltfWriter, z: f32) -> usize {
     let cam = g.push(
         "cameras",
-        json!({ "type": "perspective", "perspective": { "yfov": 0.9, "aspectRatio": 1.3333, "znear": 0.01 } }),
+        json!({ "name": "camera", "type": "perspective",
+                "perspective": { "yfov": 0.9, "aspectRatio": 1.3333, "znear": 0.01 } }),
     );
     g.push(
         "nodes",
@@ -229,25 +236,20 @@ fn alpha_modes_become_the_materials_opacity() {
     std::fs::write(&path, g.glb()).unwrap();
     let e = SceneFile::load(&path).unwrap_err().to_string();
     assert!(e.contains("alphaCutoff"), "{e}");
-    // An emitter keeps no holes (its light samples would not see them), and says so.
+    // An emitter keeps its holes, and its lights name their material.
     let mut g = GltfWriter::new();
     let m = g.push(
         "materials",
-        json!({ "alphaMode": "MASK", "emissiveFactor": [1.0, 1.0, 1.0] }),
+        json!({ "alphaMode": "BLEND", "emissiveFactor": [1.0, 1.0, 1.0],
+                "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 0.5] } }),
     );
     let mesh = square(&mut g, 1.0, 1, m);
     let node = g.push("nodes", json!({ "mesh": mesh }));
     g.push("scenes", json!({ "nodes": [node] }));
     let s = load(&g.glb(), "emitter.glb");
-    assert_eq!(s.scene.materials[0].opacity, 0.0);
-    assert!(
-        s.scene
-            .notes
-            .iter()
-            .any(|n| n.contains("alphaMode Mask is rendered as OPAQUE")),
-        "{:?}",
-        s.scene.notes
-    );
+    assert_eq!(s.scene.materials[0].opacity, -0.5);
+    assert!(s.scene.lights.iter().all(|l| l.material == 0));
+    assert!(!s.scene.notes.iter().any(|n| n.contains("alphaMode")));
 }
 
 /// The plane's x where a ray from `eye` along `d` meets z = 0.
@@ -343,4 +345,124 @@ fn blended_instanced_layers_transmit_one_minus_alpha_each_on_both_backends() {
         }
     }
     assert_validation_clean();
+}
+
+/// A white Lambertian floor (2 x 10^4 wide, z = 0) under a square emitting downward from its
+/// front face alone at z = 1 (black, emissive strength `strength`, `half` its half-width in x,
+/// its centre at x = `centre`; `extra` adds to its material, given the writer to add a texture
+/// to), the camera at z = 0.5 looking down; as a TOML scene including the file (black
+/// background), 24 x 18 pixels.
+fn emitter_scene(
+    name: &str,
+    strength: f32,
+    half: f32,
+    centre: f32,
+    extra: impl FnOnce(&mut GltfWriter) -> Value,
+) -> SceneFile {
+    let mut g = GltfWriter::new();
+    g.json["extensionsUsed"] = json!(["KHR_materials_specular", "KHR_materials_emissive_strength"]);
+    let floor_m = g.push(
+        "materials",
+        black(json!({ "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0] } })),
+    );
+    let mut lamp = black(extra(&mut g));
+    lamp["emissiveFactor"] = json!([1.0, 1.0, 1.0]);
+    lamp["extensions"]["KHR_materials_emissive_strength"] = json!({ "emissiveStrength": strength });
+    lamp["doubleSided"] = json!(false);
+    let lamp_m = g.push("materials", lamp);
+    let floor = square(&mut g, 1e4, 1, floor_m);
+    let lamp_mesh = square(&mut g, 1.0, 1, lamp_m);
+    let nodes = vec![
+        g.push("nodes", json!({ "mesh": floor })),
+        // Half a turn about x: the square's front face (+z) looks down; its u still runs along
+        // x, from x = centre - half to centre + half.
+        g.push(
+            "nodes",
+            json!({ "mesh": lamp_mesh, "translation": [centre, 0.0, 1.0],
+                    "rotation": [1.0, 0.0, 0.0, 0.0], "scale": [half, 1.0, 1.0] }),
+        ),
+        camera(&mut g, 0.5),
+    ];
+    g.push("scenes", json!({ "nodes": nodes }));
+    let dir = std::env::temp_dir().join(format!("twinpath-opacity-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join(format!("{name}.glb")), g.glb()).unwrap();
+    let toml = format!(
+        "[camera]\ngltf = \"camera\"\nwidth = 24\nheight = 18\n[[gltf]]\nfile = \"{name}.glb\"\n"
+    );
+    with_independent_samples(
+        twinpath::scene::parse_scene(&toml, &dir.join(format!("{name}.toml")))
+            .unwrap_or_else(|e| panic!("{e}")),
+    )
+}
+
+/// Asserts that renders `a` and `b` agree per pixel (99.5% within the z bound, as `cycles.rs`
+/// compares) and in their means, on both backends, and that `wrong` disagrees with `a`.
+fn assert_same_light(a: &SceneFile, b: &SceneFile, wrong: &SceneFile, label: &str) {
+    use twinpath::film::{Film, RgbImage};
+    use twinpath_tests::stats::pixel_z_test;
+    use twinpath_tests::{image_mean_z, z_critical};
+    let image = |f: &Film| RgbImage {
+        width: 24,
+        height: 18,
+        pixels: f.mean(),
+    };
+    for backend in [Backend::Cpu, Backend::Gpu] {
+        let fa = render_film(a, backend, 1024);
+        let against = |f: &Film| {
+            pixel_z_test(
+                &image(&fa),
+                &fa.variance_of_mean(),
+                &image(f),
+                Some(&f.variance_of_mean()),
+                z_critical(1e-3, 3),
+            )
+        };
+        let fb = render_film(b, backend, 1024);
+        let same = against(&fb);
+        let mean_z = image_mean_z(&fa, &fb);
+        let other = against(&render_film(wrong, backend, 1024));
+        println!(
+            "{label} {backend:?}: {:.2}% of pixels pass, image means z {mean_z:+.2}; holes \
+             ignored: {:.2}% pass",
+            100.0 * same.pass_fraction(),
+            100.0 * other.pass_fraction()
+        );
+        assert!(same.pass_fraction() >= 0.995, "{label} {backend:?}");
+        assert!(mean_z.abs() < z_critical(1e-3, 1), "{label} {backend:?}");
+        assert!(
+            other.pass_fraction() < 0.5,
+            "{label} {backend:?}: holes ignored not rejected"
+        );
+    }
+    assert_validation_clean();
+}
+
+#[test]
+fn emitters_with_holes_light_as_their_coverage_on_both_backends() {
+    // BLEND alpha 1/2 at strength 4 against opaque at strength 2 (wrong: opaque at 4).
+    let blend = |_: &mut GltfWriter| {
+        json!({ "pbrMetallicRoughness": { "baseColorFactor": [0.0, 0.0, 0.0, 0.5] },
+                "alphaMode": "BLEND" })
+    };
+    let a = emitter_scene("lamp_blend", 4.0, 1.0, 0.0, blend);
+    assert!(a.features() & kernel::features::OPACITY != 0);
+    let b = emitter_scene("lamp_half", 2.0, 1.0, 0.0, |_| json!({}));
+    let wrong = emitter_scene("lamp_full", 4.0, 1.0, 0.0, |_| json!({}));
+    assert_same_light(&a, &b, &wrong, "BLEND emitter");
+    // MASK: alpha 1 then 0 along u (2 x 1 texels, clamped), cut at 1/2: exactly the left half
+    // (x < 0) is there; against an opaque square over x in [-1, 0] (wrong: the whole square).
+    let mask = |g: &mut GltfWriter| {
+        let img = image::RgbaImage::from_raw(2, 1, vec![0, 0, 0, 255, 0, 0, 0, 0]).unwrap();
+        let mut png = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut png, image::ImageFormat::Png).unwrap();
+        let t = g.png_texture(png.get_ref());
+        let clamp = g.push("samplers", json!({ "wrapS": 33071, "wrapT": 33071 }));
+        g.json["textures"][t]["sampler"] = json!(clamp);
+        json!({ "pbrMetallicRoughness": { "baseColorTexture": { "index": t } },
+                "alphaMode": "MASK", "alphaCutoff": 0.5 })
+    };
+    let a = emitter_scene("lamp_mask", 4.0, 1.0, 0.0, mask);
+    let b = emitter_scene("lamp_left", 4.0, 0.5, -0.5, |_| json!({}));
+    assert_same_light(&a, &b, &wrong, "MASK emitter");
 }

@@ -152,7 +152,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     specular,
                     ior,
                     eta,
-                    complex,
+                    opacity,
                     k,
                     two_sided,
                     textures,
@@ -160,8 +160,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     roughness,
                     normal_scale,
                     layer_f0,
-                    layer_f90,
-                    opacity
+                    layer_f90
                 ],
                 true
             ),
@@ -186,7 +185,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     point_error,
                     uv,
                     emission_texture,
-                    _pad
+                    material
                 ],
                 true
             ),

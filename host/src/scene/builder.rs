@@ -173,11 +173,21 @@ impl SceneTables {
         if self.is_emissive(material) {
             tri.light = self.lights.len() as u32;
             let mut light = triangle_light(&tri, m.emission, m.two_sided != 0);
+            light.material = material;
             if let Some(a) = attributes {
-                // The emission texture's own set of coordinates.
-                let emission = m.textures[texture_slot::EMISSION];
+                // The emission texture's own set of coordinates (without one, the base
+                // colour's, whose alpha the light's holes read).
+                let reads_second = |slot: usize| {
+                    let t = m.textures[slot];
+                    t != NONE && self.textures.reads_second_set(t)
+                };
+                let second = if m.textures[texture_slot::EMISSION] != NONE {
+                    reads_second(texture_slot::EMISSION)
+                } else {
+                    reads_second(texture_slot::KD)
+                };
                 let uv = match trailing.second_uvs {
-                    Some(t) if emission != NONE && self.textures.reads_second_set(emission) => t,
+                    Some(t) if second => t,
                     _ => [a.uv0, a.uv1, a.uv2],
                 };
                 light.uv = uv.concat().try_into().expect("six numbers");

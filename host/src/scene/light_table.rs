@@ -23,7 +23,7 @@ pub fn sphere_light(center: Vec3, radius: f32, radiance: [f32; 3]) -> Light {
         point_error: 0.0,
         uv: [0.0; 6],
         emission_texture: NONE,
-        _pad: 0,
+        material: NONE,
     }
 }
 
@@ -141,7 +141,7 @@ pub fn triangle_light(tri: &Triangle, radiance: [f32; 3], two_sided: bool) -> Li
         point_error: triangle_point_error(p0, e1, e2, 1.0, 1.0),
         uv: [0.0; 6],
         emission_texture: NONE,
-        _pad: 0,
+        material: NONE,
     }
 }
 

@@ -25,7 +25,7 @@ pub fn flags(m: &Material) -> BsdfFlags {
 /// reflectance.
 #[inline]
 fn fresnel(m: &Material, cos: f32) -> Vec3 {
-    if m.complex != 0 {
+    if m.is_complex_conductor() {
         conductor_rgb(cos, Vec3::from(m.eta), Vec3::from(m.k))
     } else {
         Vec3::from(m.specular)

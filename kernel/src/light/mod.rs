@@ -131,7 +131,8 @@ pub fn pdf(
 }
 
 /// The radiance light sample `ls` sends toward its receiver: the light's constant radiance (a
-/// triangle's times its emission texture at the point, where the scene has textures), the
+/// triangle's times its emission texture and its coverage at the point, where the scene has
+/// textures or holes: `triangle::radiance_factor`), the
 /// environment map's along the sample, a punctual light's intensity times its spot falloff, a
 /// directional light's irradiance. Always inlined: it sits in the Lambertian vertex's hot path.
 #[inline(always)]
@@ -143,8 +144,9 @@ pub fn radiance<F: FeatureSet>(
 ) -> Vec3 {
     let l = &scene.lights[ls.light as usize];
     match l.kind {
-        light_kind::TRIANGLE if kinds.triangles && features.textures() => {
-            Vec3::from(l.radiance) * triangle::emission_texture_at(features, scene.textures, l, ls)
+        light_kind::TRIANGLE if kinds.triangles && (features.textures() || features.opacity()) => {
+            Vec3::from(l.radiance)
+                * triangle::radiance_factor(features, scene.materials, scene.textures, l, ls)
         }
         light_kind::ENVIRONMENT if kinds.environment => environment::radiance(scene, ls),
         light_kind::PUNCTUAL if kinds.delta => punctual::radiance(l, ls),

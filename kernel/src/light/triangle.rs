@@ -8,8 +8,9 @@ use crate::features::FeatureSet;
 use crate::geometry::{
     area_to_solid_angle_pdf, blend2, triangle_barycentrics, triangle_normal, triangle_point,
 };
+use crate::opacity::coverage;
 use crate::sampling::{sample_triangle_barycentrics, SurfacePoint};
-use crate::scene::{light_sampling, Light, NONE};
+use crate::scene::{light_sampling, Light, Material, NONE};
 use crate::spherical_triangle::{barycentrics_along, SphericalTriangle};
 use crate::texture;
 use spirv_std::glam::{Vec2, Vec3};
@@ -127,17 +128,22 @@ fn pdf_given(l: &Light, spherical: Option<SphericalTriangle>, x: Vec3, y: Vec3, 
     }
 }
 
-/// The emission texture's value at the point of light sample `ls` on triangle light `l`
-/// (1 where the light has no texture): the point's barycentrics on the triangle, its texture
-/// coordinates from the light's `uv`, the texture there.
+/// What multiplies triangle light `l`'s radiance at the point of light sample `ls`: its
+/// emission texture's value there (1 without one) times its material's coverage there
+/// (`opacity::coverage`: 1 without holes), both at the texture coordinates the light's `uv`
+/// gives the point's barycentrics on the triangle.
 #[inline]
-pub fn emission_texture_at<F: FeatureSet>(
+pub fn radiance_factor<F: FeatureSet>(
     features: F,
+    materials: &[Material],
     textures: &[u32],
     l: &Light,
     ls: &LightSample,
 ) -> Vec3 {
-    if l.emission_texture == NONE {
+    let textured = features.textures() && l.emission_texture != NONE;
+    let holed =
+        features.opacity() && l.material != NONE && materials[l.material as usize].opacity != 0.0;
+    if !(textured || holed) {
         return Vec3::ONE;
     }
     let bary = triangle_barycentrics(
@@ -152,7 +158,14 @@ pub fn emission_texture_at<F: FeatureSet>(
         Vec2::new(l.uv[4], l.uv[5]),
         bary,
     );
-    texture::lookup_in(features, textures, l.emission_texture, uv)
+    let mut factor = Vec3::ONE;
+    if textured {
+        factor = texture::lookup_in(features, textures, l.emission_texture, uv);
+    }
+    if holed {
+        factor *= coverage(features, materials, textures, l.material, uv);
+    }
+    factor
 }
 
 /// Rounding-error bound of a point sampled on `l` (barycentrics on the triangle): what lifts

@@ -112,14 +112,6 @@ pub(super) fn material(
     out.roughness = roughness;
     (out.layer_f0, out.layer_f90) = dielectric_layer(imp, &label, &m, &err)?;
     out.opacity = opacity(&m, base[3], pbr.base_color_texture().is_some(), &err)?;
-    if emits && out.opacity != 0.0 {
-        imp.note(format!(
-            "{label}: emits, so its alphaMode {:?} is rendered as OPAQUE (a light's samples \
-             do not see holes)",
-            m.alpha_mode()
-        ));
-        out.opacity = 0.0;
-    }
     if emits {
         // A light (its triangles in the light table) that reflects as its material does, as
         // a Principled BSDF with emission does in Blender.

@@ -350,7 +350,6 @@ fn conductor(
             };
             out.eta = *eta;
             out.k = *k;
-            out.complex = 1;
             Ok(())
         }
         toml::Value::Table(t) => {
@@ -386,7 +385,6 @@ fn conductor(
                     }
                     out.eta = eta.to_array();
                     out.k = k.to_array();
-                    out.complex = 1;
                     Ok(())
                 }
                 (None, None, Some(r)) => {
