@@ -130,6 +130,22 @@ impl GltfWriter {
         self.push("meshes", json!({ "primitives": [primitive] }))
     }
 
+    /// The default scene: a node of mesh `mesh` and a perspective camera (yfov 0.9, aspect
+    /// 4:3) at (0, 0, `eye_z`) looking down -z.
+    pub fn scene_of(&mut self, mesh: usize, eye_z: f32) {
+        let cam = self.push(
+            "cameras",
+            json!({ "type": "perspective",
+                    "perspective": { "yfov": 0.9, "aspectRatio": 1.3333, "znear": 0.1 } }),
+        );
+        let mesh_node = self.push("nodes", json!({ "mesh": mesh }));
+        let camera_node = self.push(
+            "nodes",
+            json!({ "camera": cam, "translation": [0.0, 0.0, eye_z] }),
+        );
+        self.push("scenes", json!({ "nodes": [mesh_node, camera_node] }));
+    }
+
     /// The document as a .glb file: header, JSON chunk (space padded), binary chunk (zero
     /// padded).
     pub fn glb(&self) -> Vec<u8> {

@@ -394,6 +394,37 @@ pub fn pixel_quadrature(
         .collect()
 }
 
+/// The barycentrics (b1, b2) of corners 1 and 2 where the ray from `eye` along `d` meets
+/// triangle `p`, which lies in the plane z = 0 (computed in f64); `None` outside it.
+pub fn plane_triangle_barycentrics(
+    p: [[f32; 3]; 3],
+    eye: glam::Vec3,
+    d: glam::Vec3,
+) -> Option<(f64, f64)> {
+    let (eye, d) = (eye.as_dvec3(), d.as_dvec3());
+    let x = eye + d * (-eye.z / d.z);
+    let p = p.map(|v| glam::Vec3::from(v).as_dvec3());
+    let (e1, e2, q) = (p[1] - p[0], p[2] - p[0], x - p[0]);
+    let det = e1.x * e2.y - e1.y * e2.x;
+    let b1 = (q.x * e2.y - q.y * e2.x) / det;
+    let b2 = (e1.x * q.y - e1.y * q.x) / det;
+    (b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0).then_some((b1, b2))
+}
+
+/// Writes `bytes` as file `name` in this test process's temporary folder for `tag` and loads
+/// it as a scene.
+pub fn load_scene_bytes(
+    tag: &str,
+    name: &str,
+    bytes: &[u8],
+) -> Result<SceneFile, twinpath::scene::SceneError> {
+    let dir = std::env::temp_dir().join(format!("twinpath-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    SceneFile::load(&path)
+}
+
 /// Asserts that each pixel `want` gives (`None`: not compared) holds that value in the film's
 /// red channel to 1e-5 relative: for pixels whose every sample is the same value (a diffuse
 /// plane under a directional light, direct light only), where only the f32 rounding of the

@@ -27,13 +27,13 @@
 
 use glam::Vec3;
 use serde_json::{json, Value};
-use std::path::PathBuf;
 use twinpath::render::Backend;
 use twinpath::scene::SceneFile;
 use twinpath_tests::gltf_writer::GltfWriter;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches, assert_noiseless_pixels, max_abs_z, render_film, with_independent_samples,
+    assert_film_matches, assert_noiseless_pixels, load_scene_bytes, max_abs_z, render_film,
+    with_independent_samples,
 };
 
 /// The MASK's cutoff and the texture's second alpha byte.
@@ -41,12 +41,7 @@ const CUTOFF: f64 = 0.3;
 const ALPHA_BYTE: u8 = 200;
 
 fn load(bytes: &[u8], name: &str) -> SceneFile {
-    let dir: PathBuf =
-        std::env::temp_dir().join(format!("twinpath-opacity-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    std::fs::write(&path, bytes).unwrap();
-    SceneFile::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    load_scene_bytes("opacity", name, bytes).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A material that reflects nothing (base colour black, metallic 0, specular factor 0) with
@@ -231,10 +226,9 @@ fn alpha_modes_become_the_materials_opacity() {
     let mesh = square(&mut g, 1.0, 1, m);
     let node = g.push("nodes", json!({ "mesh": mesh }));
     g.push("scenes", json!({ "nodes": [node] }));
-    let dir = std::env::temp_dir().join(format!("twinpath-opacity-{}", std::process::id()));
-    let path = dir.join("negative.glb");
-    std::fs::write(&path, g.glb()).unwrap();
-    let e = SceneFile::load(&path).unwrap_err().to_string();
+    let e = load_scene_bytes("opacity", "negative.glb", &g.glb())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("alphaCutoff"), "{e}");
     // An emitter keeps its holes, and its lights name their material.
     let mut g = GltfWriter::new();

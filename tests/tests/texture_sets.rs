@@ -12,16 +12,15 @@
 //!    everywhere: each pixel's exact value is the base factor times that, averaged over the
 //!    pixel. Both backends match it by z-test; set 0's value (black) is rejected by far.
 
-use glam::Vec3;
 use kernel::scene::shading_flags;
 use serde_json::json;
-use std::path::PathBuf;
 use twinpath::render::Backend;
 use twinpath::scene::SceneFile;
 use twinpath_tests::gltf_writer::GltfWriter;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches, max_abs_z, pixel_quadrature, render_film, with_independent_samples,
+    assert_film_matches, load_scene_bytes, max_abs_z, pixel_quadrature,
+    plane_triangle_barycentrics, render_film, with_independent_samples,
 };
 
 const BASE: f32 = 0.9;
@@ -68,25 +67,12 @@ fn file(second: bool, colours: bool, emissive: bool) -> Vec<u8> {
         let a = g.floats(&[1.0; 9], "VEC3");
         g.json["meshes"][mesh]["primitives"][0]["attributes"]["COLOR_0"] = json!(a);
     }
-    let cam = g.push(
-        "cameras",
-        json!({ "type": "perspective", "perspective": { "yfov": 0.9, "aspectRatio": 1.3333, "znear": 0.1 } }),
-    );
-    g.push("nodes", json!({ "mesh": mesh }));
-    g.push(
-        "nodes",
-        json!({ "camera": cam, "translation": [0.0, 0.0, 3.0] }),
-    );
-    g.push("scenes", json!({ "nodes": [0, 1] }));
+    g.scene_of(mesh, 3.0);
     g.glb()
 }
 
 fn load(bytes: &[u8], name: &str) -> Result<SceneFile, twinpath::scene::SceneError> {
-    let dir: PathBuf = std::env::temp_dir().join(format!("twinpath-sets-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    std::fs::write(&path, bytes).unwrap();
-    SceneFile::load(&path)
+    load_scene_bytes("sets", name, bytes)
 }
 
 #[test]
@@ -138,16 +124,7 @@ fn a_texture_on_the_second_set_reads_it_on_both_backends() {
     // interpolated by the point's barycentrics (None outside the triangle); set 0 reads black.
     let value = |second: bool| {
         pixel_quadrature(&scene.scene, 8, move |eye, d| {
-            let (eye, d) = (eye.as_dvec3(), d.as_dvec3());
-            let x = eye + d * (-eye.z / d.z);
-            let p = P.map(|v| Vec3::from(v).as_dvec3());
-            let (e1, e2, q) = (p[1] - p[0], p[2] - p[0], x - p[0]);
-            let det = e1.x * e2.y - e1.y * e2.x;
-            let b1 = (q.x * e2.y - q.y * e2.x) / det;
-            let b2 = (e1.x * q.y - e1.y * q.x) / det;
-            if b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 {
-                return None;
-            }
+            let (b1, b2) = plane_triangle_barycentrics(P, eye, d)?;
             let u1 = U1[0] as f64 * (1.0 - b1 - b2) + U1[1] as f64 * b1 + U1[2] as f64 * b2;
             Some(BASE as f64 * if second { 2.0 * u1 - 0.5 } else { 0.0 })
         })

@@ -10,16 +10,16 @@
 //!    base x the interpolated colour, averaged over the pixel. Both backends match it by
 //!    z-test; the same images against the base colour alone (colours ignored) fail by far.
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use kernel::scene::{shading_flags, texture_slot, NONE};
 use serde_json::json;
-use std::path::PathBuf;
 use twinpath::render::Backend;
 use twinpath::scene::SceneFile;
 use twinpath_tests::gltf_writer::GltfWriter;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches, max_abs_z, pixel_quadrature, render_film, with_independent_samples,
+    assert_film_matches, load_scene_bytes, max_abs_z, pixel_quadrature,
+    plane_triangle_barycentrics, render_film, with_independent_samples,
 };
 
 const BASE: [f32; 3] = [0.9, 0.8, 0.7];
@@ -55,16 +55,7 @@ fn file(colour: impl Fn(&mut GltfWriter) -> usize, normal_map: bool) -> Vec<u8> 
     );
     let a = colour(&mut g);
     g.json["meshes"][mesh]["primitives"][0]["attributes"]["COLOR_0"] = json!(a);
-    let cam = g.push(
-        "cameras",
-        json!({ "type": "perspective", "perspective": { "yfov": 0.9, "aspectRatio": 1.3333, "znear": 0.1 } }),
-    );
-    g.push("nodes", json!({ "mesh": mesh }));
-    g.push(
-        "nodes",
-        json!({ "camera": cam, "translation": [0.0, 0.0, 3.0] }),
-    );
-    g.push("scenes", json!({ "nodes": [0, 1] }));
+    g.scene_of(mesh, 3.0);
     g.glb()
 }
 
@@ -86,12 +77,7 @@ fn byte_colours(g: &mut GltfWriter) -> usize {
 }
 
 fn load(bytes: &[u8], name: &str) -> Result<SceneFile, twinpath::scene::SceneError> {
-    let dir: PathBuf =
-        std::env::temp_dir().join(format!("twinpath-colours-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    std::fs::write(&path, bytes).unwrap();
-    SceneFile::load(&path)
+    load_scene_bytes("colours", name, bytes)
 }
 
 #[test]
@@ -150,16 +136,7 @@ fn vertex_colours_multiply_the_base_colour_on_both_backends() {
     // interpolated by the point's barycentrics in the triangle (None outside it).
     let value = |with_colours: bool| {
         pixel_quadrature(&scene.scene, 8, move |eye, d| {
-            let (eye, d) = (eye.as_dvec3(), d.as_dvec3());
-            let x = eye + d * (-eye.z / d.z);
-            let p = P.map(|v| Vec3::from(v).as_dvec3());
-            let (e1, e2, q) = (p[1] - p[0], p[2] - p[0], x - p[0]);
-            let det = e1.x * e2.y - e1.y * e2.x;
-            let b1 = (q.x * e2.y - q.y * e2.x) / det;
-            let b2 = (e1.x * q.y - e1.y * q.x) / det;
-            if b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 {
-                return None;
-            }
+            let (b1, b2) = plane_triangle_barycentrics(P, eye, d)?;
             let c = DVec3::from(C[0].map(f64::from)) * (1.0 - b1 - b2)
                 + DVec3::from(C[1].map(f64::from)) * b1
                 + DVec3::from(C[2].map(f64::from)) * b2;
