@@ -30,6 +30,8 @@ timeout 30 $B/twinpath render scenes/cornell.toml --backend gpu --spp 1024 --val
 echo "== tests"
 for t in spirv_module gpu_functions gpu_render; do echo "-- $t"; timeout ${TT:-120} $B/$t --test-threads=1 2>&1 | grep -vE "^test .* ok$|^$"; done
 echo "-- closed_form_materials"; timeout 120 $B/closed_form_materials --test-threads=1 2>&1 | grep -vE "^test .* ok$|^$"
+# Holes through the any-hit shaders, and the second texture coordinates, on a real GPU.
+for t in opacity texture_sets; do echo "-- $t"; timeout 120 $B/$t --test-threads=1 --nocapture 2>&1 | grep -vE "^test .* ok$|^$"; done
 for t in scene_scale specialize_adaptive hard_lighting light_selection sobol; do echo "-- $t gpu"; timeout 60 $B/$t gpu both_backends --test-threads=1 2>&1 | grep -vE "^test .* ok$|^$"; done
 echo "-- furnace gpu, 10^8 samples"; TWINPATH_FURNACE_GPU_SPP=24576 timeout 90 $B/furnace gpu --nocapture 2>&1 | tail -15
 echo "== mesh scaling"

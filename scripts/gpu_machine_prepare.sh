@@ -15,7 +15,7 @@ apt-get "${apt_opts[@]}" update -qq
   libopengl0 libgles2 vulkan-validationlayers)
 strip -o .gpu/bin/twinpath target/debug/twinpath
 for t in gpu_functions gpu_render spirv_module furnace scene_scale specialize_adaptive \
-  hard_lighting light_selection sobol closed_form_materials; do
+  hard_lighting light_selection sobol closed_form_materials opacity texture_sets; do
   f=$(cargo test -p twinpath-tests --test "$t" --no-run 2>&1 | sed -n 's/.*Executable .*(\(.*\))/\1/p')
   strip -o ".gpu/bin/$t" "$f"
 done
