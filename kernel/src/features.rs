@@ -113,7 +113,7 @@ pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> 
     {
         f |= VERTEX_COLOURS;
     }
-    if materials.iter().any(|m| m.opacity != 0.0) {
+    if materials.iter().any(Material::has_holes) {
         f |= OPACITY;
     }
     if shading

@@ -79,8 +79,7 @@ pub fn covers<F: FeatureSet>(
     ray: &CandidateRay,
 ) -> bool {
     let material = &tables.materials[tri.material as usize];
-    let t = material.opacity;
-    if t == 0.0 {
+    if !material.has_holes() {
         return true;
     }
     let mut alpha = 1.0;
@@ -88,11 +87,9 @@ pub fn covers<F: FeatureSet>(
         let coords = tex_coords(features, tables.shading, tri.shading, material, bary);
         alpha = texture_alpha(features, tables.textures, material, coords);
     }
-    if t > 0.0 {
-        alpha >= t
-    } else {
-        ray.draw() < -t * alpha
-    }
+    // A MASK's presence is 0 or 1 and needs no number; a BLEND draws one.
+    let p = presence(material.opacity, alpha);
+    p >= 1.0 || (p > 0.0 && ray.draw() < p)
 }
 
 /// The expected presence of material `material` (an index, or `NONE`: 1) at a point of
@@ -114,13 +111,26 @@ pub fn coverage<F: FeatureSet>(
         return 1.0;
     }
     let m = &materials[material as usize];
-    let t = m.opacity;
-    if t == 0.0 {
+    if !m.has_holes() {
         return 1.0;
     }
-    let alpha = texture_alpha(features, textures, m, TexCoords::one(uv));
+    presence(
+        m.opacity,
+        texture_alpha(features, textures, m, TexCoords::one(uv)),
+    )
+}
+
+/// The probability that a surface of opacity `t` (`Material::opacity`, not 0) is there where
+/// its texture's alpha is `alpha`: a MASK's 1 where alpha reaches t, else 0; a BLEND's -t x
+/// alpha. The one definition [`covers`] and [`coverage`] share.
+#[inline]
+fn presence(t: f32, alpha: f32) -> f32 {
     if t > 0.0 {
-        (alpha >= t) as u32 as f32
+        if alpha >= t {
+            1.0
+        } else {
+            0.0
+        }
     } else {
         -t * alpha
     }

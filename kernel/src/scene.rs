@@ -254,6 +254,12 @@ impl Material {
         m
     }
 
+    /// Whether the surface has holes (glTF's MASK or BLEND: `opacity` not 0; `crate::opacity`).
+    #[inline]
+    pub fn has_holes(&self) -> bool {
+        self.opacity != 0.0
+    }
+
     /// Whether a CONDUCTOR reflects by the exact Fresnel of its complex index `eta` + i `k`
     /// (its `eta` positive) rather than its constant `specular` (`eta` zero).
     #[inline]

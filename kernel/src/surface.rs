@@ -79,12 +79,20 @@ pub fn tex_coords<F: FeatureSet>(
     let tri = &shading[record as usize];
     let mut coords = TexCoords::one(interpolated_uv(tri, bary));
     if features.second_uvs() && tri.flags & shading_flags::SECOND_UVS != 0 {
-        let after = 1
-            + (material.textures[texture_slot::NORMAL] != NONE) as u32
-            + (tri.flags & shading_flags::VERTEX_COLOURS != 0) as u32;
-        coords.second = interpolated_uv(&shading[(record + after) as usize], bary);
+        let second =
+            after_frame(record, material) + (tri.flags & shading_flags::VERTEX_COLOURS != 0) as u32;
+        coords.second = interpolated_uv(&shading[second as usize], bary);
     }
     coords
+}
+
+/// The index of the first record after shading record `record`'s own and its tangent frame
+/// (which a triangle of `material` has where the material has a normal map): its vertex
+/// colours where it has them, then its second texture coordinates (the order the builder
+/// writes them in; `ShadingTriangle`).
+#[inline]
+fn after_frame(record: u32, material: &Material) -> u32 {
+    record + 1 + (material.textures[texture_slot::NORMAL] != NONE) as u32
 }
 
 /// The shading normal a tangent-space normal map gives (glTF 2.0, `material.normalTexture`;
@@ -180,13 +188,7 @@ pub fn shade<F: FeatureSet>(features: F, scene: &SceneView, hit: &SurfaceHit) ->
     if features.vertex_colours() && record != NONE {
         let tri = shading[record as usize];
         if tri.flags & shading_flags::VERTEX_COLOURS != 0 {
-            // After the tangent frame, where the material has a normal map.
-            let after = if m.textures[texture_slot::NORMAL] != NONE {
-                2
-            } else {
-                1
-            };
-            let colours = shading[record as usize + after];
+            let colours = shading[after_frame(record, &m) as usize];
             let colour = blend3(
                 Vec3::from(colours.normal0),
                 Vec3::from(colours.normal1),

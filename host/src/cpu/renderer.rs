@@ -34,6 +34,9 @@ pub struct CpuRenderer {
     pub features: u32,
     /// How a tile's samples are computed, chosen once when the renderer is built.
     pub tiles: TileStrategy,
+    /// Whether a material has holes (`Material::has_holes`): rays then pass through the
+    /// candidates that are not there ([`CpuRenderer::tracer`]).
+    pub holes: bool,
 }
 
 /// How the CPU renderer computes a tile's samples. All give the same image bit for bit
@@ -126,7 +129,7 @@ impl CpuRenderer {
     /// `bench::rays`, which times the build apart).
     pub fn with_bvh(scene: &Scene, settings: &RenderSettings, bvh: Bvh) -> Self {
         // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).
-        let holes = scene.materials.iter().any(|m| m.opacity != 0.0);
+        let holes = scene.materials.iter().any(Material::has_holes);
         let tiles = if !(settings.packets && scene.instances.is_empty()) || holes {
             TileStrategy::OnePath
         } else if let Some(small) = SmallScene::if_small(&bvh.spheres, &bvh.triangles) {
@@ -143,6 +146,7 @@ impl CpuRenderer {
             textures: scene.textures.words.clone(),
             features: with_all_extended(scene.features(settings)),
             tiles,
+            holes,
         }
     }
 
@@ -150,7 +154,7 @@ impl CpuRenderer {
     /// have them (`kernel::opacity`).
     pub fn tracer(&self) -> BvhTracer<'_> {
         let mut tracer = BvhTracer::new(&self.bvh);
-        if self.materials.iter().any(|m| m.opacity != 0.0) {
+        if self.holes {
             tracer.holes = Some(HoleTables {
                 materials: &self.materials,
                 shading: &self.shading,

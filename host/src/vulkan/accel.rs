@@ -139,7 +139,7 @@ impl Context {
     ) -> Result<AccelerationStructure> {
         let holes = triangles
             .iter()
-            .any(|t| materials[t.material as usize].opacity != 0.0);
+            .any(|t| materials[t.material as usize].has_holes());
         let mut vertices: Vec<[f32; 3]> = Vec::with_capacity(3 * triangles.len());
         for t in triangles {
             let p0 = glam::Vec3::from(t.p0);

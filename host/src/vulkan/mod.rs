@@ -20,7 +20,7 @@ use ash::vk;
 use device::Context;
 use gpu_allocator::MemoryLocation;
 use indicatif::ProgressBar;
-use kernel::scene::RenderParams;
+use kernel::scene::{Material, RenderParams};
 use memory::{Buffer, Image};
 use pipeline::{binding, HitGroups, RtPipeline};
 use std::time::{Duration, Instant};
@@ -76,7 +76,7 @@ impl GpuRenderer {
                 triangles: scene.world_triangle_count() > 0,
                 spheres: !scene.spheres.is_empty(),
                 instances: !scene.instances.is_empty(),
-                holes: scene.materials.iter().any(|m| m.opacity != 0.0),
+                holes: scene.materials.iter().any(Material::has_holes),
             }
         } else {
             HitGroups::ALL

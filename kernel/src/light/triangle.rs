@@ -142,7 +142,7 @@ pub fn radiance_factor<F: FeatureSet>(
 ) -> Vec3 {
     let textured = features.textures() && l.emission_texture != NONE;
     let holed =
-        features.opacity() && l.material != NONE && materials[l.material as usize].opacity != 0.0;
+        features.opacity() && l.material != NONE && materials[l.material as usize].has_holes();
     if !(textured || holed) {
         return Vec3::ONE;
     }

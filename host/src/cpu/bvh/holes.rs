@@ -63,7 +63,8 @@ impl Presence for Holes<'_> {
     const SOLID: bool = false;
     #[inline]
     fn present(&self, tri: &Triangle, index: u32, origin: Vec3, dir: Vec3) -> bool {
-        if self.tables.materials[tri.material as usize].opacity == 0.0 {
+        // Only a material with holes needs the point's barycentrics.
+        if !self.tables.materials[tri.material as usize].has_holes() {
             return true;
         }
         // The barycentrics as the hit record computes them (`Bvh::barycentrics`).
