@@ -251,6 +251,26 @@ def scene_glowing_wall():
     return scene
 
 
+def scene_rough_metal():
+    """Two smooth-shaded spheres of Principled metal (Metallic 1): roughness 0.5 in a gold base
+    colour and roughness 0.9 in a light grey, on a grey floor under a 300 W point light. Cycles'
+    multiscatter GGX keeps the energy the single-scattering lobe loses between microfacets."""
+    scene = reset()
+    floor()
+    for x, roughness, base in ((-0.75, 0.5, (0.9, 0.6, 0.3)), (0.75, 0.9, (0.9, 0.9, 0.9))):
+        bpy.ops.mesh.primitive_uv_sphere_add(
+            radius=0.6, location=(x, 0.0, 0.6), segments=48, ring_count=24
+        )
+        ball = bpy.context.object
+        bpy.ops.object.shade_smooth()
+        metal = principled(f"metal_{roughness}", base=base, roughness=roughness)
+        metal.node_tree.nodes["Principled BSDF"].inputs["Metallic"].default_value = 1.0
+        ball.data.materials.append(metal)
+    light(scene, "POINT", 300.0, (1.0, -2.0, 3.0), shadow_soft_size=0.0)
+    camera(scene, location=(0.0, -4.0, 2.2), target=(0.0, 0.0, 0.5))
+    return scene
+
+
 def alpha_checker_image(path):
     """A 4 x 4 image of one colour, green (bytes 0 and 255: sRGB-decoded exactly to 0 and 1, so
     the same texels in both renderers, read as linear as in the mapping scene), whose alpha
@@ -329,6 +349,7 @@ SCENES = {
     "glowing_wall": scene_glowing_wall,
     "cutout": scene_cutout,
     "blend": scene_blend,
+    "rough_metal": scene_rough_metal,
 }
 
 

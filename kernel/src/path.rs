@@ -14,7 +14,7 @@ use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{light_sampling, mis, Light, Material, RenderParams, NONE};
 use crate::scene_view::SceneView;
-use crate::surface::{emission_at, shade};
+use crate::surface::{self, emission_at, shade};
 use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION, LENS_DIMENSION};
 use spirv_std::glam::Vec3;
 
@@ -493,6 +493,8 @@ impl PathState {
         } else {
             material.ior
         };
+        // What the glossy lobe loses to multiple scattering seen from wo (glTF's material).
+        let albedo = surface::glossy_albedo(features, material, scene.textures, n, wo);
 
         // 2(a): next-event estimation.
         if query.samples_light() {
@@ -501,7 +503,7 @@ impl PathState {
             let wi = (y - x).normalize();
             let cos_y = -ls.point.normal.dot(wi);
             let pdf_w = ls.pdf_solid_angle;
-            let (f_cos, pdf_b) = bsdf::eval(features, material, n, wo, wi, eta);
+            let (f_cos, pdf_b) = bsdf::eval(features, material, n, wo, wi, eta, albedo);
             // With a shading normal, the BSDF's reflection must be one geometrically too, and
             // its transmission cross the surface (`crate::surface`).
             let consistent = !smooth || (n.dot(wi) > 0.0) == (ng.dot(wi) > 0.0);
@@ -531,7 +533,17 @@ impl PathState {
 
         // 3: extension by BSDF sampling.
         let (u1, u2) = samples.u_brdf;
-        let s = bsdf::sample(features, material, n, wo, eta, samples.u_lobe, u1, u2);
+        let s = bsdf::sample(
+            features,
+            material,
+            n,
+            wo,
+            eta,
+            albedo,
+            samples.u_lobe,
+            u1,
+            u2,
+        );
         if smooth && (ng.dot(s.wi) > 0.0) == s.transmitted {
             return;
         }

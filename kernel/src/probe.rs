@@ -7,6 +7,7 @@ use crate::bsdf;
 use crate::bsdf::fresnel::{conductor, dielectric, schlick};
 use crate::bsdf::lambert::{eval_scattering, pdf_brdf, sample_brdf};
 use crate::bsdf::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal};
+use crate::bsdf::multiple_scattering::GlossyAlbedo;
 use crate::camera::camera_ray_direction;
 use crate::features::Dynamic;
 use crate::frame::orthonormal_basis;
@@ -67,7 +68,8 @@ pub mod function {
     /// out1.x = ggx_g1(cos, alpha), out1.y = pdf_reflected(n . wo, (cos, sin^2), alpha)
     pub const MICROFACET: u32 = 12;
     /// n = in0.xyz, alpha = in0.w, wo = in1.xyz, eta = in1.w, wi = in2.xyz, material kind and
-    /// complex flag = in3.xy as u32 ([`probe_material`]) -> out0 = (bsdf::eval's f cos, pdf)
+    /// complex flag = in3.xy as u32 ([`probe_material`]), GGX albedo (E, E_avg) = in3.zw
+    /// (`bsdf::multiple_scattering::GlossyAlbedo`) -> out0 = (bsdf::eval's f cos, pdf)
     pub const BSDF_EVAL: u32 = 13;
     /// As [`BSDF_EVAL`] with (u_lobe, u1, u2) = in2.xyz -> bsdf::sample's out0 = (wi, pdf),
     /// out1 = (weight, eta2)
@@ -284,11 +286,15 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
     } else if function == function::BSDF_EVAL || function == function::BSDF_SAMPLE {
         let m = probe_material(input[3].x, input[3].y, i0.w, i1.w);
         let (n, wo) = (i0.truncate(), i1.truncate());
+        let albedo = GlossyAlbedo {
+            directional: i3.z,
+            average: i3.w,
+        };
         if function == function::BSDF_EVAL {
-            let (f, pdf) = bsdf::eval(Dynamic(0), &m, n, wo, i2.truncate(), i1.w);
+            let (f, pdf) = bsdf::eval(Dynamic(0), &m, n, wo, i2.truncate(), i1.w, albedo);
             (f.extend(pdf), Vec4::ZERO)
         } else {
-            let s = bsdf::sample(Dynamic(0), &m, n, wo, i1.w, i2.x, i2.y, i2.z);
+            let s = bsdf::sample(Dynamic(0), &m, n, wo, i1.w, albedo, i2.x, i2.y, i2.z);
             (s.wi.extend(s.pdf), s.weight.extend(s.eta2))
         }
     } else if function == function::TRIANGLE_LIGHT {

@@ -17,13 +17,14 @@
 //! which is near silhouettes of coarse meshes (docs/materials.md, "Shading normals").
 
 use crate::bsdf;
+use crate::bsdf::multiple_scattering::GlossyAlbedo;
 use crate::features::FeatureSet;
 use crate::geometry::{blend2, blend3};
 use crate::hit::SurfaceHit;
 use crate::instance::{normal_to_world, vector_to_world};
-use crate::scene::{shading_flags, texture_slot, Material, ShadingTriangle, NONE};
+use crate::scene::{material_kind, shading_flags, texture_slot, Material, ShadingTriangle, NONE};
 use crate::scene_view::SceneView;
-use crate::texture::{lookup_at, textured_material, TexCoords};
+use crate::texture::{self, lookup_at, textured_material, TexCoords};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
@@ -218,5 +219,29 @@ pub fn emission_at<F: FeatureSet>(
         emission * lookup_at(features, scene.textures, texture, coords)
     } else {
         emission
+    }
+}
+
+/// What the glossy lobe of material `m` at a point (resolved, `bsdf::at_point`) with unit
+/// normal `n` loses to multiple scattering seen from `wo` (`bsdf::multiple_scattering`): for
+/// glTF's metallic-roughness material with a rough lobe, the GGX albedo at its roughness from
+/// the texture table `textures` (`texture::ggx_albedo`); for a smooth lobe (a mirror loses
+/// nothing) and every other kind, `GlossyAlbedo::NONE`. `bsdf::eval` and `bsdf::sample` take
+/// it; a vertex looks it up once.
+#[inline]
+pub fn glossy_albedo<F: FeatureSet>(
+    features: F,
+    m: &Material,
+    textures: &[u32],
+    n: Vec3,
+    wo: Vec3,
+) -> GlossyAlbedo {
+    if m.kind == material_kind::METALLIC_ROUGHNESS
+        && features.metallic_roughness()
+        && !(m.alpha < bsdf::DELTA_ALPHA)
+    {
+        texture::ggx_albedo(textures, m.roughness, n.dot(wo).max(0.0))
+    } else {
+        GlossyAlbedo::NONE
     }
 }

@@ -4,6 +4,8 @@
 //!
 //! Layout of the table (`TextureTable` on the host builds it):
 //! - word 0: the number of textures T;
+//! - word [`GGX_ALBEDO`]: the record of the GGX albedo table (`bsdf::multiple_scattering`), a
+//!   float texture read by [`at_nodes`], or `NONE`;
 //! - words [`SRGB_TABLE`]..+256: the sRGB-decoded value of each byte (f32 bits; the host
 //!   computes the IEC 61966-2-1 curve in f64), words [`LINEAR_TABLE`]..+256: byte / 255;
 //! - words [`RECORDS`] + 10k..+10: texture k's record: first texel word, width, height, flags
@@ -19,14 +21,17 @@
 //! the point (pbrt-v4 `Image::Bilerp`, the same weights).
 
 use crate::bsdf;
+use crate::bsdf::multiple_scattering::GlossyAlbedo;
 use crate::features::{Dynamic, FeatureSet};
 use crate::scene::{texture_slot, Material, NONE};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
 
+/// Word holding the record of the GGX albedo table, or `NONE`.
+pub const GGX_ALBEDO: usize = 1;
 /// Word of the sRGB decoding table.
-pub const SRGB_TABLE: usize = 1;
+pub const SRGB_TABLE: usize = 2;
 /// Word of the linear decoding table (byte / 255).
 pub const LINEAR_TABLE: usize = SRGB_TABLE + 256;
 /// Word of texture 0's record.
@@ -277,6 +282,43 @@ pub fn lookup_at<F: FeatureSet>(
         f.fx,
         f.fy,
     )
+}
+
+/// Float texture `texture` read as a table of values at nodes: texel (i, j) (column i, row j
+/// from the top) is the value at (x, y) = (i / (w - 1), j / (h - 1)); bilinear between the
+/// nodes around (`x`, `y`), each clamped to [0, 1] (no texture coordinates, no wrap, no map).
+#[inline]
+pub fn at_nodes(table: &[u32], texture: u32, x: f32, y: f32) -> Vec3 {
+    let r = RECORDS + RECORD_WORDS * texture as usize;
+    let (offset, width, height, tex_flags) = (table[r], table[r + 1], table[r + 2], table[r + 3]);
+    let (x0, x1, fx) = axis(x.clamp(0.0, 1.0) * (width - 1) as f32, width, true);
+    let (y0, y1, fy) = axis(y.clamp(0.0, 1.0) * (height - 1) as f32, height, true);
+    bilerp(
+        texel(table, offset, width, tex_flags, x0, y0),
+        texel(table, offset, width, tex_flags, x1, y0),
+        texel(table, offset, width, tex_flags, x0, y1),
+        texel(table, offset, width, tex_flags, x1, y1),
+        fx,
+        fy,
+    )
+}
+
+/// E(`mu`) and E_avg at perceptual roughness `roughness` (alpha = roughness^2) from the GGX
+/// albedo table of `table` (its record at word [`GGX_ALBEDO`]; `bsdf::multiple_scattering`),
+/// bilinear in (roughness, sqrt(mu)) between its nodes (roughness i / (w - 1), cosine
+/// (j / (h - 1))^2), clamped to them; [`GlossyAlbedo::NONE`] where the table has none (a scene
+/// without glTF's material). `table` is a whole table (its header at least).
+#[inline]
+pub fn ggx_albedo(table: &[u32], roughness: f32, mu: f32) -> GlossyAlbedo {
+    let record = table[GGX_ALBEDO];
+    if record == NONE {
+        return GlossyAlbedo::NONE;
+    }
+    let value = at_nodes(table, record, roughness, mu.sqrt());
+    GlossyAlbedo {
+        directional: value.x,
+        average: value.y,
+    }
 }
 
 /// The alpha channel of texture `texture` at `uv`, bilinearly filtered as [`lookup_in`]

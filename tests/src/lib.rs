@@ -126,6 +126,7 @@ pub fn shade_at(
 }
 
 pub mod cubature;
+pub mod ggx_table;
 pub mod gltf_writer;
 #[cfg(feature = "gpu")]
 pub mod gpu;

@@ -214,18 +214,39 @@ impl RefMaterial {
                 let alpha = roughness * roughness;
                 let h = (wo + wi).normalize();
                 let voh = wo.dot(h).abs();
-                let specular = ggx_d(n.dot(h), alpha) * ggx_g1(co, alpha) * ggx_g1(ci, alpha)
-                    / (4.0 * co * ci);
+                // Appendix B's visibility: the height-correlated Smith G2 = 1 / (1 + Lambda(wo)
+                // + Lambda(wi)), Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2 (Heitz 2014).
+                let lambda = |c: f64| {
+                    let tan2 = (1.0 - c * c) / (c * c);
+                    ((1.0 + alpha * alpha * tan2).sqrt() - 1.0) / 2.0
+                };
+                let g2 = 1.0 / (1.0 + lambda(co) + lambda(ci));
+                let specular = ggx_d(n.dot(h), alpha) * g2 / (4.0 * co * ci);
                 let diffuse = base / PI;
                 // fresnel_mix(f0_color, ior, weight, base, layer) =
                 // (1 - weight max(fr)) base + weight fr layer, fr = f0 + (1 - f0)(1 - |VdotH|)^5,
                 // f0 = min(((1 - ior) / (1 + ior))^2 f0_color, 1).
                 let f0 = (specular_color * ((1.0 - ior) / (1.0 + ior)).powi(2)).min(DVec3::ONE);
                 let fr = f0 + (DVec3::ONE - f0) * (1.0 - voh).powi(5);
-                let dielectric_brdf =
-                    diffuse * (1.0 - weight * fr.max_element()) + fr * (weight * specular);
                 let metal_brdf = specular * (base + (DVec3::ONE - base) * (1.0 - voh).powi(5));
-                dielectric_brdf * (1.0 - metallic) + metal_brdf * metallic
+                // Multiple scattering given back (Turquin 2019, Kulla and Conty 2017): the
+                // specular terms times 1 + F_ms (1 - E(co)) / E(co), F_ms from the lobes'
+                // Fresnel averages F_avg = F0 + (F90 - F0) / 21; none for a mirror.
+                let f_avg = |f0: DVec3, f90: f64| f0 + (DVec3::splat(f90) - f0) / 21.0;
+                let fresnel_average =
+                    f_avg(f0, 1.0) * weight * (1.0 - metallic) + f_avg(base, 1.0) * metallic;
+                let factor = if alpha < 1e-3 {
+                    DVec3::ONE
+                } else {
+                    let (e, e_avg) = crate::ggx_table::reference_albedo(roughness, co);
+                    let f_ms =
+                        fresnel_average * e_avg / (DVec3::ONE - fresnel_average * (1.0 - e_avg));
+                    DVec3::ONE + f_ms * ((1.0 - e) / e)
+                };
+                let specular_part =
+                    fr * (weight * specular) * (1.0 - metallic) + metal_brdf * metallic;
+                diffuse * (1.0 - weight * fr.max_element()) * (1.0 - metallic)
+                    + specular_part * factor
             }
             RefMaterial::Glossy { kd, ks, alpha } => {
                 if ci < 0.0 {

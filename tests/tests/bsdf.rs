@@ -4,12 +4,17 @@
 //! and the delta lobes' discrete choices.
 
 use glam::{DVec3, Vec3};
+use kernel::bsdf::multiple_scattering::GlossyAlbedo;
 use kernel::bsdf::{eval, sample, DELTA_PDF};
+
+/// No multiple scattering given back.
+const NONE: GlossyAlbedo = GlossyAlbedo::NONE;
 use kernel::features::Dynamic;
 use kernel::rng::SampleRng;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use twinpath_tests::cubature::integrate;
+use twinpath_tests::ggx_table::albedo;
 use twinpath_tests::reference_bsdf::{fresnel, schlick, RefMaterial};
 use twinpath_tests::{chi_square, z_critical, SplitMix};
 
@@ -178,19 +183,20 @@ fn rough_samplers_follow_their_pdfs() {
             let mut rng = SampleRng::new(777, k as u32, 0);
             for _ in 0..SAMPLES {
                 let u = (rng.next_f32(), rng.next_f32(), rng.next_f32());
-                let s = sample(Dynamic(0), &km, n, wo, eta, u.0, u.1, u.2);
+                let s = sample(Dynamic(0), &km, n, wo, eta, albedo(&km, n, wo), u.0, u.1, u.2);
                 if !(s.weight.max_element() > 0.0) {
                     observed[THETA_BINS * PHI_BINS] += 1.0;
                     continue;
                 }
                 // A sample where its own density is zero fails at once.
-                let (_, pdf) = eval(Dynamic(0), &km, n, wo, s.wi, eta);
+                let (_, pdf) = eval(Dynamic(0), &km, n, wo, s.wi, eta, albedo(&km, n, wo));
                 if !(pdf > 0.0) {
                     return Some(format!("{name}, n {n}, {degrees} deg: sample {} has pdf {pdf}", s.wi));
                 }
                 observed[bin(n, s.wi)] += 1.0;
             }
-            let pdf = |w: Vec3| eval(Dynamic(0), &km, n, wo, w, eta).1 as f64;
+            let a = albedo(&km, n, wo);
+            let pdf = |w: Vec3| eval(Dynamic(0), &km, n, wo, w, eta, a).1 as f64;
             let (mut exp, total) = expected(n, &pdf, SAMPLES as f64);
             if !(total <= 1.0 + 1e-3) {
                 return Some(format!("{name}, n {n}, {degrees} deg: pdf integrates to {total}"));
@@ -271,7 +277,16 @@ fn values_and_densities_match_the_f64_reference() {
                 continue;
             }
         }
-        let (f_cos, pdf) = eval(Dynamic(0), &m.kernel_at_hit(), n, wo, wi, m.eta() as f32);
+        let km = m.kernel_at_hit();
+        let (f_cos, pdf) = eval(
+            Dynamic(0),
+            &km,
+            n,
+            wo,
+            wi,
+            m.eta() as f32,
+            albedo(&km, n, wo),
+        );
         let f_ref = m.f(nd, wod, wid) * wid.dot(nd).abs();
         let pdf_ref = m.pdf(nd, wod, wid);
         // Values below 1e-4 (the lobes' peaks reach 1e4) are compared absolutely: there, near
@@ -326,14 +341,14 @@ fn evaluation_is_reciprocal() {
         }
         let km = m.kernel_at_hit();
         let eta = m.eta() as f32;
-        let forward = eval(Dynamic(0), &km, n, wo, wi, eta).0 / wi.dot(n).abs();
+        let forward = eval(Dynamic(0), &km, n, wo, wi, eta, NONE).0 / wi.dot(n).abs();
         let through = wi.dot(n) < 0.0;
         let (n_back, eta_back, scale) = if through {
             (-n, 1.0 / eta, eta * eta)
         } else {
             (n, eta, 1.0)
         };
-        let backward = eval(Dynamic(0), &km, n_back, wi, wo, eta_back).0 / wo.dot(n).abs();
+        let backward = eval(Dynamic(0), &km, n_back, wi, wo, eta_back, NONE).0 / wo.dot(n).abs();
         for c in 0..3 {
             let (a, b) = ((forward[c] * scale) as f64, backward[c] as f64);
             // Values below 1e-6 (where the peaks reach 1e4) are compared absolutely.
@@ -371,11 +386,12 @@ fn sampled_weight_is_value_over_density() {
         }
         let km = m.kernel_at_hit();
         let eta = m.eta() as f32;
-        let s = sample(Dynamic(0), &km, n, wo, eta, g.unit(), g.unit(), g.unit());
+        let a = albedo(&km, n, wo);
+        let s = sample(Dynamic(0), &km, n, wo, eta, a, g.unit(), g.unit(), g.unit());
         if !(s.weight.max_element() > 0.0) || s.wi.dot(n).abs() < 1e-2 {
             continue;
         }
-        let (f_cos, pdf) = eval(Dynamic(0), &km, n, wo, s.wi, eta);
+        let (f_cos, pdf) = eval(Dynamic(0), &km, n, wo, s.wi, eta, a);
         assert!(pdf > 0.0, "{m:?}: sampled {} where the pdf is 0", s.wi);
         assert!(
             rel(pdf as f64, s.pdf as f64) < 1e-3,
@@ -418,6 +434,7 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
                 n,
                 wo,
                 1.0,
+                NONE,
                 0.3,
                 0.4,
                 0.5,
@@ -440,7 +457,17 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
                 let mut g = SplitMix(0xde17a + degrees as u64);
                 let mut reflected = 0;
                 for _ in 0..TRIALS {
-                    let s = sample(Dynamic(0), &m, n, wo, eta, g.unit(), g.unit(), g.unit());
+                    let s = sample(
+                        Dynamic(0),
+                        &m,
+                        n,
+                        wo,
+                        eta,
+                        NONE,
+                        g.unit(),
+                        g.unit(),
+                        g.unit(),
+                    );
                     assert_eq!(s.pdf, DELTA_PDF);
                     if s.transmitted {
                         let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
@@ -484,7 +511,17 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
             let mut g = SplitMix(0x9105 + degrees as u64);
             let mut mirrored = 0;
             for _ in 0..TRIALS {
-                let s = sample(Dynamic(0), &km, n, wo, 1.0, g.unit(), g.unit(), g.unit());
+                let s = sample(
+                    Dynamic(0),
+                    &km,
+                    n,
+                    wo,
+                    1.0,
+                    NONE,
+                    g.unit(),
+                    g.unit(),
+                    g.unit(),
+                );
                 if s.pdf == DELTA_PDF {
                     assert!((s.wi - mirror).length() < 1e-6);
                     for c in 0..3 {
@@ -513,7 +550,17 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
             let p = fs.element_sum() / (fs.element_sum() + kd.element_sum());
             let mut mirrored = 0;
             for _ in 0..TRIALS {
-                let s = sample(Dynamic(0), &km, n, wo, 1.0, g.unit(), g.unit(), g.unit());
+                let s = sample(
+                    Dynamic(0),
+                    &km,
+                    n,
+                    wo,
+                    1.0,
+                    NONE,
+                    g.unit(),
+                    g.unit(),
+                    g.unit(),
+                );
                 if s.pdf == DELTA_PDF {
                     assert!((s.wi - mirror).length() < 1e-6);
                     for c in 0..3 {

@@ -180,10 +180,11 @@ proptest! {
         u in (0.0f32..1.0, 0.0f32..1.0, 0.0f32..1.0),
     ) {
         let m = kernel::probe::probe_material(kind, complex, alpha, eta);
-        let (f, pdf) = kernel::bsdf::eval(kernel::features::Dynamic(0), &m, n, wo, wi, eta);
+        let a = twinpath_tests::ggx_table::albedo(&m, n, wo);
+        let (f, pdf) = kernel::bsdf::eval(kernel::features::Dynamic(0), &m, n, wo, wi, eta, a);
         prop_assert!(f.is_finite() && f.min_element() >= 0.0, "eval {f} for {m:?}");
         prop_assert!(pdf.is_finite() && pdf >= 0.0, "pdf {pdf} for {m:?}");
-        let s = kernel::bsdf::sample(kernel::features::Dynamic(0), &m, n, wo, eta, u.0, u.1, u.2);
+        let s = kernel::bsdf::sample(kernel::features::Dynamic(0), &m, n, wo, eta, a, u.0, u.1, u.2);
         prop_assert!(s.weight.is_finite() && s.weight.min_element() >= 0.0, "weight {} for {m:?}", s.weight);
         prop_assert!(s.eta2.is_finite() && s.eta2 > 0.0);
         if s.weight.max_element() > 0.0 {

@@ -3,6 +3,7 @@
 //! triangle becomes the same kernel records (and a light) whichever file it came from.
 
 use super::environment::EnvironmentMap;
+use super::ggx_albedo;
 use super::instancing::{instance_box, instance_record, instances_box, mesh_box, MAX_INSTANCES};
 use super::light_table::{place_directional_lights, triangle_light};
 use super::limits::MAX_COORDINATE;
@@ -404,6 +405,13 @@ impl SceneTables {
         if let Some(map) = &environment {
             let light = map.light(&self.spheres, world_triangles, instanced);
             self.lights.push(light);
+        }
+        if self
+            .materials
+            .iter()
+            .any(|m| m.kind == material_kind::METALLIC_ROUGHNESS)
+        {
+            ggx_albedo::add_to(&mut self.textures).expect("the GGX albedo table is a texture");
         }
         Scene {
             name,

@@ -9,6 +9,8 @@ mod closed_surface;
 pub mod environment;
 mod error;
 mod flat_scene;
+pub mod ggx_albedo;
+mod ggx_albedo_table;
 pub mod gltf;
 pub mod inputs;
 pub mod instancing;

@@ -4,7 +4,7 @@
 //! the table's sRGB or linear byte tables), float images three.
 
 use super::error::SceneError;
-use kernel::texture::{flags, LINEAR_TABLE, RECORDS, RECORD_WORDS, SRGB_TABLE};
+use kernel::texture::{flags, GGX_ALBEDO, LINEAR_TABLE, RECORDS, RECORD_WORDS, SRGB_TABLE};
 use std::path::{Path, PathBuf};
 
 /// Largest texture side accepted.
@@ -84,9 +84,10 @@ impl Default for TextureTable {
 }
 
 impl TextureTable {
-    /// An empty table: no textures, the decoding tables in place.
+    /// An empty table: no textures (no GGX albedo table either), the decoding tables in place.
     pub fn new() -> Self {
         let mut words = vec![0u32; RECORDS];
+        words[GGX_ALBEDO] = kernel::scene::NONE;
         for b in 0..=255u8 {
             words[SRGB_TABLE + b as usize] = (srgb_to_linear(b) as f32).to_bits();
             words[LINEAR_TABLE + b as usize] = ((b as f64 / 255.0) as f32).to_bits();

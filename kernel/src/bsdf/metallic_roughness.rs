@@ -4,6 +4,7 @@
 //! form with the dielectric layer, which evaluates and samples it.
 
 use super::mixture;
+use super::multiple_scattering::GlossyAlbedo;
 use super::{BsdfFlags, BsdfSample};
 use crate::features;
 use crate::scene::Material;
@@ -46,14 +47,16 @@ pub fn apply_ks_texture(m: &mut Material, value: Vec3) {
     m.roughness *= value.y;
 }
 
-/// `bsdf::eval` of the resolved material: the mixture's, with the layer.
+/// `bsdf::eval` of the resolved material: the mixture's, with the layer and the glossy lobe's
+/// multiple scattering given back (`albedo`: the GGX albedo at the point's roughness and `wo`,
+/// `surface::glossy_albedo`).
 #[inline]
-pub fn eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-    mixture::eval(m, n, wo, wi, true)
+pub fn eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, albedo: GlossyAlbedo) -> (Vec3, f32) {
+    mixture::eval(m, n, wo, wi, true, albedo)
 }
 
-/// `bsdf::sample` of the resolved material: the mixture's, with the layer.
+/// `bsdf::sample` of the resolved material: the mixture's, as [`eval`].
 #[inline]
-pub fn sample(m: &Material, n: Vec3, wo: Vec3, u_lobe: f32, u1: f32, u2: f32) -> BsdfSample {
-    mixture::sample(m, n, wo, true, u_lobe, u1, u2)
+pub fn sample(m: &Material, n: Vec3, wo: Vec3, albedo: GlossyAlbedo, u: Vec3) -> BsdfSample {
+    mixture::sample(m, n, wo, true, albedo, u)
 }

@@ -103,3 +103,31 @@ pub fn reflection(n: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32, alpha: f3
         pdf: pdf_reflected(cos_o, angle, alpha),
     }
 }
+
+/// The [`Reflection`] from `wo` to `wi` with the height-correlated Smith masking-shadowing
+/// G2 = 1 / (1 + Lambda(wo) + Lambda(wi)) (Heitz 2014, eq. 99; glTF 2.0 Appendix B's
+/// visibility term and Cycles' microfacet BSDFs use it). With a = sqrt(alpha^2 + (1 - alpha^2)
+/// cos^2) per direction, the sum of one and the two Lambdas is (a_o / cos_o + a_i / cos_i) / 2,
+/// so D G2 / (4 cos_o) = D cos_i / (2 (a_o cos_i + a_i cos_o)): no tangent, no division by a
+/// cosine.
+#[inline]
+pub fn reflection_height_correlated(
+    n: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+    cos_o: f32,
+    cos_i: f32,
+    alpha: f32,
+) -> Reflection {
+    let h = (wo + wi).normalize();
+    let angle = normal_angle(n, h);
+    let d = ggx_d(angle.0, angle.1, alpha);
+    let a2 = alpha * alpha;
+    let a_o = (a2 + (1.0 - a2) * cos_o * cos_o).max(0.0).sqrt();
+    let a_i = (a2 + (1.0 - a2) * cos_i * cos_i).max(0.0).sqrt();
+    Reflection {
+        h,
+        value: d * cos_i / (2.0 * (a_o * cos_i + a_i * cos_o)),
+        pdf: pdf_reflected(cos_o, angle, alpha),
+    }
+}

@@ -4,11 +4,15 @@
 //! dielectric layer of reflectance `layer_f0` at normal incidence and `layer_f90` at grazing
 //! (`crate::scene::LAYER_F0` and 1 by default) and is weighed by the share it lets through (glTF's
 //! `fresnel_mix` with `KHR_materials_specular`'s weight and colour, which `metallic_roughness`
-//! resolves into this form).
+//! resolves into this form). With the layer (glTF's material) the glossy lobe's masking is
+//! the height-correlated Smith G2 (glTF's Appendix B, as Cycles), and the lobe is multiplied by
+//! its multiple-scattering factor (`multiple_scattering::factor`); GLOSSY keeps the separable
+//! G1 G1 (as Mitsuba's models, its peer) and single scattering.
 
 use super::fresnel::schlick_f90;
 use super::lambert::sample_brdf;
-use super::microfacet::{reflection, sample_visible_normal};
+use super::microfacet::{reflection, reflection_height_correlated, sample_visible_normal};
+use super::multiple_scattering::{factor, GlossyAlbedo};
 use super::{reflect, BsdfFlags, BsdfSample, DELTA_ALPHA};
 use crate::features;
 use crate::scene::Material;
@@ -62,10 +66,18 @@ fn diffuse_share(m: &Material, layered: bool, wo: Vec3, wi: Vec3) -> f32 {
 }
 
 /// `bsdf::eval` of the mixture: Kd/pi cos (times the layer's share) + D G F_Schlick(wi . h) /
-/// (4 cos_o), density the mixture of the cosine lobe and the visible-normal reflection. Zero
-/// where `wo` is not above `n` (rounding at grazing hits).
+/// (4 cos_o) (times the multiple-scattering factor of `albedo`, E at `wo`), density the
+/// mixture of the cosine lobe and the visible-normal reflection. Zero where `wo` is not above
+/// `n` (rounding at grazing hits).
 #[inline]
-pub fn eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, layered: bool) -> (Vec3, f32) {
+pub fn eval(
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+    layered: bool,
+    albedo: GlossyAlbedo,
+) -> (Vec3, f32) {
     let cos_o = n.dot(wo);
     let cos_i = n.dot(wi);
     if !(cos_o > 0.0) || !(cos_i > 0.0) {
@@ -76,24 +88,35 @@ pub fn eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, layered: bool) -> (Vec3, 
     let mut f = Vec3::from(m.albedo) * (c * diffuse_share(m, layered, wo, wi));
     let mut pdf = (1.0 - p_glossy) * c;
     if !(m.alpha < DELTA_ALPHA) {
-        let r = reflection(n, wo, wi, cos_o, cos_i, m.alpha);
-        f += schlick_f90(Vec3::from(m.specular), glossy_f90(m), wi.dot(r.h)) * r.value;
+        let r = if layered {
+            reflection_height_correlated(n, wo, wi, cos_o, cos_i, m.alpha)
+        } else {
+            reflection(n, wo, wi, cos_o, cos_i, m.alpha)
+        };
+        let (f0, f90) = (Vec3::from(m.specular), glossy_f90(m));
+        let glossy = schlick_f90(f0, f90, wi.dot(r.h)) * r.value;
+        f += if layered {
+            glossy * factor(albedo, f0, f90)
+        } else {
+            glossy
+        };
         pdf += p_glossy * r.pdf;
     }
     (f, pdf)
 }
 
-/// `bsdf::sample` of the mixture: `u_lobe` below the glossy lobe's probability chooses it.
+/// `bsdf::sample` of the mixture with numbers `u` = (u_lobe, u1, u2): `u_lobe` below the
+/// glossy lobe's probability chooses it, (u1, u2) the direction in the chosen lobe.
 #[inline]
 pub fn sample(
     m: &Material,
     n: Vec3,
     wo: Vec3,
     layered: bool,
-    u_lobe: f32,
-    u1: f32,
-    u2: f32,
+    albedo: GlossyAlbedo,
+    u: Vec3,
 ) -> BsdfSample {
+    let (u_lobe, u1, u2) = (u.x, u.y, u.z);
     let cos_o = n.dot(wo);
     if !(cos_o > 0.0) {
         return BsdfSample::NONE;
@@ -118,7 +141,7 @@ pub fn sample(
         let weight = Vec3::from(m.albedo) * (diffuse_share(m, layered, wo, wi) / (1.0 - p_glossy));
         return BsdfSample::reflected(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
     }
-    let (f, pdf) = eval(m, n, wo, wi, layered);
+    let (f, pdf) = eval(m, n, wo, wi, layered, albedo);
     if !(pdf > 0.0) {
         return BsdfSample::NONE;
     }

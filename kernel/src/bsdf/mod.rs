@@ -3,8 +3,9 @@
 //! kind: `lambert` (DIFFUSE), `mixture` (GLOSSY, the seed's Kd + Ks), `metallic_roughness`
 //! (glTF's), `conductor`, `dielectric`; `fresnel` and `microfacet` are what they share. This
 //! module holds the one dispatch over kinds ([`flags`], [`eval`], [`sample`], [`at_point`],
-//! [`apply_ks_texture`], [`material_features`]), pbrt-v4's tagged `BxDF` dispatch in one
-//! `match`. Derivations and sources: `docs/materials.md`.
+//! [`apply_ks_texture`], [`material_features`]), pbrt-v4's tagged `BxDF`
+//! dispatch in one `match`; `multiple_scattering` gives back what a GGX lobe loses between its
+//! microfacets (glTF's material). Derivations and sources: `docs/materials.md`.
 //!
 //! Conventions: `wo` is the unit direction toward the previous vertex (the camera side), `wi`
 //! the unit direction toward the next one (the light side); `n` is the unit normal on `wo`'s
@@ -23,9 +24,11 @@ pub mod lambert;
 pub mod metallic_roughness;
 pub mod microfacet;
 pub mod mixture;
+pub mod multiple_scattering;
 
 use crate::features::FeatureSet;
 use crate::scene::{material_kind, Material};
+use multiple_scattering::GlossyAlbedo;
 use spirv_std::glam::Vec3;
 
 /// Roughness below which a lobe is a perfect mirror or refraction (a delta distribution),
@@ -170,7 +173,9 @@ pub fn apply_ks_texture(m: &mut Material, value: Vec3) {
 
 /// The non-delta part of the scattering from `wi` toward `wo`: (f |n . wi|, the density with
 /// which [`sample`] draws `wi`, per unit solid angle). Delta lobes contribute to neither (no
-/// direction given in advance meets them). `features` keeps only the kinds the scene may have.
+/// direction given in advance meets them). `features` keeps only the kinds the scene may have;
+/// `albedo` is `surface::glossy_albedo` at the point for `wo` (what the glossy lobe of glTF's
+/// material loses to multiple scattering; `GlossyAlbedo::NONE` for every other kind).
 #[inline]
 pub fn eval<F: FeatureSet>(
     features: F,
@@ -179,14 +184,15 @@ pub fn eval<F: FeatureSet>(
     wo: Vec3,
     wi: Vec3,
     eta: f32,
+    albedo: GlossyAlbedo,
 ) -> (Vec3, f32) {
     match m.kind {
         material_kind::DIFFUSE => lambert::eval(m, n, wi),
         material_kind::GLOSSY if features.has_all(mixture::FEATURES) => {
-            mixture::eval(m, n, wo, wi, false)
+            mixture::eval(m, n, wo, wi, false, GlossyAlbedo::NONE)
         }
         material_kind::METALLIC_ROUGHNESS if features.has_all(metallic_roughness::FEATURES) => {
-            metallic_roughness::eval(m, n, wo, wi)
+            metallic_roughness::eval(m, n, wo, wi, albedo)
         }
         material_kind::CONDUCTOR if features.has_all(conductor::FEATURES) => {
             conductor::eval(m, n, wo, wi)
@@ -202,7 +208,7 @@ pub fn eval<F: FeatureSet>(
 /// [`BsdfFlags::chooses_lobe`]), `(u1, u2)` the direction within it. The weight is
 /// f |n . wi| / pdf in the forms that cancel analytically (a conductor's F G1(wi); a
 /// dielectric's G1(wi), over eta^2 after a refraction; exactly 1 for smooth reflection), and
-/// computed for the Kd + Ks mixture.
+/// computed for the Kd + Ks mixture. `albedo` as for [`eval`].
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn sample<F: FeatureSet>(
@@ -211,17 +217,23 @@ pub fn sample<F: FeatureSet>(
     n: Vec3,
     wo: Vec3,
     eta: f32,
+    albedo: GlossyAlbedo,
     u_lobe: f32,
     u1: f32,
     u2: f32,
 ) -> BsdfSample {
     match m.kind {
         material_kind::DIFFUSE => lambert::sample(m, n, u1, u2),
-        material_kind::GLOSSY if features.has_all(mixture::FEATURES) => {
-            mixture::sample(m, n, wo, false, u_lobe, u1, u2)
-        }
+        material_kind::GLOSSY if features.has_all(mixture::FEATURES) => mixture::sample(
+            m,
+            n,
+            wo,
+            false,
+            GlossyAlbedo::NONE,
+            Vec3::new(u_lobe, u1, u2),
+        ),
         material_kind::METALLIC_ROUGHNESS if features.has_all(metallic_roughness::FEATURES) => {
-            metallic_roughness::sample(m, n, wo, u_lobe, u1, u2)
+            metallic_roughness::sample(m, n, wo, albedo, Vec3::new(u_lobe, u1, u2))
         }
         material_kind::CONDUCTOR if features.has_all(conductor::FEATURES) => {
             conductor::sample(m, n, wo, u1, u2)
