@@ -968,12 +968,10 @@ fn sampler_wrap_modes_are_read_per_axis() {
     g.push("scenes", json!({ "nodes": [0, 1, 2] }));
     let scene =
         twinpath::scene::gltf::load_bytes(Path::new("samplers.glb"), &g.glb(), None, None).unwrap();
-    // The file's textures (the GGX albedo table its material brings is not one).
+    // The file's images (the GGX albedo table its material brings is not one).
     let modes: Vec<u32> = scene
         .textures
-        .textures
-        .iter()
-        .filter(|t| t.path != Path::new(twinpath::scene::ggx_albedo::NAME))
+        .images()
         .map(|t| t.flags & (flags::wrap(3, 3)))
         .collect();
     assert_eq!(

@@ -284,24 +284,26 @@ impl Scene {
         };
         let tables = self.table_bytes();
         let total: usize = tables.iter().map(|t| t.1).sum();
+        let images: Vec<String> = self
+            .textures
+            .images()
+            .map(|t| format!("{}x{}", t.width, t.height))
+            .collect();
         let mut parts: Vec<String> = tables
             .iter()
             .filter(|t| t.1 > 0 && (t.0 != "textures" || !self.textures.textures.is_empty()))
             .map(|(name, b)| format!("{name} {}", size(*b)))
             .collect();
-        if !self.textures.textures.is_empty() {
-            let sizes: Vec<String> = self
-                .textures
-                .textures
-                .iter()
-                .map(|t| format!("{}x{}", t.width, t.height))
-                .collect();
-            let noun = if sizes.len() == 1 {
+        if !images.is_empty() {
+            let noun = if images.len() == 1 {
                 "texture"
             } else {
                 "textures"
             };
-            parts.push(format!("{} {noun} ({})", sizes.len(), sizes.join(", ")));
+            parts.push(format!("{} {noun} ({})", images.len(), images.join(", ")));
+        }
+        if self.textures.images().count() < self.textures.textures.len() {
+            parts.push("the GGX albedo table".to_string());
         }
         format!("{} in all: {}", size(total), parts.join(", "))
     }

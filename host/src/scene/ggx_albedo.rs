@@ -33,7 +33,8 @@ pub const TABLE_POINTS: usize = 128;
 /// Gauss-Legendre cosines of [`average_albedo`] in the committed table.
 pub const AVERAGE_COSINES: usize = 64;
 
-/// The texture table's name for the GGX albedo table (it is not a file).
+/// The texture table's name for the GGX albedo table (not a file: it starts with
+/// `textures::TABLE_NAME_START`).
 pub const NAME: &str = "<GGX albedo table>";
 
 /// The height-correlated Smith G2 of GGX for directions at cosines `co`, `ci` > 0 and alpha^2

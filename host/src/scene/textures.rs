@@ -7,6 +7,10 @@ use super::error::SceneError;
 use kernel::texture::{flags, GGX_ALBEDO, LINEAR_TABLE, RECORDS, RECORD_WORDS, SRGB_TABLE};
 use std::path::{Path, PathBuf};
 
+/// The first character of a record's name that is a table the renderer adds (the GGX albedo
+/// table, `super::ggx_albedo`), not an image of the scene: no file name starts with it.
+pub const TABLE_NAME_START: char = '<';
+
 /// Largest texture side accepted.
 pub const MAX_TEXTURE_SIDE: u32 = 16384;
 
@@ -96,6 +100,14 @@ impl TextureTable {
             words,
             textures: Vec::new(),
         }
+    }
+
+    /// The scene's images: every record but the tables the renderer adds
+    /// ([`TABLE_NAME_START`]).
+    pub fn images(&self) -> impl Iterator<Item = &TextureInfo> {
+        self.textures
+            .iter()
+            .filter(|t| !t.path.to_string_lossy().starts_with(TABLE_NAME_START))
     }
 
     /// Bytes the kernel's table takes.
