@@ -271,6 +271,29 @@ def scene_rough_metal():
     return scene
 
 
+def scene_coat():
+    """Two smooth-shaded spheres of red Principled plastic (base colour (0.8, 0.1, 0.1),
+    roughness 0.5, Specular IOR Level 0: a Lambertian base) under a Coat of weight 1: roughness
+    0.6 on the left, 0 (a mirror) on the right; a grey floor,
+    a 300 W point light."""
+    scene = reset()
+    floor()
+    for x, coat_roughness in ((-0.75, 0.6), (0.75, 0.0)):
+        bpy.ops.mesh.primitive_uv_sphere_add(
+            radius=0.6, location=(x, 0.0, 0.6), segments=48, ring_count=24
+        )
+        ball = bpy.context.object
+        bpy.ops.object.shade_smooth()
+        coated = principled(f"coated_{coat_roughness}", base=(0.8, 0.1, 0.1), roughness=0.5)
+        inputs = coated.node_tree.nodes["Principled BSDF"].inputs
+        inputs["Coat Weight"].default_value = 1.0
+        inputs["Coat Roughness"].default_value = coat_roughness
+        ball.data.materials.append(coated)
+    light(scene, "POINT", 300.0, (1.0, -2.0, 3.0), shadow_soft_size=0.0)
+    camera(scene, location=(0.0, -4.0, 2.2), target=(0.0, 0.0, 0.5))
+    return scene
+
+
 def alpha_checker_image(path):
     """A 4 x 4 image of one colour, green (bytes 0 and 255: sRGB-decoded exactly to 0 and 1, so
     the same texels in both renderers, read as linear as in the mapping scene), whose alpha
@@ -350,6 +373,7 @@ SCENES = {
     "cutout": scene_cutout,
     "blend": scene_blend,
     "rough_metal": scene_rough_metal,
+    "coat": scene_coat,
 }
 
 

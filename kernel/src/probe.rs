@@ -112,10 +112,11 @@ fn v3(v: Vec3) -> Vec4 {
 
 /// The material of the BSDF probes: kind `kind` with roughness `alpha` and, for a dielectric,
 /// index `eta`; Kd (0.5, 0.4, 0.3) and Ks (0.2, 0.3, 0.4) for the Kd + Ks mixture; gold's RGB
-/// index (`complex` 1) or reflectance (0.9, 0.8, 0.7) for a conductor; for glTF's
+/// index (`complex` bit 0) or reflectance (0.9, 0.8, 0.7) for a conductor; for glTF's
 /// metallic-roughness material base colour (0.5, 0.4, 0.3), metallic 0.3 with a coloured,
-/// weakened dielectric layer (`complex` 0; `KHR_materials_specular`) or 0.9 with the default one,
-/// roughness sqrt(alpha), resolved as `surface::shade` resolves it.
+/// weakened dielectric layer (`complex` bit 0 clear; `KHR_materials_specular`) or 0.9 with the
+/// default one, roughness sqrt(alpha), with a clear coat of weight 0.8 and the same roughness
+/// where bit 1 is set, resolved as `surface::shade` resolves it.
 #[inline]
 pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material {
     let mut m = Material::diffuse([0.5, 0.4, 0.3]);
@@ -123,25 +124,30 @@ pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material
     m.alpha = alpha;
     m.ior = eta;
     // Gold's index where `complex`, else none (the constant reflectance).
-    m.eta = if complex != 0 {
+    m.eta = if complex & 1 != 0 {
         [0.143036, 0.375307, 1.44205]
     } else {
         [0.0; 3]
     };
     m.k = [3.983, 2.38556, 1.60336];
-    m.specular = if complex != 0 || kind != crate::scene::material_kind::CONDUCTOR {
+    m.specular = if complex & 1 != 0 || kind != crate::scene::material_kind::CONDUCTOR {
         [0.2, 0.3, 0.4]
     } else {
         [0.9, 0.8, 0.7]
     };
     if kind == crate::scene::material_kind::METALLIC_ROUGHNESS {
         m.specular = [0.0; 3];
-        m.metallic = if complex != 0 { 0.9 } else { 0.3 };
+        m.metallic = if complex & 1 != 0 { 0.9 } else { 0.3 };
         m.roughness = alpha.sqrt();
-        if complex == 0 {
+        if complex & 1 == 0 {
             // A coloured, weakened layer (KHR_materials_specular, KHR_materials_ior).
             m.layer_f0 = [0.06, 0.02, 0.1];
             m.layer_f90 = 0.7;
+        }
+        if complex & 2 != 0 {
+            // A clear coat (KHR_materials_clearcoat) of weight 0.8, rough or smooth with the
+            // material.
+            m.coat = Material::pack_coat(0.8, alpha.sqrt());
         }
         m = crate::bsdf::metallic_roughness::resolve(&m);
     }
@@ -286,9 +292,14 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
     } else if function == function::BSDF_EVAL || function == function::BSDF_SAMPLE {
         let m = probe_material(input[3].x, input[3].y, i0.w, i1.w);
         let (n, wo) = (i0.truncate(), i1.truncate());
+        // The probe's coat has the material's roughness, so its albedos too; its reflectance
+        // a number in the table's range drawn from them.
         let albedo = GlossyAlbedo {
             directional: i3.z,
             average: i3.w,
+            coat_directional: i3.z,
+            coat_average: i3.w,
+            coat_reflectance: 0.05 + 0.5 * (1.0 - i3.w),
         };
         if function == function::BSDF_EVAL {
             let (f, pdf) = bsdf::eval(Dynamic(0), &m, n, wo, i2.truncate(), i1.w, albedo);

@@ -201,9 +201,12 @@ pub struct Material {
     pub opacity: f32,
     /// CONDUCTOR with a complex index: the extinction coefficient k.
     pub k: [f32; 3],
-    /// A light on triangles: 1 if both faces emit, 0 for the front face alone (copied into
-    /// each of its triangles' `Light::two_sided`).
-    pub two_sided: u32,
+    /// METALLIC_ROUGHNESS: glTF's clear coat (`KHR_materials_clearcoat`, `crate::bsdf::coat`):
+    /// its weight (`clearcoatFactor`) in the low 16 bits and its roughness
+    /// (`clearcoatRoughnessFactor`) in the high 16, each round(x 65535)
+    /// ([`Material::pack_coat`], [`Material::coat_weight`], [`Material::coat_roughness`]); 0,
+    /// no coat.
+    pub coat: u32,
     /// Per [`texture_slot`]: the texture (an index into the texture table, `crate::texture`)
     /// whose value at the point multiplies that parameter, or [`NONE`].
     pub textures: [u32; texture_slot::COUNT],
@@ -237,7 +240,7 @@ impl Material {
             eta: [0.0; 3],
             opacity: 0.0,
             k: [0.0; 3],
-            two_sided: 0,
+            coat: 0,
             textures: [NONE; texture_slot::COUNT],
             metallic: 0.0,
             roughness: 0.0,
@@ -258,6 +261,25 @@ impl Material {
     #[inline]
     pub fn has_holes(&self) -> bool {
         self.opacity != 0.0
+    }
+
+    /// The [`Material::coat`] word of a coat of `weight` and `roughness` (each clamped to
+    /// [0, 1]).
+    pub fn pack_coat(weight: f32, roughness: f32) -> u32 {
+        let q = |x: f32| (x.clamp(0.0, 1.0) * 65535.0 + 0.5) as u32;
+        q(weight) | (q(roughness) << 16)
+    }
+
+    /// The clear coat's weight in [0, 1] (0: none).
+    #[inline]
+    pub fn coat_weight(&self) -> f32 {
+        (self.coat & 0xffff) as f32 * (1.0 / 65535.0)
+    }
+
+    /// The clear coat's perceptual roughness in [0, 1] (GGX alpha = its square).
+    #[inline]
+    pub fn coat_roughness(&self) -> f32 {
+        (self.coat >> 16) as f32 * (1.0 / 65535.0)
     }
 
     /// Whether a CONDUCTOR reflects by the exact Fresnel of its complex index `eta` + i `k`

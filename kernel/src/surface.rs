@@ -222,11 +222,11 @@ pub fn emission_at<F: FeatureSet>(
     }
 }
 
-/// What the glossy lobe of material `m` at a point (resolved, `bsdf::at_point`) with unit
-/// normal `n` loses to multiple scattering seen from `wo` (`bsdf::multiple_scattering`): for
-/// glTF's metallic-roughness material with a rough lobe, the GGX albedo at its roughness from
-/// the texture table `textures` (`texture::ggx_albedo`); for a smooth lobe (a mirror loses
-/// nothing) and every other kind, `GlossyAlbedo::NONE`. `bsdf::eval` and `bsdf::sample` take
+/// What the glossy lobes of material `m` at a point (resolved, `bsdf::at_point`) with unit
+/// normal `n` lose to multiple scattering seen from `wo` (`bsdf::multiple_scattering`): for
+/// glTF's metallic-roughness material, the GGX albedos at its roughness and at its clear coat's
+/// from the texture table `textures` (`texture::ggx_albedo`), each where the lobe is rough (a
+/// mirror loses nothing); for every other kind, `GlossyAlbedo::NONE`. `bsdf::eval` and `bsdf::sample` take
 /// it; a vertex looks it up once.
 #[inline]
 pub fn glossy_albedo<F: FeatureSet>(
@@ -236,12 +236,22 @@ pub fn glossy_albedo<F: FeatureSet>(
     n: Vec3,
     wo: Vec3,
 ) -> GlossyAlbedo {
-    if m.kind == material_kind::METALLIC_ROUGHNESS
-        && features.metallic_roughness()
-        && !(m.alpha < bsdf::DELTA_ALPHA)
-    {
-        texture::ggx_albedo(textures, m.roughness, n.dot(wo).max(0.0))
-    } else {
-        GlossyAlbedo::NONE
+    if !(m.kind == material_kind::METALLIC_ROUGHNESS && features.metallic_roughness()) {
+        return GlossyAlbedo::NONE;
     }
+    let mu = n.dot(wo).max(0.0);
+    let mut albedo = GlossyAlbedo::NONE;
+    if !(m.alpha < bsdf::DELTA_ALPHA) {
+        let e = texture::ggx_albedo(textures, m.roughness, mu);
+        albedo.directional = e.x;
+        albedo.average = e.y;
+    }
+    let coat_roughness = m.coat_roughness();
+    if m.coat != 0 && !(coat_roughness * coat_roughness < bsdf::DELTA_ALPHA) {
+        let e = texture::ggx_albedo(textures, coat_roughness, mu);
+        albedo.coat_directional = e.x;
+        albedo.coat_average = e.y;
+        albedo.coat_reflectance = e.z;
+    }
+    albedo
 }

@@ -21,7 +21,6 @@
 //! the point (pbrt-v4 `Image::Bilerp`, the same weights).
 
 use crate::bsdf;
-use crate::bsdf::multiple_scattering::GlossyAlbedo;
 use crate::features::{Dynamic, FeatureSet};
 use crate::scene::{texture_slot, Material, NONE};
 #[cfg(target_arch = "spirv")]
@@ -303,22 +302,18 @@ pub fn at_nodes(table: &[u32], texture: u32, x: f32, y: f32) -> Vec3 {
     )
 }
 
-/// E(`mu`) and E_avg at perceptual roughness `roughness` (alpha = roughness^2) from the GGX
-/// albedo table of `table` (its record at word [`GGX_ALBEDO`]; `bsdf::multiple_scattering`),
-/// bilinear in (roughness, sqrt(mu)) between its nodes (roughness i / (w - 1), cosine
-/// (j / (h - 1))^2), clamped to them; [`GlossyAlbedo::NONE`] where the table has none (a scene
-/// without glTF's material). `table` is a whole table (its header at least).
+/// (E(`mu`), E_avg, the coat's albedo) at perceptual roughness `roughness` (alpha =
+/// roughness^2) from the GGX albedo table of `table` (its record at word [`GGX_ALBEDO`];
+/// `bsdf::multiple_scattering`, `bsdf::coat`), bilinear in (roughness, sqrt(mu)) between its
+/// nodes (roughness i / (w - 1), cosine (j / (h - 1))^2), clamped to them; all 1 where the table
+/// has none (a scene without glTF's material). `table` is a whole table (its header at least).
 #[inline]
-pub fn ggx_albedo(table: &[u32], roughness: f32, mu: f32) -> GlossyAlbedo {
+pub fn ggx_albedo(table: &[u32], roughness: f32, mu: f32) -> Vec3 {
     let record = table[GGX_ALBEDO];
     if record == NONE {
-        return GlossyAlbedo::NONE;
+        return Vec3::ONE;
     }
-    let value = at_nodes(table, record, roughness, mu.sqrt());
-    GlossyAlbedo {
-        directional: value.x,
-        average: value.y,
-    }
+    at_nodes(table, record, roughness, mu.sqrt())
 }
 
 /// The alpha channel of texture `texture` at `uv`, bilinearly filtered as [`lookup_in`]

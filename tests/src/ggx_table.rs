@@ -10,8 +10,8 @@ use kernel::scene::Material;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 use twinpath::scene::ggx_albedo::{
-    add_to, average_albedo, cosine_of, directional_albedo, roughness_of, AVERAGE, AVERAGE_COSINES,
-    COSINES, DIRECTIONAL, ROUGHNESSES, TABLE_POINTS,
+    add_to, average_albedo, coat_albedo, cosine_of, directional_albedo, roughness_of, AVERAGE,
+    AVERAGE_COSINES, COAT, COSINES, DIRECTIONAL, ROUGHNESSES, TABLE_POINTS,
 };
 use twinpath::scene::textures::TextureTable;
 
@@ -35,6 +35,12 @@ pub fn albedo(m: &Material, n: Vec3, wo: Vec3) -> GlossyAlbedo {
 /// here (bilinear in roughness and sqrt(mu) between the nodes, clamped): the reference's own
 /// reading, written apart from `kernel::texture::at_nodes`.
 pub fn reference_albedo(roughness: f64, mu: f64) -> (f64, f64) {
+    let (e, average, _) = reference_albedos(roughness, mu);
+    (e, average)
+}
+
+/// [`reference_albedo`] with the coat's albedo (the table's third channel).
+pub fn reference_albedos(roughness: f64, mu: f64) -> (f64, f64, f64) {
     let locate = |t: f64, n: usize| {
         let x = t.clamp(0.0, 1.0) * (n - 1) as f64;
         let i = (x.floor() as usize).min(n - 2);
@@ -46,30 +52,41 @@ pub fn reference_albedo(roughness: f64, mu: f64) -> (f64, f64) {
     let top = e(j, i) * (1.0 - fx) + e(j, i + 1) * fx;
     let bottom = e(j + 1, i) * (1.0 - fx) + e(j + 1, i + 1) * fx;
     let average = AVERAGE[i] as f64 * (1.0 - fx) + AVERAGE[i + 1] as f64 * fx;
-    (top * (1.0 - fy) + bottom * fy, average)
+    let c = |j: usize, i: usize| COAT[j][i] as f64;
+    let coat_top = c(j, i) * (1.0 - fx) + c(j, i + 1) * fx;
+    let coat_bottom = c(j + 1, i) * (1.0 - fx) + c(j + 1, i + 1) * fx;
+    (
+        top * (1.0 - fy) + bottom * fy,
+        average,
+        coat_top * (1.0 - fy) + coat_bottom * fy,
+    )
 }
 
 /// E at every node (rows: cosines; columns: roughnesses) and E_avg at every roughness, as the
 /// committed table stores them (f32).
-pub fn values() -> (Vec<Vec<f32>>, Vec<f32>) {
-    let directional = (0..COSINES)
-        .into_par_iter()
-        .map(|j| {
-            (0..ROUGHNESSES)
-                .map(|i| directional_albedo(cosine_of(j), roughness_of(i), TABLE_POINTS) as f32)
-                .collect()
-        })
-        .collect();
+pub fn values() -> (Vec<Vec<f32>>, Vec<f32>, Vec<Vec<f32>>) {
+    let grid = |f: fn(f64, f64, usize) -> f64| -> Vec<Vec<f32>> {
+        (0..COSINES)
+            .into_par_iter()
+            .map(|j| {
+                (0..ROUGHNESSES)
+                    .map(|i| f(cosine_of(j), roughness_of(i), TABLE_POINTS) as f32)
+                    .collect()
+            })
+            .collect()
+    };
+    let directional = grid(directional_albedo);
+    let coat = grid(coat_albedo);
     let average = (0..ROUGHNESSES)
         .into_par_iter()
         .map(|i| average_albedo(roughness_of(i), AVERAGE_COSINES, TABLE_POINTS) as f32)
         .collect();
-    (directional, average)
+    (directional, average, coat)
 }
 
 /// The file's text.
 pub fn source() -> String {
-    let (directional, average) = values();
+    let (directional, average, coat) = values();
     let list = |v: &[f32]| {
         v.iter()
             .map(|x| format!("{x:?}"))
@@ -90,8 +107,15 @@ pub fn source() -> String {
     s += "/// E_avg(r) at roughness r = i / 31.\n";
     s += "#[rustfmt::skip]\n";
     s += &format!(
-        "pub const AVERAGE: [f32; {ROUGHNESSES}] = [{}];\n",
+        "pub const AVERAGE: [f32; {ROUGHNESSES}] = [{}];\n\n",
         list(&average)
     );
+    s += "/// The clear coat's albedo (F(wo . h) of index 1.5 in the lobe) at DIRECTIONAL's nodes.\n";
+    s += "#[rustfmt::skip]\n";
+    s += &format!("pub const COAT: [[f32; {ROUGHNESSES}]; {COSINES}] = [\n");
+    for row in &coat {
+        s += &format!("    [{}],\n", list(row));
+    }
+    s += "];\n";
     s
 }

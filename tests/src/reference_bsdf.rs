@@ -75,6 +75,53 @@ pub fn ggx_g1(cos: f64, alpha: f64) -> f64 {
     1.0 / (1.0 + lambda)
 }
 
+/// Smith's height-correlated G2 of GGX for cosines `co`, `ci` > 0 (Heitz 2014, eq. 99):
+/// 1 / (1 + Lambda(co) + Lambda(ci)), Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2.
+pub fn g2(co: f64, ci: f64, alpha: f64) -> f64 {
+    let lambda = |c: f64| {
+        let tan2 = (1.0 - c * c) / (c * c);
+        ((1.0 + alpha * alpha * tan2).sqrt() - 1.0) / 2.0
+    };
+    1.0 / (1.0 + lambda(co) + lambda(ci))
+}
+
+/// A clear coat of weight `weight` and roughness `roughness` as the kernel stores them (16-bit
+/// fixed point, `Material::pack_coat`) seen at cosine `co`: (its weight c, what the coat
+/// reflects: weight F(co) for a smooth coat (alpha below 1e-3), weight k A for a rough one, A
+/// the coat's albedo from the table and k its multiple-scattering factor; its alpha; k).
+pub fn coat_at(weight: f64, roughness: f64, co: f64) -> (f64, f64, f64) {
+    let q = |x: f64| (x * 65535.0).round() / 65535.0;
+    if weight <= 0.0 {
+        return (0.0, 0.0, 1.0);
+    }
+    let (w, r) = (q(weight), q(roughness));
+    let alpha = r * r;
+    if alpha < 1e-3 {
+        return (w * fresnel(co, 1.5, 0.0), alpha, 1.0);
+    }
+    let (e, e_avg, a) = crate::ggx_table::reference_albedos(r, co);
+    let f_avg = coat_fresnel_average();
+    let f_ms = f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg));
+    let k = 1.0 + f_ms * (1.0 - e) / e;
+    (w * k * a, alpha, k)
+}
+
+/// 2 \int_0^1 F(mu) mu dmu for the exact Fresnel reflectance of index 1.5 (midpoint rule,
+/// 10^5 points, computed once).
+pub fn coat_fresnel_average() -> f64 {
+    static AVERAGE: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+    *AVERAGE.get_or_init(|| {
+        let n = 100_000;
+        (0..n)
+            .map(|i| {
+                let mu = (i as f64 + 0.5) / n as f64;
+                2.0 * mu * fresnel(mu, 1.5, 0.0)
+            })
+            .sum::<f64>()
+            / n as f64
+    })
+}
+
 /// A material of the reference, with the kernel's parameters.
 #[derive(Clone, Copy, Debug)]
 pub enum RefMaterial {
@@ -95,7 +142,12 @@ pub enum RefMaterial {
     /// metal_brdf = specular * conductor_fresnel(f0 = base); alpha = roughness^2; with
     /// `KHR_materials_specular`'s fresnel_mix(f0_color = `specular_color`, ior,
     /// weight = `specular`, base, layer) (`KHR_materials_ior`: `ior`; 1.5, 1 and white
-    /// without the extensions).
+    /// without the extensions); under `KHR_materials_clearcoat`'s coat of weight `coat` and
+    /// roughness `coat_roughness` (none at weight 0): fresnel_coat(normal, 1.5, coat, material,
+    /// specular_brdf(coat_roughness^2)) with Cycles' layering: the layer weighed by coat k
+    /// F(|wo . h|), F the exact reflectance of index 1.5 and k the lobe's multiple-scattering
+    /// factor, the material by 1 - c, c the layer's albedo ([`coat_at`]; `kernel::bsdf::coat`
+    /// says why).
     MetallicRoughness {
         base: DVec3,
         metallic: f64,
@@ -103,10 +155,40 @@ pub enum RefMaterial {
         ior: f64,
         specular: f64,
         specular_color: DVec3,
+        coat: f64,
+        coat_roughness: f64,
     },
 }
 
 impl RefMaterial {
+    /// glTF's metallic-roughness material of base colour `base`, without the extensions: index
+    /// 1.5, specular weight 1 and white, no clear coat.
+    pub fn gltf(base: DVec3, metallic: f64, roughness: f64) -> Self {
+        RefMaterial::MetallicRoughness {
+            base,
+            metallic,
+            roughness,
+            ior: 1.5,
+            specular: 1.0,
+            specular_color: DVec3::ONE,
+            coat: 0.0,
+            coat_roughness: 0.0,
+        }
+    }
+
+    /// This glTF material under a clear coat of weight `weight` and roughness `roughness`.
+    pub fn coated(mut self, weight: f64, roughness: f64) -> Self {
+        if let RefMaterial::MetallicRoughness {
+            coat,
+            coat_roughness,
+            ..
+        } = &mut self
+        {
+            (*coat, *coat_roughness) = (weight, roughness);
+        }
+        self
+    }
+
     /// The material as the kernel stores it.
     pub fn kernel(&self) -> kernel::scene::Material {
         use kernel::scene::{material_kind, Material};
@@ -151,8 +233,13 @@ impl RefMaterial {
                 ior,
                 specular,
                 specular_color,
+                coat,
+                coat_roughness,
             } => {
                 let mut m = Material::diffuse(f(base));
+                if coat > 0.0 {
+                    m.coat = Material::pack_coat(coat as f32, coat_roughness as f32);
+                }
                 m.kind = material_kind::METALLIC_ROUGHNESS;
                 m.metallic = metallic as f32;
                 m.roughness = roughness as f32;
@@ -207,6 +294,8 @@ impl RefMaterial {
                 ior,
                 specular: weight,
                 specular_color,
+                coat,
+                coat_roughness,
             } => {
                 if ci < 0.0 {
                     return DVec3::ZERO;
@@ -216,12 +305,7 @@ impl RefMaterial {
                 let voh = wo.dot(h).abs();
                 // Appendix B's visibility: the height-correlated Smith G2 = 1 / (1 + Lambda(wo)
                 // + Lambda(wi)), Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2 (Heitz 2014).
-                let lambda = |c: f64| {
-                    let tan2 = (1.0 - c * c) / (c * c);
-                    ((1.0 + alpha * alpha * tan2).sqrt() - 1.0) / 2.0
-                };
-                let g2 = 1.0 / (1.0 + lambda(co) + lambda(ci));
-                let specular = ggx_d(n.dot(h), alpha) * g2 / (4.0 * co * ci);
+                let specular = ggx_d(n.dot(h), alpha) * g2(co, ci, alpha) / (4.0 * co * ci);
                 let diffuse = base / PI;
                 // fresnel_mix(f0_color, ior, weight, base, layer) =
                 // (1 - weight max(fr)) base + weight fr layer, fr = f0 + (1 - f0)(1 - |VdotH|)^5,
@@ -245,8 +329,23 @@ impl RefMaterial {
                 };
                 let specular_part =
                     fr * (weight * specular) * (1.0 - metallic) + metal_brdf * metallic;
-                diffuse * (1.0 - weight * fr.max_element()) * (1.0 - metallic)
-                    + specular_part * factor
+                let material = diffuse * (1.0 - weight * fr.max_element()) * (1.0 - metallic)
+                    + specular_part * factor;
+                let (c, alpha_c, k) = coat_at(coat, coat_roughness, co);
+                if c == 0.0 {
+                    return material;
+                }
+                // The coat's layer: Appendix B's specular_brdf times the coat's factor and the
+                // exact Fresnel reflectance at the microfacet (a smooth coat is a delta lobe, in
+                // no value).
+                let layer = if alpha_c < 1e-3 {
+                    0.0
+                } else {
+                    // Cycles' coat: the exact Fresnel at the microfacet.
+                    let coat_at_h = (coat * 65535.0).round() / 65535.0 * k * fresnel(voh, 1.5, 0.0);
+                    coat_at_h * ggx_d(n.dot(h), alpha_c) * g2(co, ci, alpha_c) / (4.0 * co * ci)
+                };
+                material * (1.0 - c) + DVec3::splat(layer)
             }
             RefMaterial::Glossy { kd, ks, alpha } => {
                 if ci < 0.0 {
@@ -340,6 +439,8 @@ impl RefMaterial {
                 ior,
                 specular,
                 specular_color,
+                coat,
+                coat_roughness,
             } => {
                 if ci <= 0.0 {
                     return 0.0;
@@ -354,7 +455,15 @@ impl RefMaterial {
                 let f90 = specular * (1.0 - metallic) + metallic;
                 let fs = (ks + (DVec3::splat(f90) - ks) * (1.0 - co).powi(5)).element_sum();
                 let p = fs / (fs + kd.element_sum());
-                (1.0 - p) * ci / PI + p * reflected(roughness * roughness)
+                let material = (1.0 - p) * ci / PI + p * reflected(roughness * roughness);
+                // Under a coat of weight c, the coat is chosen with probability c.
+                let (c, alpha_c, _) = coat_at(coat, coat_roughness, co);
+                let coat_pdf = if c > 0.0 && alpha_c >= 1e-3 {
+                    reflected(alpha_c)
+                } else {
+                    0.0
+                };
+                (1.0 - c) * material + c * coat_pdf
             }
             RefMaterial::Glossy { kd, ks, alpha } => {
                 if ci <= 0.0 {

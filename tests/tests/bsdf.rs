@@ -43,14 +43,13 @@ fn dielectric(eta: f64, alpha: f64) -> RefMaterial {
 }
 
 fn metallic_roughness(metallic: f64, roughness: f64) -> RefMaterial {
-    RefMaterial::MetallicRoughness {
-        base: DVec3::new(0.8, 0.5, 0.2),
-        metallic,
-        roughness,
-        ior: 1.5,
-        specular: 1.0,
-        specular_color: DVec3::ONE,
-    }
+    RefMaterial::gltf(DVec3::new(0.8, 0.5, 0.2), metallic, roughness)
+}
+
+/// [`metallic_roughness`] under a clear coat (`KHR_materials_clearcoat`) of weight `coat` and
+/// roughness `coat_roughness`.
+fn coated(metallic: f64, roughness: f64, coat: f64, coat_roughness: f64) -> RefMaterial {
+    metallic_roughness(metallic, roughness).coated(coat, coat_roughness)
 }
 
 /// [`metallic_roughness`] with `KHR_materials_specular`'s weight and a coloured F0 (clamped to
@@ -63,6 +62,8 @@ fn specular_layered(metallic: f64, roughness: f64, specular: f64) -> RefMaterial
         ior: 2.0,
         specular,
         specular_color: DVec3::new(1.0, 0.5, 12.0),
+        coat: 0.0,
+        coat_roughness: 0.0,
     }
 }
 
@@ -87,6 +88,16 @@ fn rough_materials() -> Vec<(String, RefMaterial)> {
                 "glTF metallic {metallic} roughness {roughness} specular {specular}, coloured, ior 2"
             ),
             specular_layered(metallic, roughness, specular),
+        ));
+    }
+    for (metallic, roughness, coat, coat_roughness) in [(0.3, 0.6, 0.8, 0.3), (1.0, 0.2, 0.5, 0.7)]
+    {
+        v.push((
+            format!(
+                "glTF metallic {metallic} roughness {roughness} under coat {coat} roughness \
+                 {coat_roughness}"
+            ),
+            coated(metallic, roughness, coat, coat_roughness),
         ));
     }
     for eta in [1.5, 1.0 / 1.5] {
@@ -235,7 +246,16 @@ fn random_material(g: &mut SplitMix) -> RefMaterial {
     let alpha = 10f64.powf(-2.0 + 2.0 * g.unit() as f64);
     match g.u64() % 6 {
         0 => glossy(alpha),
-        4 => metallic_roughness(g.unit() as f64, alpha.sqrt()),
+        4 => {
+            // Half of them under a rough clear coat.
+            let coat = if g.unit() < 0.5 { g.unit() as f64 } else { 0.0 };
+            coated(
+                g.unit() as f64,
+                alpha.sqrt(),
+                coat,
+                0.05 + 0.95 * g.unit() as f64,
+            )
+        }
         5 => specular_layered(g.unit() as f64, alpha.sqrt(), g.unit() as f64),
         1 => conductor(alpha),
         2 => RefMaterial::Conductor {
@@ -339,7 +359,10 @@ fn evaluation_is_reciprocal() {
         if wo.dot(n) < 1e-2 || wi.dot(n).abs() < 1e-2 {
             continue;
         }
-        let km = m.kernel_at_hit();
+        // glTF's material without what depends on wo alone (the clear coat's weight, the
+        // multiple-scattering factor): those make it non-reciprocal, as the extensions define.
+        let mut km = m.kernel_at_hit();
+        km.coat = 0;
         let eta = m.eta() as f32;
         let forward = eval(Dynamic(0), &km, n, wo, wi, eta, NONE).0 / wi.dot(n).abs();
         let through = wi.dot(n) < 0.0;
@@ -581,6 +604,41 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
                 mirrored,
                 TRIALS,
                 p,
+            );
+            // A smooth clear coat of weight 0.7 over a rough material: the coat's mirror with
+            // probability c = 0.7 F(n . wo) (index 1.5), weighing c / c = 1; every other sample weighs
+            // f cos / pdf of the rough material, whose value and density both carry 1 - c.
+            let coated = coated(0.25, 0.5, 0.7, 0.0);
+            let km = coated.kernel_at_hit();
+            let c = 0.7 * fresnel(cos_o, 1.5, 0.0);
+            // (A smooth coat reflects exactly F(n . wo) of the light.)
+            let a = albedo(&km, n, wo);
+            let mut coat_mirrors = 0;
+            for _ in 0..TRIALS {
+                let (u_lobe, u1, u2) = (g.unit(), g.unit(), g.unit());
+                let s = sample(Dynamic(0), &km, n, wo, 1.0, a, u_lobe, u1, u2);
+                if s.pdf == DELTA_PDF {
+                    assert!((s.wi - mirror).length() < 1e-6);
+                    assert_eq!(s.weight, Vec3::ONE);
+                    coat_mirrors += 1;
+                } else if s.weight.max_element() > 0.0 {
+                    let (f_cos, pdf) = eval(Dynamic(0), &km, n, wo, s.wi, 1.0, a);
+                    let (f_ref, pdf_ref) = (
+                        coated.f(n.as_dvec3(), wo.as_dvec3(), s.wi.as_dvec3()) * s.wi.dot(n) as f64,
+                        coated.pdf(n.as_dvec3(), wo.as_dvec3(), s.wi.as_dvec3()),
+                    );
+                    assert!(rel(pdf as f64, pdf_ref) < 1e-3, "{pdf} vs {pdf_ref}");
+                    for k in 0..3 {
+                        assert!(rel(f_cos[k] as f64, f_ref[k]) < 1e-3);
+                        assert!(rel(s.weight[k] as f64, (f_cos[k] / pdf) as f64) < 1e-5);
+                    }
+                }
+            }
+            assert_binomial(
+                &format!("glTF smooth coat at {degrees} deg"),
+                coat_mirrors,
+                TRIALS,
+                c,
             );
         }
     }

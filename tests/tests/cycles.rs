@@ -28,6 +28,10 @@
 //! - `blend`: a square over the floor whose Principled BSDF has Alpha 0.4, which the exporter
 //!   writes as `alphaMode` BLEND: seen and passed through 60% of the time. The same render
 //!   with the square opaque is rejected.
+//! - `coat`: two red Principled spheres under a Coat of weight 1, rough (0.6) and smooth (0):
+//!   `KHR_materials_clearcoat`. Means within 2%; the per-pixel test is measured, not asserted
+//!   (Cycles' layering under a rough coat differs, docs/gltf.md). The same render without the
+//!   coats is rejected.
 //! - `rough_metal`: two spheres of Principled metal, roughness 0.5 (gold) and 0.9 (light grey),
 //!   on a lit floor: Cycles' multiscatter GGX, which twinpath's compensation
 //!   (`bsdf::multiple_scattering`) matches. The same render with single scattering alone (the
@@ -49,12 +53,13 @@ const SPP: u32 = 1024;
 /// A fixture's scene (its glTF file through its camera, at the reference's size, black
 /// background as the fixture's world) and its Cycles reference with per-pixel variance.
 struct Fixture {
+    name: &'static str,
     scene: SceneFile,
     reference: RgbImage,
     reference_var: Vec<[f32; 3]>,
 }
 
-fn fixture(name: &str) -> Fixture {
+fn fixture(name: &'static str) -> Fixture {
     let dir = repo_root().join("tests/reference/cycles").join(name);
     let read = |f: &str| RgbImage::read(&dir.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
     let (a, b) = (read("cycles_half_a.exr"), read("cycles_half_b.exr"));
@@ -81,6 +86,7 @@ fn fixture(name: &str) -> Fixture {
     );
     let scene = parse_scene(&toml, &dir.join("fixture.toml")).unwrap_or_else(|e| panic!("{e}"));
     Fixture {
+        name,
         scene: with_independent_samples(scene),
         reference,
         reference_var,
@@ -101,14 +107,48 @@ fn compare(
     compared: Option<&[bool]>,
     floor: f32,
     heavy_tailed: bool,
+    spp: u32,
 ) -> f64 {
-    let film = render_film(&f.scene, backend, SPP);
+    let m = measure(f, backend, label, compared, floor, heavy_tailed, spp);
+    assert!(
+        m.pass_fraction >= 0.995,
+        "{label} ({backend:?}): only {:.2}% of pixels pass",
+        100.0 * m.pass_fraction
+    );
+    assert!(
+        m.z_mean.abs() < z_critical(1e-3, 1),
+        "{label} ({backend:?}): image means differ, z = {:.2}",
+        m.z_mean
+    );
+    m.ratio
+}
+
+/// What [`compare`] measures: the fraction of pixels that pass the per-pixel z-test, the z of
+/// the image means' difference, and our mean over Cycles'.
+struct Agreement {
+    pass_fraction: f64,
+    z_mean: f64,
+    ratio: f64,
+}
+
+/// [`compare`]'s render and statistics, printed, without its assertions.
+#[allow(clippy::too_many_arguments)]
+fn measure(
+    f: &Fixture,
+    backend: Backend,
+    label: &str,
+    compared: Option<&[bool]>,
+    floor: f32,
+    heavy_tailed: bool,
+    spp: u32,
+) -> Agreement {
+    let film = render_film(&f.scene, backend, spp);
     assert_eq!(film.discarded, 0, "{label}: non-finite samples");
     let mut var = film.variance_of_mean();
     if heavy_tailed {
         let mut other = f.scene.clone();
         other.settings.seed += 1;
-        let independent = variance_of_mean_from(&render_film(&other, backend, 4 * SPP), &film);
+        let independent = variance_of_mean_from(&render_film(&other, backend, 4 * spp), &film);
         for (v, w) in var.iter_mut().zip(independent) {
             *v = std::array::from_fn(|c| v[c].max(w[c]));
         }
@@ -153,22 +193,17 @@ fn compare(
         t.max_abs_z,
         m_ours / m_theirs
     );
-    assert!(
-        t.pass_fraction() >= 0.995,
-        "{label} ({backend:?}): only {:.2}% of pixels pass",
-        100.0 * t.pass_fraction()
-    );
-    assert!(
-        z_mean.abs() < z_critical(1e-3, 1),
-        "{label} ({backend:?}): image means differ, z = {z_mean:.2}"
-    );
-    m_ours / m_theirs
+    Agreement {
+        pass_fraction: t.pass_fraction(),
+        z_mean,
+        ratio: m_ours / m_theirs,
+    }
 }
 
-fn agrees_with_cycles(name: &str) {
+fn agrees_with_cycles(name: &'static str) {
     let f = fixture(name);
     for backend in [Backend::Cpu, Backend::Gpu] {
-        compare(&f, backend, name, None, 0.0, false);
+        compare(&f, backend, name, None, 0.0, false, SPP);
     }
     assert_validation_clean();
 }
@@ -212,7 +247,15 @@ fn a_blender_sun_renders_as_cycles_renders_it() {
     for backend in [Backend::Cpu, Backend::Gpu] {
         let ours = deviation(&render_film(&f.scene, backend, 16).mean());
         assert!(ours < 1e-5, "{backend:?}: {ours:.2e} from the closed form");
-        compare(&f, backend, "sun", None, cycles_deviation as f32, false);
+        compare(
+            &f,
+            backend,
+            "sun",
+            None,
+            cycles_deviation as f32,
+            false,
+            SPP,
+        );
     }
     assert_validation_clean();
 }
@@ -254,7 +297,7 @@ fn a_blender_alpha_clipped_texture_renders_as_cycles_renders_it() {
     // holes: three bounces, rare, heavy-tailed.
     let f = fixture("cutout");
     for backend in [Backend::Cpu, Backend::Gpu] {
-        compare(&f, backend, "cutout", None, 0.0, true);
+        compare(&f, backend, "cutout", None, 0.0, true, SPP);
     }
     assert_validation_clean();
     let m = &f.scene.scene.materials;
@@ -266,7 +309,7 @@ fn a_blender_alpha_clipped_texture_renders_as_cycles_renders_it() {
 fn a_blender_alpha_blended_surface_renders_as_cycles_renders_it() {
     let f = fixture("blend");
     for backend in [Backend::Cpu, Backend::Gpu] {
-        compare(&f, backend, "blend", None, 0.0, true);
+        compare(&f, backend, "blend", None, 0.0, true, SPP);
     }
     assert_validation_clean();
     let m = &f.scene.scene.materials;
@@ -283,17 +326,53 @@ fn a_blender_rough_metal_renders_as_cycles_renders_it() {
     // heavy-tailed.
     let f = fixture("rough_metal");
     for backend in [Backend::Cpu, Backend::Gpu] {
-        compare(&f, backend, "rough_metal", None, 0.0, true);
+        compare(&f, backend, "rough_metal", None, 0.0, true, SPP);
     }
     assert_validation_clean();
     // Without the table the kernel gives nothing back (`GlossyAlbedo::NONE`): single scattering.
     let mut single = f.scene.clone();
     single.scene.textures.words[kernel::texture::GGX_ALBEDO] = kernel::scene::NONE;
     assert_rejected(&f, &single, "rough_metal, single scattering");
-    // Per roughness: the pixels each sphere fills (Blender's (x, 0, 0.6), radius 0.6, is glTF's
-    // (x, 0.6, 0)), each set compared as the image is, and single scattering's ratio printed.
-    let single_film = render_film(&single, Backend::Cpu, SPP);
-    for (x, roughness) in [(-0.75, 0.5), (0.75, 0.9)] {
+    // Per roughness: the pixels each sphere fills, each set compared as the image is, and
+    // single scattering's ratio printed.
+    per_sphere(
+        &f,
+        &single,
+        [(-0.75, "roughness 0.5"), (0.75, "roughness 0.9")],
+    );
+}
+
+#[test]
+fn a_blender_clear_coat_renders_as_cycles_renders_it() {
+    // As `rough_metal`: the floor lit through the spheres' coats.
+    // Cycles' coat takes a base's share by an estimate of its reflectance that twinpath's does
+    // not reproduce (docs/gltf.md, "Against Cycles"): the means are held to the issue's 2%, the
+    // per-pixel agreement measured and printed.
+    let f = fixture("coat");
+    for backend in [Backend::Cpu, Backend::Gpu] {
+        let m = measure(&f, backend, "coat", None, 0.0, true, SPP);
+        assert!(
+            (m.ratio - 1.0).abs() < 0.02,
+            "coat ({backend:?}): means {:.4} apart",
+            m.ratio
+        );
+    }
+    assert_validation_clean();
+    let coats: Vec<_> = f.scene.scene.materials.iter().map(|m| m.coat).collect();
+    assert!(coats.iter().filter(|&&c| c != 0).count() == 2, "{coats:?}");
+    let mut bare = f.scene.clone();
+    for m in &mut bare.scene.materials {
+        m.coat = 0;
+    }
+    assert_rejected(&f, &bare, "coat, coats removed");
+}
+
+/// Compares the pixels each of fixture `f`'s two spheres fills (Blender's (x, 0, 0.6), radius
+/// 0.6, is glTF's (x, 0.6, 0)) with Cycles' as the whole image is compared (CPU), and prints
+/// how `changed` (its scene without the feature) compares there.
+fn per_sphere(f: &Fixture, changed: &SceneFile, spheres: [(f64, &str); 2]) {
+    let changed_film = render_film(changed, Backend::Cpu, SPP);
+    for (x, what) in spheres {
         let centre = glam::DVec3::new(x, 0.6, 0.0);
         let mask: Vec<bool> = pixel_quadrature(&f.scene.scene, 4, |eye, d| {
             let (o, d) = (eye.as_dvec3() - centre, d.as_dvec3().normalize());
@@ -303,8 +382,8 @@ fn a_blender_rough_metal_renders_as_cycles_renders_it() {
         .iter()
         .map(Option::is_some)
         .collect();
-        let label = format!("rough_metal, the sphere of roughness {roughness}");
-        let ratio = compare(&f, Backend::Cpu, &label, Some(&mask), 0.0, true);
+        let label = format!("{}, the sphere of {what}", f.name);
+        let ratio = compare(f, Backend::Cpu, &label, Some(&mask), 0.0, true, SPP);
         let sum = |p: &[[f32; 3]]| {
             p.iter()
                 .zip(&mask)
@@ -312,9 +391,10 @@ fn a_blender_rough_metal_renders_as_cycles_renders_it() {
                 .flat_map(|(p, _)| p.iter().map(|&x| x as f64))
                 .sum::<f64>()
         };
-        let single_ratio = sum(&single_film.mean()) / sum(&f.reference.pixels);
+        let changed_ratio = sum(&changed_film.mean()) / sum(&f.reference.pixels);
         println!(
-            "{label}: {} pixels, twinpath / Cycles {ratio:.4}, single scattering {single_ratio:.4}",
+            "{label}: {} pixels, twinpath / Cycles {ratio:.4}, without the feature \
+             {changed_ratio:.4}",
             mask.iter().filter(|&&m| m).count()
         );
     }
@@ -401,6 +481,7 @@ fn a_blender_spot_light_renders_as_cycles_renders_it_where_the_falloffs_agree() 
             Some(&agree),
             0.0,
             false,
+            SPP,
         );
         // The ring between the cones: glTF's (cos - cos_o)^2 / (cos_i - cos_o)^2 against
         // Blender's smoothstep over its blend; measured, not asserted (docs/gltf.md).

@@ -420,8 +420,11 @@ fn appendix_b_rules_each_hold() {
         &["KHR_materials_emissive_strength"],
     );
     assert_eq!(s.scene.materials[0].emission, [4.0, 2.0, 1.0]);
-    assert_eq!(s.scene.materials[0].two_sided, 1);
     assert_eq!(s.scene.lights.len(), 4, "each triangle a light");
+    assert!(
+        s.scene.lights.iter().all(|l| l.two_sided == 1),
+        "doubleSided"
+    );
     // It keeps its surface: a light that reflects as a metallic-roughness material.
     assert_eq!(s.scene.materials[0].kind, material_kind::METALLIC_ROUGHNESS);
     assert!(s.scene.materials[0].reflects());
@@ -458,6 +461,82 @@ fn appendix_b_rules_each_hold() {
     let e = SceneFile::load(&path).unwrap_err().to_string();
     assert!(
         e.contains("materials[0]") && e.contains("metallicFactor 1.5"),
+        "{e}"
+    );
+}
+
+#[test]
+fn clear_coats_are_read_from_the_extension() {
+    let dir = temp_dir("clearcoat");
+    let coat = |extension: serde_json::Value| {
+        let path = material_file(
+            &dir,
+            "coat.glb",
+            json!({ "extensions": { "KHR_materials_clearcoat": extension } }),
+            &["KHR_materials_clearcoat"],
+        );
+        SceneFile::load(&path)
+    };
+    // Factor and roughness, in 16-bit fixed point; no note of an ignored extension.
+    let s = coat(json!({ "clearcoatFactor": 0.75, "clearcoatRoughnessFactor": 0.2 })).unwrap();
+    let m = s.scene.materials[0];
+    assert_eq!(m.kind, material_kind::METALLIC_ROUGHNESS);
+    assert!(
+        (m.coat_weight() - 0.75).abs() <= 0.5 / 65535.0,
+        "{}",
+        m.coat_weight()
+    );
+    assert!(
+        (m.coat_roughness() - 0.2).abs() <= 0.5 / 65535.0,
+        "{}",
+        m.coat_roughness()
+    );
+    assert!(
+        s.scene.notes.iter().all(|n| !n.contains("ignored")),
+        "{:?}",
+        s.scene.notes
+    );
+    // The defaults: no coat (factor 0), whatever the roughness.
+    let s = coat(json!({ "clearcoatRoughnessFactor": 0.5 })).unwrap();
+    assert_eq!(s.scene.materials[0].coat, 0);
+    // Textures are noted, their factors used.
+    let s = coat(json!({ "clearcoatFactor": 1.0, "clearcoatNormalTexture": { "index": 0 } }));
+    let s = s.unwrap();
+    assert!(s.scene.materials[0].coat_weight() == 1.0);
+    assert!(
+        s.scene
+            .notes
+            .iter()
+            .any(|n| n.contains("KHR_materials_clearcoat textures ignored")),
+        "{:?}",
+        s.scene.notes
+    );
+    // Out of range: an error naming the material and the field.
+    let e = coat(json!({ "clearcoatFactor": 1.5 }))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("materials[0]") && e.contains("clearcoatFactor 1.5"),
+        "{e}"
+    );
+    // TOML: the same material's keys; a value out of range names the field.
+    let toml = |entry: &str| {
+        twinpath::scene::parse_scene(
+            &format!(
+                "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 8\nheight = 8\n[materials]\nc = {{ {entry} }}\n\
+             [[sphere]]\ncenter = [0, 0, 0]\nradius = 1.0\nmaterial = \"c\"\n"
+            ),
+            Path::new("coat.toml"),
+        )
+    };
+    let s =
+        toml("base_color = [0.8, 0.1, 0.1], clearcoat = 0.5, clearcoat_roughness = 0.1").unwrap();
+    let m = s.scene.materials[0];
+    assert!((m.coat_weight() - 0.5).abs() <= 0.5 / 65535.0);
+    assert!((m.coat_roughness() - 0.1).abs() <= 0.5 / 65535.0);
+    let e = toml("clearcoat = 2.0").unwrap_err().to_string();
+    assert!(
+        e.contains("materials.c.clearcoat") && e.contains("outside 0..=1"),
         "{e}"
     );
 }

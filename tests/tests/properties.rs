@@ -174,7 +174,7 @@ proptest! {
         (n, wo) in normal_and_outgoing(),
         wi in unit(),
         kind in 1u32..4,
-        complex in 0u32..2,
+        complex in 0u32..4,
         alpha in roughness(),
         eta in relative_index(),
         u in (0.0f32..1.0, 0.0f32..1.0, 0.0f32..1.0),

@@ -154,7 +154,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     eta,
                     opacity,
                     k,
-                    two_sided,
+                    coat,
                     textures,
                     metallic,
                     roughness,

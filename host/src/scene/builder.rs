@@ -24,6 +24,8 @@ use kernel::scene::{
 pub(super) struct SceneTables {
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
+    /// Per material: whether its triangles, where it emits, emit from both faces.
+    pub two_sided: Vec<bool>,
     pub spheres: Vec<Sphere>,
     pub triangles: Vec<Triangle>,
     pub triangle_groups: Vec<TriangleGroup>,
@@ -60,10 +62,12 @@ pub(super) fn wound<T: Copy>(corners: [T; 3], mirror: bool) -> [T; 3] {
 }
 
 impl SceneTables {
-    /// Adds a material under `name`; its index.
-    pub fn add_material(&mut self, name: String, material: Material) -> u32 {
+    /// Adds a material under `name`, whose triangles, where it emits, emit from both faces if
+    /// `two_sided` (copied into each one's `Light::two_sided`); its index.
+    pub fn add_material(&mut self, name: String, material: Material, two_sided: bool) -> u32 {
         self.materials.push(material);
         self.material_names.push(name);
+        self.two_sided.push(two_sided);
         (self.materials.len() - 1) as u32
     }
 
@@ -173,7 +177,8 @@ impl SceneTables {
         }
         if self.is_emissive(material) {
             tri.light = self.lights.len() as u32;
-            let mut light = triangle_light(&tri, m.emission, m.two_sided != 0);
+            let two_sided = self.two_sided[material as usize];
+            let mut light = triangle_light(&tri, m.emission, two_sided);
             light.material = material;
             if let Some(a) = attributes {
                 // The emission texture's own set of coordinates (without one, the base

@@ -3,8 +3,10 @@
 //! `microfacet::reflection_height_correlated`; Fresnel factor 1, alpha = r^2) at
 //! [`ROUGHNESSES`] perceptual roughnesses r = i / 31 by [`COSINES`] cosines mu = (j / 31)^2
 //! (nodes crowd toward grazing, where E falls steeply over mu < alpha), and
-//! its hemispherical average E_avg(r) = 2 \int_0^1 E(mu, r) mu dmu, computed here in f64 by
-//! quadrature ([`directional_albedo`], [`average_albedo`]). The values the renderer uses are
+//! its hemispherical average E_avg(r) = 2 \int_0^1 E(mu, r) mu dmu, and the clear coat's
+//! albedo (the same lobe with the exact Fresnel reflectance of index 1.5 at each microfacet,
+//! `kernel::bsdf::coat`), computed here in f64 by quadrature ([`directional_albedo`],
+//! [`average_albedo`], [`coat_albedo`]). The values the renderer uses are
 //! the committed [`ggx_albedo_table`](super::ggx_albedo_table) (`tests/examples/
 //! ggx_albedo_table.rs` writes it from these functions; `tests/tests/multiple_scattering.rs`
 //! checks that it is what they give). [`add_to`] puts it in a scene's texture table.
@@ -20,7 +22,7 @@
 //! each rule integrates a smooth function ([`directional_albedo`]).
 
 use super::error::SceneError;
-pub use super::ggx_albedo_table::{AVERAGE, DIRECTIONAL};
+pub use super::ggx_albedo_table::{AVERAGE, COAT, DIRECTIONAL};
 use super::textures::{TextureTable, TextureUse};
 use std::path::Path;
 
@@ -56,6 +58,31 @@ fn g2(co: f64, ci: f64, a2: f64) -> f64 {
 /// `points / 2` nodes each (at grazing mu, theta* changes steeply just before pi / 2, over a
 /// width ~ mu, which the rule's nodes crowding toward the ends resolve).
 pub fn directional_albedo(mu: f64, roughness: f64, points: usize) -> f64 {
+    integral(mu, roughness, points, |_| 1.0)
+}
+
+/// The clear coat's directional albedo (`kernel::bsdf::coat`): [`directional_albedo`] with the
+/// exact Fresnel reflectance of index 1.5 at each microfacet, F(wo . h), in the integrand; F(mu)
+/// at roughness 0.
+pub fn coat_albedo(mu: f64, roughness: f64, points: usize) -> f64 {
+    if roughness == 0.0 {
+        return dielectric_fresnel(mu.clamp(1e-7, 1.0));
+    }
+    integral(mu, roughness, points, dielectric_fresnel)
+}
+
+/// The exact Fresnel reflectance of a dielectric of index 1.5 seen from outside at cosine `c`
+/// (unpolarised: the mean of s and p; Born and Wolf 1.5.2).
+pub fn dielectric_fresnel(c: f64) -> f64 {
+    let eta = 1.5;
+    let cos_t = (1.0 - (1.0 - c * c) / (eta * eta)).sqrt();
+    let rs = (c - eta * cos_t) / (c + eta * cos_t);
+    let rp = (eta * c - cos_t) / (eta * c + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// The quadrature of [`directional_albedo`] with the factor `fresnel(wo . h)` in the integrand.
+fn integral(mu: f64, roughness: f64, points: usize, fresnel: impl Fn(f64) -> f64) -> f64 {
     let alpha = roughness * roughness;
     if alpha == 0.0 {
         return 1.0;
@@ -97,7 +124,7 @@ pub fn directional_albedo(mu: f64, roughness: f64, points: usize) -> f64 {
             if oh <= 0.0 || wi_z <= 0.0 {
                 continue;
             }
-            row += w * du_ds * g2(mu, wi_z, a2) * oh / cos_h;
+            row += w * du_ds * g2(mu, wi_z, a2) * oh / cos_h * fresnel(oh);
         }
         sum += pw * half_pi * row * (s_max - s_min);
     }
@@ -155,12 +182,13 @@ pub fn cosine_of(j: usize) -> f64 {
 }
 
 /// Adds the committed table to `textures` as a float texture (texel (i, j): E(mu_j, r_i),
-/// E_avg(r_i), 0) and names its record in the table's header (`kernel::texture::GGX_ALBEDO`).
+/// E_avg(r_i), the coat's albedo at (mu_j, r_i)) and names its record in the table's header
+/// (`kernel::texture::GGX_ALBEDO`).
 pub fn add_to(textures: &mut TextureTable) -> Result<u32, SceneError> {
     let mut image = image::Rgb32FImage::new(ROUGHNESSES as u32, COSINES as u32);
     for (j, row) in DIRECTIONAL.iter().enumerate() {
         for (i, &e) in row.iter().enumerate() {
-            image.put_pixel(i as u32, j as u32, image::Rgb([e, AVERAGE[i], 0.0]));
+            image.put_pixel(i as u32, j as u32, image::Rgb([e, AVERAGE[i], COAT[j][i]]));
         }
     }
     let usage = TextureUse {

@@ -9,6 +9,7 @@
 //! its multiple-scattering factor (`multiple_scattering::factor`); GLOSSY keeps the separable
 //! G1 G1 (as Mitsuba's models, its peer) and single scattering.
 
+use super::coat::{self, Coat};
 use super::fresnel::schlick_f90;
 use super::lambert::sample_brdf;
 use super::microfacet::{reflection, reflection_height_correlated, sample_visible_normal};
@@ -102,11 +103,27 @@ pub fn eval(
         };
         pdf += p_glossy * r.pdf;
     }
+    if layered {
+        let coat = coat::at(m, cos_o, albedo);
+        if coat.weight > 0.0 {
+            // Under glTF's clear coat (`coat`): the material's 1 - c, and the coat's rough
+            // lobe (a smooth one is a delta lobe: in neither).
+            f *= 1.0 - coat.weight;
+            pdf *= 1.0 - coat.weight;
+            if !(coat.alpha < DELTA_ALPHA) {
+                let r = coat::reflection(&coat, n, wo, wi, cos_o, cos_i);
+                f += Vec3::splat(coat::lobe_weight(m, wo, r.h, albedo) * r.value);
+                pdf += coat.weight * r.pdf;
+            }
+        }
+    }
     (f, pdf)
 }
 
-/// `bsdf::sample` of the mixture with numbers `u` = (u_lobe, u1, u2): `u_lobe` below the
-/// glossy lobe's probability chooses it, (u1, u2) the direction in the chosen lobe.
+/// `bsdf::sample` of the mixture with numbers `u` = (u_lobe, u1, u2): with the layer, `u_lobe`
+/// below the clear coat's weight c chooses the coat (`coat`), and is else mapped onto [0, 1)
+/// again by (u_lobe - c) / (1 - c); then `u_lobe` below the glossy lobe's probability chooses
+/// it; (u1, u2) draw the direction in the chosen lobe.
 #[inline]
 pub fn sample(
     m: &Material,
@@ -116,10 +133,27 @@ pub fn sample(
     albedo: GlossyAlbedo,
     u: Vec3,
 ) -> BsdfSample {
-    let (u_lobe, u1, u2) = (u.x, u.y, u.z);
+    let (mut u_lobe, u1, u2) = (u.x, u.y, u.z);
     let cos_o = n.dot(wo);
     if !(cos_o > 0.0) {
         return BsdfSample::NONE;
+    }
+    let coat = if layered {
+        coat::at(m, cos_o, albedo)
+    } else {
+        Coat::NONE
+    };
+    if coat.weight > 0.0 {
+        if u_lobe < coat.weight {
+            // The coat, chosen with probability c: a smooth one's mirror weighs c / c.
+            if coat.alpha < DELTA_ALPHA {
+                return BsdfSample::mirror(n, reflect(wo, n), Vec3::ONE);
+            }
+            let wi = reflect(wo, sample_visible_normal(n, wo, coat.alpha, u1, u2));
+            return weighed(m, n, wo, wi, layered, albedo);
+        }
+        // c < 1 here (u_lobe < 1).
+        u_lobe = (u_lobe - coat.weight) / (1.0 - coat.weight);
     }
     let smooth = m.alpha < DELTA_ALPHA;
     let p_glossy = glossy_lobe_probability(m, cos_o);
@@ -136,11 +170,25 @@ pub fn sample(
     } else {
         sample_brdf(n, u1, u2)
     };
-    if smooth {
+    if smooth && coat.weight == 0.0 {
         // The diffuse lobe beside a delta one: (Kd/pi cos) / ((1 - p) cos/pi), exactly.
         let weight = Vec3::from(m.albedo) * (diffuse_share(m, layered, wo, wi) / (1.0 - p_glossy));
         return BsdfSample::reflected(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
     }
+    weighed(m, n, wo, wi, layered, albedo)
+}
+
+/// The sample of direction `wi` weighed f cos / pdf by [`eval`] (the whole mixture's value and
+/// density, the delta lobes in neither), or none where the density is 0.
+#[inline]
+fn weighed(
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    wi: Vec3,
+    layered: bool,
+    albedo: GlossyAlbedo,
+) -> BsdfSample {
     let (f, pdf) = eval(m, n, wo, wi, layered, albedo);
     if !(pdf > 0.0) {
         return BsdfSample::NONE;

@@ -5,7 +5,8 @@
 //! module holds the one dispatch over kinds ([`flags`], [`eval`], [`sample`], [`at_point`],
 //! [`apply_ks_texture`], [`material_features`]), pbrt-v4's tagged `BxDF`
 //! dispatch in one `match`; `multiple_scattering` gives back what a GGX lobe loses between its
-//! microfacets (glTF's material). Derivations and sources: `docs/materials.md`.
+//! microfacets (glTF's material), `coat` its clear coat (`KHR_materials_clearcoat`).
+//! Derivations and sources: `docs/materials.md`.
 //!
 //! Conventions: `wo` is the unit direction toward the previous vertex (the camera side), `wi`
 //! the unit direction toward the next one (the light side); `n` is the unit normal on `wo`'s
@@ -17,6 +18,7 @@
 //! A kind's arm is compiled only where the scene's features allow it (`features`: its
 //! `FEATURES` bits); a material whose kind no arm takes scatters nothing.
 
+pub mod coat;
 pub mod conductor;
 pub mod dielectric;
 pub mod fresnel;

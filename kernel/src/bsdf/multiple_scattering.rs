@@ -14,7 +14,9 @@
 //! F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)) (their F_ms with one F_avg less, since the
 //! scaled lobe already carries one Fresnel factor). So the lobe is multiplied by
 //!
-//!     factor = 1 + F_ms (1 - E(mu_o)) / E(mu_o)     (per channel),
+//! ```text
+//! factor = 1 + F_ms (1 - E(mu_o)) / E(mu_o)     (per channel),
+//! ```
 //!
 //! which is 1 / E for F = 1 (Turquin's scale, the white furnace exact) and 1 where E = 1. This
 //! is Cycles' `microfacet_ggx_preserve_energy`. The factor depends on `wo` alone: the
@@ -30,21 +32,48 @@
 
 use spirv_std::glam::Vec3;
 
-/// The directional albedo E(mu_o) of a GGX lobe (Fresnel factor 1) at a point's roughness and
-/// view, and its hemispherical average E_avg: what the compensation divides by and weighs with.
-/// [`GlossyAlbedo::NONE`] (both 1) is no compensation.
+/// The directional albedo E(mu_o) of a point's GGX lobes (Fresnel factor 1) at their
+/// roughness and its view, and their hemispherical averages E_avg: the material's glossy lobe's
+/// (`directional`, `average`) and its clear coat's (`coat_directional`, `coat_average`; `coat`).
+/// What the compensation divides by and weighs with; 1 (as in [`GlossyAlbedo::NONE`]) is no
+/// compensation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GlossyAlbedo {
     pub directional: f32,
     pub average: f32,
+    pub coat_directional: f32,
+    pub coat_average: f32,
+    /// The coat lobe's directional albedo with its Fresnel factor F(wo . h) (index 1.5), before
+    /// its weight and its compensation: what the coat reflects of light from everywhere, and so
+    /// what it takes from the material below (`coat`).
+    pub coat_reflectance: f32,
 }
 
 impl GlossyAlbedo {
-    /// No energy lost, none given back: the factor is exactly 1.
+    /// No energy lost, none given back: every factor is exactly 1.
+    /// (`coat_reflectance` 1: a rough coat needs the table's.)
     pub const NONE: Self = Self {
         directional: 1.0,
         average: 1.0,
+        coat_directional: 1.0,
+        coat_average: 1.0,
+        coat_reflectance: 1.0,
     };
+}
+
+/// The cosine-weighted hemispherical average of the exact Fresnel reflectance of a dielectric of
+/// index 1.5 seen from outside, 2 \int_0^1 F(mu) mu dmu (`tests/multiple_scattering.rs`
+/// integrates it): the clear coat's F_avg.
+pub const COAT_FRESNEL_AVERAGE: f32 = 0.091_777_96;
+
+/// The factor on the clear coat's lobe (`coat`): 1 + F_ms (1 - E) / E with the coat's albedos
+/// and F_avg = [`COAT_FRESNEL_AVERAGE`], as Cycles gives its coat's energy back.
+#[inline]
+pub fn coat_factor(albedo: GlossyAlbedo) -> f32 {
+    let (e, e_avg) = (albedo.coat_directional, albedo.coat_average);
+    let f_avg = COAT_FRESNEL_AVERAGE;
+    let f_ms = f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg));
+    1.0 + f_ms * ((1.0 - e) / e)
 }
 
 /// The factor on a Schlick lobe of reflectances `f0` (normal incidence) and `f90` (grazing):

@@ -1,6 +1,7 @@
 //! glTF materials onto the kernel's: the metallic-roughness model as the specification's
 //! Appendix B defines it (`material_kind::METALLIC_ROUGHNESS`), its dielectric layer as
-//! `KHR_materials_specular` and `KHR_materials_ior` change it, emissive materials as lights,
+//! `KHR_materials_specular` and `KHR_materials_ior` change it, its clear coat
+//! (`KHR_materials_clearcoat`), emissive materials as lights,
 //! `KHR_materials_transmission` with `KHR_materials_ior` as the dielectric. What is approximated
 //! or ignored is noted (`Scene::notes`); docs/gltf.md lists it.
 
@@ -111,12 +112,12 @@ pub(super) fn material(
     out.metallic = metallic;
     out.roughness = roughness;
     (out.layer_f0, out.layer_f90) = dielectric_layer(imp, &label, &m, &err)?;
+    out.coat = clear_coat(imp, &label, &m, &err)?;
     out.opacity = opacity(&m, base[3], pbr.base_color_texture().is_some(), &err)?;
     if emits {
         // A light (its triangles in the light table) that reflects as its material does, as
         // a Principled BSDF with emission does in Blender.
         out.emission = emission.to_array();
-        out.two_sided = m.double_sided() as u32;
         if let Some(info) = m.emissive_texture() {
             out.textures[texture_slot::EMISSION] = texture(imp, &label, &info, true)?;
         }
@@ -208,6 +209,52 @@ fn dielectric_layer(
     let f0 = ((ior as f64 - 1.0) / (ior as f64 + 1.0)).powi(2);
     let layer_f0 = colour.map(|c| ((f0 * c as f64).min(1.0) * factor as f64) as f32);
     Ok((layer_f0, factor))
+}
+
+/// The `Material::coat` word of opaque material `m`'s `KHR_materials_clearcoat`
+/// (`clearcoatFactor` and `clearcoatRoughnessFactor`, defaults 0; each within 0..=1), 0
+/// without one. The `gltf` crate does not read the extension: its JSON is read here. Its
+/// textures (weight, roughness, normal) are noted and the factors used.
+fn clear_coat(
+    imp: &mut Import,
+    label: &str,
+    m: &gltf::Material,
+    err: &dyn Fn(String) -> SceneError,
+) -> Result<u32, SceneError> {
+    let Some(coat) = m.extension_value("KHR_materials_clearcoat") else {
+        return Ok(0);
+    };
+    let factor = |key: &str| -> Result<f32, SceneError> {
+        match coat.get(key) {
+            None => Ok(0.0),
+            Some(v) => match v.as_f64() {
+                Some(x) if (0.0..=1.0).contains(&x) => Ok(x as f32),
+                _ => Err(err(format!(
+                    "KHR_materials_clearcoat.{key} {v} must be a number within 0..=1"
+                ))),
+            },
+        }
+    };
+    let (weight, roughness) = (
+        factor("clearcoatFactor")?,
+        factor("clearcoatRoughnessFactor")?,
+    );
+    let textures = [
+        "clearcoatTexture",
+        "clearcoatRoughnessTexture",
+        "clearcoatNormalTexture",
+    ];
+    if weight > 0.0 && textures.iter().any(|t| coat.get(*t).is_some()) {
+        imp.note(format!(
+            "{label}: KHR_materials_clearcoat textures ignored (its factors are used; the coat \
+             shades with the surface's normal)"
+        ));
+    }
+    Ok(if weight > 0.0 {
+        Material::pack_coat(weight, roughness)
+    } else {
+        0
+    })
 }
 
 /// `out` with glTF material `m`'s `normalTexture` (linear) and its scale, where it has one.

@@ -126,7 +126,10 @@ impl Import<'_> {
             (Some(i), Some(n)) => format!("{n} (materials[{i}])"),
             (Some(i), None) => format!("materials[{i}]"),
         };
-        let index = self.tables.add_material(name, m);
+        // Where it emits, glTF's doubleSided: both faces emit.
+        let index = self
+            .tables
+            .add_material(name, m, p.material().double_sided());
         self.materials.insert(gltf_material, index);
         Ok(index)
     }

@@ -68,6 +68,10 @@ pub(super) struct MaterialFile {
     pub roughness: Option<Spanned<f32>>,
     pub base_color_map: Option<Spanned<String>>,
     pub metallic_roughness_map: Option<Spanned<String>>,
+    /// Its clear coat (glTF's `KHR_materials_clearcoat`): weight and perceptual roughness,
+    /// each in [0, 1], default 0.
+    pub clearcoat: Option<Spanned<f32>>,
+    pub clearcoat_roughness: Option<Spanned<f32>>,
     /// A tangent-space normal map (linear; glTF's `normalTexture`, OpenGL's +y convention) and
     /// its x/y scale (default 1), for any reflecting material on triangles.
     pub normal_map: Option<Spanned<String>>,
@@ -82,6 +86,8 @@ impl MaterialFile {
             || self.roughness.is_some()
             || self.base_color_map.is_some()
             || self.metallic_roughness_map.is_some()
+            || self.clearcoat.is_some()
+            || self.clearcoat_roughness.is_some()
     }
 }
 
@@ -103,7 +109,8 @@ pub(super) fn add_materials(
         let field = format!("materials.{name}");
         let mut material = material(ck, &field, m)?;
         attach_textures(ck, &field, m, base_dir, &mut tables.textures, &mut material)?;
-        tables.add_material(name.clone(), material);
+        let two_sided = m.get_ref().two_sided.as_ref().is_some_and(|t| *t.get_ref());
+        tables.add_material(name.clone(), material, two_sided);
     }
     Ok(())
 }
@@ -188,7 +195,6 @@ pub(super) fn material(
         };
         let mut out = Material::diffuse(kd.to_array());
         out.emission = radiance.to_array();
-        out.two_sided = mf.two_sided.as_ref().is_some_and(|t| *t.get_ref()) as u32;
         return Ok(out);
     }
     if let Some(t) = &mf.two_sided {
@@ -271,8 +277,8 @@ pub(super) fn material(
 }
 
 /// glTF's metallic-roughness material: `base_color` (default white), `metallic` and
-/// `roughness` (each in [0, 1], default 1, glTF's defaults) and their maps; nothing of the
-/// other kinds beside them.
+/// `roughness` (each in [0, 1], default 1, glTF's defaults) and their maps, a clear coat
+/// (`clearcoat`, `clearcoat_roughness`, default 0); nothing of the other kinds beside them.
 fn metallic_roughness(
     ck: &Checker,
     field: &str,
@@ -302,9 +308,9 @@ fn metallic_roughness(
             ),
         ));
     }
-    let unit = |v: &Option<Spanned<f32>>, name: &str| -> Result<f32, SceneError> {
+    let unit = |v: &Option<Spanned<f32>>, name: &str, default: f32| -> Result<f32, SceneError> {
         match v {
-            None => Ok(1.0),
+            None => Ok(default),
             Some(x) => {
                 let value = *x.get_ref();
                 if (0.0..=1.0).contains(&value) {
@@ -325,8 +331,13 @@ fn metallic_roughness(
     };
     let mut out = Material::diffuse(base.to_array());
     out.kind = material_kind::METALLIC_ROUGHNESS;
-    out.metallic = unit(&mf.metallic, "metallic")?;
-    out.roughness = unit(&mf.roughness, "roughness")?;
+    out.metallic = unit(&mf.metallic, "metallic", 1.0)?;
+    out.roughness = unit(&mf.roughness, "roughness", 1.0)?;
+    let coat = unit(&mf.clearcoat, "clearcoat", 0.0)?;
+    let coat_roughness = unit(&mf.clearcoat_roughness, "clearcoat_roughness", 0.0)?;
+    if coat > 0.0 {
+        out.coat = Material::pack_coat(coat, coat_roughness);
+    }
     Ok(out)
 }
 

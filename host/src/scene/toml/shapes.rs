@@ -106,7 +106,7 @@ pub(super) fn add_spheres(
                 ),
             ));
         }
-        if tables.materials[material as usize].two_sided != 0 {
+        if tables.two_sided[material as usize] {
             return Err(ck.err(
                 sf.material.span(),
                 &format!("sphere[{i}].material"),
