@@ -246,9 +246,8 @@ pub fn glossy_albedo<F: FeatureSet>(
         albedo.directional = e.x;
         albedo.average = e.y;
     }
-    let coat_roughness = m.coat_roughness();
-    if m.coat != 0 && !(coat_roughness * coat_roughness < bsdf::DELTA_ALPHA) {
-        let e = texture::ggx_albedo(textures, coat_roughness, mu);
+    if m.coat != 0 && !(m.coat_roughness() * m.coat_roughness() < bsdf::DELTA_ALPHA) {
+        let e = texture::ggx_albedo(textures, m.coat_roughness(), mu);
         albedo.coat_directional = e.x;
         albedo.coat_average = e.y;
         albedo.coat_reflectance = e.z;

@@ -52,11 +52,11 @@ pub fn apply_ks_texture(m: &mut Material, value: Vec3) {
 /// `surface::glossy_albedo`).
 #[inline]
 pub fn eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, albedo: GlossyAlbedo) -> (Vec3, f32) {
-    mixture::eval(m, n, wo, wi, true, albedo)
+    mixture::eval::<true>(m, n, wo, wi, albedo)
 }
 
 /// `bsdf::sample` of the resolved material: the mixture's, as [`eval`].
 #[inline]
 pub fn sample(m: &Material, n: Vec3, wo: Vec3, albedo: GlossyAlbedo, u: Vec3) -> BsdfSample {
-    mixture::sample(m, n, wo, true, albedo, u)
+    mixture::sample::<true>(m, n, wo, albedo, u)
 }

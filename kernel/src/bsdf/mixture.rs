@@ -1,6 +1,6 @@
 //! The seed's Kd + Ks BRDF (`material_kind::GLOSSY`): a Lambertian lobe Kd / pi plus a GGX
 //! microfacet lobe with Schlick's Fresnel (F0 = Ks, F90 [`glossy_f90`]), each sampled in
-//! proportion to an estimate of its albedo. With `layered`, the Lambertian lobe lies under a
+//! proportion to an estimate of its albedo. With `LAYERED`, the Lambertian lobe lies under a
 //! dielectric layer of reflectance `layer_f0` at normal incidence and `layer_f90` at grazing
 //! (`crate::scene::LAYER_F0` and 1 by default) and is weighed by the share it lets through (glTF's
 //! `fresnel_mix` with `KHR_materials_specular`'s weight and colour, which `metallic_roughness`
@@ -57,8 +57,8 @@ pub fn glossy_f90(m: &Material) -> f32 {
 /// `layer_f90`, |wo . h|) at the half vector h of `wo` and `wi` (Appendix B's `fresnel_mix`
 /// as `KHR_materials_specular` extends it: `1 - weight * max_value(fr)`).
 #[inline]
-fn diffuse_share(m: &Material, layered: bool, wo: Vec3, wi: Vec3) -> f32 {
-    if layered {
+fn diffuse_share<const LAYERED: bool>(m: &Material, wo: Vec3, wi: Vec3) -> f32 {
+    if LAYERED {
         let h = (wo + wi).normalize();
         1.0 - schlick_f90(Vec3::from(m.layer_f0), m.layer_f90, wo.dot(h).abs()).max_element()
     } else {
@@ -71,12 +71,11 @@ fn diffuse_share(m: &Material, layered: bool, wo: Vec3, wi: Vec3) -> f32 {
 /// mixture of the cosine lobe and the visible-normal reflection. Zero where `wo` is not above
 /// `n` (rounding at grazing hits).
 #[inline]
-pub fn eval(
+pub fn eval<const LAYERED: bool>(
     m: &Material,
     n: Vec3,
     wo: Vec3,
     wi: Vec3,
-    layered: bool,
     albedo: GlossyAlbedo,
 ) -> (Vec3, f32) {
     let cos_o = n.dot(wo);
@@ -86,24 +85,24 @@ pub fn eval(
     }
     let p_glossy = glossy_lobe_probability(m, cos_o);
     let c = cos_i * (1.0 / PI);
-    let mut f = Vec3::from(m.albedo) * (c * diffuse_share(m, layered, wo, wi));
+    let mut f = Vec3::from(m.albedo) * (c * diffuse_share::<LAYERED>(m, wo, wi));
     let mut pdf = (1.0 - p_glossy) * c;
     if !(m.alpha < DELTA_ALPHA) {
-        let r = if layered {
+        let r = if LAYERED {
             reflection_height_correlated(n, wo, wi, cos_o, cos_i, m.alpha)
         } else {
             reflection(n, wo, wi, cos_o, cos_i, m.alpha)
         };
         let (f0, f90) = (Vec3::from(m.specular), glossy_f90(m));
         let glossy = schlick_f90(f0, f90, wi.dot(r.h)) * r.value;
-        f += if layered {
+        f += if LAYERED {
             glossy * factor(albedo, f0, f90)
         } else {
             glossy
         };
         pdf += p_glossy * r.pdf;
     }
-    if layered {
+    if LAYERED && m.coat != 0 {
         let coat = coat::at(m, cos_o, albedo);
         if coat.weight > 0.0 {
             // Under glTF's clear coat (`coat`): the material's 1 - c, and the coat's rough
@@ -125,11 +124,10 @@ pub fn eval(
 /// again by (u_lobe - c) / (1 - c); then `u_lobe` below the glossy lobe's probability chooses
 /// it; (u1, u2) draw the direction in the chosen lobe.
 #[inline]
-pub fn sample(
+pub fn sample<const LAYERED: bool>(
     m: &Material,
     n: Vec3,
     wo: Vec3,
-    layered: bool,
     albedo: GlossyAlbedo,
     u: Vec3,
 ) -> BsdfSample {
@@ -138,7 +136,7 @@ pub fn sample(
     if !(cos_o > 0.0) {
         return BsdfSample::NONE;
     }
-    let coat = if layered {
+    let coat = if LAYERED && m.coat != 0 {
         coat::at(m, cos_o, albedo)
     } else {
         Coat::NONE
@@ -150,7 +148,7 @@ pub fn sample(
                 return BsdfSample::mirror(n, reflect(wo, n), Vec3::ONE);
             }
             let wi = reflect(wo, sample_visible_normal(n, wo, coat.alpha, u1, u2));
-            return weighed(m, n, wo, wi, layered, albedo);
+            return weighed::<LAYERED>(m, n, wo, wi, albedo);
         }
         // c < 1 here (u_lobe < 1).
         u_lobe = (u_lobe - coat.weight) / (1.0 - coat.weight);
@@ -172,24 +170,24 @@ pub fn sample(
     };
     if smooth && coat.weight == 0.0 {
         // The diffuse lobe beside a delta one: (Kd/pi cos) / ((1 - p) cos/pi), exactly.
-        let weight = Vec3::from(m.albedo) * (diffuse_share(m, layered, wo, wi) / (1.0 - p_glossy));
+        let weight =
+            Vec3::from(m.albedo) * (diffuse_share::<LAYERED>(m, wo, wi) / (1.0 - p_glossy));
         return BsdfSample::reflected(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
     }
-    weighed(m, n, wo, wi, layered, albedo)
+    weighed::<LAYERED>(m, n, wo, wi, albedo)
 }
 
 /// The sample of direction `wi` weighed f cos / pdf by [`eval`] (the whole mixture's value and
 /// density, the delta lobes in neither), or none where the density is 0.
 #[inline]
-fn weighed(
+fn weighed<const LAYERED: bool>(
     m: &Material,
     n: Vec3,
     wo: Vec3,
     wi: Vec3,
-    layered: bool,
     albedo: GlossyAlbedo,
 ) -> BsdfSample {
-    let (f, pdf) = eval(m, n, wo, wi, layered, albedo);
+    let (f, pdf) = eval::<LAYERED>(m, n, wo, wi, albedo);
     if !(pdf > 0.0) {
         return BsdfSample::NONE;
     }

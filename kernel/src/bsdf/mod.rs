@@ -191,7 +191,7 @@ pub fn eval<F: FeatureSet>(
     match m.kind {
         material_kind::DIFFUSE => lambert::eval(m, n, wi),
         material_kind::GLOSSY if features.has_all(mixture::FEATURES) => {
-            mixture::eval(m, n, wo, wi, false, GlossyAlbedo::NONE)
+            mixture::eval::<false>(m, n, wo, wi, GlossyAlbedo::NONE)
         }
         material_kind::METALLIC_ROUGHNESS if features.has_all(metallic_roughness::FEATURES) => {
             metallic_roughness::eval(m, n, wo, wi, albedo)
@@ -226,14 +226,9 @@ pub fn sample<F: FeatureSet>(
 ) -> BsdfSample {
     match m.kind {
         material_kind::DIFFUSE => lambert::sample(m, n, u1, u2),
-        material_kind::GLOSSY if features.has_all(mixture::FEATURES) => mixture::sample(
-            m,
-            n,
-            wo,
-            false,
-            GlossyAlbedo::NONE,
-            Vec3::new(u_lobe, u1, u2),
-        ),
+        material_kind::GLOSSY if features.has_all(mixture::FEATURES) => {
+            mixture::sample::<false>(m, n, wo, GlossyAlbedo::NONE, Vec3::new(u_lobe, u1, u2))
+        }
         material_kind::METALLIC_ROUGHNESS if features.has_all(metallic_roughness::FEATURES) => {
             metallic_roughness::sample(m, n, wo, albedo, Vec3::new(u_lobe, u1, u2))
         }
