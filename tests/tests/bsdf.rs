@@ -532,11 +532,11 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
             let p = fs.element_sum() / (fs.element_sum() + kd.element_sum());
             let km = m.kernel_at_hit();
             let mut g = SplitMix(0x9105 + degrees as u64);
-            let mut mirrored = 0;
-            for _ in 0..TRIALS {
-                let s = sample(
+            // A sample of a smooth lobe from wo (no multiple scattering to give back).
+            let draw = |km: &kernel::scene::Material, g: &mut SplitMix| {
+                sample(
                     Dynamic(0),
-                    &km,
+                    km,
                     n,
                     wo,
                     1.0,
@@ -544,7 +544,11 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
                     g.unit(),
                     g.unit(),
                     g.unit(),
-                );
+                )
+            };
+            let mut mirrored = 0;
+            for _ in 0..TRIALS {
+                let s = draw(&km, &mut g);
                 if s.pdf == DELTA_PDF {
                     assert!((s.wi - mirror).length() < 1e-6);
                     for c in 0..3 {
@@ -573,17 +577,7 @@ fn smooth_lobes_choose_by_fresnel_and_weigh_exactly() {
             let p = fs.element_sum() / (fs.element_sum() + kd.element_sum());
             let mut mirrored = 0;
             for _ in 0..TRIALS {
-                let s = sample(
-                    Dynamic(0),
-                    &km,
-                    n,
-                    wo,
-                    1.0,
-                    NONE,
-                    g.unit(),
-                    g.unit(),
-                    g.unit(),
-                );
+                let s = draw(&km, &mut g);
                 if s.pdf == DELTA_PDF {
                     assert!((s.wi - mirror).length() < 1e-6);
                     for c in 0..3 {
