@@ -282,6 +282,13 @@ impl Material {
         (self.coat >> 16) as f32 * (1.0 / 65535.0)
     }
 
+    /// The clear coat's GGX alpha, its roughness squared (below `bsdf::DELTA_ALPHA`: a mirror).
+    #[inline]
+    pub fn coat_alpha(&self) -> f32 {
+        let r = self.coat_roughness();
+        r * r
+    }
+
     /// Whether a CONDUCTOR reflects by the exact Fresnel of its complex index `eta` + i `k`
     /// (its `eta` positive) rather than its constant `specular` (`eta` zero).
     #[inline]

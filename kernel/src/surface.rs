@@ -226,8 +226,8 @@ pub fn emission_at<F: FeatureSet>(
 /// normal `n` lose to multiple scattering seen from `wo` (`bsdf::multiple_scattering`): for
 /// glTF's metallic-roughness material, the GGX albedos at its roughness and at its clear coat's
 /// from the texture table `textures` (`texture::ggx_albedo`), each where the lobe is rough (a
-/// mirror loses nothing); for every other kind, `GlossyAlbedo::NONE`. `bsdf::eval` and `bsdf::sample` take
-/// it; a vertex looks it up once.
+/// mirror loses nothing); for every other kind, `GlossyAlbedo::NONE`. `bsdf::eval` and
+/// `bsdf::sample` take it; a vertex looks it up once.
 #[inline]
 pub fn glossy_albedo<F: FeatureSet>(
     features: F,
@@ -246,7 +246,7 @@ pub fn glossy_albedo<F: FeatureSet>(
         albedo.directional = e.x;
         albedo.average = e.y;
     }
-    if m.coat != 0 && !(m.coat_roughness() * m.coat_roughness() < bsdf::DELTA_ALPHA) {
+    if m.coat != 0 && !(m.coat_alpha() < bsdf::DELTA_ALPHA) {
         let e = texture::ggx_albedo(textures, m.coat_roughness(), mu);
         albedo.coat_directional = e.x;
         albedo.coat_average = e.y;

@@ -200,17 +200,20 @@ fn measure(
     }
 }
 
-fn agrees_with_cycles(name: &'static str) {
+/// Fixture `name` compared with Cycles on both backends (`heavy_tailed` as for [`compare`]),
+/// the GPU's validation layers clean; the fixture, for what else its test checks.
+fn agrees_with_cycles(name: &'static str, heavy_tailed: bool) -> Fixture {
     let f = fixture(name);
     for backend in [Backend::Cpu, Backend::Gpu] {
-        compare(&f, backend, name, None, 0.0, false, SPP);
+        compare(&f, backend, name, None, 0.0, heavy_tailed, SPP);
     }
     assert_validation_clean();
+    f
 }
 
 #[test]
 fn a_blender_point_light_in_watts_renders_as_cycles_renders_it() {
-    agrees_with_cycles("point");
+    agrees_with_cycles("point", false);
 }
 
 /// The sun lights the floor uniformly, so a pixel the floor fills has no noise in either
@@ -262,15 +265,14 @@ fn a_blender_sun_renders_as_cycles_renders_it() {
 
 #[test]
 fn a_blender_emissive_principled_bsdf_renders_as_cycles_renders_it() {
-    agrees_with_cycles("emission");
+    agrees_with_cycles("emission", false);
 }
 
 #[test]
 fn a_blender_texture_through_a_mapping_node_renders_as_cycles_renders_it() {
-    agrees_with_cycles("mapping");
+    let f = agrees_with_cycles("mapping", false);
     // The map is read under `features::TEXTURE_TRANSFORMS`: the specialized path and the
     // generic one (which reads every record's flags) give the same bits.
-    let f = fixture("mapping");
     assert!(f.scene.features() & kernel::features::TEXTURE_TRANSFORMS != 0);
     let mut generic = f.scene.clone();
     generic.settings.specialize = false;
@@ -283,23 +285,19 @@ fn a_blender_texture_through_a_mapping_node_renders_as_cycles_renders_it() {
 
 #[test]
 fn a_blender_color_attribute_renders_as_cycles_renders_it() {
-    agrees_with_cycles("colour");
+    agrees_with_cycles("colour", false);
 }
 
 #[test]
 fn a_blender_surface_that_emits_and_reflects_renders_as_cycles_renders_it() {
-    agrees_with_cycles("glowing_wall");
+    agrees_with_cycles("glowing_wall", false);
 }
 
 #[test]
 fn a_blender_alpha_clipped_texture_renders_as_cycles_renders_it() {
     // The floor's green light comes by the leaf's underside from the patches lit through the
     // holes: three bounces, rare, heavy-tailed.
-    let f = fixture("cutout");
-    for backend in [Backend::Cpu, Backend::Gpu] {
-        compare(&f, backend, "cutout", None, 0.0, true, SPP);
-    }
-    assert_validation_clean();
+    let f = agrees_with_cycles("cutout", true);
     let m = &f.scene.scene.materials;
     assert!(m.iter().any(|m| m.opacity == 0.5), "the file's MASK: {m:?}");
     assert_opaque_rejected(&f, "cutout");
@@ -307,11 +305,7 @@ fn a_blender_alpha_clipped_texture_renders_as_cycles_renders_it() {
 
 #[test]
 fn a_blender_alpha_blended_surface_renders_as_cycles_renders_it() {
-    let f = fixture("blend");
-    for backend in [Backend::Cpu, Backend::Gpu] {
-        compare(&f, backend, "blend", None, 0.0, true, SPP);
-    }
-    assert_validation_clean();
+    let f = agrees_with_cycles("blend", true);
     let m = &f.scene.scene.materials;
     assert!(
         m.iter().any(|m| (m.opacity + 0.4).abs() < 1e-6),
@@ -324,11 +318,7 @@ fn a_blender_alpha_blended_surface_renders_as_cycles_renders_it() {
 fn a_blender_rough_metal_renders_as_cycles_renders_it() {
     // The floor's light reflected by the spheres from the point light (a glossy caustic) is
     // heavy-tailed.
-    let f = fixture("rough_metal");
-    for backend in [Backend::Cpu, Backend::Gpu] {
-        compare(&f, backend, "rough_metal", None, 0.0, true, SPP);
-    }
-    assert_validation_clean();
+    let f = agrees_with_cycles("rough_metal", true);
     // Without the table the kernel gives nothing back (`GlossyAlbedo::NONE`): single scattering.
     let mut single = f.scene.clone();
     single.scene.textures.words[kernel::texture::GGX_ALBEDO] = kernel::scene::NONE;

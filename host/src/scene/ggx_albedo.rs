@@ -13,13 +13,13 @@
 //!
 //! The quadrature: E(mu) = \int VNDF_wo(h) G2(wo, wi) / G1(wo) dh over the half vectors h with
 //! wi = the mirror image of wo about h above the surface (Heitz 2014: f cos / pdf of
-//! visible-normal sampling is G2 / G1(wo)). Writing VNDF_wo(h) dh = G1(wo) (wo . h) / (mu cos_h)
-//! D(h) cos_h dh and drawing h from D(h) cos_h dh by tan^2 theta_h = alpha^2 u / (1 - u)
-//! (Walter et al. 2007, eq. 35), E is the mean over (u, phi) in [0, 1) x [0, 2 pi) of
-//! G2(wo, wi) (wo . h) / (mu cos_h), zero where wo . h <= 0 or wi is below the surface, with
-//! G2 = 2 mu c_i / (a_o c_i + a_i mu), a = sqrt(alpha^2 + (1 - alpha^2) c^2); phi is folded onto [0, pi)
-//! by the symmetry about wo's plane, and the boundary in u is found exactly for each phi, so
-//! each rule integrates a smooth function ([`directional_albedo`]).
+//! visible-normal sampling is G2 / G1(wo)). With VNDF_wo(h) dh = G1(wo) (wo . h) / (mu cos_h)
+//! D(h) cos_h dh, and D(h) cos_h dh = du dphi / (2 pi) for tan^2 theta_h = alpha^2 u / (1 - u)
+//! (Walter et al. 2007, eq. 35), E is the mean over (u, phi) of G2(wo, wi) (wo . h) /
+//! (mu cos_h), zero where wi is below the surface, with G2 = 2 mu c_i / (a_o c_i + a_i mu),
+//! a = sqrt(alpha^2 + (1 - alpha^2) c^2). phi is folded onto [0, pi) by the symmetry about wo's
+//! plane, u is integrated through s = ln tan^2 theta_h up to the horizon, found exactly for each
+//! phi, so each Gauss-Legendre rule integrates a smooth function ([`directional_albedo`]).
 
 use super::error::SceneError;
 pub use super::ggx_albedo_table::{AVERAGE, COAT, DIRECTIONAL};
@@ -30,7 +30,8 @@ use std::path::Path;
 pub const ROUGHNESSES: usize = 32;
 /// Nodes along the cosine of `wo` (the table's height).
 pub const COSINES: usize = 32;
-/// Midpoints per axis of [`directional_albedo`] in the committed table.
+/// Gauss-Legendre nodes along s (and, in halves, along phi) of [`directional_albedo`] in the
+/// committed table.
 pub const TABLE_POINTS: usize = 128;
 /// Gauss-Legendre cosines of [`average_albedo`] in the committed table.
 pub const AVERAGE_COSINES: usize = 64;

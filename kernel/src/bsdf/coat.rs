@@ -45,8 +45,8 @@ use spirv_std::glam::Vec3;
 /// read).
 pub const COAT_IOR: f32 = 1.5;
 
-/// A clear coat at a point seen from `wo`: its weight c = factor x fr(n . wo) (the probability
-/// with which the mixture samples it) and its GGX alpha.
+/// A clear coat at a point seen from `wo`: its weight c, what it reflects of light from
+/// everywhere (the probability with which the mixture samples it, [`at`]), and its GGX alpha.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Coat {
     pub weight: f32,
@@ -68,8 +68,7 @@ impl Coat {
 #[inline]
 pub fn at(m: &Material, cos_o: f32, albedo: GlossyAlbedo) -> Coat {
     let factor = m.coat_weight();
-    let r = m.coat_roughness();
-    let alpha = r * r;
+    let alpha = m.coat_alpha();
     let weight = if alpha < DELTA_ALPHA {
         factor * dielectric(cos_o, COAT_IOR).0
     } else {

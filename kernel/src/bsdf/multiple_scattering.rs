@@ -23,11 +23,12 @@
 //! compensated lobe is not reciprocal (f(wo, wi) / factor(wo) is).
 //!
 //! E and E_avg come from a table (`GlossyAlbedo`), computed by quadrature on the host over
-//! this kernel's own lobe (`microfacet`: GGX, separable Smith masking) at 32 roughnesses by 32
-//! cosines (crowded toward grazing: node j at mu = (j / 31)^2) and stored as a float texture of the texture table (its record at word
+//! this kernel's own lobe (`microfacet::reflection_height_correlated`: GGX, height-correlated
+//! Smith G2) at 32 roughnesses by 32 cosines (crowded toward grazing: node j at
+//! mu = (j / 31)^2) and stored as a float texture of the texture table (its record at word
 //! `texture::GGX_ALBEDO`); `texture::ggx_albedo` interpolates it and `surface::glossy_albedo`
-//! looks it up once per vertex. For Schlick's F with F0 and F90,
-//! F_avg = F0 + (F90 - F0) / 21 (the integral of 2 mu (1 - mu)^5 over [0, 1] is 1/21).
+//! looks it up once per vertex. For Schlick's F with F0 and F90, F_avg = F0 + (F90 - F0) / 21
+//! (the integral of 2 mu (1 - mu)^5 over [0, 1] is 1/21).
 //! Derivations and bounds: `docs/materials.md` ("Multiple scattering").
 
 use spirv_std::glam::Vec3;
