@@ -294,6 +294,33 @@ def scene_coat():
     return scene
 
 
+def scene_sheen():
+    """Two smooth-shaded spheres under a Sheen of weight 1 over a Lambertian base (Specular IOR
+    Level 0): on the left a white sheen of roughness 0.5 over dark blue (0.05, 0.1, 0.4), on
+    the right an orange sheen (1, 0.6, 0.3) of roughness 1 over grey 0.5; a grey floor, a 300 W
+    point light behind them on the left, so that the sheen's grazing light shows."""
+    scene = reset()
+    floor()
+    for x, base, tint, roughness in (
+        (-0.75, (0.05, 0.1, 0.4), (1.0, 1.0, 1.0), 0.5),
+        (0.75, (0.5, 0.5, 0.5), (1.0, 0.6, 0.3), 1.0),
+    ):
+        bpy.ops.mesh.primitive_uv_sphere_add(
+            radius=0.6, location=(x, 0.0, 0.6), segments=48, ring_count=24
+        )
+        ball = bpy.context.object
+        bpy.ops.object.shade_smooth()
+        velvet = principled(f"sheen_{roughness}", base=base, roughness=0.5)
+        inputs = velvet.node_tree.nodes["Principled BSDF"].inputs
+        inputs["Sheen Weight"].default_value = 1.0
+        inputs["Sheen Roughness"].default_value = roughness
+        inputs["Sheen Tint"].default_value = (*tint, 1.0)
+        ball.data.materials.append(velvet)
+    light(scene, "POINT", 300.0, (-1.5, 2.0, 2.5), shadow_soft_size=0.0)
+    camera(scene, location=(0.0, -4.0, 2.2), target=(0.0, 0.0, 0.5))
+    return scene
+
+
 def alpha_checker_image(path):
     """A 4 x 4 image of one colour, green (bytes 0 and 255: sRGB-decoded exactly to 0 and 1, so
     the same texels in both renderers, read as linear as in the mapping scene), whose alpha
@@ -374,6 +401,7 @@ SCENES = {
     "blend": scene_blend,
     "rough_metal": scene_rough_metal,
     "coat": scene_coat,
+    "sheen": scene_sheen,
 }
 
 

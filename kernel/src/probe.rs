@@ -149,6 +149,12 @@ pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material
             // material.
             m.coat = Material::pack_coat(0.8, alpha.sqrt());
         }
+        // Gold's index is a conductor's: no sheen, unless `complex` asks for one
+        // (KHR_materials_sheen), orange, its roughness drawn from the material's.
+        m.set_sheen([0.0; 3], 0.0);
+        if complex & 4 != 0 {
+            m.set_sheen([0.9, 0.6, 0.3], 0.2 + 0.8 * alpha.sqrt());
+        }
         m = crate::bsdf::metallic_roughness::resolve(&m);
     }
     m
@@ -300,6 +306,8 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
             coat_directional: i3.z,
             coat_average: i3.w,
             coat_reflectance: 0.05 + 0.5 * (1.0 - i3.w),
+            // A sheen lobe (A, B, R) in the table's range, drawn from the same numbers.
+            sheen: Vec3::new(0.2 + 0.7 * i3.w, -0.15 * i3.z, 0.05 + 0.6 * (1.0 - i3.z)),
         };
         if function == function::BSDF_EVAL {
             let (f, pdf) = bsdf::eval(Dynamic(0), &m, n, wo, i2.truncate(), i1.w, albedo);

@@ -192,14 +192,17 @@ pub struct Material {
     pub ior: f32,
     /// CONDUCTOR: the real part eta of the complex index of refraction, positive in every
     /// channel for the exact Fresnel of `eta` + i `k` (a metal's is); zero for the constant
-    /// `specular` (`Material::is_complex_conductor`).
+    /// `specular` (`Material::is_complex_conductor`). METALLIC_ROUGHNESS: the sheen's colour
+    /// (`KHR_materials_sheen`'s sheenColorFactor, `crate::bsdf::sheen`; zero: no sheen),
+    /// [`Material::sheen_colour`].
     pub eta: [f32; 3],
     /// Where a triangle of this material is present (glTF's `alphaMode`, `crate::opacity`),
     /// as one number: 0, everywhere (OPAQUE); t > 0, MASK: where the `KD` texture's alpha (1
     /// without one) is at least t = alphaCutoff / baseColorFactor's alpha (above 1: nowhere);
     /// t < 0, BLEND: with probability -t x that alpha, -t in (0, 1] being the factor's alpha.
     pub opacity: f32,
-    /// CONDUCTOR with a complex index: the extinction coefficient k.
+    /// CONDUCTOR with a complex index: the extinction coefficient k. METALLIC_ROUGHNESS: k[0]
+    /// is the sheen's roughness in [0, 1] ([`Material::sheen_roughness`]).
     pub k: [f32; 3],
     /// METALLIC_ROUGHNESS: glTF's clear coat (`KHR_materials_clearcoat`, `crate::bsdf::coat`):
     /// its weight (`clearcoatFactor`) in the low 16 bits and its roughness
@@ -287,6 +290,35 @@ impl Material {
     pub fn coat_alpha(&self) -> f32 {
         let r = self.coat_roughness();
         r * r
+    }
+
+    /// METALLIC_ROUGHNESS: the sheen's colour (stored in `eta`; zero: no sheen).
+    #[inline]
+    pub fn sheen_colour(&self) -> [f32; 3] {
+        self.eta
+    }
+
+    /// METALLIC_ROUGHNESS: the sheen's roughness (stored in `k[0]`).
+    #[inline]
+    pub fn sheen_roughness(&self) -> f32 {
+        self.k[0]
+    }
+
+    /// Whether a METALLIC_ROUGHNESS material has a sheen: its colour is not black.
+    #[inline]
+    pub fn has_sheen(&self) -> bool {
+        self.eta[0] > 0.0 || self.eta[1] > 0.0 || self.eta[2] > 0.0
+    }
+
+    /// Sets the sheen of a METALLIC_ROUGHNESS material (colour clamped to [0, 1] per channel,
+    /// roughness to [0, 1]).
+    pub fn set_sheen(&mut self, colour: [f32; 3], roughness: f32) {
+        self.eta = [
+            colour[0].clamp(0.0, 1.0),
+            colour[1].clamp(0.0, 1.0),
+            colour[2].clamp(0.0, 1.0),
+        ];
+        self.k = [roughness.clamp(0.0, 1.0), 0.0, 0.0];
     }
 
     /// Whether a CONDUCTOR reflects by the exact Fresnel of its complex index `eta` + i `k`

@@ -226,7 +226,7 @@ pub fn emission_at<F: FeatureSet>(
 /// normal `n` lose to multiple scattering seen from `wo` (`bsdf::multiple_scattering`): for
 /// glTF's metallic-roughness material, the GGX albedos at its roughness and at its clear coat's
 /// from the texture table `textures` (`texture::ggx_albedo`), each where the lobe is rough (a
-/// mirror loses nothing); for every other kind, `GlossyAlbedo::NONE`. `bsdf::eval` and
+/// mirror loses nothing), and its sheen's lobe (`texture::sheen_ltc`) where it has one; for every other kind, `GlossyAlbedo::NONE`. `bsdf::eval` and
 /// `bsdf::sample` take it; a vertex looks it up once.
 #[inline]
 pub fn glossy_albedo<F: FeatureSet>(
@@ -251,6 +251,9 @@ pub fn glossy_albedo<F: FeatureSet>(
         albedo.coat_directional = e.x;
         albedo.coat_average = e.y;
         albedo.coat_reflectance = e.z;
+    }
+    if m.has_sheen() {
+        albedo.sheen = texture::sheen_ltc(textures, m.sheen_roughness(), mu);
     }
     albedo
 }

@@ -6,6 +6,7 @@
 //! - word 0: the number of textures T;
 //! - word [`GGX_ALBEDO`]: the record of the GGX albedo table (`bsdf::multiple_scattering`), a
 //!   float texture read by [`at_nodes`], or `NONE`;
+//! - word [`SHEEN_LTC`]: the record of the sheen table (`bsdf::sheen`), likewise, or `NONE`;
 //! - words [`SRGB_TABLE`]..+256: the sRGB-decoded value of each byte (f32 bits; the host
 //!   computes the IEC 61966-2-1 curve in f64), words [`LINEAR_TABLE`]..+256: byte / 255;
 //! - words [`RECORDS`] + 10k..+10: texture k's record: first texel word, width, height, flags
@@ -29,8 +30,10 @@ use spirv_std::glam::{Vec2, Vec3};
 
 /// Word holding the record of the GGX albedo table, or `NONE`.
 pub const GGX_ALBEDO: usize = 1;
+/// Word holding the record of the sheen table, or `NONE`.
+pub const SHEEN_LTC: usize = 2;
 /// Word of the sRGB decoding table.
-pub const SRGB_TABLE: usize = 2;
+pub const SRGB_TABLE: usize = 3;
 /// Word of the linear decoding table (byte / 255).
 pub const LINEAR_TABLE: usize = SRGB_TABLE + 256;
 /// Word of texture 0's record.
@@ -314,6 +317,19 @@ pub fn ggx_albedo(table: &[u32], roughness: f32, mu: f32) -> Vec3 {
         return Vec3::ONE;
     }
     at_nodes(table, record, roughness, mu.sqrt())
+}
+
+/// The sheen's linearly transformed cosine (A, B, R) at sheen roughness `roughness` and view
+/// cosine `mu` from the sheen table of `table` (its record at word [`SHEEN_LTC`];
+/// `bsdf::sheen`), bilinear in (roughness, mu) between its nodes (roughness i / (w - 1),
+/// cosine j / (h - 1)), clamped to them; zero (no sheen) where the table has none.
+#[inline]
+pub fn sheen_ltc(table: &[u32], roughness: f32, mu: f32) -> Vec3 {
+    let record = table[SHEEN_LTC];
+    if record == NONE {
+        return Vec3::ZERO;
+    }
+    at_nodes(table, record, roughness, mu)
 }
 
 /// The alpha channel of texture `texture` at `uv`, bilinearly filtered as [`lookup_in`]

@@ -15,12 +15,14 @@ use twinpath::scene::ggx_albedo::{
 };
 use twinpath::scene::textures::TextureTable;
 
-/// A texture table holding the GGX albedo table alone (what a scene with glTF's material has).
+/// A texture table holding the GGX albedo table and the sheen table alone (what a scene with
+/// glTF's material and a sheen has).
 pub fn texture_table() -> &'static [u32] {
     static TABLE: OnceLock<Vec<u32>> = OnceLock::new();
     TABLE.get_or_init(|| {
         let mut t = TextureTable::new();
         add_to(&mut t).expect("the table is a texture");
+        twinpath::scene::sheen_ltc::add_to(&mut t).expect("the sheen table is a texture");
         t.words
     })
 }

@@ -131,6 +131,7 @@ pub mod gltf_writer;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod reference_bsdf;
+pub mod sheen_fit;
 pub mod spirv;
 pub mod stats;
 

@@ -122,6 +122,76 @@ pub fn coat_fresnel_average() -> f64 {
     })
 }
 
+/// The sheen's lobe at a point (`kernel::bsdf::sheen`): colour x R, the weight s = max of it
+/// (at most 1), and the transform M^-1 = [[a, 0, b], [0, a, 0], [0, 0, 1]] in the frame whose x
+/// axis is wo's projection onto the surface.
+pub struct SheenLobe {
+    pub reflectance: DVec3,
+    pub weight: f64,
+    pub a: f64,
+    pub b: f64,
+}
+
+impl SheenLobe {
+    /// The transformed cosine's density at `wi` (Heitz et al. 2016: a direction w comes from
+    /// the cosine-distributed w_o = M^-1 w / |M^-1 w|, with Jacobian |det M^-1| / |M^-1 w|^3).
+    pub fn density(&self, n: DVec3, wo: DVec3, wi: DVec3) -> f64 {
+        let tangent = wo - n * n.dot(wo);
+        let x = if tangent.length() > 1e-9 {
+            tangent.normalize()
+        } else {
+            n.any_orthonormal_vector()
+        };
+        let y = n.cross(x);
+        let m_inverse = glam::DMat3::from_cols(
+            DVec3::new(self.a, 0.0, 0.0),
+            DVec3::new(0.0, self.a, 0.0),
+            DVec3::new(self.b, 0.0, 1.0),
+        );
+        let w = DVec3::new(wi.dot(x), wi.dot(y), wi.dot(n));
+        if w.z <= 0.0 {
+            return 0.0;
+        }
+        let v = m_inverse * w;
+        let length = v.length();
+        (v.z / length).max(0.0) / PI * m_inverse.determinant().abs() / length.powi(3)
+    }
+}
+
+/// The sheen of `colour` and `roughness` seen at cosine `co`, from the committed sheen table
+/// read in f64 here (bilinear in roughness and mu between the nodes, clamped); none for a black
+/// colour or a lobe of no reflectance.
+pub fn sheen_at(colour: DVec3, roughness: f64, co: f64) -> Option<SheenLobe> {
+    use twinpath::scene::sheen_ltc::{COSINES, LTC, ROUGHNESSES};
+    if colour.max_element() <= 0.0 {
+        return None;
+    }
+    let locate = |t: f64, n: usize| {
+        let x = t.clamp(0.0, 1.0) * (n - 1) as f64;
+        let i = (x.floor() as usize).min(n - 2);
+        (i, x - i as f64)
+    };
+    let (i, fx) = locate(roughness, ROUGHNESSES);
+    let (j, fy) = locate(co, COSINES);
+    let at = |j: usize, i: usize, c: usize| LTC[j][i][c] as f64;
+    let lerp = |c: usize| {
+        let top = at(j, i, c) * (1.0 - fx) + at(j, i + 1, c) * fx;
+        let bottom = at(j + 1, i, c) * (1.0 - fx) + at(j + 1, i + 1, c) * fx;
+        top * (1.0 - fy) + bottom * fy
+    };
+    let (a, b, r) = (lerp(0), lerp(1), lerp(2));
+    if !(r > 0.0 && a > 0.0) {
+        return None;
+    }
+    let reflectance = colour.as_vec3().as_dvec3() * r;
+    Some(SheenLobe {
+        reflectance,
+        weight: reflectance.max_element().min(1.0),
+        a,
+        b,
+    })
+}
+
 /// A material of the reference, with the kernel's parameters.
 #[derive(Clone, Copy, Debug)]
 pub enum RefMaterial {
@@ -147,7 +217,8 @@ pub enum RefMaterial {
     /// specular_brdf(coat_roughness^2)) with Cycles' layering: the layer weighed by coat k
     /// F(|wo . h|), F the exact reflectance of index 1.5 and k the lobe's multiple-scattering
     /// factor, the material by 1 - c, c the layer's albedo ([`coat_at`]; `kernel::bsdf::coat`
-    /// says why).
+    /// says why); under the sheen (`sheen`, `sheen_roughness`): the fibre layer's transformed
+    /// cosine over the rest weighed by 1 - s ([`sheen_at`]; `kernel::bsdf::sheen`).
     MetallicRoughness {
         base: DVec3,
         metallic: f64,
@@ -157,6 +228,10 @@ pub enum RefMaterial {
         specular_color: DVec3,
         coat: f64,
         coat_roughness: f64,
+        /// `KHR_materials_sheen`'s colour (zero: none) and roughness, over everything as
+        /// Cycles layers it ([`sheen_at`]).
+        sheen: DVec3,
+        sheen_roughness: f64,
     },
 }
 
@@ -173,7 +248,22 @@ impl RefMaterial {
             specular_color: DVec3::ONE,
             coat: 0.0,
             coat_roughness: 0.0,
+            sheen: DVec3::ZERO,
+            sheen_roughness: 0.0,
         }
+    }
+
+    /// This glTF material under a sheen of colour `colour` and roughness `roughness`.
+    pub fn sheened(mut self, colour: DVec3, roughness: f64) -> Self {
+        if let RefMaterial::MetallicRoughness {
+            sheen,
+            sheen_roughness,
+            ..
+        } = &mut self
+        {
+            (*sheen, *sheen_roughness) = (colour, roughness);
+        }
+        self
     }
 
     /// This glTF material under a clear coat of weight `weight` and roughness `roughness`.
@@ -235,8 +325,11 @@ impl RefMaterial {
                 specular_color,
                 coat,
                 coat_roughness,
+                sheen,
+                sheen_roughness,
             } => {
                 let mut m = Material::diffuse(f(base));
+                m.set_sheen(f(sheen), sheen_roughness as f32);
                 if coat > 0.0 {
                     m.coat = Material::pack_coat(coat as f32, coat_roughness as f32);
                 }
@@ -296,10 +389,16 @@ impl RefMaterial {
                 specular_color,
                 coat,
                 coat_roughness,
+                sheen,
+                sheen_roughness,
             } => {
                 if ci < 0.0 {
                     return DVec3::ZERO;
                 }
+                let (sheen_value, s) = match sheen_at(sheen, sheen_roughness, co) {
+                    Some(l) => (l.reflectance * l.density(n, wo, wi) / ci, l.weight),
+                    None => (DVec3::ZERO, 0.0),
+                };
                 let alpha = roughness * roughness;
                 let h = (wo + wi).normalize();
                 let voh = wo.dot(h).abs();
@@ -333,7 +432,7 @@ impl RefMaterial {
                     + specular_part * factor;
                 let (c, alpha_c, k) = coat_at(coat, coat_roughness, co);
                 if c == 0.0 {
-                    return material;
+                    return sheen_value + material * (1.0 - s);
                 }
                 // The coat's layer: Appendix B's specular_brdf times the coat's factor and the
                 // exact Fresnel reflectance at the microfacet (a smooth coat is a delta lobe, in
@@ -345,7 +444,7 @@ impl RefMaterial {
                     let coat_at_h = (coat * 65535.0).round() / 65535.0 * k * fresnel(voh, 1.5, 0.0);
                     coat_at_h * ggx_d(n.dot(h), alpha_c) * g2(co, ci, alpha_c) / (4.0 * co * ci)
                 };
-                material * (1.0 - c) + DVec3::splat(layer)
+                sheen_value + (material * (1.0 - c) + DVec3::splat(layer)) * (1.0 - s)
             }
             RefMaterial::Glossy { kd, ks, alpha } => {
                 if ci < 0.0 {
@@ -441,6 +540,8 @@ impl RefMaterial {
                 specular_color,
                 coat,
                 coat_roughness,
+                sheen,
+                sheen_roughness,
             } => {
                 if ci <= 0.0 {
                     return 0.0;
@@ -463,7 +564,12 @@ impl RefMaterial {
                 } else {
                     0.0
                 };
-                (1.0 - c) * material + c * coat_pdf
+                let rest = (1.0 - c) * material + c * coat_pdf;
+                // Over everything, the sheen chosen with probability s.
+                match sheen_at(sheen, sheen_roughness, co) {
+                    Some(l) => (1.0 - l.weight) * rest + l.weight * l.density(n, wo, wi),
+                    None => rest,
+                }
             }
             RefMaterial::Glossy { kd, ks, alpha } => {
                 if ci <= 0.0 {

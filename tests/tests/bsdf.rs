@@ -64,7 +64,19 @@ fn specular_layered(metallic: f64, roughness: f64, specular: f64) -> RefMaterial
         specular_color: DVec3::new(1.0, 0.5, 12.0),
         coat: 0.0,
         coat_roughness: 0.0,
+        sheen: DVec3::ZERO,
+        sheen_roughness: 0.0,
     }
+}
+
+/// [`coated`] under a sheen (`KHR_materials_sheen`) of colour `colour` and roughness
+/// `sheen_roughness`.
+fn sheened(
+    (metallic, roughness, coat, coat_roughness): (f64, f64, f64, f64),
+    colour: DVec3,
+    sheen_roughness: f64,
+) -> RefMaterial {
+    coated(metallic, roughness, coat, coat_roughness).sheened(colour, sheen_roughness)
 }
 
 /// The rough materials the sampler tests cover.
@@ -98,6 +110,16 @@ fn rough_materials() -> Vec<(String, RefMaterial)> {
                  {coat_roughness}"
             ),
             coated(metallic, roughness, coat, coat_roughness),
+        ));
+    }
+    for (layers, colour, sheen_roughness) in [
+        ((0.0, 0.5, 0.0, 0.0), DVec3::ONE, 0.5),
+        ((0.0, 0.8, 0.0, 0.0), DVec3::new(0.9, 0.6, 0.3), 0.2),
+        ((0.3, 0.3, 0.5, 0.4), DVec3::new(0.8, 0.5, 0.2), 0.9),
+    ] {
+        v.push((
+            format!("glTF {layers:?} under sheen {colour} roughness {sheen_roughness}"),
+            sheened(layers, colour, sheen_roughness),
         ));
     }
     for eta in [1.5, 1.0 / 1.5] {
@@ -247,14 +269,20 @@ fn random_material(g: &mut SplitMix) -> RefMaterial {
     match g.u64() % 6 {
         0 => glossy(alpha),
         4 => {
-            // Half of them under a rough clear coat.
+            // Half of them under a rough clear coat, half under a sheen.
             let coat = if g.unit() < 0.5 { g.unit() as f64 } else { 0.0 };
-            coated(
+            let layers = (
                 g.unit() as f64,
                 alpha.sqrt(),
                 coat,
                 0.05 + 0.95 * g.unit() as f64,
-            )
+            );
+            let colour = if g.unit() < 0.5 {
+                DVec3::new(g.unit() as f64, g.unit() as f64, g.unit() as f64)
+            } else {
+                DVec3::ZERO
+            };
+            sheened(layers, colour, 0.1 + 0.9 * g.unit() as f64)
         }
         5 => specular_layered(g.unit() as f64, alpha.sqrt(), g.unit() as f64),
         1 => conductor(alpha),
@@ -360,9 +388,11 @@ fn evaluation_is_reciprocal() {
             continue;
         }
         // glTF's material without what depends on wo alone (the clear coat's weight, the
-        // multiple-scattering factor): those make it non-reciprocal, as the extensions define.
+        // multiple-scattering factor, the sheen): those make it non-reciprocal, as the
+        // extensions (and Cycles) define.
         let mut km = m.kernel_at_hit();
         km.coat = 0;
+        km.set_sheen([0.0; 3], 0.0);
         let eta = m.eta() as f32;
         let forward = eval(Dynamic(0), &km, n, wo, wi, eta, NONE).0 / wi.dot(n).abs();
         let through = wi.dot(n) < 0.0;

@@ -32,6 +32,9 @@
 //!   `KHR_materials_clearcoat`. Means within 2%; the per-pixel test is measured, not asserted
 //!   (Cycles' layering under a rough coat differs, docs/gltf.md). The same render without the
 //!   coats is rejected.
+//! - `sheen`: two spheres under a Principled Sheen of weight 1 (white, roughness 0.5, over dark
+//!   blue; orange, roughness 1, over grey): `KHR_materials_sheen`, Cycles' fibre-layer sheen
+//!   (`bsdf::sheen`). The same render without the sheens is rejected.
 //! - `rough_metal`: two spheres of Principled metal, roughness 0.5 (gold) and 0.9 (light grey),
 //!   on a lit floor: Cycles' multiscatter GGX, which twinpath's compensation
 //!   (`bsdf::multiple_scattering`) matches. The same render with single scattering alone (the
@@ -355,6 +358,30 @@ fn a_blender_clear_coat_renders_as_cycles_renders_it() {
         m.coat = 0;
     }
     assert_rejected(&f, &bare, "coat, coats removed");
+}
+
+#[test]
+fn a_blender_sheen_renders_as_cycles_renders_it() {
+    // The floor lit through the spheres' sheen: heavy-tailed as `coat`.
+    let f = agrees_with_cycles("sheen", true);
+    let sheens = f
+        .scene
+        .scene
+        .materials
+        .iter()
+        .filter(|m| m.has_sheen())
+        .count();
+    assert_eq!(sheens, 2, "the file's KHR_materials_sheen");
+    let mut bare = f.scene.clone();
+    for m in &mut bare.scene.materials {
+        m.set_sheen([0.0; 3], 0.0);
+    }
+    assert_rejected(&f, &bare, "sheen, sheens removed");
+    per_sphere(
+        &f,
+        &bare,
+        [(-0.75, "white sheen 0.5"), (0.75, "orange sheen 1")],
+    );
 }
 
 /// Compares the pixels each of fixture `f`'s two spheres fills (Blender's (x, 0, 0.6), radius

@@ -442,12 +442,12 @@ fn appendix_b_rules_each_hold() {
         (1.33, 0.25)
     );
     // An extension that is not read is noted once; one that is required is an error.
-    let s = one("ignored.glb", json!({}), &["KHR_materials_sheen"]);
+    let s = one("ignored.glb", json!({}), &["KHR_materials_iridescence"]);
     assert!(
         s.scene
             .notes
             .iter()
-            .any(|n| n.contains("extensions ignored: KHR_materials_sheen")),
+            .any(|n| n.contains("extensions ignored: KHR_materials_iridescence")),
         "{:?}",
         s.scene.notes
     );
@@ -539,6 +539,89 @@ fn clear_coats_are_read_from_the_extension() {
         e.contains("materials.c.clearcoat") && e.contains("outside 0..=1"),
         "{e}"
     );
+}
+
+#[test]
+fn sheens_are_read_from_the_extension() {
+    let dir = temp_dir("sheen");
+    let sheen = |extension: serde_json::Value| {
+        let path = material_file(
+            &dir,
+            "sheen.glb",
+            json!({ "extensions": { "KHR_materials_sheen": extension } }),
+            &["KHR_materials_sheen"],
+        );
+        SceneFile::load(&path)
+    };
+    // Colour and roughness as written; no note of an ignored extension.
+    let s =
+        sheen(json!({ "sheenColorFactor": [1.0, 0.6, 0.3], "sheenRoughnessFactor": 0.4 })).unwrap();
+    let m = s.scene.materials[0];
+    assert_eq!(m.kind, material_kind::METALLIC_ROUGHNESS);
+    assert_eq!(
+        (m.sheen_colour(), m.sheen_roughness()),
+        ([1.0, 0.6, 0.3], 0.4)
+    );
+    assert!(
+        s.scene.notes.iter().all(|n| !n.contains("ignored")),
+        "{:?}",
+        s.scene.notes
+    );
+    // The scene carries the sheen table (and a scene without a sheen does not).
+    let table = kernel::texture::SHEEN_LTC;
+    assert_ne!(s.scene.textures.words[table], kernel::scene::NONE);
+    let bare = sheen(json!({ "sheenRoughnessFactor": 0.5 })).unwrap();
+    assert!(
+        !bare.scene.materials[0].has_sheen(),
+        "default colour black: none"
+    );
+    assert_eq!(bare.scene.textures.words[table], kernel::scene::NONE);
+    // Textures are noted, the factors used.
+    let s =
+        sheen(json!({ "sheenColorFactor": [1.0, 1.0, 1.0], "sheenColorTexture": { "index": 0 } }))
+            .unwrap();
+    assert!(s.scene.materials[0].has_sheen());
+    assert!(
+        s.scene
+            .notes
+            .iter()
+            .any(|n| n.contains("KHR_materials_sheen textures ignored")),
+        "{:?}",
+        s.scene.notes
+    );
+    // Out of range or malformed: an error naming the material and the field.
+    for (bad, field) in [
+        (
+            json!({ "sheenColorFactor": [1.5, 0.0, 0.0] }),
+            "sheenColorFactor",
+        ),
+        (
+            json!({ "sheenColorFactor": [1.0, 0.0] }),
+            "sheenColorFactor",
+        ),
+        (
+            json!({ "sheenColorFactor": [1.0, 1.0, 1.0], "sheenRoughnessFactor": -0.1 }),
+            "sheenRoughnessFactor",
+        ),
+    ] {
+        let e = sheen(bad).unwrap_err().to_string();
+        assert!(e.contains("materials[0]") && e.contains(field), "{e}");
+    }
+    // TOML: the same material's keys; a colour above 1 names the field.
+    let toml = |entry: &str| {
+        twinpath::scene::parse_scene(
+            &format!(
+                "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 8\nheight = 8\n[materials]\nc = {{ {entry} }}\n\
+             [[sphere]]\ncenter = [0, 0, 0]\nradius = 1.0\nmaterial = \"c\"\n"
+            ),
+            Path::new("sheen.toml"),
+        )
+    };
+    let s = toml("base_color = [0.1, 0.1, 0.4], sheen = [1, 1, 1], sheen_roughness = 0.5").unwrap();
+    let m = s.scene.materials[0];
+    assert_eq!((m.sheen_colour(), m.sheen_roughness()), ([1.0; 3], 0.5));
+    let e = toml("sheen = [2, 0, 0]").unwrap_err().to_string();
+    assert!(e.contains("materials.c.sheen"), "{e}");
 }
 
 #[test]

@@ -237,7 +237,8 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                 };
                 let mut x = rec([w(n, alpha), w(wo, eta), third, [0.0; 4]]);
                 x[3][0] = (g.u64() % 5) as u32;
-                x[3][1] = (g.u64() % 4) as u32;
+                // Bits of `probe_material`'s `complex`: gold's index, a clear coat, a sheen.
+                x[3][1] = (g.u64() % 8) as u32;
                 // The GGX albedo (E, E_avg) the compensation reads: none, or a table's range.
                 let drawn = (g.range(0.3, 1.0), g.range(0.37, 1.0));
                 let (e, e_avg) = g.pick(&[(1.0, 1.0), (0.3, 0.37), drawn]);

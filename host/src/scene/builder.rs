@@ -7,6 +7,7 @@ use super::ggx_albedo;
 use super::instancing::{instance_box, instance_record, instances_box, mesh_box, MAX_INSTANCES};
 use super::light_table::{place_directional_lights, triangle_light};
 use super::limits::MAX_COORDINATE;
+use super::sheen_ltc;
 use super::soup::TriangleSoup;
 use super::tangents::{face_tangent, mikktspace_tangents};
 use super::textures::TextureTable;
@@ -417,6 +418,13 @@ impl SceneTables {
             .any(|m| m.kind == material_kind::METALLIC_ROUGHNESS)
         {
             ggx_albedo::add_to(&mut self.textures).expect("the GGX albedo table is a texture");
+        }
+        if self
+            .materials
+            .iter()
+            .any(|m| m.kind == material_kind::METALLIC_ROUGHNESS && m.has_sheen())
+        {
+            sheen_ltc::add_to(&mut self.textures).expect("the sheen table is a texture");
         }
         Scene {
             name,

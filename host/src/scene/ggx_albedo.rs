@@ -23,8 +23,7 @@
 
 use super::error::SceneError;
 pub use super::ggx_albedo_table::{AVERAGE, COAT, DIRECTIONAL};
-use super::textures::{TextureTable, TextureUse};
-use std::path::Path;
+use super::textures::TextureTable;
 
 /// Nodes along roughness (the table's width).
 pub const ROUGHNESSES: usize = 32;
@@ -186,24 +185,10 @@ pub fn cosine_of(j: usize) -> f64 {
 /// E_avg(r_i), the coat's albedo at (mu_j, r_i)) and names its record in the table's header
 /// (`kernel::texture::GGX_ALBEDO`).
 pub fn add_to(textures: &mut TextureTable) -> Result<u32, SceneError> {
-    let mut image = image::Rgb32FImage::new(ROUGHNESSES as u32, COSINES as u32);
-    for (j, row) in DIRECTIONAL.iter().enumerate() {
-        for (i, &e) in row.iter().enumerate() {
-            image.put_pixel(i as u32, j as u32, image::Rgb([e, AVERAGE[i], COAT[j][i]]));
-        }
-    }
-    let usage = TextureUse {
-        colour: false,
-        wrap: [kernel::texture::wrap::CLAMP; 2],
-        transform: None,
-        second_set: false,
-    };
-    let index = textures.add_image(
-        Path::new(NAME),
-        image::DynamicImage::ImageRgb32F(image),
-        usage,
-        "GGX albedo",
-    )?;
-    textures.words[kernel::texture::GGX_ALBEDO] = index;
-    Ok(index)
+    textures.add_table(
+        NAME,
+        (ROUGHNESSES, COSINES),
+        |i, j| [DIRECTIONAL[j][i], AVERAGE[i], COAT[j][i]],
+        kernel::texture::GGX_ALBEDO,
+    )
 }

@@ -18,6 +18,8 @@ pub mod light_table;
 pub mod limits;
 mod load;
 pub mod mesh;
+pub mod sheen_ltc;
+mod sheen_ltc_table;
 pub mod soup;
 mod tangents;
 pub mod textures;

@@ -4,11 +4,14 @@
 //! the table's sRGB or linear byte tables), float images three.
 
 use super::error::SceneError;
-use kernel::texture::{flags, GGX_ALBEDO, LINEAR_TABLE, RECORDS, RECORD_WORDS, SRGB_TABLE};
+use kernel::texture::{
+    flags, GGX_ALBEDO, LINEAR_TABLE, RECORDS, RECORD_WORDS, SHEEN_LTC, SRGB_TABLE,
+};
 use std::path::{Path, PathBuf};
 
 /// The first character of a record's name that is a table the renderer adds (the GGX albedo
-/// table, `super::ggx_albedo`), not an image of the scene: no file name starts with it.
+/// table, `super::ggx_albedo`; the sheen table, `super::sheen_ltc`), not an image of the scene:
+/// no file name starts with it.
 pub const TABLE_NAME_START: char = '<';
 
 /// Largest texture side accepted.
@@ -92,6 +95,7 @@ impl TextureTable {
     pub fn new() -> Self {
         let mut words = vec![0u32; RECORDS];
         words[GGX_ALBEDO] = kernel::scene::NONE;
+        words[SHEEN_LTC] = kernel::scene::NONE;
         for b in 0..=255u8 {
             words[SRGB_TABLE + b as usize] = (srgb_to_linear(b) as f32).to_bits();
             words[LINEAR_TABLE + b as usize] = ((b as f64 / 255.0) as f32).to_bits();
@@ -145,6 +149,39 @@ impl TextureTable {
             .map(|k| k as u32)
     }
 
+    /// Adds one of the renderer's own float tables (`name` starts with [`TABLE_NAME_START`]),
+    /// `width` x `height` texels, texel (i, j) = `texel(i, j)`, clamped at its edges, and records
+    /// its index in the table's header word `header`; returns the index. The kernel reads it
+    /// at its nodes (`kernel::texture::at_nodes`).
+    pub fn add_table(
+        &mut self,
+        name: &str,
+        (width, height): (usize, usize),
+        texel: impl Fn(usize, usize) -> [f32; 3],
+        header: usize,
+    ) -> Result<u32, SceneError> {
+        let mut image = image::Rgb32FImage::new(width as u32, height as u32);
+        for j in 0..height {
+            for i in 0..width {
+                image.put_pixel(i as u32, j as u32, image::Rgb(texel(i, j)));
+            }
+        }
+        let usage = TextureUse {
+            colour: false,
+            wrap: [kernel::texture::wrap::CLAMP; 2],
+            transform: None,
+            second_set: false,
+        };
+        let index = self.add_image(
+            Path::new(name),
+            image::DynamicImage::ImageRgb32F(image),
+            usage,
+            name,
+        )?;
+        self.words[header] = index;
+        Ok(index)
+    }
+
     /// The index of decoded `image` used as `usage`, named `path` (a file, or a glTF file's
     /// image as `file#images[k]`): one record per name and use.
     pub fn add_image(
@@ -178,10 +215,13 @@ impl TextureTable {
         let texels: Vec<u32> = if float {
             tex_flags |= flags::FLOAT;
             let rgb = image.into_rgb32f();
+            // A scene's image holds radiance or factors (non-negative); the renderer's own
+            // tables may hold any finite number (the sheen table's B is negative).
+            let table = path.to_string_lossy().starts_with(TABLE_NAME_START);
             if let Some((k, p)) = rgb
                 .pixels()
                 .enumerate()
-                .find(|(_, p)| !p.0.iter().all(|c| c.is_finite() && *c >= 0.0))
+                .find(|(_, p)| !p.0.iter().all(|c| c.is_finite() && (table || *c >= 0.0)))
             {
                 return Err(err(format!(
                     "texel ({}, {}) is {:?}: values must be finite and non-negative",

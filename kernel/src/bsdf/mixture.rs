@@ -14,6 +14,7 @@ use super::fresnel::schlick_f90;
 use super::lambert::sample_brdf;
 use super::microfacet::{reflection, reflection_height_correlated, sample_visible_normal};
 use super::multiple_scattering::{factor, GlossyAlbedo};
+use super::sheen::{self, Sheen};
 use super::{reflect, BsdfFlags, BsdfSample, DELTA_ALPHA};
 use crate::features;
 use crate::scene::Material;
@@ -68,8 +69,9 @@ fn diffuse_share<const LAYERED: bool>(m: &Material, wo: Vec3, wi: Vec3) -> f32 {
 
 /// `bsdf::eval` of the mixture: Kd/pi cos (times the layer's share) + D G F_Schlick(wi . h) /
 /// (4 cos_o) (times the multiple-scattering factor of `albedo`, E at `wo`), density the
-/// mixture of the cosine lobe and the visible-normal reflection. Zero where `wo` is not above
-/// `n` (rounding at grazing hits).
+/// mixture of the cosine lobe and the visible-normal reflection; with the layer, under the
+/// clear coat and the sheen where the material has them. Zero where `wo` is not above `n`
+/// (rounding at grazing hits).
 #[inline]
 pub fn eval<const LAYERED: bool>(
     m: &Material,
@@ -116,12 +118,24 @@ pub fn eval<const LAYERED: bool>(
             }
         }
     }
+    if LAYERED && albedo.sheen.z > 0.0 {
+        // Over everything, glTF's sheen (`sheen`): the rest's 1 - s, and the sheen's lobe.
+        // Its R is 0 where the material has none (`surface::glossy_albedo` looks it up only
+        // for a sheen): one test of a number already at hand.
+        let sheen = sheen::at(Vec3::from(m.sheen_colour()), albedo.sheen);
+        if sheen.weight > 0.0 {
+            let (value, density) = sheen::eval(&sheen, n, wo, wi);
+            f = f * (1.0 - sheen.weight) + value;
+            pdf = pdf * (1.0 - sheen.weight) + sheen.weight * density;
+        }
+    }
     (f, pdf)
 }
 
 /// `bsdf::sample` of the mixture with numbers `u` = (u_lobe, u1, u2): with the layer, `u_lobe`
-/// below the clear coat's weight c chooses the coat (`coat`), and is else mapped onto [0, 1)
-/// again by (u_lobe - c) / (1 - c); then `u_lobe` below the glossy lobe's probability chooses
+/// below the sheen's weight s chooses the sheen (`sheen`), and is else mapped onto [0, 1) again
+/// by (u_lobe - s) / (1 - s); then below the clear coat's weight c it chooses the coat
+/// (`coat`), and is else mapped again by (u_lobe - c) / (1 - c); then `u_lobe` below the glossy lobe's probability chooses
 /// it; (u1, u2) draw the direction in the chosen lobe.
 #[inline]
 pub fn sample<const LAYERED: bool>(
@@ -135,6 +149,16 @@ pub fn sample<const LAYERED: bool>(
     let cos_o = n.dot(wo);
     if !(cos_o > 0.0) {
         return BsdfSample::NONE;
+    }
+    let mut sheen_weight = 0.0;
+    if LAYERED && albedo.sheen.z > 0.0 {
+        let sheen = sheen::at(Vec3::from(m.sheen_colour()), albedo.sheen);
+        if u_lobe < sheen.weight {
+            return sampled_sheen::<LAYERED>(&sheen, m, n, wo, albedo, (u1, u2));
+        }
+        // s < 1 here (u_lobe < 1).
+        sheen_weight = sheen.weight;
+        u_lobe = (u_lobe - sheen.weight) / (1.0 - sheen.weight);
     }
     let coat = if LAYERED && m.coat != 0 {
         coat::at(m, cos_o, albedo)
@@ -168,12 +192,27 @@ pub fn sample<const LAYERED: bool>(
     } else {
         sample_brdf(n, u1, u2)
     };
-    if smooth && coat.weight == 0.0 {
+    if smooth && coat.weight == 0.0 && sheen_weight == 0.0 {
         // The diffuse lobe beside a delta one: (Kd/pi cos) / ((1 - p) cos/pi), exactly.
         let weight =
             Vec3::from(m.albedo) * (diffuse_share::<LAYERED>(m, wo, wi) / (1.0 - p_glossy));
         return BsdfSample::reflected(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
     }
+    weighed::<LAYERED>(m, n, wo, wi, albedo)
+}
+
+/// The sheen's sample (chosen with probability s) from numbers `u`, weighed by the whole
+/// mixture. Kept out of line on the CPU: materials without a sheen never run it.
+#[cfg_attr(not(target_arch = "spirv"), inline(never))]
+fn sampled_sheen<const LAYERED: bool>(
+    sheen: &Sheen,
+    m: &Material,
+    n: Vec3,
+    wo: Vec3,
+    albedo: GlossyAlbedo,
+    u: (f32, f32),
+) -> BsdfSample {
+    let wi = sheen::sample(sheen, n, wo, u.0, u.1);
     weighed::<LAYERED>(m, n, wo, wi, albedo)
 }
 

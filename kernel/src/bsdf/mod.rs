@@ -5,7 +5,8 @@
 //! module holds the one dispatch over kinds ([`flags`], [`eval`], [`sample`], [`at_point`],
 //! [`apply_ks_texture`], [`material_features`]), pbrt-v4's tagged `BxDF`
 //! dispatch in one `match`; `multiple_scattering` gives back what a GGX lobe loses between its
-//! microfacets (glTF's material), `coat` its clear coat (`KHR_materials_clearcoat`).
+//! microfacets (glTF's material), `coat` its clear coat (`KHR_materials_clearcoat`), `sheen`
+//! its sheen (`KHR_materials_sheen`).
 //! Derivations and sources: `docs/materials.md`.
 //!
 //! Conventions: `wo` is the unit direction toward the previous vertex (the camera side), `wi`
@@ -27,6 +28,7 @@ pub mod metallic_roughness;
 pub mod microfacet;
 pub mod mixture;
 pub mod multiple_scattering;
+pub mod sheen;
 
 use crate::features::FeatureSet;
 use crate::scene::{material_kind, Material};

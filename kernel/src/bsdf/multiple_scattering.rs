@@ -48,17 +48,21 @@ pub struct GlossyAlbedo {
     /// its weight and its compensation: what the coat reflects of light from everywhere, and so
     /// what it takes from the material below (`coat`).
     pub coat_reflectance: f32,
+    /// The sheen's linearly transformed cosine (A, B, R) at its roughness and the view
+    /// (`sheen`, `texture::sheen_ltc`); R = 0: no sheen.
+    pub sheen: Vec3,
 }
 
 impl GlossyAlbedo {
     /// No energy lost, none given back: every factor is exactly 1.
-    /// (`coat_reflectance` 1: a rough coat needs the table's.)
+    /// (`coat_reflectance` 1: a rough coat needs the table's; `sheen` zero: no sheen lobe.)
     pub const NONE: Self = Self {
         directional: 1.0,
         average: 1.0,
         coat_directional: 1.0,
         coat_average: 1.0,
         coat_reflectance: 1.0,
+        sheen: Vec3::ZERO,
     };
 }
 

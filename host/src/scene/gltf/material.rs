@@ -113,6 +113,9 @@ pub(super) fn material(
     out.roughness = roughness;
     (out.layer_f0, out.layer_f90) = dielectric_layer(imp, &label, &m, &err)?;
     out.coat = clear_coat(imp, &label, &m, &err)?;
+    if let Some((colour, roughness)) = sheen(imp, &label, &m, &err)? {
+        out.set_sheen(colour, roughness);
+    }
     out.opacity = opacity(&m, base[3], pbr.base_color_texture().is_some(), &err)?;
     if emits {
         // A light (its triangles in the light table) that reflects as its material does, as
@@ -221,23 +224,13 @@ fn clear_coat(
     m: &gltf::Material,
     err: &dyn Fn(String) -> SceneError,
 ) -> Result<u32, SceneError> {
-    let Some(coat) = m.extension_value("KHR_materials_clearcoat") else {
+    let extension = "KHR_materials_clearcoat";
+    let Some(coat) = m.extension_value(extension) else {
         return Ok(0);
     };
-    let factor = |key: &str| -> Result<f32, SceneError> {
-        match coat.get(key) {
-            None => Ok(0.0),
-            Some(v) => match v.as_f64() {
-                Some(x) if (0.0..=1.0).contains(&x) => Ok(x as f32),
-                _ => Err(err(format!(
-                    "KHR_materials_clearcoat.{key} {v} must be a number within 0..=1"
-                ))),
-            },
-        }
-    };
     let (weight, roughness) = (
-        factor("clearcoatFactor")?,
-        factor("clearcoatRoughnessFactor")?,
+        unit_number(coat, extension, "clearcoatFactor", err)?,
+        unit_number(coat, extension, "clearcoatRoughnessFactor", err)?,
     );
     let textures = [
         "clearcoatTexture",
@@ -255,6 +248,70 @@ fn clear_coat(
     } else {
         0
     })
+}
+
+/// Number `key` of extension `extension`'s JSON `value` (0 where absent), within 0..=1.
+fn unit_number(
+    value: &gltf::json::Value,
+    extension: &str,
+    key: &str,
+    err: &dyn Fn(String) -> SceneError,
+) -> Result<f32, SceneError> {
+    match value.get(key) {
+        None => Ok(0.0),
+        Some(v) => match v.as_f64() {
+            Some(x) if (0.0..=1.0).contains(&x) => Ok(x as f32),
+            _ => Err(err(format!(
+                "{extension}.{key} {v} must be a number within 0..=1"
+            ))),
+        },
+    }
+}
+
+/// Opaque material `m`'s `KHR_materials_sheen` (`sheenColorFactor`, default black: no sheen;
+/// `sheenRoughnessFactor`, default 0; each within 0..=1), read from its JSON as the `gltf`
+/// crate does not read the extension. Its textures are noted and the factors used.
+fn sheen(
+    imp: &mut Import,
+    label: &str,
+    m: &gltf::Material,
+    err: &dyn Fn(String) -> SceneError,
+) -> Result<Option<([f32; 3], f32)>, SceneError> {
+    let extension = "KHR_materials_sheen";
+    let Some(sheen) = m.extension_value(extension) else {
+        return Ok(None);
+    };
+    let colour = match sheen.get("sheenColorFactor") {
+        None => [0.0; 3],
+        Some(v) => {
+            let c: Option<Vec<f64>> = v
+                .as_array()
+                .map(|a| a.iter().filter_map(|x| x.as_f64()).collect());
+            match c.as_deref() {
+                Some(&[r, g, b]) if [r, g, b].iter().all(|x| (0.0..=1.0).contains(x)) => {
+                    [r as f32, g as f32, b as f32]
+                }
+                _ => {
+                    return Err(err(format!(
+                        "{extension}.sheenColorFactor {v} must be three numbers within 0..=1"
+                    )))
+                }
+            }
+        }
+    };
+    let roughness = unit_number(sheen, extension, "sheenRoughnessFactor", err)?;
+    if colour == [0.0; 3] {
+        return Ok(None);
+    }
+    if ["sheenColorTexture", "sheenRoughnessTexture"]
+        .iter()
+        .any(|t| sheen.get(*t).is_some())
+    {
+        imp.note(format!(
+            "{label}: KHR_materials_sheen textures ignored (its factors are used)"
+        ));
+    }
+    Ok(Some((colour, roughness)))
 }
 
 /// `out` with glTF material `m`'s `normalTexture` (linear) and its scale, where it has one.

@@ -35,9 +35,10 @@ use std::path::Path;
 
 /// The extensions read (docs/gltf.md); any other a file uses is noted, and one it requires is
 /// an error.
-pub const SUPPORTED_EXTENSIONS: [&str; 8] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 9] = [
     "EXT_texture_webp",
     "KHR_materials_clearcoat",
+    "KHR_materials_sheen",
     "KHR_materials_emissive_strength",
     "KHR_materials_transmission",
     "KHR_materials_ior",

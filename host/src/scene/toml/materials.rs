@@ -72,6 +72,10 @@ pub(super) struct MaterialFile {
     /// each in [0, 1], default 0.
     pub clearcoat: Option<Spanned<f32>>,
     pub clearcoat_roughness: Option<Spanned<f32>>,
+    /// Its sheen (glTF's `KHR_materials_sheen`): colour (linear RGB in [0, 1], default black:
+    /// none) and roughness in [0, 1] (default 0).
+    pub sheen: Option<V3>,
+    pub sheen_roughness: Option<Spanned<f32>>,
     /// A tangent-space normal map (linear; glTF's `normalTexture`, OpenGL's +y convention) and
     /// its x/y scale (default 1), for any reflecting material on triangles.
     pub normal_map: Option<Spanned<String>>,
@@ -88,6 +92,8 @@ impl MaterialFile {
             || self.metallic_roughness_map.is_some()
             || self.clearcoat.is_some()
             || self.clearcoat_roughness.is_some()
+            || self.sheen.is_some()
+            || self.sheen_roughness.is_some()
     }
 }
 
@@ -278,7 +284,8 @@ pub(super) fn material(
 
 /// glTF's metallic-roughness material: `base_color` (default white), `metallic` and
 /// `roughness` (each in [0, 1], default 1, glTF's defaults) and their maps, a clear coat
-/// (`clearcoat`, `clearcoat_roughness`, default 0); nothing of the other kinds beside them.
+/// (`clearcoat`, `clearcoat_roughness`, default 0), a sheen (`sheen`, default black, and
+/// `sheen_roughness`, default 0); nothing of the other kinds beside them.
 fn metallic_roughness(
     ck: &Checker,
     field: &str,
@@ -338,6 +345,14 @@ fn metallic_roughness(
     if coat > 0.0 {
         out.coat = Material::pack_coat(coat, coat_roughness);
     }
+    let sheen = match &mf.sheen {
+        Some(c) => ck.color(c, &format!("{field}.sheen"), Some(1.0))?,
+        None => Vec3::ZERO,
+    };
+    out.set_sheen(
+        sheen.to_array(),
+        unit(&mf.sheen_roughness, "sheen_roughness", 0.0)?,
+    );
     Ok(out)
 }
 
