@@ -74,12 +74,17 @@ pub const OPACITY: u32 = 1 << 22;
 /// `TEXCOORD_1`): lookups may read it.
 pub const SECOND_UVS: u32 = 1 << 23;
 
+/// A dielectric has an absorbing medium inside (`crate::medium`): paths track the medium they
+/// are in and attenuate their throughput and shadow rays in it. Scenes with it run the
+/// CPU's generic path, so that others do not carry its checks.
+pub const MEDIA: u32 = 1 << 24;
+
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
 /// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals,
 /// [`NORMAL_MAPS`] and [`SHADING_NORMALS`] if a material has a normal map,
 /// [`REFLECTING_LIGHTS`] if an emitting material reflects, [`VERTEX_COLOURS`] if a triangle
 /// has vertex colours, [`OPACITY`] if a material has holes, [`SECOND_UVS`] if a triangle has
-/// a second set of texture coordinates.
+/// a second set of texture coordinates, [`MEDIA`] if a dielectric holds an absorbing medium.
 #[inline]
 pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> u32 {
     let mut f = 0;
@@ -115,6 +120,9 @@ pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> 
     }
     if materials.iter().any(Material::has_holes) {
         f |= OPACITY;
+    }
+    if materials.iter().any(Material::has_interior_medium) {
+        f |= MEDIA;
     }
     if shading
         .iter()
@@ -291,6 +299,12 @@ pub trait FeatureSet: Copy {
     fn second_uvs(self) -> bool {
         self.answer(SECOND_UVS, true)
     }
+    /// The generic path tracks media wherever it is (a path outside every medium has
+    /// absorption zero, which attenuates nothing).
+    #[inline]
+    fn media(self) -> bool {
+        self.answer(MEDIA, true)
+    }
     /// The generic path asks each light's material (`Material::reflects`).
     #[inline]
     fn reflecting_lights(self) -> bool {
@@ -328,5 +342,22 @@ impl FeatureSet for Dynamic {
     #[inline(always)]
     fn bits(self) -> u32 {
         self.0
+    }
+}
+
+/// [`Dynamic`] for specialised bits without [`MEDIA`] (the CPU's run-time path for scenes
+/// without media): the medium code compiled out, so that such scenes do not test for it at
+/// every vertex. Its answers are [`Dynamic`]'s for those bits.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DynamicWithoutMedia(pub u32);
+
+impl FeatureSet for DynamicWithoutMedia {
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        self.0
+    }
+    #[inline(always)]
+    fn media(self) -> bool {
+        false
     }
 }

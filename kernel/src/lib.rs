@@ -21,6 +21,7 @@ pub mod hit;
 pub mod instance;
 pub mod intersect;
 pub mod light;
+pub mod medium;
 pub mod opacity;
 pub mod path;
 #[cfg(feature = "probe")]

@@ -10,6 +10,7 @@ use crate::features::FeatureSet;
 use crate::geometry::{offset_ray_origin, shadow_ray_end};
 use crate::hit::SurfaceHit;
 use crate::light::{self, eval_radiance, LightKinds, LightSample};
+use crate::medium;
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{light_sampling, mis, Light, Material, RenderParams, NONE};
@@ -130,6 +131,9 @@ pub struct PathState {
     /// throughput times it is what roulette reads, so radiance scaling at refractions alone
     /// does not end paths inside glass nor keep them after they leave it.
     pub eta_scale: f32,
+    /// The absorption coefficient of the medium the current ray travels through (`medium`;
+    /// zero outside every medium, where every path starts).
+    pub absorption: Vec3,
     /// Vertices so far: 0 while the camera ray is out.
     pub depth: u32,
     /// The sample's random numbers (the one-path loop draws a vertex's samples from them; the
@@ -163,6 +167,7 @@ impl PathState {
             previous_vertex: origin,
             previous_pdf: 0.0,
             eta_scale: 1.0,
+            absorption: Vec3::ZERO,
             depth: 0,
             rng,
         }
@@ -249,6 +254,9 @@ impl PathState {
             return false;
         }
         self.extend = false;
+        if features.media() {
+            self.cross_medium(hit);
+        }
         if !hit.is_hit() {
             if features.environment(params) && environment::has_map(params) {
                 // 1: the camera ray sees the environment map; 2(b): an extension found it,
@@ -439,8 +447,12 @@ impl PathState {
                     pdf_w,
                     pdf_brdf(n, wi),
                 );
-                let radiance =
+                let mut radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
+                if features.media() {
+                    // A Lambertian surface leaves the path in its medium.
+                    radiance *= medium::along(self.absorption, ray_origin, ls.point.position);
+                }
                 self.await_shadow(query.light_kinds, lights, ray_origin, &ls, radiance);
             }
         }
@@ -518,7 +530,11 @@ impl PathState {
                     pdf_b,
                 );
                 let from = offset_ray_origin(x, side(ng, ng.dot(wi) > 0.0), hit.error);
-                let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
+                let mut radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
+                if features.media() {
+                    let absorption = medium::beyond(material, hit.normal, wi, self.absorption);
+                    radiance *= medium::along(absorption, from, ls.point.position);
+                }
                 self.await_shadow(query.light_kinds, lights, from, &ls, radiance);
             }
         }
@@ -550,6 +566,10 @@ impl PathState {
         self.throughput *= s.weight;
         if features.dielectric() {
             self.eta_scale *= s.eta2;
+            // Only a dielectric bounds a medium (`features::MEDIA` implies `DIELECTRIC`).
+            if features.media() {
+                self.absorption = medium::beyond(material, hit.normal, s.wi, self.absorption);
+            }
         }
         if !(self.throughput.max_element() > 0.0) {
             return;
@@ -572,8 +592,24 @@ impl PathState {
         true
     }
 
+    /// The ray just traced crossed the medium it travels in up to `hit` (or out of the scene):
+    /// its throughput times the segment's transmittance (`medium`). Out of line on the CPU: only
+    /// scenes with media call it.
+    #[cfg_attr(not(target_arch = "spirv"), inline(never))]
+    fn cross_medium(&mut self, hit: &SurfaceHit) {
+        if self.absorption.max_element() > 0.0 {
+            let distance = if hit.is_hit() {
+                (hit.position - self.ray_origin).length()
+            } else {
+                f32::MAX
+            };
+            self.throughput *= medium::transmittance(self.absorption, distance);
+        }
+    }
+
     /// The light sample `ls` waits for its shadow segment from `from` (offset off the surface)
-    /// to the light point; `radiance` is what it adds if the segment is clear.
+    /// to the light point; `radiance` is what it adds if the segment is clear (in a medium, the
+    /// caller has applied the segment's transmittance: `medium::along`).
     #[inline]
     fn await_shadow(
         &mut self,

@@ -202,7 +202,9 @@ pub struct Material {
     /// t < 0, BLEND: with probability -t x that alpha, -t in (0, 1] being the factor's alpha.
     pub opacity: f32,
     /// CONDUCTOR with a complex index: the extinction coefficient k. METALLIC_ROUGHNESS: k[0]
-    /// is the sheen's roughness in [0, 1] ([`Material::sheen_roughness`]).
+    /// is the sheen's roughness in [0, 1] ([`Material::sheen_roughness`]). DIELECTRIC: the
+    /// absorption coefficient of the medium inside (per unit length, RGB; zero: clear;
+    /// `crate::medium`, [`Material::interior_absorption`]).
     pub k: [f32; 3],
     /// METALLIC_ROUGHNESS: glTF's clear coat (`KHR_materials_clearcoat`, `crate::bsdf::coat`):
     /// its weight (`clearcoatFactor`) in the low 16 bits and its roughness
@@ -319,6 +321,19 @@ impl Material {
             colour[2].clamp(0.0, 1.0),
         ];
         self.k = [roughness.clamp(0.0, 1.0), 0.0, 0.0];
+    }
+
+    /// DIELECTRIC: the absorption coefficient of the medium inside (stored in `k`).
+    #[inline]
+    pub fn interior_absorption(&self) -> [f32; 3] {
+        self.k
+    }
+
+    /// Whether the material is a dielectric with an absorbing medium inside.
+    #[inline]
+    pub fn has_interior_medium(&self) -> bool {
+        self.kind == material_kind::DIELECTRIC
+            && (self.k[0] > 0.0 || self.k[1] > 0.0 || self.k[2] > 0.0)
     }
 
     /// Whether a CONDUCTOR reflects by the exact Fresnel of its complex index `eta` + i `k`

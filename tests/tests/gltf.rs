@@ -542,6 +542,60 @@ fn clear_coats_are_read_from_the_extension() {
 }
 
 #[test]
+fn coloured_glass_is_read_from_the_volume_extension() {
+    let dir = temp_dir("volume");
+    let glass = |volume: serde_json::Value| {
+        let path = material_file(
+            &dir,
+            "glass.glb",
+            json!({ "extensions": {
+                "KHR_materials_transmission": { "transmissionFactor": 1.0 },
+                "KHR_materials_volume": volume } }),
+            &["KHR_materials_transmission", "KHR_materials_volume"],
+        );
+        SceneFile::load(&path)
+    };
+    // sigma_a = -ln(colour) / distance, the thickness ignored (a path tracer traces it).
+    let s = glass(json!({ "thicknessFactor": 0.1, "attenuationDistance": 2.0,
+                          "attenuationColor": [0.5, 0.25, 1.0] }))
+    .unwrap();
+    let m = s.scene.materials[0];
+    assert_eq!(m.kind, material_kind::DIELECTRIC);
+    let want = [0.5f64, 0.25, 1.0].map(|c| (-c.ln() / 2.0) as f32);
+    assert_eq!(m.interior_absorption(), want);
+    assert_ne!(
+        s.scene.features(&s.settings) & kernel::features::MEDIA,
+        0,
+        "a scene with coloured glass tracks media"
+    );
+    assert!(
+        s.scene.notes.iter().all(|n| !n.contains("ignored")),
+        "{:?}",
+        s.scene.notes
+    );
+    // Without a distance (infinite by default): clear glass.
+    let s = glass(json!({ "attenuationColor": [0.5, 0.5, 0.5] })).unwrap();
+    assert!(!s.scene.materials[0].has_interior_medium());
+    // A colour of 0 is noted; bad values name the field.
+    let s =
+        glass(json!({ "attenuationDistance": 1.0, "attenuationColor": [0.0, 1.0, 1.0] })).unwrap();
+    assert!(s.scene.notes.iter().any(|n| n.contains("read as 1e-6")));
+    for (bad, field) in [
+        (
+            json!({ "attenuationDistance": -1.0 }),
+            "attenuationDistance",
+        ),
+        (
+            json!({ "attenuationDistance": 1.0, "attenuationColor": [2.0, 1.0, 1.0] }),
+            "attenuationColor",
+        ),
+    ] {
+        let e = glass(bad).unwrap_err().to_string();
+        assert!(e.contains("materials[0]") && e.contains(field), "{e}");
+    }
+}
+
+#[test]
 fn sheens_are_read_from_the_extension() {
     let dir = temp_dir("sheen");
     let sheen = |extension: serde_json::Value| {

@@ -13,7 +13,7 @@ use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use glam::Vec3;
 use indicatif::ProgressBar;
-use kernel::features::{self, Dynamic, FeatureSet, Static};
+use kernel::features::{self, Dynamic, DynamicWithoutMedia, FeatureSet, Static};
 use kernel::path::render_sample;
 use kernel::scene::{Light, Material, RenderParams, ShadingTriangle};
 use kernel::{SceneView, Tracer};
@@ -55,7 +55,8 @@ pub enum TileStrategy {
     BvhPackets,
 }
 
-/// `match bits { combo => body with f = Static::<combo>, ..., other => body with Dynamic(other) }`.
+/// `match bits { combo => body with f = Static::<combo>, ..., other => body with Dynamic(other) }`
+/// (`DynamicWithoutMedia(other)` where `other` is specialised and has no media).
 macro_rules! monomorphised {
     ($bits:expr, $f:ident => $body:expr; $($combo:expr),+) => {
         match $bits {
@@ -63,6 +64,10 @@ macro_rules! monomorphised {
                 let $f = Static::<{ $combo }>;
                 $body
             })+
+            other if other & features::SPECIALIZED != 0 && other & features::MEDIA == 0 => {
+                let $f = DynamicWithoutMedia(other);
+                $body
+            }
             other => {
                 let $f = Dynamic(other);
                 $body

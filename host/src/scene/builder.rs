@@ -72,6 +72,20 @@ impl SceneTables {
         (self.materials.len() - 1) as u32
     }
 
+    /// The index of dielectric `m` holding the medium named `medium`, of absorption
+    /// `absorption`, inside (`Material::interior_absorption`): a copy named "MATERIAL holding
+    /// MEDIUM", made once per pair.
+    pub fn with_interior(&mut self, m: u32, medium: &str, absorption: [f32; 3]) -> u32 {
+        let name = format!("{} holding {medium}", self.material_names[m as usize]);
+        if let Some(k) = self.material_names.iter().position(|n| *n == name) {
+            return k as u32;
+        }
+        let mut material = self.materials[m as usize];
+        material.k = absorption;
+        let two_sided = self.two_sided[m as usize];
+        self.add_material(name, material, two_sided)
+    }
+
     pub fn is_emissive(&self, m: u32) -> bool {
         self.materials[m as usize].emission.iter().any(|&c| c > 0.0)
     }

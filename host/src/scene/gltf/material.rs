@@ -103,6 +103,7 @@ pub(super) fn material(
             out.kind = material_kind::DIELECTRIC;
             out.ior = ior;
             out.alpha = roughness * roughness;
+            out.k = volume_absorption(imp, &label, &m, &err)?;
             return normal_map(imp, &label, &m, out);
         }
     }
@@ -250,6 +251,43 @@ fn clear_coat(
     })
 }
 
+/// The absorption coefficient of transmissive material `m`'s `KHR_materials_volume`: the
+/// medium inside the mesh, sigma_a = -ln(attenuationColor) / attenuationDistance per channel
+/// (the extension's definition; distance in world units, default infinite: none), zero without
+/// the extension. `thicknessFactor` and its texture are for rasterisers that cannot trace the
+/// thickness (the extension says path tracers ignore them). A colour of 0 absorbs everything at
+/// once, which no coefficient says: it is read as 1e-6 (noted).
+fn volume_absorption(
+    imp: &mut Import,
+    label: &str,
+    m: &gltf::Material,
+    err: &dyn Fn(String) -> SceneError,
+) -> Result<[f32; 3], SceneError> {
+    let extension = "KHR_materials_volume";
+    let Some(volume) = m.extension_value(extension) else {
+        return Ok([0.0; 3]);
+    };
+    let distance = match volume.get("attenuationDistance") {
+        None => return Ok([0.0; 3]),
+        Some(v) => match v.as_f64() {
+            Some(d) if d > 0.0 && d.is_finite() => d,
+            _ => {
+                return Err(err(format!(
+                    "{extension}.attenuationDistance {v} must be a positive number"
+                )))
+            }
+        },
+    };
+    let colour = unit_rgb(volume, extension, "attenuationColor", [1.0; 3], err)?;
+    if colour.contains(&0.0) {
+        imp.note(format!(
+            "{label}: {extension}.attenuationColor has a channel of 0 (all absorbed at once): \
+             read as 1e-6"
+        ));
+    }
+    Ok(colour.map(|c| (-(c.max(1e-6) as f64).ln() / distance) as f32))
+}
+
 /// Number `key` of extension `extension`'s JSON `value` (0 where absent), within 0..=1.
 fn unit_number(
     value: &gltf::json::Value,
@@ -268,6 +306,31 @@ fn unit_number(
     }
 }
 
+/// Colour `key` of extension `extension`'s JSON `value` (`default` where absent): three numbers
+/// within 0..=1.
+fn unit_rgb(
+    value: &gltf::json::Value,
+    extension: &str,
+    key: &str,
+    default: [f32; 3],
+    err: &dyn Fn(String) -> SceneError,
+) -> Result<[f32; 3], SceneError> {
+    let Some(v) = value.get(key) else {
+        return Ok(default);
+    };
+    let c: Option<Vec<f64>> = v
+        .as_array()
+        .map(|a| a.iter().filter_map(|x| x.as_f64()).collect());
+    match c.as_deref() {
+        Some(&[r, g, b]) if [r, g, b].iter().all(|x| (0.0..=1.0).contains(x)) => {
+            Ok([r as f32, g as f32, b as f32])
+        }
+        _ => Err(err(format!(
+            "{extension}.{key} {v} must be three numbers within 0..=1"
+        ))),
+    }
+}
+
 /// Opaque material `m`'s `KHR_materials_sheen` (`sheenColorFactor`, default black: no sheen;
 /// `sheenRoughnessFactor`, default 0; each within 0..=1), read from its JSON as the `gltf`
 /// crate does not read the extension. Its textures are noted and the factors used.
@@ -281,24 +344,7 @@ fn sheen(
     let Some(sheen) = m.extension_value(extension) else {
         return Ok(None);
     };
-    let colour = match sheen.get("sheenColorFactor") {
-        None => [0.0; 3],
-        Some(v) => {
-            let c: Option<Vec<f64>> = v
-                .as_array()
-                .map(|a| a.iter().filter_map(|x| x.as_f64()).collect());
-            match c.as_deref() {
-                Some(&[r, g, b]) if [r, g, b].iter().all(|x| (0.0..=1.0).contains(x)) => {
-                    [r as f32, g as f32, b as f32]
-                }
-                _ => {
-                    return Err(err(format!(
-                        "{extension}.sheenColorFactor {v} must be three numbers within 0..=1"
-                    )))
-                }
-            }
-        }
-    };
+    let colour = unit_rgb(sheen, extension, "sheenColorFactor", [0.0; 3], err)?;
     let roughness = unit_number(sheen, extension, "sheenRoughnessFactor", err)?;
     if colour == [0.0; 3] {
         return Ok(None);

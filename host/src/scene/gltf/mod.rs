@@ -35,12 +35,13 @@ use std::path::Path;
 
 /// The extensions read (docs/gltf.md); any other a file uses is noted, and one it requires is
 /// an error.
-pub const SUPPORTED_EXTENSIONS: [&str; 9] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 10] = [
     "EXT_texture_webp",
     "KHR_materials_clearcoat",
     "KHR_materials_sheen",
     "KHR_materials_emissive_strength",
     "KHR_materials_transmission",
+    "KHR_materials_volume",
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_texture_transform",

@@ -48,6 +48,9 @@ pub(super) struct MaterialFile {
     pub alpha: Option<Spanned<f32>>,
     pub conductor: Option<Spanned<toml::Value>>,
     pub dielectric: Option<Spanned<DielectricFile>>,
+    /// No surface at all, only where a medium begins and ends (`interior`): a smooth
+    /// dielectric of index 1, alone in its entry.
+    pub interface: Option<Spanned<bool>>,
     pub emission: Option<V3>,
     /// With `emission`, on quads and meshes: both faces emit (default: the front face).
     pub two_sided: Option<Spanned<bool>>,
@@ -153,6 +156,14 @@ pub(super) fn material(
 ) -> Result<Material, SceneError> {
     let mf = m.get_ref();
     let whole = |msg: &str| ck.err(m.span(), field, msg);
+    if let Some(interface) = &mf.interface {
+        let surface_keys = mf.is_metallic_roughness()
+            || mf.kd.is_some() | mf.ks.is_some() | mf.alpha.is_some() | mf.emission.is_some()
+            || mf.conductor.is_some() | mf.dielectric.is_some() | mf.two_sided.is_some()
+            || mf.kd_map.is_some() | mf.ks_map.is_some() | mf.alpha_map.is_some()
+            || mf.emission_map.is_some() | mf.normal_map.is_some();
+        return super::media::interface_material(ck, field, interface, m.span(), surface_keys);
+    }
     if mf.is_metallic_roughness() {
         return metallic_roughness(ck, field, m);
     }

@@ -4,6 +4,7 @@
 
 use super::checker::{Checker, V3};
 use super::materials::find_material;
+use super::media::{with_interior, Media};
 use super::transform::{parse_transform, transform_fields};
 use crate::scene::builder::SceneTables;
 use crate::scene::closed_surface::check_closed_outward;
@@ -22,6 +23,9 @@ use toml::Spanned;
 pub(super) struct MeshFile {
     pub file: Spanned<String>,
     pub material: Spanned<String>,
+    /// The medium inside (a `[media]` name; the material must be a dielectric or interface,
+    /// and the mesh closed).
+    pub interior: Option<Spanned<String>>,
     /// Optional transform (`transform::parse_transform`): scale (a number or [x, y, z]), then
     /// rotate ([degrees, axis x, y, z]), then translate; or a row-major 4 x 4 affine matrix.
     pub scale: Option<Spanned<toml::Value>>,
@@ -34,12 +38,17 @@ pub(super) struct MeshFile {
 pub(super) fn add_meshes(
     ck: &Checker,
     meshes: &[Spanned<MeshFile>],
+    media: &Media,
     base_dir: &Path,
     tables: &mut SceneTables,
 ) -> Result<(), SceneError> {
     // A mesh file that several entries place with the same material is read once; from
     // INSTANCE_MIN_TRIANGLES triangles on and unless it emits, it is stored once and instanced.
-    let mesh_key = |mf: &MeshFile| (mf.file.get_ref().clone(), mf.material.get_ref().clone());
+    let mesh_key = |mf: &MeshFile| {
+        let interior = mf.interior.as_ref().map(|i| i.get_ref().as_str());
+        let material = format!("{} {interior:?}", mf.material.get_ref());
+        (mf.file.get_ref().clone(), material)
+    };
     let mut mesh_uses: HashMap<(String, String), usize> = HashMap::new();
     for m in meshes {
         *mesh_uses.entry(mesh_key(m.get_ref())).or_insert(0) += 1;
@@ -54,6 +63,14 @@ pub(super) fn add_meshes(
             &tables.material_names,
             &mf.material,
             &format!("{field}.material"),
+        )?;
+        let material = with_interior(
+            ck,
+            media,
+            tables,
+            (material, &mf.material),
+            mf.interior.as_ref(),
+            &field,
         )?;
         let mesh_path = base_dir.join(mf.file.get_ref());
         if !mesh_path.is_file() {

@@ -10,6 +10,7 @@ mod checker;
 mod includes;
 mod lights;
 mod materials;
+mod media;
 mod meshes;
 mod settings;
 mod shapes;
@@ -41,6 +42,9 @@ struct TomlScene {
     render: BTreeMap<String, Spanned<toml::Value>>,
     #[serde(default)]
     materials: BTreeMap<String, Spanned<materials::MaterialFile>>,
+    #[serde(default)]
+    media: BTreeMap<String, Spanned<media::MediumFile>>,
+    scene: Option<Spanned<media::SceneSection>>,
     #[serde(default)]
     sphere: Vec<Spanned<shapes::SphereFile>>,
     #[serde(default)]
@@ -78,9 +82,10 @@ pub fn parse_scene_with_camera(
     let settings = settings::render_settings(&ck, &file.render)?;
     let mut tables = SceneTables::default();
     materials::add_materials(&ck, &file.materials, base_dir, &mut tables)?;
-    shapes::add_spheres(&ck, &file.sphere, &mut tables)?;
+    let media = media::parse_media(&ck, &file.media, file.scene.as_ref())?;
+    shapes::add_spheres(&ck, &file.sphere, &media, &mut tables)?;
     shapes::add_quads(&ck, &file.quad, &mut tables)?;
-    meshes::add_meshes(&ck, &file.mesh, base_dir, &mut tables)?;
+    meshes::add_meshes(&ck, &file.mesh, &media, base_dir, &mut tables)?;
     lights::add_lights(&ck, &file.light, &mut tables)?;
     let (notes, gltf_cameras) = includes::add_gltf(&ck, &file.gltf, base_dir, &mut tables)?;
     let camera = match camera {

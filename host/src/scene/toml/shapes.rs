@@ -3,6 +3,7 @@
 
 use super::checker::{Checker, V3};
 use super::materials::find_material;
+use super::media::{with_interior, Media};
 use super::transform::{parse_transform, transform_fields};
 use crate::scene::builder::{wound, SceneTables};
 use crate::scene::light_table::sphere_light;
@@ -18,6 +19,8 @@ pub(super) struct SphereFile {
     pub center: V3,
     pub radius: Spanned<f32>,
     pub material: Spanned<String>,
+    /// The medium inside (a `[media]` name; the material must be a dielectric or interface).
+    pub interior: Option<Spanned<String>>,
     /// Optional transform (`transform::parse_transform`): scale (a number or [x, y, z]), then
     /// rotate ([degrees, axis x, y, z]), then translate; or a row-major 4 x 4 affine matrix.
     pub scale: Option<Spanned<toml::Value>>,
@@ -45,6 +48,7 @@ pub(super) struct QuadFile {
 pub(super) fn add_spheres(
     ck: &Checker,
     spheres: &[Spanned<SphereFile>],
+    media: &Media,
     tables: &mut SceneTables,
 ) -> Result<(), SceneError> {
     for (i, s) in spheres.iter().enumerate() {
@@ -94,6 +98,14 @@ pub(super) fn add_spheres(
             &tables.material_names,
             &sf.material,
             &format!("sphere[{i}].material"),
+        )?;
+        let material = with_interior(
+            ck,
+            media,
+            tables,
+            (material, &sf.material),
+            sf.interior.as_ref(),
+            &format!("sphere[{i}]"),
         )?;
         if tables.is_textured(material) {
             return Err(ck.err(
