@@ -209,3 +209,22 @@ fn media_and_interiors_are_checked_where_they_are_written() {
     assert_eq!(holding[0].interior_absorption(), [0.3, 0.9, 2.0]);
     assert_eq!(holding[0].ior, 1.5);
 }
+
+#[test]
+fn the_shipped_scene_holds_its_two_media() {
+    let path = twinpath_tests::repo_root().join("scenes/coloured_glass.toml");
+    let s = SceneFile::load(&path).unwrap();
+    let holding: Vec<_> = s
+        .scene
+        .materials
+        .iter()
+        .filter(|m| m.has_interior_medium())
+        .map(|m| (m.ior, m.interior_absorption()))
+        .collect();
+    assert_eq!(
+        holding,
+        vec![(1.5, [0.2, 1.5, 3.0]), (1.0, [1.5, 1.5, 1.5])],
+        "juice in glass, murk behind an interface"
+    );
+    assert_ne!(s.scene.features(&s.settings) & kernel::features::MEDIA, 0);
+}
