@@ -345,19 +345,17 @@ impl FeatureSet for Dynamic {
     }
 }
 
-/// [`Dynamic`] for specialised bits without [`MEDIA`] (the CPU's run-time path for scenes
-/// without media): the medium code compiled out, so that such scenes do not test for it at
-/// every vertex. Its answers are [`Dynamic`]'s for those bits.
+/// [`Dynamic`] for specialised bits known to lack every bit of `ABSENT` (constructed only from
+/// such bits: the invariant): [`SPECIALIZED`] and the absent bits are constants of its
+/// [`FeatureSet::bits`], so every answer about them is fixed at compile time and the code it
+/// guards compiled out, while the other answers are [`Dynamic`]'s. The CPU's run-time path for
+/// scenes without media is `DynamicWithout<{ MEDIA }>`.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct DynamicWithoutMedia(pub u32);
+pub struct DynamicWithout<const ABSENT: u32>(pub u32);
 
-impl FeatureSet for DynamicWithoutMedia {
+impl<const ABSENT: u32> FeatureSet for DynamicWithout<ABSENT> {
     #[inline(always)]
     fn bits(self) -> u32 {
-        self.0
-    }
-    #[inline(always)]
-    fn media(self) -> bool {
-        false
+        (self.0 | SPECIALIZED) & !ABSENT
     }
 }

@@ -226,8 +226,9 @@ pub fn emission_at<F: FeatureSet>(
 /// normal `n` lose to multiple scattering seen from `wo` (`bsdf::multiple_scattering`): for
 /// glTF's metallic-roughness material, the GGX albedos at its roughness and at its clear coat's
 /// from the texture table `textures` (`texture::ggx_albedo`), each where the lobe is rough (a
-/// mirror loses nothing), and its sheen's lobe (`texture::sheen_ltc`) where it has one; for every other kind, `GlossyAlbedo::NONE`. `bsdf::eval` and
-/// `bsdf::sample` take it; a vertex looks it up once.
+/// mirror loses nothing), and its sheen's lobe (`texture::sheen_ltc`) where it has one; for
+/// every other kind, `GlossyAlbedo::NONE`. `bsdf::eval` and `bsdf::sample` take it; a vertex
+/// looks it up once.
 #[inline]
 pub fn glossy_albedo<F: FeatureSet>(
     features: F,

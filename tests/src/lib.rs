@@ -251,6 +251,10 @@ impl SplitMix {
     pub fn unit(&mut self) -> f32 {
         (self.u64() >> 40) as f32 / (1u64 << 24) as f32
     }
+    /// Uniform in [0, 1) with 53 random bits.
+    pub fn unit_f64(&mut self) -> f64 {
+        (self.u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
 }
 
 /// Each pixel's variance of the mean for `film`'s sample counts, from the per-sample variance of

@@ -32,6 +32,7 @@
 //! (the scattering rate sigma(wi) times the specular phase function D(h) / (4 sigma(wi)),
 //! integrated over the depth z in [0, 1] with the attenuation exp(-z (lambda_i + lambda_o))).
 
+use crate::SplitMix;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -100,29 +101,15 @@ pub fn single_scattering(wi: DVec3, wo: DVec3, s: f64) -> f64 {
     normal_density((wi + wo).normalize(), s) * (-(-t).exp_m1()) / (4.0 * wi.z * t)
 }
 
-/// SplitMix64: the walks' numbers, one stream per node (the table does not depend on how
-/// rayon schedules the nodes).
-struct Numbers(u64);
-
-impl Numbers {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
-
 /// One random walk into the layer from the view direction at cosine `mu` (light arriving from
 /// wi = (sqrt(1 - mu^2), 0, mu)); `visit` sees each scattering event's depth, the direction
 /// the light travelled and its order (1, 2, ...). Returns whether the light left upward.
-fn walk(mu: f64, s: f64, numbers: &mut Numbers, mut visit: impl FnMut(f64, DVec3, u32)) -> bool {
+fn walk(mu: f64, s: f64, numbers: &mut SplitMix, mut visit: impl FnMut(f64, DVec3, u32)) -> bool {
     let mut dir = -DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let mut depth = 0.0;
     for order in 1..=MAX_BOUNCES {
         let rate = projected_area(dir, s);
-        let distance = -(1.0 - numbers.next()).ln() / rate;
+        let distance = -(1.0 - numbers.unit_f64()).ln() / rate;
         depth += distance * -dir.z;
         if depth < 0.0 {
             return true;
@@ -131,17 +118,18 @@ fn walk(mu: f64, s: f64, numbers: &mut Numbers, mut visit: impl FnMut(f64, DVec3
             return false;
         }
         visit(depth, dir, order);
-        let m = sample_visible_normal(-dir, s, numbers.next(), numbers.next());
+        let m = sample_visible_normal(-dir, s, numbers.unit_f64(), numbers.unit_f64());
         dir = 2.0 * m.dot(-dir) * m + dir;
     }
     dir.z > 0.0
 }
 
 /// The layer's reflectance R from the view at cosine `mu` (the fraction of [`walk`]s that
-/// leave upward; `seed` selects the stream).
+/// leave upward; `seed` selects the stream of numbers, one per node, so that the table does not
+/// depend on how rayon schedules the nodes).
 pub fn volume_reflectance(mu: f64, alpha: f64, walks: u32, seed: u64) -> f64 {
     let s = cross_section(alpha);
-    let mut numbers = Numbers(seed);
+    let mut numbers = SplitMix(seed);
     let up = (0..walks)
         .filter(|_| walk(mu, s, &mut numbers, |_, _, _| {}))
         .count();
@@ -180,7 +168,7 @@ pub fn multiple_scattering(
         .map(|&w| projected_area(w, s) / w.z)
         .collect();
     let mut sum = vec![0.0; directions.len()];
-    let mut numbers = Numbers(seed);
+    let mut numbers = SplitMix(seed);
     for _ in 0..walks {
         walk(mu, s, &mut numbers, |depth, dir, order| {
             if order < 2 {

@@ -13,7 +13,7 @@ use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use glam::Vec3;
 use indicatif::ProgressBar;
-use kernel::features::{self, Dynamic, DynamicWithoutMedia, FeatureSet, Static};
+use kernel::features::{self, Dynamic, DynamicWithout, FeatureSet, Static};
 use kernel::path::render_sample;
 use kernel::scene::{Light, Material, RenderParams, ShadingTriangle};
 use kernel::{SceneView, Tracer};
@@ -56,7 +56,7 @@ pub enum TileStrategy {
 }
 
 /// `match bits { combo => body with f = Static::<combo>, ..., other => body with Dynamic(other) }`
-/// (`DynamicWithoutMedia(other)` where `other` is specialised and has no media).
+/// (`DynamicWithout::<{ MEDIA }>(other)` where `other` is specialised and has no media).
 macro_rules! monomorphised {
     ($bits:expr, $f:ident => $body:expr; $($combo:expr),+) => {
         match $bits {
@@ -65,7 +65,7 @@ macro_rules! monomorphised {
                 $body
             })+
             other if other & features::SPECIALIZED != 0 && other & features::MEDIA == 0 => {
-                let $f = DynamicWithoutMedia(other);
+                let $f = DynamicWithout::<{ features::MEDIA }>(other);
                 $body
             }
             other => {

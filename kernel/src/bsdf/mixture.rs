@@ -135,8 +135,8 @@ pub fn eval<const LAYERED: bool>(
 /// `bsdf::sample` of the mixture with numbers `u` = (u_lobe, u1, u2): with the layer, `u_lobe`
 /// below the sheen's weight s chooses the sheen (`sheen`), and is else mapped onto [0, 1) again
 /// by (u_lobe - s) / (1 - s); then below the clear coat's weight c it chooses the coat
-/// (`coat`), and is else mapped again by (u_lobe - c) / (1 - c); then `u_lobe` below the glossy lobe's probability chooses
-/// it; (u1, u2) draw the direction in the chosen lobe.
+/// (`coat`), and is else mapped again by (u_lobe - c) / (1 - c); then below the glossy lobe's
+/// probability it chooses that lobe; (u1, u2) draw the direction in the chosen lobe.
 #[inline]
 pub fn sample<const LAYERED: bool>(
     m: &Material,

@@ -22,7 +22,7 @@
 //! Lambertian material reflects exactly 1 in a white furnace (tested). As there, the weights
 //! depend on `wo` alone, so the sheen is not reciprocal. The extension's own suggestion (the
 //! "Charlie" distribution of Estevez and Kulla 2017) differs from Cycles' sheen by factors of 2
-//! and more; `docs/gltf.md` gives the numbers.
+//! and more; `docs/materials.md` gives the numbers.
 //!
 //! Sampling (`mixture`): the sheen is chosen with probability s, so the material's lobes keep
 //! their weights ((1 - s) / (1 - s)).

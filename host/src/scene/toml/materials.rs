@@ -98,6 +98,24 @@ impl MaterialFile {
             || self.sheen.is_some()
             || self.sheen_roughness.is_some()
     }
+
+    /// The keys of the other kinds (Lambertian, Kd + Ks, metal, glass, light), each with
+    /// whether the entry gives it.
+    fn other_kind_keys(&self) -> [(&'static str, bool); 11] {
+        [
+            ("kd", self.kd.is_some()),
+            ("ks", self.ks.is_some()),
+            ("alpha", self.alpha.is_some()),
+            ("conductor", self.conductor.is_some()),
+            ("dielectric", self.dielectric.is_some()),
+            ("emission", self.emission.is_some()),
+            ("two_sided", self.two_sided.is_some()),
+            ("kd_map", self.kd_map.is_some()),
+            ("ks_map", self.ks_map.is_some()),
+            ("alpha_map", self.alpha_map.is_some()),
+            ("emission_map", self.emission_map.is_some()),
+        ]
+    }
 }
 
 #[derive(Deserialize)]
@@ -158,10 +176,8 @@ pub(super) fn material(
     let whole = |msg: &str| ck.err(m.span(), field, msg);
     if let Some(interface) = &mf.interface {
         let surface_keys = mf.is_metallic_roughness()
-            || mf.kd.is_some() | mf.ks.is_some() | mf.alpha.is_some() | mf.emission.is_some()
-            || mf.conductor.is_some() | mf.dielectric.is_some() | mf.two_sided.is_some()
-            || mf.kd_map.is_some() | mf.ks_map.is_some() | mf.alpha_map.is_some()
-            || mf.emission_map.is_some() | mf.normal_map.is_some();
+            || mf.normal_map.is_some()
+            || mf.other_kind_keys().iter().any(|k| k.1);
         return super::media::interface_material(ck, field, interface, m.span(), surface_keys);
     }
     if mf.is_metallic_roughness() {
@@ -303,20 +319,7 @@ fn metallic_roughness(
     m: &Spanned<MaterialFile>,
 ) -> Result<Material, SceneError> {
     let mf = m.get_ref();
-    let others = [
-        ("kd", mf.kd.is_some()),
-        ("ks", mf.ks.is_some()),
-        ("alpha", mf.alpha.is_some()),
-        ("conductor", mf.conductor.is_some()),
-        ("dielectric", mf.dielectric.is_some()),
-        ("emission", mf.emission.is_some()),
-        ("two_sided", mf.two_sided.is_some()),
-        ("kd_map", mf.kd_map.is_some()),
-        ("ks_map", mf.ks_map.is_some()),
-        ("alpha_map", mf.alpha_map.is_some()),
-        ("emission_map", mf.emission_map.is_some()),
-    ];
-    if let Some((name, _)) = others.iter().find(|o| o.1) {
+    if let Some((name, _)) = mf.other_kind_keys().iter().find(|o| o.1) {
         return Err(ck.err(
             m.span(),
             field,
