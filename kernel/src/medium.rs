@@ -12,7 +12,17 @@
 //! leaving, and reflecting on either side follow from that one rule. Any other surface leaves
 //! the medium as it is. Shapes with media must not overlap (the medium inside glass inside
 //! another medium is the inner glass's alone).
+//!
+//! An interface ([`is_interface`], TOML's `interface = true`) is a smooth dielectric of index
+//! 1: it neither reflects nor bends, so light crosses it with weight exactly 1 and it is no
+//! scattering event at all, only the place where the medium changes. Paths and shadow rays
+//! therefore pass through it (pbrt-v4's surfaces without a material, `TraceTransmittance`,
+//! section 14.1): an extension ray that meets one continues from the far side in the medium
+//! beyond, keeping the vertex it left and the density it was drawn with (a light it finds is
+//! weighed against next-event estimation from that vertex), and a shadow segment that meets
+//! one continues from the far side with the transmittance of the part it crossed.
 
+use crate::bsdf::DELTA_ALPHA;
 use crate::scene::{material_kind, Material};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -39,6 +49,16 @@ pub fn along(absorption: Vec3, from: Vec3, to: Vec3) -> Vec3 {
     } else {
         Vec3::ONE
     }
+}
+
+/// Whether light crosses `material` unchanged: a dielectric of index exactly 1 that is smooth
+/// (GGX alpha below `bsdf::DELTA_ALPHA`), whose only lobe is the straight transmission with
+/// Fresnel reflectance 0 (see the module's documentation).
+#[inline]
+pub fn is_interface(material: &Material) -> bool {
+    material.kind == material_kind::DIELECTRIC
+        && material.ior == 1.0
+        && material.alpha < DELTA_ALPHA
 }
 
 /// The absorption of the medium a ray leaving the surface of `material` in direction `dir`

@@ -26,6 +26,10 @@ pub trait Tracer {
     fn closest_hit(&mut self, origin: Vec3, dir: Vec3) -> SurfaceHit;
     /// Whether any surface lies on the open segment from `from` to `to`.
     fn occluded(&mut self, from: Vec3, to: Vec3) -> bool;
+    /// The closest surface on the open segment from `from` to `to`: the ray
+    /// `from + t (to - from)`, t in (0, 1), as [`Tracer::occluded`] tests it. A scene with media
+    /// traces its shadow segments so, to pass through interfaces (`crate::medium`).
+    fn first_hit_on(&mut self, from: Vec3, to: Vec3) -> SurfaceHit;
 }
 
 /// Seed: `TracePath(ray)`. One unbiased estimate of the radiance arriving at `origin` from
@@ -121,8 +125,12 @@ pub struct PathState {
     pub shadow_to: Vec3,
     /// Whether the segment `shadow_from -> shadow_to` waits to be tested (any hit).
     pub shadow: bool,
-    /// What the light sample adds if the segment is clear.
+    /// What the light sample adds if the segment is clear (in a scene with media, before the
+    /// transmittance of the part of the segment from `shadow_from` on).
     pub shadow_radiance: Vec3,
+    /// The absorption coefficient of the medium the shadow segment starts in, at `shadow_from`
+    /// (scenes with media: the segment passes interfaces, `crate::medium`).
+    pub shadow_absorption: Vec3,
     /// The vertex the extension ray left and the BSDF density it was sampled with (for the MIS
     /// weight of a light it finds; `bsdf::DELTA_PDF` after a delta lobe).
     pub previous_vertex: Vec3,
@@ -164,6 +172,7 @@ impl PathState {
             shadow_to: Vec3::ZERO,
             shadow: false,
             shadow_radiance: Vec3::ZERO,
+            shadow_absorption: Vec3::ZERO,
             previous_vertex: origin,
             previous_pdf: 0.0,
             eta_scale: 1.0,
@@ -197,7 +206,19 @@ impl PathState {
             } else {
                 SurfaceHit::miss()
             };
-            let occluded = self.shadow && tracer.occluded(self.shadow_from, self.shadow_to);
+            // A scene with media asks for the surface that blocks the segment (it may be an
+            // interface, which the segment passes); any other only whether one does.
+            let mut occluded = false;
+            if self.shadow {
+                if features.media() {
+                    let blocker = tracer.first_hit_on(self.shadow_from, self.shadow_to);
+                    if self.shadow_passes(scene, &blocker) {
+                        continue;
+                    }
+                } else {
+                    occluded = tracer.occluded(self.shadow_from, self.shadow_to);
+                }
+            }
             if self.advance(features, scene, &hit, occluded) {
                 let arrival = self.arrival(features, scene, &hit);
                 let samples = VertexSamples::draw(&arrival.query, &mut self.rng);
@@ -233,11 +254,13 @@ impl PathState {
 
     /// Takes the answers to this round's rays: `hit`, the closest hit of the extension ray
     /// (ignored unless `extend`), and whether the shadow segment is `occluded` (ignored unless
-    /// `shadow`); then runs the estimator up to its next ray casts (steps 1-5 above) or up to
-    /// the vertex at `hit`. Returns whether the path reached that vertex: then the caller
-    /// states its query ([`PathState::vertex_query`]), fills its samples and hands them to
-    /// [`PathState::vertex`], which prepares the next rays.
-    #[inline]
+    /// `shadow`; in a scene with media, [`PathState::shadow_passes`] has settled the segment
+    /// first); then runs the estimator up to its next ray casts (steps 1-5 above) or up to the
+    /// vertex at `hit`. Returns whether the path reached that vertex: then the caller states
+    /// its query ([`PathState::vertex_query`]), fills its samples and hands them to
+    /// [`PathState::vertex`], which prepares the next rays. An interface (`crate::medium`) is
+    /// no vertex: an extension ray that meets one goes on from its far side.
+    #[inline(always)]
     pub fn advance<F: FeatureSet>(
         &mut self,
         features: F,
@@ -256,6 +279,10 @@ impl PathState {
         self.extend = false;
         if features.media() {
             self.cross_medium(hit);
+            if hit.is_hit() && medium::is_interface(&scene.materials[hit.material as usize]) {
+                self.pass_interface(scene, hit);
+                return false;
+            }
         }
         if !hit.is_hit() {
             if features.environment(params) && environment::has_map(params) {
@@ -263,7 +290,8 @@ impl PathState {
                 // weighted against light sampling's choice of the same direction as any light.
                 let emitted = environment::eval(params, environment, self.ray_dir);
                 if self.depth == 0 {
-                    self.radiance = emitted;
+                    // (The throughput: 1, or what media before the first vertex leave.)
+                    self.radiance = self.throughput * emitted;
                 } else {
                     let pdf_l = light::environment::pdf(
                         &lights[params.environment.light as usize],
@@ -278,7 +306,7 @@ impl PathState {
             }
             // 1: the camera ray sees the background; an extension adds it with weight 1.
             if self.depth == 0 {
-                self.radiance = background(params);
+                self.radiance = self.throughput * background(params);
             } else if features.background() {
                 self.radiance += self.throughput * background(params);
             }
@@ -291,7 +319,7 @@ impl PathState {
             let emitted = eval_radiance(emission, hit.arrived_behind, two_sided);
             if self.depth == 0 {
                 // 1: a light seen directly.
-                self.radiance = emitted;
+                self.radiance = self.throughput * emitted;
             } else {
                 // 2(b): the extension found a light.
                 let pdf_l = light::pdf(
@@ -447,13 +475,13 @@ impl PathState {
                     pdf_w,
                     pdf_brdf(n, wi),
                 );
-                let mut radiance =
+                let radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
+                self.await_shadow(query.light_kinds, lights, ray_origin, &ls, radiance);
                 if features.media() {
                     // A Lambertian surface leaves the path in its medium.
-                    radiance *= medium::along(self.absorption, ray_origin, ls.point.position);
+                    self.shadow_absorption = self.absorption;
                 }
-                self.await_shadow(query.light_kinds, lights, ray_origin, &ls, radiance);
             }
         }
 
@@ -530,12 +558,12 @@ impl PathState {
                     pdf_b,
                 );
                 let from = offset_ray_origin(x, side(ng, ng.dot(wi) > 0.0), hit.error);
-                let mut radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
-                if features.media() {
-                    let absorption = medium::beyond(material, hit.normal, wi, self.absorption);
-                    radiance *= medium::along(absorption, from, ls.point.position);
-                }
+                let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
                 self.await_shadow(query.light_kinds, lights, from, &ls, radiance);
+                if features.media() {
+                    self.shadow_absorption =
+                        medium::beyond(material, hit.normal, wi, self.absorption);
+                }
             }
         }
 
@@ -608,8 +636,9 @@ impl PathState {
     }
 
     /// The light sample `ls` waits for its shadow segment from `from` (offset off the surface)
-    /// to the light point; `radiance` is what it adds if the segment is clear (in a medium, the
-    /// caller has applied the segment's transmittance: `medium::along`).
+    /// to the light point; `radiance` is what it adds if the segment is clear (in a scene with
+    /// media, times the segment's transmittance: the caller sets `shadow_absorption`, the
+    /// medium the segment leaves into, and [`PathState::shadow_passes`] applies it).
     #[inline]
     fn await_shadow(
         &mut self,
@@ -628,6 +657,50 @@ impl PathState {
             light::point_error(kinds, &lights[ls.light as usize]),
         );
         self.shadow_radiance = radiance;
+    }
+
+    /// In a scene with media, the shadow segment's answer, taken before
+    /// [`PathState::advance`]: `blocker`, the closest surface on the segment from
+    /// `shadow_from` ([`Tracer::first_hit_on`]). Clear (a miss): the light sample adds its
+    /// radiance times the transmittance of the segment. An interface: the segment keeps the
+    /// transmittance of the part up to it and goes on from the interface's far side, in the
+    /// medium beyond, to the same end; returns true: the segment waits, and the caller leaves
+    /// this round's extension answer untaken (the same ray is traced again with the segment,
+    /// so the radiance sums its terms in the one order). Any other surface: the sample adds
+    /// nothing. Returns false once the segment is settled (`shadow` is then false). Out of line
+    /// on the CPU: only scenes with media call it.
+    #[cfg_attr(not(target_arch = "spirv"), inline(never))]
+    pub fn shadow_passes(&mut self, scene: &SceneView, blocker: &SurfaceHit) -> bool {
+        if !blocker.is_hit() {
+            let t = medium::along(self.shadow_absorption, self.shadow_from, self.shadow_to);
+            self.radiance += self.shadow_radiance * t;
+            self.shadow = false;
+            return false;
+        }
+        let material = &scene.materials[blocker.material as usize];
+        if !medium::is_interface(material) {
+            self.shadow = false;
+            return false;
+        }
+        let dir = self.shadow_to - self.shadow_from;
+        self.shadow_radiance *=
+            medium::along(self.shadow_absorption, self.shadow_from, blocker.position);
+        self.shadow_absorption =
+            medium::beyond(material, blocker.normal, dir, self.shadow_absorption);
+        self.shadow_from = beyond_surface(blocker, dir);
+        true
+    }
+
+    /// The extension ray met an interface at `hit` (its transmittance up to there already
+    /// applied): it goes on from the far side in the medium beyond, as the same ray (the
+    /// vertex it left, its density and the depth unchanged). Out of line on the CPU, as
+    /// [`PathState::shadow_passes`].
+    #[cfg_attr(not(target_arch = "spirv"), inline(never))]
+    fn pass_interface(&mut self, scene: &SceneView, hit: &SurfaceHit) {
+        let material = &scene.materials[hit.material as usize];
+        self.absorption = medium::beyond(material, hit.normal, self.ray_dir, self.absorption);
+        self.ray_origin = beyond_surface(hit, self.ray_dir);
+        self.extend = true;
     }
 
     /// The extension ray `origin + t dir` waits to be traced, leaving vertex `x`, drawn with
@@ -665,6 +738,17 @@ impl PathState {
             bsdf_strategy_weight(mode)
         }
     }
+}
+
+/// The origin of a ray along `dir` that goes on through the surface at `hit`: its point,
+/// offset to the side `dir` points to (`geometry::offset_ray_origin`).
+#[inline]
+fn beyond_surface(hit: &SurfaceHit, dir: Vec3) -> Vec3 {
+    offset_ray_origin(
+        hit.position,
+        side(hit.normal, hit.normal.dot(dir) > 0.0),
+        hit.error,
+    )
 }
 
 /// `n` where `toward_n`, else `-n`: the normal of the side a ray leaves from.

@@ -137,6 +137,25 @@ impl Tracer for RayTracer<'_> {
         }
         self.payload.hit != 0
     }
+
+    fn first_hit_on(&mut self, from: Vec3, to: Vec3) -> SurfaceHit {
+        self.payload.hit = 0;
+        unsafe {
+            self.tlas.trace_ray(
+                self.opaque,
+                0xff,
+                0,
+                1,
+                0,
+                from,
+                0.0,
+                to - from,
+                1.0,
+                self.payload,
+            );
+        }
+        self.payload.surface()
+    }
 }
 
 /// Ray generation: `samples_per_launch` samples of this pixel, merged into the running mean and

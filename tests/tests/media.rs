@@ -86,14 +86,37 @@ fn a_sphere_of_absorbing_medium_transmits_exp_of_minus_sigma_times_the_chord() {
         .fold(f64::MAX, f64::min);
     println!("darkest pixel (blue) {darkest:.4} of {L}");
     assert!(darkest < 0.1 * L, "the medium absorbs visibly");
+    assert_backends_agree_with(&file, &exact, 256);
+    // The same sphere without its medium is the environment everywhere: rejected.
+    let clear: SceneFile = scene_from_toml(&scene(""));
+    assert_eq!(
+        clear.scene.features(&clear.settings) & kernel::features::MEDIA,
+        0
+    );
+    let film = render_film(&clear, Backend::Cpu, 16);
+    let mean = film.mean();
+    let centre = ((SIZE / 2) * SIZE + SIZE / 2) as usize;
+    assert!(
+        (mean[centre][2] as f64 - L).abs() < 1e-5,
+        "{:?}",
+        mean[centre]
+    );
+    assert!(exact[centre].expect("the centre is inside")[2] < 0.1 * L);
+}
+
+/// Renders `file` with `spp` samples per pixel on the CPU (packets and one path) and the GPU,
+/// and z-tests every pixel with a closed form in `exact` (`None`: not tested) per channel at
+/// a family-wise level of 1e-3, and the sum over the tested pixels per channel.
+fn assert_backends_agree_with(file: &SceneFile, exact: &[Option<[f64; 3]>], spp: u32) {
+    let tested = exact.iter().flatten().count();
     let mut one_path = file.clone();
     one_path.settings.packets = false;
     for (label, scene, backend) in [
-        ("cpu packets", &file, Backend::Cpu),
+        ("cpu packets", file, Backend::Cpu),
         ("cpu one path", &one_path, Backend::Cpu),
-        ("gpu", &file, Backend::Gpu),
+        ("gpu", file, Backend::Gpu),
     ] {
-        let film = render_film(scene, backend, 256);
+        let film = render_film(scene, backend, spp);
         assert_eq!(film.discarded, 0);
         let (mean, var) = (film.mean(), film.variance_of_mean());
         let z_max = z_critical(1e-3, 3 * tested);
@@ -123,21 +146,105 @@ fn a_sphere_of_absorbing_medium_transmits_exp_of_minus_sigma_times_the_chord() {
             assert!(z.abs() < z_critical(1e-3, 3), "{label}: z = {z:.2}");
         }
     }
-    // The same sphere without its medium is the environment everywhere: rejected.
-    let clear: SceneFile = scene_from_toml(&scene(""));
+}
+
+/// The length of the part of the segment from `o` to `o + t_end d` (`d` unit) inside the
+/// sphere of centre `c` and radius `r`, in f64.
+fn chord_within(o: glam::DVec3, d: glam::DVec3, t_end: f64, c: glam::DVec3, r: f64) -> f64 {
+    let f = o - c;
+    let b = f.dot(d);
+    let disc = b * b - (f.length_squared() - r * r);
+    if disc <= 0.0 {
+        return 0.0;
+    }
+    let (t0, t1) = (-b - disc.sqrt(), -b + disc.sqrt());
+    (t1.min(t_end) - t0.max(0.0)).max(0.0)
+}
+
+/// Light and shadow rays pass interfaces (`kernel::medium::is_interface`): a point light of
+/// intensity I at the centre of a sphere of absorbing medium (radius R, an interface) above a
+/// Lambertian floor of albedo rho, nothing else. A floor point x at distance d from the light,
+/// cos theta to it, reflects rho / pi x I cos theta / d^2 x exp(-sigma_a R) (the light's
+/// segment inside the sphere is its radius), and the camera's ray to x keeps exp(-sigma_a
+/// chord) of it where it crosses the sphere. A delta light is found by next-event estimation
+/// alone, so while an interface stopped shadow rays this floor was black.
+#[test]
+fn a_point_light_inside_an_absorbing_sphere_lights_the_floor_through_its_interface() {
+    const I: f64 = 6.0;
+    const RHO: f64 = 0.6;
+    const R: f64 = 0.5;
+    let centre = glam::DVec3::new(0.0, 1.0, 0.0);
+    let text = format!(
+        r#"
+[camera]
+eye = [0.0, 3.0, 2.5]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 50.0
+width = {SIZE}
+height = {SIZE}
+
+[render]
+seed = 12
+roulette = "throughput"
+rr_start_depth = 1
+sampler = "independent"
+
+[media]
+juice = {{ sigma_a = [{}, {}, {}] }}
+
+[materials]
+boundary = {{ interface = true }}
+floor = {{ kd = [{RHO}, {RHO}, {RHO}] }}
+
+[[quad]]
+corner = [-20.0, 0.0, 20.0]
+edge1 = [40.0, 0.0, 0.0]
+edge2 = [0.0, 0.0, -40.0]
+material = "floor"
+
+[[sphere]]
+center = [{}, {}, {}]
+radius = {R}
+material = "boundary"
+interior = "juice"
+
+[[light]]
+position = [{}, {}, {}]
+intensity = [{I}, {I}, {I}]
+"#,
+        SIGMA[0], SIGMA[1], SIGMA[2], centre.x, centre.y, centre.z, centre.x, centre.y, centre.z
+    );
+    let file: SceneFile = scene_from_toml(&text);
+    let channel = |c: usize| {
+        pixel_quadrature(&file.scene, 64, |e, d| {
+            let (o, d) = (e.as_dvec3(), d.as_dvec3().normalize());
+            let t = -o.y / d.y;
+            if !(t > 0.0) {
+                return None;
+            }
+            let x = o + t * d;
+            let to_light = centre - x;
+            let d2 = to_light.length_squared();
+            let cos = to_light.y / d2.sqrt();
+            let camera_side = (-SIGMA[c] * chord_within(o, d, t, centre, R)).exp();
+            Some(RHO / std::f64::consts::PI * I * cos / d2 * (-SIGMA[c] * R).exp() * camera_side)
+        })
+    };
+    let (r, g, b) = (channel(0), channel(1), channel(2));
+    let exact: Vec<Option<[f64; 3]>> = (0..r.len()).map(|i| Some([r[i]?, g[i]?, b[i]?])).collect();
     assert_eq!(
-        clear.scene.features(&clear.settings) & kernel::features::MEDIA,
-        0
+        exact.iter().flatten().count(),
+        (SIZE * SIZE) as usize,
+        "the floor fills the view"
     );
-    let film = render_film(&clear, Backend::Cpu, 16);
-    let mean = film.mean();
-    let centre = ((SIZE / 2) * SIZE + SIZE / 2) as usize;
+    let centre_pixel = exact[((SIZE / 2) * SIZE + SIZE / 2) as usize].unwrap();
+    println!("centre pixel {centre_pixel:.4?}");
     assert!(
-        (mean[centre][2] as f64 - L).abs() < 1e-5,
-        "{:?}",
-        mean[centre]
+        centre_pixel[2] > 0.01,
+        "the floor is lit through the interface"
     );
-    assert!(exact[centre].expect("the centre is inside")[2] < 0.1 * L);
+    assert_backends_agree_with(&file, &exact, 64);
 }
 
 fn error_of(text: &str) -> String {

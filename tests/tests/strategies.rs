@@ -288,6 +288,21 @@ fn light_only_bsdf_only_and_mis_agree_inside_an_absorbing_medium() {
     variants_agree("absorbing medium", &text, None, &MODES);
 }
 
+/// The glossy scene with its sphere light inside a sphere of absorbing medium (an interface of
+/// radius 1.4 around it, `interior`): next-event estimation reaches the light through the
+/// interface, its shadow segment keeping the transmittance of the part inside
+/// (`PathState::shadow_passes`); BSDF sampling reaches it as an extension that passes the
+/// interface, weighed against light sampling from the vertex it left. While an interface
+/// stopped shadow rays, light sampling alone read black.
+#[test]
+fn light_only_bsdf_only_and_mis_agree_through_an_interface() {
+    let text = SPHERE_LIGHT_SCENE.replace(
+        "[materials]\n",
+        "[media]\nglow = { sigma_a = [0.2, 0.5, 0.9] }\n\n[materials]\nboundary = { interface = true }\n",
+    ) + "\n[[sphere]]\ncenter = [0.0, 2.6, 1.5]\nradius = 1.4\nmaterial = \"boundary\"\ninterior = \"glow\"\n";
+    variants_agree("through an interface", &text, None, &MODES);
+}
+
 /// The glossy scene without its sphere light, under an environment map with a bright patch (a
 /// "sun" of 2 x 1 texels) over a smooth sky: importance sampling by luminance (power MIS)
 /// against light-only, BSDF-only, half weights and uniform directions.

@@ -439,6 +439,10 @@ pub fn path_rays(
             self.shadows.push((self.key, from, to));
             self.inner.occluded(from, to)
         }
+        fn first_hit_on(&mut self, from: Vec3, to: Vec3) -> SurfaceHit {
+            self.shadows.push((self.key, from, to));
+            self.inner.first_hit_on(from, to)
+        }
     }
     // The image size only changes the camera, i.e. the parameters, not the renderer's tables.
     let mut sized = scene.clone();

@@ -45,4 +45,12 @@ impl Tracer for BvhTracer<'_> {
             Some(tables) => self.bvh.any_hit_through(from, to - from, 1.0, tables),
         }
     }
+    #[inline]
+    fn first_hit_on(&mut self, from: Vec3, to: Vec3) -> SurfaceHit {
+        self.rays.shadow += 1;
+        match &self.holes {
+            None => self.bvh.closest_hit(from, to - from, 1.0),
+            Some(tables) => self.bvh.closest_hit_through(from, to - from, 1.0, tables),
+        }
+    }
 }

@@ -45,6 +45,37 @@ fn gather(slots: &[Option<(usize, Path)>; LANES]) -> [(RayPacket, [f32; LANES]);
     [(extension, t_max[0]), (shadow, t_max[1])]
 }
 
+/// In a scene with media: each shadow segment of `shadow` (t_max `t_max`) traced to its
+/// closest surface and settled by its path (`PathState::shadow_passes`); returns the lanes
+/// whose segment passed an interface and waits again.
+#[inline(never)]
+fn settle_shadows<T: PacketTracer>(
+    tracer: &T,
+    scene: &SceneView,
+    bvh: &Bvh,
+    slots: &mut [Option<(usize, Path)>; LANES],
+    shadow: &RayPacket,
+    t_max: [f32; LANES],
+) -> [bool; LANES] {
+    let h = tracer.closest_hits(shadow, Simd::from_array(t_max));
+    let (prims, ts) = (h.prim.to_array(), h.t.to_array());
+    let (us, vs) = (h.u.to_array(), h.v.to_array());
+    let mut waiting = [false; LANES];
+    for (lane, slot) in slots.iter_mut().enumerate() {
+        let Some((_, path)) = slot else { continue };
+        if !path.shadow {
+            continue;
+        }
+        let mut blocker = SurfaceHit::miss();
+        if prims[lane] != NONE {
+            let (o, d) = (path.shadow_from, path.shadow_to - path.shadow_from);
+            blocker = bvh.surface_with_uv(prims[lane], o, d, ts[lane], (us[lane], vs[lane]));
+        }
+        waiting[lane] = path.shadow_passes(scene, &blocker);
+    }
+    waiting
+}
+
 /// A path of the packets.
 type Path = PathState;
 
@@ -122,13 +153,14 @@ pub(super) fn tile_by_packets<F: FeatureSet, T: PacketTracer>(
         } else {
             ([NONE; LANES], [0.0; LANES], [0.0; LANES], [0.0; LANES])
         };
-        let occluded = if shadows > 0 {
-            tracer
+        // A scene with media asks for the surface blocking each shadow segment (an interface
+        // lets it pass, `kernel::medium`); any other only whether one does.
+        let mut occluded = [false; LANES];
+        if shadows > 0 && !features.media() {
+            occluded = tracer
                 .occluded_lanes(&shadow, Simd::from_array(shadow_t_max))
-                .to_array()
-        } else {
-            [false; LANES]
-        };
+                .to_array();
+        }
         // Filled in place (an array built by `from_fn` was copied each round).
         hits.fill(SurfaceHit::miss());
         for (lane, slot) in slots.iter().enumerate() {
@@ -139,12 +171,20 @@ pub(super) fn tile_by_packets<F: FeatureSet, T: PacketTracer>(
                 hits[lane] = bvh.surface_with_uv(prims[lane], o, d, ts[lane], uv);
             }
         }
+        // (Shadow segments that pass an interface wait again, with their extension untaken.)
+        let mut waiting = [false; LANES];
+        if shadows > 0 && features.media() {
+            waiting = settle_shadows(tracer, scene, bvh, &mut slots, &shadow, shadow_t_max);
+        }
         // Each path takes its round's answers; those that reach a vertex state what it will
         // draw, and the sixteen vertices' samples are filled together.
         let mut queries = [None; LANES];
         for (lane, slot) in slots.iter_mut().enumerate() {
             let Some((_, path)) = slot else { continue };
             let hit = &hits[lane];
+            if waiting[lane] {
+                continue;
+            }
             if path.advance(features, scene, hit, occluded[lane]) {
                 let arrival = path.arrival(features, scene, hit);
                 materials[lane] = arrival.material;
