@@ -74,9 +74,10 @@ pub const OPACITY: u32 = 1 << 22;
 /// `TEXCOORD_1`): lookups may read it.
 pub const SECOND_UVS: u32 = 1 << 23;
 
-/// A dielectric has an absorbing medium inside (`crate::medium`): paths track the medium they
-/// are in and attenuate their throughput and shadow rays in it. Scenes with it run the
-/// CPU's generic path, so that others do not carry its checks.
+/// A dielectric has a medium inside, or the scene is filled with one (`crate::medium`): paths
+/// track the medium they are in, attenuate their throughput and shadow rays in it, scatter in
+/// it, and pass interfaces. Scenes with it run the CPU's generic path, so that others do not
+/// carry its checks.
 pub const MEDIA: u32 = 1 << 24;
 
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
@@ -84,7 +85,7 @@ pub const MEDIA: u32 = 1 << 24;
 /// [`NORMAL_MAPS`] and [`SHADING_NORMALS`] if a material has a normal map,
 /// [`REFLECTING_LIGHTS`] if an emitting material reflects, [`VERTEX_COLOURS`] if a triangle
 /// has vertex colours, [`OPACITY`] if a material has holes, [`SECOND_UVS`] if a triangle has
-/// a second set of texture coordinates, [`MEDIA`] if a dielectric holds an absorbing medium.
+/// a second set of texture coordinates, [`MEDIA`] if a dielectric holds a medium.
 #[inline]
 pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> u32 {
     let mut f = 0;
@@ -163,6 +164,9 @@ pub fn scene_features(params: &RenderParams) -> u32 {
     }
     if params.environment.width > 0 {
         f |= ENVIRONMENT | BACKGROUND;
+    }
+    if params.environment.medium != 0 {
+        f |= MEDIA;
     }
     f
 }
@@ -299,8 +303,8 @@ pub trait FeatureSet: Copy {
     fn second_uvs(self) -> bool {
         self.answer(SECOND_UVS, true)
     }
-    /// The generic path tracks media wherever it is (a path outside every medium has
-    /// absorption zero, which attenuates nothing).
+    /// The generic path tracks media wherever it is (a path in vacuum, medium 0, attenuates
+    /// nothing and never scatters).
     #[inline]
     fn media(self) -> bool {
         self.answer(MEDIA, true)

@@ -15,6 +15,7 @@ pub mod environment;
 pub mod features;
 pub mod film_sample;
 pub mod frame;
+pub mod free_flight;
 pub mod geometry;
 pub mod hash;
 pub mod hit;
@@ -24,6 +25,7 @@ pub mod light;
 pub mod medium;
 pub mod opacity;
 pub mod path;
+pub mod phase;
 #[cfg(feature = "probe")]
 pub mod probe;
 pub mod real;

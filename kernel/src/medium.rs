@@ -1,17 +1,22 @@
-//! Absorbing media inside closed dielectric shapes (coloured glass, a drink; TOML `[media]`
-//! with `interior`, glTF's `KHR_materials_volume`): light travelling a distance d through a
-//! medium of absorption coefficient sigma_a (per unit length, per channel) keeps
-//! exp(-sigma_a d) of itself (Beer-Lambert; pbrt-v4, 4th ed., section 11.2, the transmittance of
-//! a homogeneous medium). Exact and without sampling: a medium that only absorbs has nothing
-//! to scatter toward, so the transmittance multiplies the path's throughput.
+//! Homogeneous participating media (TOML `[media]`, `interior`, `[scene] medium`; glTF's
+//! `KHR_materials_volume`): their records, the transmittance of a segment, and which medium a
+//! ray is in.
 //!
-//! Where a path is: its `PathState::absorption`, the coefficient of the medium its current ray
-//! travels through (zero outside every medium). A dielectric's `Material::k` holds the medium
-//! inside it; a ray leaving one of its surfaces toward its inside (against the outward normal)
-//! travels in that medium, one leaving toward its outside in none ([`beyond`]): entering,
-//! leaving, and reflecting on either side follow from that one rule. Any other surface leaves
-//! the medium as it is. Shapes with media must not overlap (the medium inside glass inside
-//! another medium is the inner glass's alone).
+//! A medium of absorption coefficient sigma_a and scattering coefficient sigma_s (per unit
+//! length, per channel) has extinction sigma_t = sigma_a + sigma_s; light travelling a distance
+//! d through it keeps T(d) = exp(-sigma_t d) of itself (Beer-Lambert; pbrt-v4, 4th ed., section
+//! 11.2). A medium that only absorbs scatters nothing toward the camera, so its transmittance
+//! multiplies a path's throughput exactly; one that scatters is sampled (`crate::free_flight`,
+//! `crate::phase`).
+//!
+//! Where a path is: its `PathState::medium`, an index into the media table; record 0 is
+//! [`VACUUM`]. Outside every closed shape a ray is in the scene's medium
+//! (`EnvironmentParams::medium`: the camera's, a fog; vacuum by default). A dielectric's
+//! `Material::interior_medium` is the medium inside it; a ray leaving one of its surfaces toward
+//! its inside (against the outward normal) travels in that medium, one leaving toward its
+//! outside in the scene's ([`beyond`]): entering, leaving, and reflecting on either side follow
+//! from that one rule. Any other surface leaves the medium as it is. Shapes with media must not
+//! overlap or nest (the rule puts a ray that leaves an inner shape in the scene's medium).
 //!
 //! An interface ([`is_interface`], TOML's `interface = true`) is a smooth dielectric of index
 //! 1: it neither reflects nor bends, so light crosses it with weight exactly 1 and it is no
@@ -28,24 +33,77 @@ use crate::scene::{material_kind, Material};
 use crate::Float;
 use spirv_std::glam::Vec3;
 
-/// exp(-`absorption` x `distance`) per channel; `distance` may be `f32::MAX` (a ray that left
-/// the scene): then 0 where the medium absorbs, 1 where it does not.
+/// The media table's record 0: no medium (every coefficient zero).
+pub const VACUUM: u32 = 0;
+
+/// A homogeneous medium: coefficients per scene unit of length, linear RGB, and the
+/// Henyey-Greenstein asymmetry of its phase function (`crate::phase`). 32 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct Medium {
+    /// The absorption coefficient sigma_a.
+    pub sigma_a: [f32; 3],
+    /// The phase function's asymmetry g in (-1, 1): 0 isotropic, positive forward.
+    pub g: f32,
+    /// The scattering coefficient sigma_s.
+    pub sigma_s: [f32; 3],
+    pub _pad: u32,
+}
+
+impl Medium {
+    /// Record 0 of every media table.
+    pub const VACUUM: Self = Self::new([0.0; 3], [0.0; 3], 0.0);
+
+    /// The medium of absorption `sigma_a`, scattering `sigma_s` and asymmetry `g`.
+    pub const fn new(sigma_a: [f32; 3], sigma_s: [f32; 3], g: f32) -> Self {
+        Self {
+            sigma_a,
+            g,
+            sigma_s,
+            _pad: 0,
+        }
+    }
+
+    /// sigma_t = sigma_a + sigma_s per channel.
+    #[inline]
+    pub fn extinction(&self) -> Vec3 {
+        Vec3::from(self.sigma_a) + Vec3::from(self.sigma_s)
+    }
+
+    /// Whether the medium scatters in some channel (else it only absorbs, or is vacuum).
+    #[inline]
+    pub fn scatters(&self) -> bool {
+        self.sigma_s[0] > 0.0 || self.sigma_s[1] > 0.0 || self.sigma_s[2] > 0.0
+    }
+
+    /// Whether the medium attenuates light in some channel (else it is vacuum).
+    #[inline]
+    pub fn attenuates(&self) -> bool {
+        self.extinction().max_element() > 0.0
+    }
+}
+
+/// exp(-`sigma_t` x `distance`) per channel; `distance` may be `f32::MAX` (a ray that left
+/// the scene): then 0 where the medium attenuates, 1 where it does not.
 #[inline]
-pub fn transmittance(absorption: Vec3, distance: f32) -> Vec3 {
+pub fn transmittance(sigma_t: Vec3, distance: f32) -> Vec3 {
     Vec3::new(
-        (-(absorption.x * distance)).exp(),
-        (-(absorption.y * distance)).exp(),
-        (-(absorption.z * distance)).exp(),
+        (-(sigma_t.x * distance)).exp(),
+        (-(sigma_t.y * distance)).exp(),
+        (-(sigma_t.z * distance)).exp(),
     )
 }
 
-/// The transmittance of the segment from `from` to `to` in the medium of absorption
-/// `absorption` (a shadow ray crosses no surface, so one medium): 1 outside every medium.
-/// Out of line on the CPU: only scenes with media call it.
+/// The transmittance of the segment from `from` to `to` in medium `medium` of `media` (a
+/// segment between surfaces lies in one medium): 1 in vacuum. Exact for a homogeneous medium,
+/// so a shadow segment needs no estimate of it (ratio tracking estimates what has no closed
+/// form). Out of line on the CPU: only scenes with media call it.
 #[cfg_attr(not(target_arch = "spirv"), inline(never))]
-pub fn along(absorption: Vec3, from: Vec3, to: Vec3) -> Vec3 {
-    if absorption.max_element() > 0.0 {
-        transmittance(absorption, (to - from).length())
+pub fn along(media: &[Medium], medium: u32, from: Vec3, to: Vec3) -> Vec3 {
+    let sigma_t = media[medium as usize].extinction();
+    if sigma_t.max_element() > 0.0 {
+        transmittance(sigma_t, (to - from).length())
     } else {
         Vec3::ONE
     }
@@ -61,17 +119,17 @@ pub fn is_interface(material: &Material) -> bool {
         && material.alpha < DELTA_ALPHA
 }
 
-/// The absorption of the medium a ray leaving the surface of `material` in direction `dir`
-/// travels through: for a dielectric, the medium inside it where `dir` points against the
-/// surface's outward normal `outward` and none where it points along it; for any other
-/// material, `current`, the medium the path is in. Out of line on the CPU, as [`along`].
+/// The medium a ray leaving the surface of `material` in direction `dir` travels through: for
+/// a dielectric, the medium inside it where `dir` points against the surface's outward normal
+/// `outward` and the scene's medium `outside` where it points along it; for any other material,
+/// `current`, the medium the path is in. Out of line on the CPU, as [`along`].
 #[cfg_attr(not(target_arch = "spirv"), inline(never))]
-pub fn beyond(material: &Material, outward: Vec3, dir: Vec3, current: Vec3) -> Vec3 {
+pub fn beyond(material: &Material, outward: Vec3, dir: Vec3, current: u32, outside: u32) -> u32 {
     if material.kind == material_kind::DIELECTRIC {
         if dir.dot(outward) < 0.0 {
-            Vec3::from(material.interior_absorption())
+            material.interior_medium()
         } else {
-            Vec3::ZERO
+            outside
         }
     } else {
         current

@@ -7,16 +7,20 @@ use crate::bsdf::{self, DELTA_PDF};
 use crate::camera::{camera_origin, camera_ray_direction, lens_radius, thin_lens_ray};
 use crate::environment;
 use crate::features::FeatureSet;
+use crate::free_flight;
 use crate::geometry::{offset_ray_origin, shadow_ray_end};
 use crate::hit::SurfaceHit;
 use crate::light::{self, eval_radiance, LightKinds, LightSample};
 use crate::medium;
+use crate::phase;
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{light_sampling, mis, Light, Material, RenderParams, NONE};
 use crate::scene_view::SceneView;
 use crate::surface::{self, emission_at, shade};
-use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION, LENS_DIMENSION};
+use crate::vertex_samples::{
+    VertexQuery, VertexSamples, CAMERA_DIMENSION, FLIGHT_DIMENSION, LENS_DIMENSION,
+};
 use spirv_std::glam::Vec3;
 
 /// How the kernel meets the scene: the GPU implements it with `trace_ray` on an acceleration
@@ -128,9 +132,9 @@ pub struct PathState {
     /// What the light sample adds if the segment is clear (in a scene with media, before the
     /// transmittance of the part of the segment from `shadow_from` on).
     pub shadow_radiance: Vec3,
-    /// The absorption coefficient of the medium the shadow segment starts in, at `shadow_from`
-    /// (scenes with media: the segment passes interfaces, `crate::medium`).
-    pub shadow_absorption: Vec3,
+    /// The medium the shadow segment starts in, at `shadow_from` (scenes with media: the
+    /// segment passes interfaces, `crate::medium`).
+    pub shadow_medium: u32,
     /// The vertex the extension ray left and the BSDF density it was sampled with (for the MIS
     /// weight of a light it finds; `bsdf::DELTA_PDF` after a delta lobe).
     pub previous_vertex: Vec3,
@@ -139,9 +143,19 @@ pub struct PathState {
     /// throughput times it is what roulette reads, so radiance scaling at refractions alone
     /// does not end paths inside glass nor keep them after they leave it.
     pub eta_scale: f32,
-    /// The absorption coefficient of the medium the current ray travels through (`medium`;
-    /// zero outside every medium, where every path starts).
-    pub absorption: Vec3,
+    /// The medium the current ray travels through (an index into the media table,
+    /// `crate::medium`; the scene's medium where a path starts, vacuum by default).
+    pub medium: u32,
+    /// The path's free flights in media that scatter (`crate::free_flight`), one word (a
+    /// path's state is copied every round; scenes without media carry it unread): bits 2..30
+    /// count the flights sampled so far (their numbers' dimensions, `FLIGHT_DIMENSION`), bits
+    /// 0..2 are the hero channel that draws them (drawn at the first flight), and bit 31 says
+    /// the last extension ray scattered at `ray_origin`, the vertex [`PathState::advance`]
+    /// reached: a medium vertex ([`PathState::scattered`]).
+    pub flights: u32,
+    /// The ratios of the three channels' densities of the path's flights to their mean
+    /// (`crate::free_flight`; the throughput is already divided by that mean).
+    pub ratios: Vec3,
     /// Vertices so far: 0 while the camera ray is out.
     pub depth: u32,
     /// The sample's random numbers (the one-path loop draws a vertex's samples from them; the
@@ -172,11 +186,13 @@ impl PathState {
             shadow_to: Vec3::ZERO,
             shadow: false,
             shadow_radiance: Vec3::ZERO,
-            shadow_absorption: Vec3::ZERO,
+            shadow_medium: medium::VACUUM,
             previous_vertex: origin,
             previous_pdf: 0.0,
             eta_scale: 1.0,
-            absorption: Vec3::ZERO,
+            medium: medium::VACUUM,
+            flights: 0,
+            ratios: Vec3::ONE,
             depth: 0,
             rng,
         }
@@ -247,6 +263,12 @@ impl PathState {
         scene: &SceneView,
         hit: &SurfaceHit,
     ) -> Arrival {
+        if features.media() && self.scattered() {
+            return Arrival {
+                material: Material::diffuse([0.0; 3]),
+                query: self.medium_query(features, scene.params),
+            };
+        }
         let (material, shading_normal) = shade(features, scene, hit);
         let query = self.vertex_query(features, scene.params, hit, &material, shading_normal);
         Arrival { material, query }
@@ -278,7 +300,10 @@ impl PathState {
         }
         self.extend = false;
         if features.media() {
-            self.cross_medium(hit);
+            if self.fly(scene, hit) {
+                self.depth += 1;
+                return true;
+            }
             if hit.is_hit() && medium::is_interface(&scene.materials[hit.material as usize]) {
                 self.pass_interface(scene, hit);
                 return false;
@@ -430,7 +455,9 @@ impl PathState {
         query: &VertexQuery,
         samples: &VertexSamples,
     ) {
-        if query.lambertian {
+        if features.media() && self.scattered() {
+            self.medium_vertex(features, scene, query, samples);
+        } else if query.lambertian {
             self.lambertian_vertex(features, scene, hit, material, query, samples);
         } else {
             self.bsdf_vertex(features, scene, hit, material, query, samples);
@@ -480,7 +507,7 @@ impl PathState {
                 self.await_shadow(query.light_kinds, lights, ray_origin, &ls, radiance);
                 if features.media() {
                     // A Lambertian surface leaves the path in its medium.
-                    self.shadow_absorption = self.absorption;
+                    self.shadow_medium = self.medium;
                 }
             }
         }
@@ -561,8 +588,7 @@ impl PathState {
                 let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
                 self.await_shadow(query.light_kinds, lights, from, &ls, radiance);
                 if features.media() {
-                    self.shadow_absorption =
-                        medium::beyond(material, hit.normal, wi, self.absorption);
+                    self.shadow_medium = self.medium_beyond(scene, material, hit, wi);
                 }
             }
         }
@@ -596,7 +622,7 @@ impl PathState {
             self.eta_scale *= s.eta2;
             // Only a dielectric bounds a medium (`features::MEDIA` implies `DIELECTRIC`).
             if features.media() {
-                self.absorption = medium::beyond(material, hit.normal, s.wi, self.absorption);
+                self.medium = self.medium_beyond(scene, material, hit, s.wi);
             }
         }
         if !(self.throughput.max_element() > 0.0) {
@@ -620,25 +646,161 @@ impl PathState {
         true
     }
 
-    /// The ray just traced crossed the medium it travels in up to `hit` (or out of the scene):
-    /// its throughput times the segment's transmittance (`medium`). Out of line on the CPU: only
-    /// scenes with media call it.
+    /// The ray just traced crosses the medium it travels in up to `hit` (or out of the scene).
+    /// In a medium that only absorbs, the throughput takes the segment's transmittance
+    /// (`medium`); in one that scatters, a free flight is sampled (`crate::free_flight`: the
+    /// path's hero channel from the number at `FLIGHT_DIMENSION`, drawn at its first flight,
+    /// the k-th distance from the one at `FLIGHT_DIMENSION + 1 + k`) and its weight taken.
+    /// Returns whether the ray scattered
+    /// before `hit`: then `ray_origin` is the collision, a medium vertex (`scattered`). Out of
+    /// line on the CPU: only scenes with media call it.
     #[cfg_attr(not(target_arch = "spirv"), inline(never))]
-    fn cross_medium(&mut self, hit: &SurfaceHit) {
-        if self.absorption.max_element() > 0.0 {
-            let distance = if hit.is_hit() {
-                (hit.position - self.ray_origin).length()
-            } else {
-                f32::MAX
-            };
-            self.throughput *= medium::transmittance(self.absorption, distance);
+    fn fly(&mut self, scene: &SceneView, hit: &SurfaceHit) -> bool {
+        let m = &scene.media[self.medium as usize];
+        let sigma_t = m.extinction();
+        if !(sigma_t.max_element() > 0.0) {
+            return false;
         }
+        let distance = if hit.is_hit() {
+            (hit.position - self.ray_origin).length()
+        } else {
+            f32::MAX
+        };
+        if !m.scatters() {
+            self.throughput *= medium::transmittance(sigma_t, distance);
+            return false;
+        }
+        let count = (self.flights >> 2) & FLIGHT_COUNT;
+        if count == 0 {
+            self.rng.seek(FLIGHT_DIMENSION);
+            self.flights = free_flight::hero_channel(self.rng.next_f32());
+        }
+        let hero = self.flights & 3;
+        self.rng.seek(FLIGHT_DIMENSION + 1 + count);
+        let u = self.rng.next_f32();
+        let sigma_s = Vec3::from(m.sigma_s);
+        let flight = free_flight::sample(sigma_t, sigma_s, distance, hero, u, self.ratios);
+        self.throughput *= flight.weight;
+        self.ratios = flight.ratios;
+        self.flights = (((count + 1) & FLIGHT_COUNT) << 2) | hero;
+        if flight.scattered {
+            self.ray_origin += self.ray_dir * flight.t;
+            self.flights |= SCATTERED;
+        }
+        flight.scattered
+    }
+
+    /// The medium a ray leaving the surface of `material` at `hit` along `dir` travels in
+    /// (`medium::beyond`; outside every shape, the scene's).
+    #[inline]
+    fn medium_beyond(
+        &self,
+        scene: &SceneView,
+        material: &Material,
+        hit: &SurfaceHit,
+        dir: Vec3,
+    ) -> u32 {
+        let outside = scene.params.environment.medium;
+        medium::beyond(material, hit.normal, dir, self.medium, outside)
+    }
+
+    /// What a medium vertex (`scattered`) will draw: a light sample unless BSDF sampling
+    /// alone is asked for (the phase function is never a delta), the extension and roulette
+    /// as at a surface; no lobe choice. Its normals are the direction of travel (unread: the
+    /// phase function has no hemisphere).
+    #[inline]
+    fn medium_query<F: FeatureSet>(&self, features: F, params: &RenderParams) -> VertexQuery {
+        let light_count = if !features.lights(params) || features.mis_mode(params) == mis::BSDF_ONLY
+        {
+            0
+        } else if features.single_light(params) {
+            1
+        } else {
+            params.integrator.light_count
+        };
+        let mut throughput = self.throughput;
+        if features.dielectric() {
+            throughput *= self.eta_scale;
+        }
+        let survival = if features.rr_throughput(params) {
+            throughput.max_element().min(1.0)
+        } else {
+            params.integrator.rr_probability
+        };
+        VertexQuery {
+            depth: self.depth,
+            x: self.ray_origin,
+            n: self.ray_dir,
+            ng: self.ray_dir,
+            smooth: false,
+            light_count,
+            mode: light_sampling_of(features, params),
+            light_kinds: LightKinds::of(features, params),
+            extend: self.depth < params.integrator.max_depth,
+            roulette: self.depth >= params.integrator.rr_start_depth,
+            survival,
+            lambertian: false,
+            chooses_lobe: false,
+        }
+    }
+
+    /// [`PathState::vertex`] at a medium vertex (the path scattered at `query.x` in its medium,
+    /// its throughput already weighed by sigma_s over the collision's density,
+    /// `crate::free_flight`): next-event estimation with the phase function in the place of
+    /// f cos (a medium point has no surface, no cosine), its shadow segment starting in the
+    /// medium, weighed by MIS against phase sampling; then roulette, and the extension drawn
+    /// from the phase function (weight exactly 1, its density the MIS density of a light it
+    /// finds). Rays leave from the point itself: there is no surface to offset from.
+    #[cfg_attr(not(target_arch = "spirv"), inline(never))]
+    fn medium_vertex<F: FeatureSet>(
+        &mut self,
+        features: F,
+        scene: &SceneView,
+        query: &VertexQuery,
+        samples: &VertexSamples,
+    ) {
+        self.flights &= !SCATTERED;
+        let (params, lights) = (scene.params, scene.lights);
+        let x = query.x;
+        let wo = -self.ray_dir;
+        let g = scene.media[self.medium as usize].g;
+        if query.samples_light() {
+            let ls = samples.light_sample(query, scene);
+            let wi = (ls.point.position - x).normalize();
+            let cos_y = -ls.point.normal.dot(wi);
+            let pdf_w = ls.pdf_solid_angle;
+            let p = phase::eval(g, wo, wi);
+            if cos_y > 0.0 && pdf_w > 0.0 && p > 0.0 {
+                let emitted = light::radiance(features, scene, query.light_kinds, &ls);
+                let weight = light_sample_weight(
+                    features,
+                    params,
+                    query.light_kinds,
+                    &lights[ls.light as usize],
+                    pdf_w,
+                    p,
+                );
+                let radiance = self.throughput * emitted * (p * weight / pdf_w);
+                self.await_shadow(query.light_kinds, lights, x, &ls, radiance);
+                self.shadow_medium = self.medium;
+            }
+        }
+        if !query.extend || !self.survives_roulette(query, samples) {
+            return;
+        }
+        let (u1, u2) = samples.u_brdf;
+        let wi = phase::sample(g, wo, u1, u2);
+        let pdf = phase::eval(g, wo, wi);
+        if !(self.throughput.max_element() > 0.0) {
+            return;
+        }
+        self.await_extension(x, wi, x, pdf);
     }
 
     /// The light sample `ls` waits for its shadow segment from `from` (offset off the surface)
     /// to the light point; `radiance` is what it adds if the segment is clear (in a scene with
-    /// media, times the segment's transmittance: the caller sets `shadow_absorption`, the
-    /// medium the segment leaves into, and [`PathState::shadow_passes`] applies it).
+    /// media, times the segment's transmittance: the caller sets `shadow_medium`, the medium
+    /// the segment leaves into, and [`PathState::shadow_passes`] applies it).
     #[inline]
     fn await_shadow(
         &mut self,
@@ -671,8 +833,9 @@ impl PathState {
     /// on the CPU: only scenes with media call it.
     #[cfg_attr(not(target_arch = "spirv"), inline(never))]
     pub fn shadow_passes(&mut self, scene: &SceneView, blocker: &SurfaceHit) -> bool {
+        let media = scene.media;
         if !blocker.is_hit() {
-            let t = medium::along(self.shadow_absorption, self.shadow_from, self.shadow_to);
+            let t = medium::along(media, self.shadow_medium, self.shadow_from, self.shadow_to);
             self.radiance += self.shadow_radiance * t;
             self.shadow = false;
             return false;
@@ -683,10 +846,15 @@ impl PathState {
             return false;
         }
         let dir = self.shadow_to - self.shadow_from;
-        self.shadow_radiance *=
-            medium::along(self.shadow_absorption, self.shadow_from, blocker.position);
-        self.shadow_absorption =
-            medium::beyond(material, blocker.normal, dir, self.shadow_absorption);
+        self.shadow_radiance *= medium::along(
+            media,
+            self.shadow_medium,
+            self.shadow_from,
+            blocker.position,
+        );
+        let outside = scene.params.environment.medium;
+        self.shadow_medium =
+            medium::beyond(material, blocker.normal, dir, self.shadow_medium, outside);
         self.shadow_from = beyond_surface(blocker, dir);
         true
     }
@@ -698,7 +866,7 @@ impl PathState {
     #[cfg_attr(not(target_arch = "spirv"), inline(never))]
     fn pass_interface(&mut self, scene: &SceneView, hit: &SurfaceHit) {
         let material = &scene.materials[hit.material as usize];
-        self.absorption = medium::beyond(material, hit.normal, self.ray_dir, self.absorption);
+        self.medium = self.medium_beyond(scene, material, hit, self.ray_dir);
         self.ray_origin = beyond_surface(hit, self.ray_dir);
         self.extend = true;
     }
@@ -715,7 +883,19 @@ impl PathState {
     }
 }
 
+/// [`PathState::flights`]: the mask of the flight count (bits 2..30, shifted down) and the
+/// medium vertex's bit.
+const FLIGHT_COUNT: u32 = (1 << 29) - 1;
+const SCATTERED: u32 = 1 << 31;
+
 impl PathState {
+    /// Whether the vertex [`PathState::advance`] reached is a medium vertex, at `ray_origin`
+    /// (see [`PathState::flights`]).
+    #[inline]
+    pub fn scattered(&self) -> bool {
+        self.flights & SCATTERED != 0
+    }
+
     /// The MIS weight of a light (area light or environment map) that the extension from
     /// `previous_vertex` found, where light sampling has density `pdf_light` (read only under
     /// the power heuristic; the other modes' unused density is pure code, which inlining
@@ -915,11 +1095,17 @@ pub fn start_path_at<F: FeatureSet>(
         u,
         v,
     );
-    if features.thin_lens() && lens_radius(camera) > 0.0 {
+    let mut path = if features.thin_lens() && lens_radius(camera) > 0.0 {
         rng.seek(LENS_DIMENSION);
         let (u1, u2) = rng.next_2d();
         let (origin, dir) = thin_lens_ray(camera, dir, u1, u2);
-        return PathState::new(origin, dir, rng);
+        PathState::new(origin, dir, rng)
+    } else {
+        PathState::new(camera_origin(camera), dir, rng)
+    };
+    if features.media() {
+        // The camera is outside every closed shape, in the scene's medium.
+        path.medium = params.environment.medium;
     }
-    PathState::new(camera_origin(camera), dir, rng)
+    path
 }

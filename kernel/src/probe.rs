@@ -11,11 +11,13 @@ use crate::bsdf::multiple_scattering::GlossyAlbedo;
 use crate::camera::camera_ray_direction;
 use crate::features::Dynamic;
 use crate::frame::orthonormal_basis;
+use crate::free_flight;
 use crate::geometry::{
     geometry_factor, intersect_sphere, intersect_triangle_uv, offset_ray_origin,
     reproject_to_sphere, shadow_ray_end, triangle_point, triangle_point_error,
 };
 use crate::light::triangle;
+use crate::phase;
 use crate::rng::{pcg4d, u32_to_unit_f32};
 use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
 use crate::scene::{light_kind, Camera, Light, Material, ShadingTriangle};
@@ -87,7 +89,12 @@ pub mod function {
     /// sign = in1.w, texel = in2.xyz, barycentrics = (in2.w, in3.x) -> out0.xyz =
     /// surface::mapped_normal
     pub const MAPPED_NORMAL: u32 = 17;
-    pub const COUNT: u32 = 18;
+    /// wo = in0.xyz, g = in0.w, wi = in1.xyz, u1 = in1.w, sigma_t = in2.xyz, u2 = in2.w,
+    /// sigma_s = in3.xyz, d = in3.w -> out0 = (phase::sample(g, wo, u1, u2),
+    /// phase::eval(g, wo, wi)), out1 = free_flight::sample(sigma_t, sigma_s, d,
+    /// hero_channel(u1), u2, (1, 1, 1))'s (t, weight)
+    pub const MEDIUM: u32 = 18;
+    pub const COUNT: u32 = 19;
 }
 
 #[inline]
@@ -244,6 +251,15 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
                 i3.truncate(),
                 i3.w,
             )),
+        )
+    } else if function == function::MEDIUM {
+        let (wo, wi) = (i0.truncate(), i1.truncate());
+        let (g, u1, u2) = (i0.w, i1.w, i2.w);
+        let hero = free_flight::hero_channel(u1);
+        let flight = free_flight::sample(i2.truncate(), i3.truncate(), i3.w, hero, u2, Vec3::ONE);
+        (
+            phase::sample(g, wo, u1, u2).extend(phase::eval(g, wo, wi)),
+            Vec4::new(flight.t, flight.weight.x, flight.weight.y, flight.weight.z),
         )
     } else if function == function::BRDF {
         let (n, w) = (i0.truncate(), i1.truncate());

@@ -202,15 +202,14 @@ pub struct Material {
     /// t < 0, BLEND: with probability -t x that alpha, -t in (0, 1] being the factor's alpha.
     pub opacity: f32,
     /// CONDUCTOR with a complex index: the extinction coefficient k. METALLIC_ROUGHNESS: k[0]
-    /// is the sheen's roughness in [0, 1] ([`Material::sheen_roughness`]). DIELECTRIC: the
-    /// absorption coefficient of the medium inside (per unit length, RGB; zero: clear;
-    /// `crate::medium`, [`Material::interior_absorption`]).
+    /// is the sheen's roughness in [0, 1] ([`Material::sheen_roughness`]).
     pub k: [f32; 3],
     /// METALLIC_ROUGHNESS: glTF's clear coat (`KHR_materials_clearcoat`, `crate::bsdf::coat`):
     /// its weight (`clearcoatFactor`) in the low 16 bits and its roughness
     /// (`clearcoatRoughnessFactor`) in the high 16, each round(x 65535)
     /// ([`Material::pack_coat`], [`Material::coat_weight`], [`Material::coat_roughness`]); 0,
-    /// no coat.
+    /// no coat. DIELECTRIC: the medium inside, an index into the media table
+    /// (`crate::medium`; 0, vacuum: clear), [`Material::interior_medium`].
     pub coat: u32,
     /// Per [`texture_slot`]: the texture (an index into the texture table, `crate::texture`)
     /// whose value at the point multiplies that parameter, or [`NONE`].
@@ -323,17 +322,22 @@ impl Material {
         self.k = [roughness.clamp(0.0, 1.0), 0.0, 0.0];
     }
 
-    /// DIELECTRIC: the absorption coefficient of the medium inside (stored in `k`).
+    /// DIELECTRIC: the medium inside, an index into the media table (stored in `coat`; 0 is
+    /// `medium::VACUUM`).
     #[inline]
-    pub fn interior_absorption(&self) -> [f32; 3] {
-        self.k
+    pub fn interior_medium(&self) -> u32 {
+        self.coat
     }
 
-    /// Whether the material is a dielectric with an absorbing medium inside.
+    /// Sets the medium inside a DIELECTRIC (an index into the media table).
+    pub fn set_interior_medium(&mut self, medium: u32) {
+        self.coat = medium;
+    }
+
+    /// Whether the material is a dielectric with a medium inside (not vacuum).
     #[inline]
     pub fn has_interior_medium(&self) -> bool {
-        self.kind == material_kind::DIELECTRIC
-            && (self.k[0] > 0.0 || self.k[1] > 0.0 || self.k[2] > 0.0)
+        self.kind == material_kind::DIELECTRIC && self.coat != 0
     }
 
     /// Whether a CONDUCTOR reflects by the exact Fresnel of its complex index `eta` + i `k`
@@ -576,5 +580,8 @@ pub struct EnvironmentParams {
     pub scale: f32,
     /// Cosine and sine of the map's rotation about +y.
     pub rotation: [f32; 2],
-    pub _pad: [u32; 2],
+    /// The medium outside every closed shape, the camera's (an index into the media table,
+    /// `crate::medium`; 0: vacuum).
+    pub medium: u32,
+    pub _pad: u32,
 }

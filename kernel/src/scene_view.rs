@@ -2,6 +2,7 @@
 //! the backend's buffers (the GPU's storage buffers, the CPU renderer's vectors) and passed
 //! once, as one value, to whatever reads the scene.
 
+use crate::medium::Medium;
 use crate::scene::{Instance, Light, Material, RenderParams, ShadingTriangle};
 
 /// The tables of `crate::scene` a path reads, and the render's parameters. Geometry (spheres,
@@ -18,4 +19,6 @@ pub struct SceneView<'a> {
     /// The texture table (`crate::texture`).
     pub textures: &'a [u32],
     pub instances: &'a [Instance],
+    /// The media table (`crate::medium`; record 0 is vacuum).
+    pub media: &'a [Medium],
 }

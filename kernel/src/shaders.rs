@@ -9,7 +9,7 @@
 //! 9 the environment table (`crate::environment`; one number when there is no map),
 //! 10 the shading table (`ShadingTriangle`s; one zero record when there is none),
 //! 11 the texture table (`crate::texture`), 12 the instance table (`Instance`s; one zero record
-//! when there is none).
+//! when there is none), 13 the media table (`crate::medium`; record 0, vacuum, always there).
 //! Specialization constant 0: the feature bits of `crate::features` (0: generic path).
 //! Hit groups: 0 triangles (closest hit), then 1 spheres (intersection + closest hit), then
 //! instanced triangles (closest hit), each present only where the scene has that geometry;
@@ -22,6 +22,7 @@ use crate::features::{Dynamic, FeatureSet};
 use crate::film_sample::{classify, sample_use};
 use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::hit::SurfaceHit;
+use crate::medium::Medium;
 use crate::opacity::{covers, CandidateRay, HoleTables};
 use crate::path::{render_sample, Tracer};
 use crate::scene::{
@@ -181,6 +182,7 @@ pub fn raygen(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] shading: &[ShadingTriangle],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] textures: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] instances: &[Instance],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 13)] media: &[Medium],
     #[spirv(descriptor_set = 0, binding = 7)] accum_m2: &Image!(
         2D,
         format = rgba32f,
@@ -227,6 +229,7 @@ pub fn raygen(
         shading,
         textures,
         instances,
+        media,
     };
     let mut s = 0;
     while s < params.samples.count {

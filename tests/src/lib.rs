@@ -113,6 +113,7 @@ pub fn shade_at(
         shading,
         textures,
         instances,
+        media: &[kernel::medium::Medium::VACUUM],
     };
     let hit = kernel::SurfaceHit {
         material,

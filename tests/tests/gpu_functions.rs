@@ -309,6 +309,27 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                     [v * 0.5, 0.0, 0.0, 0.0],
                 ])
             }
+            function::MEDIUM => {
+                // Phase: any g in (-1, 1) (isotropic below 1e-3 included), unit directions.
+                // Flights: coefficients over four decades, a channel of 0 at times, surfaces
+                // near and far and none (f32::MAX).
+                let g_any = g.range(-0.99, 0.99);
+                let gg = g.pick(&[0.0, 5e-4, -0.9, 0.9, g_any]);
+                let coefficient = |g: &mut Gen| {
+                    let any = 10f32.powf(g.range(-2.0, 2.0));
+                    g.pick(&[0.0, 1.0, any])
+                };
+                let sigma_s = Vec3::new(coefficient(g), coefficient(g), coefficient(g));
+                let sigma_a = Vec3::new(g.unit(), g.unit(), g.unit()) * g.pick(&[0.0, 1.0]);
+                let near = 10f32.powf(g.range(-2.0, 2.0));
+                let d = g.pick(&[f32::MAX, near]);
+                rec([
+                    w(g.dir(), gg),
+                    w(g.dir(), g.unit()),
+                    w(sigma_s + sigma_a, g.unit()),
+                    w(sigma_s, d),
+                ])
+            }
             _ => unreachable!(),
         })
         .collect()
@@ -353,6 +374,36 @@ struct Bound {
     why: &'static str,
 }
 
+/// The bound on the error of a medium probe record's drawn distance -ln(1 - u) / sigma_h under
+/// Vulkan's `log` (see `allowed_abs`; 0 where the hero does not attenuate), and the largest
+/// extinction coefficient. (A flight that reaches the surface has t = d on both sides.)
+fn medium_flight_error(r: &[[u32; 4]; 4]) -> (f64, f64) {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]) as f64;
+    let sigma = [f(2, 0), f(2, 1), f(2, 2)];
+    let sigma_max = sigma.iter().copied().fold(0.0, f64::max);
+    let hero = ((f(1, 3) * 3.0) as usize).min(2);
+    if sigma[hero] <= 0.0 {
+        return (0.0, sigma_max);
+    }
+    let ln = (1.0 - f(2, 3)).ln();
+    let dt = (2f64.powi(-21) + 3.0 * f32::EPSILON as f64 * ln.abs()) / sigma[hero];
+    (dt, sigma_max)
+}
+
+/// The largest exponent sigma_k t of a medium probe record's flight (t recomputed in f64).
+fn medium_exponent(r: &[[u32; 4]; 4]) -> f64 {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]) as f64;
+    let sigma = [f(2, 0), f(2, 1), f(2, 2)];
+    let hero = ((f(1, 3) * 3.0) as usize).min(2);
+    let d = f(3, 3);
+    let t = if sigma[hero] > 0.0 {
+        (-(1.0 - f(2, 3)).ln() / sigma[hero]).min(d)
+    } else {
+        d
+    };
+    sigma.iter().map(|s| s * t).fold(0.0, f64::max)
+}
+
 /// The microfacet and BSDF probes' ill-conditioned records: roughness below 0.01 (a lobe a
 /// thousandth of a radian wide: its density moves with the last bits of the half vector), and
 /// refraction with |eta - 1| < 1e-3 (the generalised half vector wo + eta wi nearly vanishes).
@@ -389,6 +440,7 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "bsdf::sample", func: function::BSDF_SAMPLE, max_ulps: 2048, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharply_sampled_or_index_matched, 5e-2)), why: "the visible-normal sampler, Fresnel choice and pdf (FMA contraction); weights of grazing directions carry G1 ~ n . wi, whose rounding moves them relatively (measured 648 ULP): 2048 ULP or 64 eps; alpha < 0.045 or |eta - 1| < 1e-3: the sampler's stretch by alpha magnifies the rounding of wo by up to 1/alpha, and the density is read at the sampled wi on a lobe alpha wide (4 eps / alpha^2 relative, 3354 ULP measured at alpha 0.016 under a clear coat), down to a thousandth of a radian (measured 2.6% where a 0.9-metallic glTF material picks the sharp lobe 9 times in 10): 5% relative" },
     Bound { name: "sample_triangle_light / solid_angle", func: function::TRIANGLE_LIGHT, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "atan2_turns, normalisations and the ray/plane step (FMA contraction): 64 eps relative to the solid angle, density and geometry size, divided by h, the receiver's elevation above the light's plane (all are 0 / 0 in it); normals 64 eps" },
     Bound { name: "texture footprint and bilerp", func: function::TEXTURE, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, why: "the same texels and weights bit for bit: wrapping, clamping and the blend" },
+    Bound { name: "phase::sample / eval, free_flight::sample", func: function::MEDIUM, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "the phase sampler's cos/sin of the azimuth, sqrt and normalisation (FMA contraction): 8 eps on a unit vector; its density a rational function of one dot product, 8 ULP; a flight's t = -ln(1 - u) / sigma under Vulkan's log (2^-21 absolute on [0.5, 2]) and its weights, quotients of exponentials (3 + 2 |x| ULP) whose exponents carry t's error, denormals flushed: derived per record in `allowed_abs`" },
     Bound { name: "surface::mapped_normal", func: function::MAPPED_NORMAL, max_ulps: 8, abs: 16.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "a blend, one Gram-Schmidt step, a cross product and two normalisations of unit-scale vectors (FMA contraction, sqrt): 16 eps on a unit vector" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
@@ -435,6 +487,40 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let t = glam::Vec3::new(f(1, 0), f(1, 1), f(1, 2)).as_dvec3();
             let across = (t - n * n.dot(t)).length();
             (b.abs as f64 * (t.length() / across).max(1.0)) as f32
+        }
+        // A flight's weights (out1.yzw): exp(-x) moves by the absolute error of x relative, and
+        // x = sigma_k t carries t's relative error (a logarithm, a division, a product: 3
+        // eps); a weight is a quotient of two such, so (8 + 6 x) eps relative, x the record's
+        // largest exponent up to 88 (beyond it every exponential is 0 or denormal on both).
+        // A flight (out1): under Vulkan's precision rules ("Precision and Operation of SPIR-V
+        // Instructions") `log` has an absolute error up to 2^-21 on [0.5, 2] (1 - u lies
+        // there for u < 0.5), so t = -ln(1 - u) / sigma_h is off by up to (2^-21 + 3 eps
+        // |ln(1 - u)|) / sigma_h (with the division), and each exponent x_k = sigma_k t by
+        // sigma_k times that; `exp` is within 3 + 2 |x| ULP. A weight, a quotient of such
+        // exponentials, is off relatively by 2 (max_k sigma_k dt + (3 + 2 x) eps) + 8 eps (x
+        // the record's largest exponent, up to 88). Vulkan may also flush denormals: a
+        // transmittance below 2^-126 read as 0 moves a weight sigma_s,c T_c / m by at most
+        // sigma_s,c 2^-126 / m, and m >= sigma_h T_h / 3 >= 0.01 x 6e-8 / 3 (the hero's own
+        // exponent is at most 17), sigma_s <= 100 here: 3e-25 absolute.
+        function::MEDIUM if k == 1 => {
+            let (dt, sigma_max) = medium_flight_error(r);
+            if j == 0 {
+                (dt + 2.0 * f32::EPSILON as f64 * value as f64) as f32
+            } else {
+                let x = medium_exponent(r).min(88.0);
+                let eps = f32::EPSILON as f64;
+                let rel = 2.0 * (sigma_max * dt + (3.0 + 2.0 * x) * eps) + 8.0 * eps;
+                ((value as f64 * rel) as f32).max(3e-25)
+            }
+        }
+        // The phase function's density near its peak: 1 + g^2 - 2 g cos cancels, and the cosine
+        // (a dot product, 2 eps absolute) moves it by 4 g eps: relative error 1.5 x 4 g eps /
+        // (1 + g^2 - 2 g cos), beside 8 eps of the rest.
+        function::MEDIUM if k == 0 && j == 3 => {
+            let v = |i: usize| glam::Vec3::new(f(i, 0), f(i, 1), f(i, 2)).as_dvec3();
+            let g = f(0, 3) as f64;
+            let denom = 1.0 + g * g - 2.0 * g * (-v(1).dot(v(0)));
+            value * ((8.0 + 6.0 * g.abs() / denom) * f32::EPSILON as f64) as f32
         }
         function::SAMPLE_SPHERE | function::SAMPLE_SPHERE_CONE if k == 0 && j < 3 => {
             let c = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2));

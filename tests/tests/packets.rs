@@ -433,6 +433,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
             shading: &[],
             textures: &[],
             instances: &[],
+            media: &[kernel::medium::Medium::VACUUM],
         };
         for (lane, entry) in queries.iter().enumerate() {
             let Some((rng, q)) = entry else { continue };

@@ -303,6 +303,28 @@ fn light_only_bsdf_only_and_mis_agree_through_an_interface() {
     variants_agree("through an interface", &text, None, &MODES);
 }
 
+/// The glossy scene filled with a fog that scatters (`[scene] medium`: the camera, the light
+/// and every surface in it; chromatic coefficients, forward scattering g = 0.4): next-event
+/// estimation from medium vertices (the phase function in the place of f cos) and from
+/// surfaces through the fog, against phase and BSDF sampling whose extensions fly until they
+/// collide or find the light; the strategies agree only if the phase function's value, its
+/// density and its sampler agree, and the shadow segments' transmittance is the extension's
+/// expected weight. The sharp sphere is Lambertian, as in the absorbing medium's test.
+#[test]
+fn light_only_bsdf_only_and_mis_agree_in_a_scattering_fog() {
+    let text = SPHERE_LIGHT_SCENE
+        .replace(
+            "sharp = { kd = [0.2, 0.3, 0.5], ks = [0.4, 0.4, 0.4], alpha = 0.1 }",
+            "sharp = { kd = [0.2, 0.3, 0.5] }",
+        )
+        .replace(
+            "[materials]\n",
+            "[media]\nfog = { sigma_a = [0.02, 0.03, 0.05], sigma_s = [0.15, 0.2, 0.3], g = 0.4 }\n\n[scene]\nmedium = \"fog\"\n\n[materials]\n",
+        );
+    assert!(text.contains("medium = \"fog\""));
+    variants_agree("scattering fog", &text, None, &MODES);
+}
+
 /// The glossy scene without its sphere light, under an environment map with a bright patch (a
 /// "sun" of 2 x 1 texels) over a smooth sky: importance sampling by luminance (power MIS)
 /// against light-only, BSDF-only, half weights and uniform directions.

@@ -14,6 +14,7 @@ use crate::settings::RenderSettings;
 use glam::Vec3;
 use indicatif::ProgressBar;
 use kernel::features::{self, Dynamic, DynamicWithout, FeatureSet, Static};
+use kernel::medium::Medium;
 use kernel::path::render_sample;
 use kernel::scene::{Light, Material, RenderParams, ShadingTriangle};
 use kernel::{SceneView, Tracer};
@@ -30,6 +31,8 @@ pub struct CpuRenderer {
     /// (`kernel::texture`).
     pub shading: Vec<ShadingTriangle>,
     pub textures: Vec<u32>,
+    /// The media table (`kernel::medium`).
+    pub media: Vec<Medium>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path).
     pub features: u32,
     /// How a tile's samples are computed, chosen once when the renderer is built.
@@ -149,6 +152,7 @@ impl CpuRenderer {
             environment: scene.environment_table(),
             shading: scene.shading_table(),
             textures: scene.textures.words.clone(),
+            media: scene.media.clone(),
             features: with_all_extended(scene.features(settings)),
             tiles,
             holes,
@@ -200,6 +204,7 @@ impl CpuRenderer {
             shading: &self.shading,
             textures: &self.textures,
             instances: self.bvh.instances(),
+            media: &self.media,
         }
     }
 

@@ -15,6 +15,7 @@ use super::transform::Transform;
 use super::{CameraDesc, Scene, TriangleGroup};
 use bytemuck::Zeroable;
 use glam::Vec3;
+use kernel::medium::Medium;
 use kernel::scene::{
     material_kind, shading_flags, texture_slot, Instance, Light, Material, ShadingTriangle, Sphere,
     Triangle, NONE,
@@ -42,6 +43,10 @@ pub(super) struct SceneTables {
     pub mesh_boxes: Vec<(Vec3, Vec3)>,
     pub instances: Vec<Instance>,
     pub instance_meshes: Vec<u32>,
+    /// The media table (`kernel::medium`): vacuum first once any medium is added
+    /// ([`SceneTables::add_medium`]), and the medium filling the scene (0: vacuum).
+    pub media: Vec<Medium>,
+    pub scene_medium: u32,
 }
 
 /// Where a loaded triangle goes: the world-space table, or an instanced mesh in object space.
@@ -72,16 +77,32 @@ impl SceneTables {
         (self.materials.len() - 1) as u32
     }
 
-    /// The index of dielectric `m` holding the medium named `medium`, of absorption
-    /// `absorption`, inside (`Material::interior_absorption`): a copy named "MATERIAL holding
-    /// MEDIUM", made once per pair.
-    pub fn with_interior(&mut self, m: u32, medium: &str, absorption: [f32; 3]) -> u32 {
-        let name = format!("{} holding {medium}", self.material_names[m as usize]);
+    /// Adds `medium` to the media table (after vacuum, record 0); its index. A medium that
+    /// attenuates nothing is vacuum: 0.
+    pub fn add_medium(&mut self, medium: Medium) -> u32 {
+        if !medium.attenuates() {
+            return kernel::medium::VACUUM;
+        }
+        if self.media.is_empty() {
+            self.media.push(Medium::VACUUM);
+        }
+        self.media.push(medium);
+        (self.media.len() - 1) as u32
+    }
+
+    /// The index of dielectric `m` holding medium `medium` (an index into the media table),
+    /// named `medium_name`, inside (`Material::interior_medium`): `m` itself for vacuum, else
+    /// a copy named "MATERIAL holding MEDIUM", made once per pair.
+    pub fn with_interior(&mut self, m: u32, medium_name: &str, medium: u32) -> u32 {
+        if medium == kernel::medium::VACUUM {
+            return m;
+        }
+        let name = format!("{} holding {medium_name}", self.material_names[m as usize]);
         if let Some(k) = self.material_names.iter().position(|n| *n == name) {
             return k as u32;
         }
         let mut material = self.materials[m as usize];
-        material.k = absorption;
+        material.set_interior_medium(medium);
         let two_sided = self.two_sided[m as usize];
         self.add_material(name, material, two_sided)
     }
@@ -456,6 +477,12 @@ impl SceneTables {
             meshes: self.meshes,
             instances: self.instances,
             instance_meshes: self.instance_meshes,
+            media: if self.media.is_empty() {
+                vec![Medium::VACUUM]
+            } else {
+                self.media
+            },
+            medium: self.scene_medium,
             notes: Vec::new(),
             inputs: Vec::new(),
         }

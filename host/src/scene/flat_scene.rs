@@ -140,6 +140,10 @@ pub struct Scene {
     pub shading: Vec<ShadingTriangle>,
     /// The materials' textures (`Material::textures` indexes it).
     pub textures: textures::TextureTable,
+    /// The media table (`kernel::medium`; record 0 is vacuum, always there) and the medium
+    /// filling the scene outside every closed shape, the camera's (0: vacuum).
+    pub media: Vec<kernel::medium::Medium>,
+    pub medium: u32,
     /// What the loader approximated or ignored (glTF features twinpath does not read yet):
     /// shown to the user before a render.
     pub notes: Vec<String>,
@@ -197,7 +201,8 @@ impl Scene {
                 },
                 scale: map.map_or(1.0, |m| m.scale),
                 rotation: [rotation.cos(), rotation.sin()],
-                _pad: [0; 2],
+                medium: self.medium,
+                _pad: 0,
             },
         }
     }
@@ -253,9 +258,9 @@ impl Scene {
     }
 
     /// Bytes of the scene's tables on either backend: triangles, spheres, shading records,
-    /// materials, lights, textures, the environment map and instances (what `twinpath info`
-    /// reports).
-    pub fn table_bytes(&self) -> [(&'static str, usize); 8] {
+    /// materials, lights, textures, the environment map, instances and media (what
+    /// `twinpath info` reports).
+    pub fn table_bytes(&self) -> [(&'static str, usize); 9] {
         use std::mem::size_of;
         [
             ("triangles", self.triangles.len() * size_of::<Triangle>()),
@@ -265,6 +270,10 @@ impl Scene {
             ("materials", self.materials.len() * size_of::<Material>()),
             ("lights", self.lights.len() * size_of::<Light>()),
             ("textures", self.textures.bytes()),
+            (
+                "media",
+                self.media.len() * size_of::<kernel::medium::Medium>(),
+            ),
             (
                 "environment",
                 self.environment.as_ref().map_or(0, |m| 4 * m.table_len()),

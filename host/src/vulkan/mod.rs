@@ -124,6 +124,7 @@ impl GpuRenderer {
                 bytemuck::cast_slice(&scene.instance_table()),
                 STORAGE,
             )?,
+            ctx.upload_buffer("media", bytemuck::cast_slice(&scene.media), STORAGE)?,
         ];
         let accum = ctx.create_storage_image("accum", w, h)?;
         let accum_sq = ctx.create_storage_image("accum_sq", w, h)?;
@@ -140,7 +141,7 @@ impl GpuRenderer {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 9,
+                descriptor_count: 10,
             },
         ];
         let (pool, set) = ctx.create_descriptor_set(pipeline.set_layout, &sizes)?;
@@ -171,6 +172,7 @@ impl GpuRenderer {
             buffer_info(&tables[5]),
             buffer_info(&tables[6]),
             buffer_info(&tables[7]),
+            buffer_info(&tables[8]),
         ];
         let buffer_bindings = [
             binding::PARAMS,
@@ -182,6 +184,7 @@ impl GpuRenderer {
             binding::SHADING,
             binding::TEXTURES,
             binding::INSTANCES,
+            binding::MEDIA,
         ];
         let mut writes = vec![
             vk::WriteDescriptorSet::default()

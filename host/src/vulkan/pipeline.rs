@@ -33,6 +33,7 @@ pub mod binding {
     pub const SHADING: u32 = 10;
     pub const TEXTURES: u32 = 11;
     pub const INSTANCES: u32 = 12;
+    pub const MEDIA: u32 = 13;
 }
 
 /// Which hit groups a pipeline has: a scene without world-space triangles (or spheres, or
@@ -141,6 +142,7 @@ impl RtPipeline {
             b(binding::SHADING, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::TEXTURES, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::INSTANCES, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::MEDIA, vk::DescriptorType::STORAGE_BUFFER),
         ];
         let set_layout = unsafe {
             ctx.device.create_descriptor_set_layout(

@@ -10,6 +10,7 @@ use super::textures::{normal_texture, texture};
 use crate::scene::limits::IOR_RANGE;
 use crate::scene::SceneError;
 use glam::Vec3;
+use kernel::medium::Medium;
 use kernel::scene::{material_kind, texture_slot, Material};
 
 /// The kernel material for glTF material `m` (`None`: the specification's default material,
@@ -103,7 +104,9 @@ pub(super) fn material(
             out.kind = material_kind::DIELECTRIC;
             out.ior = ior;
             out.alpha = roughness * roughness;
-            out.k = volume_absorption(imp, &label, &m, &err)?;
+            let sigma_a = volume_absorption(imp, &label, &m, &err)?;
+            let medium = imp.tables.add_medium(Medium::new(sigma_a, [0.0; 3], 0.0));
+            out.set_interior_medium(medium);
             return normal_map(imp, &label, &m, out);
         }
     }

@@ -82,7 +82,7 @@ pub fn parse_scene_with_camera(
     let settings = settings::render_settings(&ck, &file.render)?;
     let mut tables = SceneTables::default();
     materials::add_materials(&ck, &file.materials, base_dir, &mut tables)?;
-    let media = media::parse_media(&ck, &file.media, file.scene.as_ref())?;
+    let media = media::parse_media(&ck, &file.media, file.scene.as_ref(), &mut tables)?;
     shapes::add_spheres(&ck, &file.sphere, &media, &mut tables)?;
     shapes::add_quads(&ck, &file.quad, &mut tables)?;
     meshes::add_meshes(&ck, &file.mesh, &media, base_dir, &mut tables)?;
@@ -92,6 +92,7 @@ pub fn parse_scene_with_camera(
         Some(name) => camera::gltf_camera(&ck, None, name, &gltf_cameras)?,
         None => camera::camera(&ck, &file.camera, &gltf_cameras)?,
     };
+    media::camera_outside_media(&ck, file.camera.span(), &camera, &tables)?;
     let (background, environment) = match &file.background {
         Some(b) => background::background(&ck, b, base_dir)?,
         None => (Vec3::ZERO, None),

@@ -1,0 +1,77 @@
+//! The Henyey-Greenstein phase function (Henyey and Greenstein, "Diffuse radiation in the
+//! galaxy", Astrophysical Journal 93, 1941), the angular distribution of light a medium
+//! scatters: with theta the angle between the light's direction of travel before and after
+//! the scattering,
+//!
+//! p(cos theta) = (1 - g^2) / (4 pi (1 + g^2 - 2 g cos theta)^(3/2)),
+//!
+//! normalised over the sphere, g in (-1, 1) its mean cosine (0 isotropic, positive forward).
+//! In a path's terms (both directions leaving the scattering point x): `wo` toward where the
+//! light goes (the previous vertex), `wi` toward where it comes from; the light travels along
+//! -wi, then along wo, so cos theta = -wi . wo. A path tracer's phase "sample" is therefore a
+//! `wi` near the path's own direction of travel -wo for g > 0.
+//!
+//! Sampling inverts the distribution of mu = cos theta, whose density over [-1, 1] (the
+//! azimuth uniform) is (1 - g^2) / (2 (1 + g^2 - 2 g mu)^(3/2)). Its CDF is
+//! F(mu) = (1 - g^2) / (2 g) [(1 + g^2 - 2 g mu)^(-1/2) - 1 / (1 + g)], and F(mu) = xi gives
+//! mu = (1 + g^2 - ((1 - g^2) / (1 - g + 2 g xi))^2) / (2 g) (the form in pbrt-v4, 4th ed.,
+//! section 11.3.1, derived here from the CDF). Below |g| = 1e-3 the formula cancels badly and
+//! the distribution is isotropic to within 0.3% (its ratio to the isotropic density lies between
+//! (1 - g) / (1 + g)^2 and (1 + g) / (1 - g)^2);
+//! there [`eval`] and [`sample`] both take g as 0 (mu = 1 - 2 xi), so the sampler stays exact
+//! for the density it reports.
+
+use crate::frame::orthonormal_basis;
+#[cfg(target_arch = "spirv")]
+use crate::Float;
+use core::f32::consts::PI;
+use spirv_std::glam::Vec3;
+
+/// Below this |g| the phase function is taken as isotropic (see the module's documentation).
+pub const ISOTROPIC_G: f32 = 1e-3;
+
+/// g as the sampler and the density use it: 0 below [`ISOTROPIC_G`].
+#[inline]
+fn effective(g: f32) -> f32 {
+    if g.abs() < ISOTROPIC_G {
+        0.0
+    } else {
+        g
+    }
+}
+
+/// The phase function of asymmetry `g` at `cos_theta` (the cosine of the scattering angle),
+/// per steradian.
+#[inline]
+pub fn of_angle(g: f32, cos_theta: f32) -> f32 {
+    let g = effective(g);
+    let denom = 1.0 + g * g - 2.0 * g * cos_theta;
+    (1.0 - g * g) / (4.0 * PI * denom * denom.max(0.0).sqrt())
+}
+
+/// The phase function for light arriving from `wi` and leaving toward `wo` (unit, both
+/// pointing away from the scattering point); also the density of [`sample`]'s direction.
+#[inline]
+pub fn eval(g: f32, wo: Vec3, wi: Vec3) -> f32 {
+    of_angle(g, -wi.dot(wo))
+}
+
+/// A direction `wi` drawn with density [`eval`]`(g, wo, wi)` from uniform numbers `u1` (the
+/// angle) and `u2` (the azimuth) in [0, 1).
+#[inline]
+pub fn sample(g: f32, wo: Vec3, u1: f32, u2: f32) -> Vec3 {
+    let g = effective(g);
+    let mu = if g == 0.0 {
+        1.0 - 2.0 * u1
+    } else {
+        let s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u1);
+        (1.0 + g * g - s * s) / (2.0 * g)
+    }
+    .clamp(-1.0, 1.0);
+    let sin = (1.0 - mu * mu).max(0.0).sqrt();
+    let phi = 2.0 * PI * u2;
+    // About the direction of travel -wo: mu = cos theta = -wi . wo.
+    let travel = -wo;
+    let (t, b) = orthonormal_basis(travel);
+    (travel * mu + (t * phi.cos() + b * phi.sin()) * sin).normalize()
+}
