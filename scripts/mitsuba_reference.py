@@ -5,7 +5,8 @@ OUT/mitsuba_ref.exr, OUT/mitsuba_ref_half_a.exr, OUT/mitsuba_ref_half_b.exr and
 OUT/mitsuba_ref_meta.json: what tests/tests/mitsuba.rs compares twinpath with.
 
 Usage: mitsuba_reference.py SCENE OUTDIR [--spp 8192] [--chunk 512] [--variant llvm_ad_rgb]
-SCENE: cornell_materials (scenes/cornell_materials.toml).
+SCENE: cornell_materials (scenes/cornell_materials.toml), cornell_fog (scenes/cornell_fog.toml,
+Mitsuba's volpathmis).
 """
 
 import argparse
@@ -21,18 +22,20 @@ import peer_mitsuba
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("scene", choices=["cornell_materials"])
+    ap.add_argument("scene", choices=["cornell_materials", "cornell_fog"])
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=8192)
     ap.add_argument("--chunk", type=int, default=512)
     ap.add_argument("--variant", default="llvm_ad_rgb")
     args = ap.parse_args()
     mi.set_variant(args.variant)
-    build = {"cornell_materials": peer_mitsuba.cornell_materials_dict}[args.scene]
+    build = {"cornell_materials": peer_mitsuba.cornell_materials_dict,
+             "cornell_fog": peer_mitsuba.cornell_fog_dict}[args.scene]
     os.makedirs(args.out, exist_ok=True)
     chunks = max(2, args.spp // args.chunk)
     chunks += chunks % 2
-    scene = mi.load_dict(build(args.chunk, 1))
+    scene_dict = build(args.chunk, 1)
+    scene = mi.load_dict(scene_dict)
     halves = [None, None]
     t0 = time.perf_counter()
     for c in range(chunks):
@@ -48,7 +51,8 @@ def main():
         mi.Bitmap(img.astype(np.float32)).write(os.path.join(args.out, name + ".exr"))
     meta = {"scene": args.scene, "variant": args.variant, "spp": chunks * args.chunk,
             "chunk_spp": args.chunk, "chunks": chunks, "render_wall_s": round(wall, 3),
-            "integrator": "path, max_depth -1, rr_depth 5", "sampler": "independent",
+            "integrator": scene_dict["integrator"]["type"] + ", max_depth -1, rr_depth 5",
+            "sampler": "independent",
             "mean_rgb": ref.reshape(-1, 3).mean(axis=0).tolist()}
     with open(os.path.join(args.out, "mitsuba_ref_meta.json"), "w") as f:
         json.dump(meta, f, indent=1)

@@ -61,6 +61,42 @@ def cornell_materials_dict(spp, seed, sampler="independent"):
     return d
 
 
+def cornell_fog_dict(spp, seed, sampler="independent"):
+    """scenes/cornell_fog.toml: cornell_materials filled with a scattering fog (sigma_a, sigma_s
+    RGB, Henyey-Greenstein g 0.5) around everything, the camera included, the glass sphere
+    holding an absorbing juice; Mitsuba's volpath, each surface's both sides in the fog (the
+    glass's inside in the juice), 128 x 128, Mitsuba's volpathmis."""
+    d = cornell_materials_dict(spp, seed, sampler)
+    fog_a, fog_s = np.array([0.03, 0.04, 0.06]), np.array([0.25, 0.3, 0.4])
+
+    def medium(sigma_a, sigma_s, g):
+        # An "rgb" value above 1 is refused (a reflectance): sigma_t over its largest channel,
+        # times the medium's scale.
+        t = sigma_a + sigma_s
+        return {"type": "homogeneous", "scale": float(t.max()),
+                "sigma_t": {"type": "rgb", "value": (t / t.max()).tolist()},
+                "albedo": {"type": "rgb", "value": (sigma_s / t).tolist()},
+                "phase": {"type": "hg", "g": g}}
+
+    # volpathmis, Mitsuba's spectral-MIS volumetric path tracer: its plain volpath reads 0.83x
+    # the closed form exp(-sigma_t d) through a chromatic absorbing medium (docs/media.md).
+    d["integrator"] = {"type": "volpathmis", "max_depth": -1, "rr_depth": 5,
+                       "hide_emitters": False}
+    d["fog"] = medium(fog_a, fog_s, 0.5)
+    fog = {"type": "ref", "id": "fog"}
+    d["sensor"]["medium"] = fog
+    # Mitsuba's camera rays start at the near clip plane (0.01 by default), which in a medium
+    # skips that much of it: exp(0.01 sigma_t) brighter, measured +0.3% here.
+    d["sensor"]["near_clip"] = 1e-6
+    d["sensor"]["film"]["width"] = d["sensor"]["film"]["height"] = 128
+    for key in ["floor", "ceiling", "back", "left", "right", "sphere_left", "light"]:
+        d[key]["exterior"] = fog
+        d[key]["interior"] = fog
+    d["sphere_right"]["exterior"] = fog
+    d["sphere_right"]["interior"] = medium(np.array([0.3, 2.0, 4.0]), np.zeros(3), 0.0)
+    return d
+
+
 def scene_dict(spp, seed, sampler="independent"):
     white, red, green, blue = (0.73, 0.73, 0.73), (0.65, 0.05, 0.05), (0.12, 0.45, 0.15), \
         (0.25, 0.35, 0.75)
