@@ -25,6 +25,7 @@ pub mod light;
 pub mod medium;
 pub mod opacity;
 pub mod path;
+pub mod path_media;
 pub mod phase;
 #[cfg(feature = "probe")]
 pub mod probe;

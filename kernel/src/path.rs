@@ -7,20 +7,16 @@ use crate::bsdf::{self, DELTA_PDF};
 use crate::camera::{camera_origin, camera_ray_direction, lens_radius, thin_lens_ray};
 use crate::environment;
 use crate::features::FeatureSet;
-use crate::free_flight;
 use crate::geometry::{offset_ray_origin, shadow_ray_end};
 use crate::hit::SurfaceHit;
 use crate::light::{self, eval_radiance, LightKinds, LightSample};
 use crate::medium;
-use crate::phase;
 use crate::rng::SampleRng;
 use crate::sampling::power_heuristic;
 use crate::scene::{light_sampling, mis, Light, Material, RenderParams, NONE};
 use crate::scene_view::SceneView;
 use crate::surface::{self, emission_at, shade};
-use crate::vertex_samples::{
-    VertexQuery, VertexSamples, CAMERA_DIMENSION, FLIGHT_DIMENSION, LENS_DIMENSION,
-};
+use crate::vertex_samples::{VertexQuery, VertexSamples, CAMERA_DIMENSION, LENS_DIMENSION};
 use spirv_std::glam::Vec3;
 
 /// How the kernel meets the scene: the GPU implements it with `trace_ray` on an acceleration
@@ -396,24 +392,8 @@ impl PathState {
         } else {
             !flags.delta
         };
-        let light_count = if !(features.lights(params) && reflects)
-            || features.mis_mode(params) == mis::BSDF_ONLY
-        {
-            0
-        } else if features.single_light(params) {
-            1
-        } else {
-            params.integrator.light_count
-        };
-        let mut throughput = self.throughput;
-        if features.dielectric() {
-            throughput *= self.eta_scale;
-        }
-        let survival = if features.rr_throughput(params) {
-            throughput.max_element().min(1.0)
-        } else {
-            params.integrator.rr_probability
-        };
+        let light_count = self.light_count(features, params, reflects);
+        let survival = self.survival(features, params);
         let ng = hit.facing_normal();
         let smooth = features.shading_normals() && shading_normal != Vec3::ZERO;
         let n = if smooth {
@@ -437,6 +417,39 @@ impl PathState {
             survival,
             lambertian,
             chooses_lobe: !lambertian && flags.chooses_lobe,
+        }
+    }
+
+    /// The lights next-event estimation chooses among at a vertex that `reflects` (0: none,
+    /// for a black or delta surface, without lights, or with BSDF sampling alone).
+    #[inline]
+    pub(crate) fn light_count<F: FeatureSet>(
+        &self,
+        features: F,
+        params: &RenderParams,
+        reflects: bool,
+    ) -> u32 {
+        if !(features.lights(params) && reflects) || features.mis_mode(params) == mis::BSDF_ONLY {
+            0
+        } else if features.single_light(params) {
+            1
+        } else {
+            params.integrator.light_count
+        }
+    }
+
+    /// Roulette's survival probability at the current vertex: the throughput's largest
+    /// channel (times the refractions' eta^2) up to 1, or the constant.
+    #[inline]
+    pub(crate) fn survival<F: FeatureSet>(&self, features: F, params: &RenderParams) -> f32 {
+        let mut throughput = self.throughput;
+        if features.dielectric() {
+            throughput *= self.eta_scale;
+        }
+        if features.rr_throughput(params) {
+            throughput.max_element().min(1.0)
+        } else {
+            params.integrator.rr_probability
         }
     }
 
@@ -636,7 +649,11 @@ impl PathState {
     /// its throughput by the survival probability if so (no number is drawn, and the path
     /// always survives, where survival is certain).
     #[inline]
-    fn survives_roulette(&mut self, query: &VertexQuery, samples: &VertexSamples) -> bool {
+    pub(crate) fn survives_roulette(
+        &mut self,
+        query: &VertexQuery,
+        samples: &VertexSamples,
+    ) -> bool {
         if query.draws_roulette() {
             if !query.survives(samples.u_roulette) {
                 return false;
@@ -646,163 +663,12 @@ impl PathState {
         true
     }
 
-    /// The ray just traced crosses the medium it travels in up to `hit` (or out of the scene).
-    /// In a medium that only absorbs, the throughput takes the segment's transmittance
-    /// (`medium`); in one that scatters, a free flight is sampled (`crate::free_flight`: the
-    /// path's hero channel from the number at `FLIGHT_DIMENSION`, drawn at its first flight,
-    /// the k-th distance from the one at `FLIGHT_DIMENSION + 1 + k`) and its weight taken.
-    /// Returns whether the ray scattered
-    /// before `hit`: then `ray_origin` is the collision, a medium vertex (`scattered`). Out of
-    /// line on the CPU: only scenes with media call it.
-    #[cfg_attr(not(target_arch = "spirv"), inline(never))]
-    fn fly(&mut self, scene: &SceneView, hit: &SurfaceHit) -> bool {
-        let m = &scene.media[self.medium as usize];
-        let sigma_t = m.extinction();
-        if !(sigma_t.max_element() > 0.0) {
-            return false;
-        }
-        let distance = if hit.is_hit() {
-            (hit.position - self.ray_origin).length()
-        } else {
-            f32::MAX
-        };
-        if !m.scatters() {
-            self.throughput *= medium::transmittance(sigma_t, distance);
-            return false;
-        }
-        let count = (self.flights >> 2) & FLIGHT_COUNT;
-        if count == 0 {
-            self.rng.seek(FLIGHT_DIMENSION);
-            self.flights = free_flight::hero_channel(self.rng.next_f32());
-        }
-        let hero = self.flights & 3;
-        self.rng.seek(FLIGHT_DIMENSION + 1 + count);
-        let u = self.rng.next_f32();
-        let sigma_s = Vec3::from(m.sigma_s);
-        let flight = free_flight::sample(sigma_t, sigma_s, distance, hero, u, self.ratios);
-        self.throughput *= flight.weight;
-        self.ratios = flight.ratios;
-        self.flights = (((count + 1) & FLIGHT_COUNT) << 2) | hero;
-        if flight.scattered {
-            self.ray_origin += self.ray_dir * flight.t;
-            self.flights |= SCATTERED;
-        }
-        flight.scattered
-    }
-
-    /// The medium a ray leaving the surface of `material` at `hit` along `dir` travels in
-    /// (`medium::beyond`; outside every shape, the scene's).
-    #[inline]
-    fn medium_beyond(
-        &self,
-        scene: &SceneView,
-        material: &Material,
-        hit: &SurfaceHit,
-        dir: Vec3,
-    ) -> u32 {
-        let outside = scene.params.environment.medium;
-        medium::beyond(material, hit.normal, dir, self.medium, outside)
-    }
-
-    /// What a medium vertex (`scattered`) will draw: a light sample unless BSDF sampling
-    /// alone is asked for (the phase function is never a delta), the extension and roulette
-    /// as at a surface; no lobe choice. Its normals are the direction of travel (unread: the
-    /// phase function has no hemisphere).
-    #[inline]
-    fn medium_query<F: FeatureSet>(&self, features: F, params: &RenderParams) -> VertexQuery {
-        let light_count = if !features.lights(params) || features.mis_mode(params) == mis::BSDF_ONLY
-        {
-            0
-        } else if features.single_light(params) {
-            1
-        } else {
-            params.integrator.light_count
-        };
-        let mut throughput = self.throughput;
-        if features.dielectric() {
-            throughput *= self.eta_scale;
-        }
-        let survival = if features.rr_throughput(params) {
-            throughput.max_element().min(1.0)
-        } else {
-            params.integrator.rr_probability
-        };
-        VertexQuery {
-            depth: self.depth,
-            x: self.ray_origin,
-            n: self.ray_dir,
-            ng: self.ray_dir,
-            smooth: false,
-            light_count,
-            mode: light_sampling_of(features, params),
-            light_kinds: LightKinds::of(features, params),
-            extend: self.depth < params.integrator.max_depth,
-            roulette: self.depth >= params.integrator.rr_start_depth,
-            survival,
-            lambertian: false,
-            chooses_lobe: false,
-        }
-    }
-
-    /// [`PathState::vertex`] at a medium vertex (the path scattered at `query.x` in its medium,
-    /// its throughput already weighed by sigma_s over the collision's density,
-    /// `crate::free_flight`): next-event estimation with the phase function in the place of
-    /// f cos (a medium point has no surface, no cosine), its shadow segment starting in the
-    /// medium, weighed by MIS against phase sampling; then roulette, and the extension drawn
-    /// from the phase function (weight exactly 1, its density the MIS density of a light it
-    /// finds). Rays leave from the point itself: there is no surface to offset from.
-    #[cfg_attr(not(target_arch = "spirv"), inline(never))]
-    fn medium_vertex<F: FeatureSet>(
-        &mut self,
-        features: F,
-        scene: &SceneView,
-        query: &VertexQuery,
-        samples: &VertexSamples,
-    ) {
-        self.flights &= !SCATTERED;
-        let (params, lights) = (scene.params, scene.lights);
-        let x = query.x;
-        let wo = -self.ray_dir;
-        let g = scene.media[self.medium as usize].g;
-        if query.samples_light() {
-            let ls = samples.light_sample(query, scene);
-            let wi = (ls.point.position - x).normalize();
-            let cos_y = -ls.point.normal.dot(wi);
-            let pdf_w = ls.pdf_solid_angle;
-            let p = phase::eval(g, wo, wi);
-            if cos_y > 0.0 && pdf_w > 0.0 && p > 0.0 {
-                let emitted = light::radiance(features, scene, query.light_kinds, &ls);
-                let weight = light_sample_weight(
-                    features,
-                    params,
-                    query.light_kinds,
-                    &lights[ls.light as usize],
-                    pdf_w,
-                    p,
-                );
-                let radiance = self.throughput * emitted * (p * weight / pdf_w);
-                self.await_shadow(query.light_kinds, lights, x, &ls, radiance);
-                self.shadow_medium = self.medium;
-            }
-        }
-        if !query.extend || !self.survives_roulette(query, samples) {
-            return;
-        }
-        let (u1, u2) = samples.u_brdf;
-        let wi = phase::sample(g, wo, u1, u2);
-        let pdf = phase::eval(g, wo, wi);
-        if !(self.throughput.max_element() > 0.0) {
-            return;
-        }
-        self.await_extension(x, wi, x, pdf);
-    }
-
     /// The light sample `ls` waits for its shadow segment from `from` (offset off the surface)
     /// to the light point; `radiance` is what it adds if the segment is clear (in a scene with
     /// media, times the segment's transmittance: the caller sets `shadow_medium`, the medium
     /// the segment leaves into, and [`PathState::shadow_passes`] applies it).
     #[inline]
-    fn await_shadow(
+    pub(crate) fn await_shadow(
         &mut self,
         kinds: LightKinds,
         lights: &[Light],
@@ -821,60 +687,10 @@ impl PathState {
         self.shadow_radiance = radiance;
     }
 
-    /// In a scene with media, the shadow segment's answer, taken before
-    /// [`PathState::advance`]: `blocker`, the closest surface on the segment from
-    /// `shadow_from` ([`Tracer::first_hit_on`]). Clear (a miss): the light sample adds its
-    /// radiance times the transmittance of the segment. An interface: the segment keeps the
-    /// transmittance of the part up to it and goes on from the interface's far side, in the
-    /// medium beyond, to the same end; returns true: the segment waits, and the caller leaves
-    /// this round's extension answer untaken (the same ray is traced again with the segment,
-    /// so the radiance sums its terms in the one order). Any other surface: the sample adds
-    /// nothing. Returns false once the segment is settled (`shadow` is then false). Out of line
-    /// on the CPU: only scenes with media call it.
-    #[cfg_attr(not(target_arch = "spirv"), inline(never))]
-    pub fn shadow_passes(&mut self, scene: &SceneView, blocker: &SurfaceHit) -> bool {
-        let media = scene.media;
-        if !blocker.is_hit() {
-            let t = medium::along(media, self.shadow_medium, self.shadow_from, self.shadow_to);
-            self.radiance += self.shadow_radiance * t;
-            self.shadow = false;
-            return false;
-        }
-        let material = &scene.materials[blocker.material as usize];
-        if !medium::is_interface(material) {
-            self.shadow = false;
-            return false;
-        }
-        let dir = self.shadow_to - self.shadow_from;
-        self.shadow_radiance *= medium::along(
-            media,
-            self.shadow_medium,
-            self.shadow_from,
-            blocker.position,
-        );
-        let outside = scene.params.environment.medium;
-        self.shadow_medium =
-            medium::beyond(material, blocker.normal, dir, self.shadow_medium, outside);
-        self.shadow_from = beyond_surface(blocker, dir);
-        true
-    }
-
-    /// The extension ray met an interface at `hit` (its transmittance up to there already
-    /// applied): it goes on from the far side in the medium beyond, as the same ray (the
-    /// vertex it left, its density and the depth unchanged). Out of line on the CPU, as
-    /// [`PathState::shadow_passes`].
-    #[cfg_attr(not(target_arch = "spirv"), inline(never))]
-    fn pass_interface(&mut self, scene: &SceneView, hit: &SurfaceHit) {
-        let material = &scene.materials[hit.material as usize];
-        self.medium = self.medium_beyond(scene, material, hit, self.ray_dir);
-        self.ray_origin = beyond_surface(hit, self.ray_dir);
-        self.extend = true;
-    }
-
     /// The extension ray `origin + t dir` waits to be traced, leaving vertex `x`, drawn with
     /// density `pdf` (`bsdf::DELTA_PDF` for a delta lobe).
     #[inline]
-    fn await_extension(&mut self, origin: Vec3, dir: Vec3, x: Vec3, pdf: f32) {
+    pub(crate) fn await_extension(&mut self, origin: Vec3, dir: Vec3, x: Vec3, pdf: f32) {
         self.extend = true;
         self.ray_origin = origin;
         self.ray_dir = dir;
@@ -883,19 +699,7 @@ impl PathState {
     }
 }
 
-/// [`PathState::flights`]: the mask of the flight count (bits 2..30, shifted down) and the
-/// medium vertex's bit.
-const FLIGHT_COUNT: u32 = (1 << 29) - 1;
-const SCATTERED: u32 = 1 << 31;
-
 impl PathState {
-    /// Whether the vertex [`PathState::advance`] reached is a medium vertex, at `ray_origin`
-    /// (see [`PathState::flights`]).
-    #[inline]
-    pub fn scattered(&self) -> bool {
-        self.flights & SCATTERED != 0
-    }
-
     /// The MIS weight of a light (area light or environment map) that the extension from
     /// `previous_vertex` found, where light sampling has density `pdf_light` (read only under
     /// the power heuristic; the other modes' unused density is pure code, which inlining
@@ -923,7 +727,7 @@ impl PathState {
 /// The origin of a ray along `dir` that goes on through the surface at `hit`: its point,
 /// offset to the side `dir` points to (`geometry::offset_ray_origin`).
 #[inline]
-fn beyond_surface(hit: &SurfaceHit, dir: Vec3) -> Vec3 {
+pub(crate) fn beyond_surface(hit: &SurfaceHit, dir: Vec3) -> Vec3 {
     offset_ray_origin(
         hit.position,
         side(hit.normal, hit.normal.dot(dir) > 0.0),
@@ -945,7 +749,7 @@ fn side(n: Vec3, toward_n: bool) -> Vec3 {
 /// 1 for a delta light (`light::is_delta`), which no BSDF sample can meet, else
 /// [`light_strategy_weight`]'s.
 #[inline]
-fn light_sample_weight<F: FeatureSet>(
+pub(crate) fn light_sample_weight<F: FeatureSet>(
     features: F,
     params: &RenderParams,
     kinds: LightKinds,

@@ -99,8 +99,10 @@ struct RayTracer<'a> {
     opaque: RayFlags,
 }
 
-impl Tracer for RayTracer<'_> {
-    fn closest_hit(&mut self, origin: Vec3, dir: Vec3) -> SurfaceHit {
+impl RayTracer<'_> {
+    /// The closest hit along `origin + t dir`, t in (0, t_max), through the closest-hit and
+    /// miss shaders.
+    fn trace_closest(&mut self, origin: Vec3, dir: Vec3, t_max: f32) -> SurfaceHit {
         self.payload.hit = 0;
         unsafe {
             self.tlas.trace_ray(
@@ -112,11 +114,17 @@ impl Tracer for RayTracer<'_> {
                 origin,
                 0.0,
                 dir,
-                f32::MAX,
+                t_max,
                 self.payload,
             );
         }
         self.payload.surface()
+    }
+}
+
+impl Tracer for RayTracer<'_> {
+    fn closest_hit(&mut self, origin: Vec3, dir: Vec3) -> SurfaceHit {
+        self.trace_closest(origin, dir, f32::MAX)
     }
 
     fn occluded(&mut self, from: Vec3, to: Vec3) -> bool {
@@ -140,22 +148,7 @@ impl Tracer for RayTracer<'_> {
     }
 
     fn first_hit_on(&mut self, from: Vec3, to: Vec3) -> SurfaceHit {
-        self.payload.hit = 0;
-        unsafe {
-            self.tlas.trace_ray(
-                self.opaque,
-                0xff,
-                0,
-                1,
-                0,
-                from,
-                0.0,
-                to - from,
-                1.0,
-                self.payload,
-            );
-        }
-        self.payload.surface()
+        self.trace_closest(from, to - from, 1.0)
     }
 }
 
