@@ -128,12 +128,21 @@ pub fn run(a: RenderArgs) -> Result<()> {
             scene.instances.len()
         )
     };
+    // The media table's record 0 is vacuum, always there.
+    let media = match (scene.media.len().saturating_sub(1), scene.medium) {
+        (0, _) => String::new(),
+        (n, 0) => format!(", {n} {}", if n == 1 { "medium" } else { "media" }),
+        (n, _) => format!(
+            ", {n} {}, the scene in one",
+            if n == 1 { "medium" } else { "media" }
+        ),
+    };
     let samples = match &share {
         Some(s) => s.describe(),
         None => format!("{} spp", settings.spp),
     };
     eprintln!(
-        "twinpath: {} ({}x{}, {} spheres, {} triangles{instances}, {} lights), {samples}, seed {}",
+        "twinpath: {} ({}x{}, {} spheres, {} triangles{instances}, {} lights{media}), {samples}, seed {}",
         scene.name,
         scene.camera.width,
         scene.camera.height,
