@@ -122,7 +122,7 @@ pub fn surface_features(materials: &[Material], shading: &[ShadingTriangle]) -> 
     if materials.iter().any(Material::has_holes) {
         f |= OPACITY;
     }
-    if materials.iter().any(Material::has_interior_medium) {
+    if materials.iter().any(Material::bounds_media) {
         f |= MEDIA;
     }
     if shading

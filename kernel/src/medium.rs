@@ -12,11 +12,13 @@
 //! Where a path is: its `PathState::medium`, an index into the media table; record 0 is
 //! [`VACUUM`]. Outside every closed shape a ray is in the scene's medium
 //! (`EnvironmentParams::medium`: the camera's, a fog; vacuum by default). A dielectric's
-//! `Material::interior_medium` is the medium inside it; a ray leaving one of its surfaces toward
-//! its inside (against the outward normal) travels in that medium, one leaving toward its
-//! outside in the scene's ([`beyond`]): entering, leaving, and reflecting on either side follow
-//! from that one rule. Any other surface leaves the medium as it is. Shapes with media must not
-//! overlap or nest (the rule puts a ray that leaves an inner shape in the scene's medium).
+//! `Material::interior_medium` is the medium inside it and `Material::exterior_medium` the one
+//! outside (pbrt-v4's medium interface per shape; the scene's unless the shape names one); a ray
+//! leaving one of its surfaces toward its inside (against the outward normal) travels in the
+//! inside medium, one leaving toward its outside in the outside one ([`beyond`]): entering,
+//! leaving, and reflecting on either side follow from that one rule. Any other surface leaves
+//! the medium as it is. So nested shapes (glass in water) name the medium around them; shapes
+//! must not overlap.
 //!
 //! An interface ([`is_interface`], TOML's `interface = true`) is a smooth dielectric of index
 //! 1: it neither reflects nor bends, so light crosses it with weight exactly 1 and it is no
@@ -121,15 +123,16 @@ pub fn is_interface(material: &Material) -> bool {
 
 /// The medium a ray leaving the surface of `material` in direction `dir` travels through: for
 /// a dielectric, the medium inside it where `dir` points against the surface's outward normal
-/// `outward` and the scene's medium `outside` where it points along it; for any other material,
-/// `current`, the medium the path is in. Out of line on the CPU, as [`along`].
+/// `outward` and the medium outside it where it points along it (the one its shape names, else
+/// the scene's, `outside`); for any other material, `current`, the medium the path is in. Out
+/// of line on the CPU, as [`along`].
 #[cfg_attr(not(target_arch = "spirv"), inline(never))]
 pub fn beyond(material: &Material, outward: Vec3, dir: Vec3, current: u32, outside: u32) -> u32 {
     if material.kind == material_kind::DIELECTRIC {
         if dir.dot(outward) < 0.0 {
             material.interior_medium()
         } else {
-            outside
+            material.exterior_medium(outside)
         }
     } else {
         current

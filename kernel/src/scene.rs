@@ -208,8 +208,10 @@ pub struct Material {
     /// its weight (`clearcoatFactor`) in the low 16 bits and its roughness
     /// (`clearcoatRoughnessFactor`) in the high 16, each round(x 65535)
     /// ([`Material::pack_coat`], [`Material::coat_weight`], [`Material::coat_roughness`]); 0,
-    /// no coat. DIELECTRIC: the medium inside, an index into the media table
-    /// (`crate::medium`; 0, vacuum: clear), [`Material::interior_medium`].
+    /// no coat. DIELECTRIC: its media (`crate::medium`, pbrt-v4's medium interface): in the
+    /// low 16 bits the medium inside, an index into the media table (0, vacuum: clear,
+    /// [`Material::interior_medium`]), in the high 16 the medium outside plus 1 (0: the
+    /// scene's, [`Material::exterior_medium`]).
     pub coat: u32,
     /// Per [`texture_slot`]: the texture (an index into the texture table, `crate::texture`)
     /// whose value at the point multiplies that parameter, or [`NONE`].
@@ -322,21 +324,44 @@ impl Material {
         self.k = [roughness.clamp(0.0, 1.0), 0.0, 0.0];
     }
 
-    /// DIELECTRIC: the medium inside, an index into the media table (stored in `coat`; 0 is
-    /// `medium::VACUUM`).
+    /// DIELECTRIC: the medium inside, an index into the media table (the low 16 bits of
+    /// `coat`; 0 is `medium::VACUUM`).
     #[inline]
     pub fn interior_medium(&self) -> u32 {
-        self.coat
+        self.coat & 0xffff
     }
 
-    /// Sets the medium inside a DIELECTRIC (an index into the media table).
+    /// DIELECTRIC: the medium outside: the one its shape names (the high 16 bits of `coat`,
+    /// minus 1), or `scene`, the scene's medium, where it names none.
+    #[inline]
+    pub fn exterior_medium(&self, scene: u32) -> u32 {
+        let named = self.coat >> 16;
+        if named == 0 {
+            scene
+        } else {
+            named - 1
+        }
+    }
+
+    /// Sets the medium inside a DIELECTRIC (an index into the media table, below 65535).
     pub fn set_interior_medium(&mut self, medium: u32) {
-        self.coat = medium;
+        self.coat = (self.coat & 0xffff_0000) | (medium & 0xffff);
+    }
+
+    /// Sets the medium outside a DIELECTRIC (an index into the media table, below 65535).
+    pub fn set_exterior_medium(&mut self, medium: u32) {
+        self.coat = (self.coat & 0xffff) | (((medium + 1) & 0xffff) << 16);
     }
 
     /// Whether the material is a dielectric with a medium inside (not vacuum).
     #[inline]
     pub fn has_interior_medium(&self) -> bool {
+        self.kind == material_kind::DIELECTRIC && self.interior_medium() != 0
+    }
+
+    /// Whether the material is a dielectric that names a medium, inside or outside.
+    #[inline]
+    pub fn bounds_media(&self) -> bool {
         self.kind == material_kind::DIELECTRIC && self.coat != 0
     }
 

@@ -49,6 +49,9 @@ pub(super) struct SceneTables {
     pub scene_medium: u32,
 }
 
+/// Records of the media table: a material holds an index in 16 bits, and the exterior's plus 1.
+const MAX_MEDIA: usize = 0xffff;
+
 /// Where a loaded triangle goes: the world-space table, or an instanced mesh in object space.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Space {
@@ -77,32 +80,53 @@ impl SceneTables {
         (self.materials.len() - 1) as u32
     }
 
-    /// Adds `medium` to the media table (after vacuum, record 0); its index. A medium that
-    /// attenuates nothing is vacuum: 0.
-    pub fn add_medium(&mut self, medium: Medium) -> u32 {
+    /// Adds `medium` to the media table (after vacuum, record 0) unless it holds it already;
+    /// its index, or `None` where the table is full (a material holds an index in 16 bits,
+    /// `Material::coat`: 65535 records). A medium that attenuates nothing is vacuum: 0.
+    pub fn add_medium(&mut self, medium: Medium) -> Option<u32> {
         if !medium.attenuates() {
-            return kernel::medium::VACUUM;
+            return Some(kernel::medium::VACUUM);
         }
         if self.media.is_empty() {
             self.media.push(Medium::VACUUM);
         }
+        if let Some(k) = self.media.iter().position(|m| *m == medium) {
+            return Some(k as u32);
+        }
+        if self.media.len() >= MAX_MEDIA {
+            return None;
+        }
         self.media.push(medium);
-        (self.media.len() - 1) as u32
+        Some((self.media.len() - 1) as u32)
     }
 
-    /// The index of dielectric `m` holding medium `medium` (an index into the media table),
-    /// named `medium_name`, inside (`Material::interior_medium`): `m` itself for vacuum, else
-    /// a copy named "MATERIAL holding MEDIUM", made once per pair.
-    pub fn with_interior(&mut self, m: u32, medium_name: &str, medium: u32) -> u32 {
-        if medium == kernel::medium::VACUUM {
+    /// The index of dielectric `m` with the medium `interior` inside and the medium `exterior`
+    /// outside (each a name and an index into the media table, or none: vacuum inside, the
+    /// scene's outside; `Material::interior_medium`, `Material::exterior_medium`): `m` itself
+    /// where that is what `m` says, else a copy named "MATERIAL holding INSIDE in OUTSIDE",
+    /// made once per combination.
+    pub fn with_media(
+        &mut self,
+        m: u32,
+        interior: Option<(&str, u32)>,
+        exterior: Option<(&str, u32)>,
+    ) -> u32 {
+        let mut material = self.materials[m as usize];
+        let mut name = self.material_names[m as usize].clone();
+        if let Some((medium_name, medium)) = interior {
+            material.set_interior_medium(medium);
+            name = format!("{name} holding {medium_name}");
+        }
+        if let Some((medium_name, medium)) = exterior {
+            material.set_exterior_medium(medium);
+            name = format!("{name} in {medium_name}");
+        }
+        if material == self.materials[m as usize] {
             return m;
         }
-        let name = format!("{} holding {medium_name}", self.material_names[m as usize]);
         if let Some(k) = self.material_names.iter().position(|n| *n == name) {
             return k as u32;
         }
-        let mut material = self.materials[m as usize];
-        material.set_interior_medium(medium);
         let two_sided = self.two_sided[m as usize];
         self.add_material(name, material, two_sided)
     }

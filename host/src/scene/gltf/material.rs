@@ -105,8 +105,13 @@ pub(super) fn material(
             out.ior = ior;
             out.alpha = roughness * roughness;
             let sigma_a = volume_absorption(imp, &label, &m, &err)?;
-            let medium = imp.tables.add_medium(Medium::new(sigma_a, [0.0; 3], 0.0));
-            out.set_interior_medium(medium);
+            match imp.tables.add_medium(Medium::new(sigma_a, [0.0; 3], 0.0)) {
+                Some(medium) => out.set_interior_medium(medium),
+                None => imp.note(format!(
+                    "{label}: KHR_materials_volume dropped: the scene has 65534 other media \
+                     (rendered as clear glass)"
+                )),
+            }
             return normal_map(imp, &label, &m, out);
         }
     }

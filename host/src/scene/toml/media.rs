@@ -1,8 +1,9 @@
-//! The `[media]` table, the `[scene]` table's `medium` and the shapes' `interior`: named media,
-//! the closed shapes they fill and the medium filling the scene. A medium inside a sphere or a
-//! closed mesh whose material is a dielectric (or an `interface`, a dielectric of index 1: no
-//! surface at all) becomes that material's interior (`Material::interior_medium`,
-//! `kernel::medium`), one copy of the material per medium it holds.
+//! The `[media]` table, the `[scene]` table's `medium` and the shapes' `interior` and
+//! `exterior`: named media, the closed shapes they fill or surround and the medium filling the
+//! scene. A medium inside (outside) a sphere or a closed mesh whose material is a dielectric (or
+//! an `interface`, a dielectric of index 1: no surface at all) becomes that material's interior
+//! (exterior: `Material::interior_medium`, `Material::exterior_medium`, `kernel::medium`), one
+//! copy of the material per combination.
 //!
 //! What renders today: homogeneous media (`sigma_a`, `sigma_s` per scene unit of length, RGB;
 //! `g`, the Henyey-Greenstein asymmetry). Density grids (`grid`, `scale`) are read and refused
@@ -116,7 +117,10 @@ pub(super) fn parse_media(
             None => 0.0,
         };
         let medium = Medium::new(sigma_a.to_array(), sigma_s.to_array(), g);
-        out.index.insert(name.clone(), tables.add_medium(medium));
+        let Some(index) = tables.add_medium(medium) else {
+            return Err(ck.err(m.span(), &field, "more than 65534 media: the table is full"));
+        };
+        out.index.insert(name.clone(), index);
     }
     if let Some(medium) = scene.and_then(|s| s.get_ref().medium.as_ref()) {
         tables.scene_medium = out.get(ck, medium, "scene.medium")?;
@@ -125,33 +129,40 @@ pub(super) fn parse_media(
 }
 
 /// The material of a closed shape whose material is `material` (named by `material_name`)
-/// holding the medium `interior` names, if any: `material` itself without one; with one, the
-/// copy of that dielectric holding it. `field` is the shape's table (`sphere[i]`).
-pub(super) fn with_interior(
+/// with the medium `interior` names inside it and the one `exterior` names outside it, if
+/// any (by default vacuum inside and the scene's medium outside): `material` itself without
+/// either; else the copy of that dielectric with them (`SceneTables::with_media`). `field` is
+/// the shape's table (`sphere[i]`).
+pub(super) fn with_media(
     ck: &Checker,
     media: &Media,
     tables: &mut SceneTables,
     (material, material_name): (u32, &Spanned<String>),
-    interior: Option<&Spanned<String>>,
+    (interior, exterior): (Option<&Spanned<String>>, Option<&Spanned<String>>),
     field: &str,
 ) -> Result<u32, SceneError> {
-    let Some(interior) = interior else {
-        return Ok(material);
-    };
-    let field = format!("{field}.interior");
-    let medium = media.get(ck, interior, &field)?;
-    if !tables.is_dielectric(material) {
-        return Err(ck.err(
-            interior.span(),
-            &field,
-            format!(
-                "the shape's material '{}' is not a dielectric: a medium needs a boundary, a \
-                 dielectric or an interface (interface = true)",
-                material_name.get_ref()
-            ),
-        ));
+    let mut named = [None, None];
+    for (k, (key, name)) in [("interior", interior), ("exterior", exterior)]
+        .into_iter()
+        .enumerate()
+    {
+        let Some(name) = name else { continue };
+        let field = format!("{field}.{key}");
+        let medium = media.get(ck, name, &field)?;
+        if !tables.is_dielectric(material) {
+            return Err(ck.err(
+                name.span(),
+                &field,
+                format!(
+                    "the shape's material '{}' is not a dielectric: a medium needs a boundary, \
+                     a dielectric or an interface (interface = true)",
+                    material_name.get_ref()
+                ),
+            ));
+        }
+        named[k] = Some((name.get_ref().as_str(), medium));
     }
-    Ok(tables.with_interior(material, interior.get_ref(), medium))
+    Ok(tables.with_media(material, named[0], named[1]))
 }
 
 /// `interface = true` (the entry at `span`): a smooth dielectric of index 1 (light crosses it

@@ -4,7 +4,7 @@
 
 use super::checker::{Checker, V3};
 use super::materials::find_material;
-use super::media::{with_interior, Media};
+use super::media::{with_media, Media};
 use super::transform::{parse_transform, transform_fields};
 use crate::scene::builder::SceneTables;
 use crate::scene::closed_surface::check_closed_outward;
@@ -26,6 +26,8 @@ pub(super) struct MeshFile {
     /// The medium inside (a `[media]` name; the material must be a dielectric or interface,
     /// and the mesh closed).
     pub interior: Option<Spanned<String>>,
+    /// The medium outside it (a name in `[media]`; default: the scene's).
+    pub exterior: Option<Spanned<String>>,
     /// Optional transform (`transform::parse_transform`): scale (a number or [x, y, z]), then
     /// rotate ([degrees, axis x, y, z]), then translate; or a row-major 4 x 4 affine matrix.
     pub scale: Option<Spanned<toml::Value>>,
@@ -46,7 +48,8 @@ pub(super) fn add_meshes(
     // INSTANCE_MIN_TRIANGLES triangles on and unless it emits, it is stored once and instanced.
     let mesh_key = |mf: &MeshFile| {
         let interior = mf.interior.as_ref().map(|i| i.get_ref().as_str());
-        let material = format!("{} {interior:?}", mf.material.get_ref());
+        let exterior = mf.exterior.as_ref().map(|i| i.get_ref().as_str());
+        let material = format!("{} {interior:?} {exterior:?}", mf.material.get_ref());
         (mf.file.get_ref().clone(), material)
     };
     let mut mesh_uses: HashMap<(String, String), usize> = HashMap::new();
@@ -64,12 +67,12 @@ pub(super) fn add_meshes(
             &mf.material,
             &format!("{field}.material"),
         )?;
-        let material = with_interior(
+        let material = with_media(
             ck,
             media,
             tables,
             (material, &mf.material),
-            mf.interior.as_ref(),
+            (mf.interior.as_ref(), mf.exterior.as_ref()),
             &field,
         )?;
         let mesh_path = base_dir.join(mf.file.get_ref());

@@ -3,7 +3,7 @@
 
 use super::checker::{Checker, V3};
 use super::materials::find_material;
-use super::media::{with_interior, Media};
+use super::media::{with_media, Media};
 use super::transform::{parse_transform, transform_fields};
 use crate::scene::builder::{wound, SceneTables};
 use crate::scene::light_table::sphere_light;
@@ -21,6 +21,8 @@ pub(super) struct SphereFile {
     pub material: Spanned<String>,
     /// The medium inside (a `[media]` name; the material must be a dielectric or interface).
     pub interior: Option<Spanned<String>>,
+    /// The medium outside it (a name in `[media]`; default: the scene's).
+    pub exterior: Option<Spanned<String>>,
     /// Optional transform (`transform::parse_transform`): scale (a number or [x, y, z]), then
     /// rotate ([degrees, axis x, y, z]), then translate; or a row-major 4 x 4 affine matrix.
     pub scale: Option<Spanned<toml::Value>>,
@@ -99,12 +101,12 @@ pub(super) fn add_spheres(
             &sf.material,
             &format!("sphere[{i}].material"),
         )?;
-        let material = with_interior(
+        let material = with_media(
             ck,
             media,
             tables,
             (material, &sf.material),
-            sf.interior.as_ref(),
+            (sf.interior.as_ref(), sf.exterior.as_ref()),
             &format!("sphere[{i}]"),
         )?;
         if tables.is_textured(material) {
