@@ -4,6 +4,7 @@
 //! with its feature `probe`) holds the same entry points and the compute probe; the renderer's
 //! holds no probe.
 
+use kernel::medium::Medium;
 use kernel::scene::{
     AdaptiveParams, Camera, EnvironmentParams, Instance, IntegratorParams, Light, Material,
     RenderParams, SampleParams, ShadingTriangle, Sphere, Triangle,
@@ -225,6 +226,11 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                 true
             ),
         ),
+        (
+            "Medium",
+            binding::MEDIA,
+            host_layout!(Medium, [sigma_a, g, sigma_s, _pad], true),
+        ),
     ];
     for (name, b, host) in cases {
         let device = m.binding_layout(0, b);
@@ -279,7 +285,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
             4,
             host_layout!(
                 EnvironmentParams,
-                [background, width, height, light, scale, rotation, _pad],
+                [background, width, height, light, scale, rotation, medium, _pad],
                 false
             ),
         ),
