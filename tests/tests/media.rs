@@ -17,23 +17,33 @@ const L: f64 = 0.8;
 const SIGMA: [f64; 3] = [0.3, 0.9, 2.0];
 const SIZE: u32 = 24;
 
-fn scene(interior: &str) -> String {
+/// The `[camera]` (SIZE x SIZE, looking from `eye` at `look_at` with field of view `vfov`) and
+/// `[render]` tables of these tests: independent numbers from `seed`, throughput roulette from
+/// the first vertex.
+fn header(eye: [f32; 3], look_at: [f32; 3], vfov: f32, seed: u32) -> String {
     format!(
         r#"
 [camera]
-eye = [0.0, 0.0, 3.2]
-look_at = [0.0, 0.0, 0.0]
+eye = {eye:?}
+look_at = {look_at:?}
 up = [0.0, 1.0, 0.0]
-vfov = 40.0
+vfov = {vfov:?}
 width = {SIZE}
 height = {SIZE}
 
 [render]
-seed = 11
+seed = {seed}
 roulette = "throughput"
 rr_start_depth = 1
 sampler = "independent"
+"#
+    )
+}
 
+fn scene(interior: &str) -> String {
+    header([0.0, 0.0, 3.2], [0.0; 3], 40.0, 11)
+        + &format!(
+            r#"
 [media]
 juice = {{ sigma_a = [{}, {}, {}] }}
 
@@ -49,8 +59,8 @@ material = "boundary"
 [background]
 radiance = [{L}, {L}, {L}]
 "#,
-        SIGMA[0], SIGMA[1], SIGMA[2]
-    )
+            SIGMA[0], SIGMA[1], SIGMA[2]
+        )
 }
 
 #[test]
@@ -185,22 +195,9 @@ fn a_point_light_inside_an_absorbing_sphere_lights_the_floor_through_its_interfa
     const RHO: f64 = 0.6;
     const R: f64 = 0.5;
     let centre = glam::DVec3::new(0.0, 1.0, 0.0);
-    let text = format!(
-        r#"
-[camera]
-eye = [0.0, 3.0, 2.5]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 50.0
-width = {SIZE}
-height = {SIZE}
-
-[render]
-seed = 12
-roulette = "throughput"
-rr_start_depth = 1
-sampler = "independent"
-
+    let text = header([0.0, 3.0, 2.5], [0.0; 3], 50.0, 12)
+        + &format!(
+            r#"
 [media]
 juice = {{ sigma_a = [{}, {}, {}] }}
 
@@ -224,8 +221,16 @@ interior = "juice"
 position = [{}, {}, {}]
 intensity = [{I}, {I}, {I}]
 "#,
-        SIGMA[0], SIGMA[1], SIGMA[2], centre.x, centre.y, centre.z, centre.x, centre.y, centre.z
-    );
+            SIGMA[0],
+            SIGMA[1],
+            SIGMA[2],
+            centre.x,
+            centre.y,
+            centre.z,
+            centre.x,
+            centre.y,
+            centre.z
+        );
     let file: SceneFile = scene_from_toml(&text);
     let channel = |c: usize| {
         pixel_quadrature(&file.scene, 64, |e, d| {
