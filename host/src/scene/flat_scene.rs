@@ -300,7 +300,9 @@ impl Scene {
             .collect();
         let mut parts: Vec<String> = tables
             .iter()
+            // The media table holds vacuum alone in a scene without media: not worth a word.
             .filter(|t| t.1 > 0 && (t.0 != "textures" || !self.textures.textures.is_empty()))
+            .filter(|t| t.0 != "media" || self.media.len() > 1)
             .map(|(name, b)| format!("{name} {}", size(*b)))
             .collect();
         if !images.is_empty() {
