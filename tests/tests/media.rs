@@ -505,3 +505,35 @@ fn a_sphere_of_one_medium_inside_a_sphere_of_another_names_the_medium_around_it(
         "{e}"
     );
 }
+
+/// A camera inside a closed mesh holding a medium is an error naming `camera.eye` (found by
+/// the parity of a ray's crossings, `toml::media::camera_outside_media`); outside it, the file
+/// loads.
+#[test]
+fn a_camera_inside_a_closed_mesh_holding_a_medium_is_refused() {
+    let text = |eye: [f32; 3]| {
+        header(eye, [0.0, 0.0, -1.0], 40.0, 1)
+            + r#"
+[media]
+juice = { sigma_a = [0.3, 0.9, 2.0] }
+
+[materials]
+boundary = { interface = true }
+
+[[mesh]]
+file = "meshes/icosphere.obj"
+material = "boundary"
+interior = "juice"
+"#
+    };
+    let path = twinpath_tests::repo_root().join("scenes/test.toml");
+    let e = match parse_scene(&text([0.1, 0.05, 0.2]), &path) {
+        Ok(_) => panic!("a camera inside the mesh was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("camera.eye") && e.contains("closed mesh") && e.contains("boundary"),
+        "{e}"
+    );
+    parse_scene(&text([0.0, 0.0, 3.2]), &path).expect("a camera outside the mesh");
+}

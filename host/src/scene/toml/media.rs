@@ -195,30 +195,68 @@ pub(super) fn interface_material(
     Ok(out)
 }
 
-/// Err where the camera's eye lies inside a sphere holding a medium: a path starts in the
-/// scene's medium (`kernel::medium`), so a camera inside such a shape would see its inside as
-/// if it were outside. (A closed mesh is not tested: documented in docs/media.md.) `span` is
-/// the `[camera]` table's.
+/// Err where the camera's eye lies inside a sphere or a closed world-space mesh holding a
+/// medium: a path starts in the scene's medium (`kernel::medium`), so a camera inside such a
+/// shape would see its inside as if it were outside. A mesh's inside is found by parity: a ray
+/// from the eye crosses the closed surfaces of a material an odd number of times when the eye
+/// is inside one of them (closed shapes do not overlap). Instanced meshes are not tested
+/// (docs/media.md). `span` is the `[camera]` table's.
 pub(super) fn camera_outside_media(
     ck: &Checker,
     span: std::ops::Range<usize>,
     camera: &crate::scene::CameraDesc,
     tables: &SceneTables,
 ) -> Result<(), SceneError> {
+    let inside_error = |shape: String| {
+        Err(ck.err(
+            span.clone(),
+            "camera.eye",
+            format!(
+                "is inside {shape}, which holds a medium: a camera starts in the scene's medium \
+                 ([scene] medium), so put it outside, or fill the scene with that medium instead"
+            ),
+        ))
+    };
     for (i, s) in tables.spheres.iter().enumerate() {
         let material = &tables.materials[s.material as usize];
         let inside = (camera.eye - glam::Vec3::from(s.center)).length() < s.radius;
         if material.has_interior_medium() && inside {
-            return Err(ck.err(
-                span,
-                "camera.eye",
-                format!(
-                    "is inside sphere[{i}], which holds a medium: a camera starts in the \
-                     scene's medium ([scene] medium), so put it outside the sphere, or fill \
-                     the scene with that medium instead"
-                ),
-            ));
+            return inside_error(format!("sphere[{i}]"));
         }
     }
+    // One direction no axis-aligned or 45-degree surface holds, so that the ray meets edges and
+    // vertices with probability zero.
+    let dir = glam::DVec3::new(0.5377, 0.6147, 0.5771).normalize();
+    let eye = camera.eye.as_dvec3();
+    let mut crossings: BTreeMap<u32, u32> = BTreeMap::new();
+    for t in &tables.triangles {
+        if tables.materials[t.material as usize].has_interior_medium() && crosses(eye, dir, t) {
+            *crossings.entry(t.material).or_insert(0) += 1;
+        }
+    }
+    if let Some((&m, _)) = crossings.iter().find(|(_, &n)| n % 2 == 1) {
+        let name = &tables.material_names[m as usize];
+        return inside_error(format!("a closed mesh of material '{name}'"));
+    }
     Ok(())
+}
+
+/// Whether the ray `origin + s dir`, s > 0, crosses triangle `t` (Moller-Trumbore in f64).
+fn crosses(origin: glam::DVec3, dir: glam::DVec3, t: &kernel::scene::Triangle) -> bool {
+    let (p0, e1, e2) = (
+        glam::Vec3::from(t.p0).as_dvec3(),
+        glam::Vec3::from(t.edge1).as_dvec3(),
+        glam::Vec3::from(t.edge2).as_dvec3(),
+    );
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 {
+        return false;
+    }
+    let tv = origin - p0;
+    let u = tv.dot(p) / det;
+    let q = tv.cross(e1);
+    let v = dir.dot(q) / det;
+    let s = e2.dot(q) / det;
+    (0.0..=1.0).contains(&u) && v >= 0.0 && u + v <= 1.0 && s > 0.0
 }
