@@ -12,6 +12,7 @@
 use super::checker::{Checker, V3};
 use crate::scene::builder::SceneTables;
 use crate::scene::SceneError;
+use kernel::geometry::intersect_triangle;
 use kernel::medium::Medium;
 use kernel::scene::{material_kind, Material};
 use serde::Deserialize;
@@ -95,20 +96,17 @@ pub(super) fn parse_media(
             Some(v) => ck.color(v, &format!("{field}.{key}"), None),
             None => Ok(glam::Vec3::ZERO),
         };
+        // (`Checker::color` refuses negative and non-finite components.)
         let sigma_a = coefficient(&mf.sigma_a, "sigma_a")?;
         let sigma_s = coefficient(&mf.sigma_s, "sigma_s")?;
-        for (key, v) in [("sigma_a", sigma_a), ("sigma_s", sigma_s)] {
-            if !v.is_finite() {
-                return Err(ck.err(m.span(), &format!("{field}.{key}"), "must be finite"));
-            }
-        }
         let g = match &mf.g {
             Some(g) if !(g.get_ref().abs() < 1.0) => {
                 return Err(ck.err(
                     g.span(),
                     &format!("{field}.g"),
                     format!(
-                        "{} is not in (-1, 1): the Henyey-Greenstein asymmetry is a mean cosine                          (0 isotropic, toward 1 forward)",
+                        "{} is not in (-1, 1): the Henyey-Greenstein asymmetry is a mean cosine \
+                         (0 isotropic, toward 1 forward)",
                         g.get_ref()
                     ),
                 ));
@@ -226,11 +224,14 @@ pub(super) fn camera_outside_media(
     }
     // One direction no axis-aligned or 45-degree surface holds, so that the ray meets edges and
     // vertices with probability zero.
-    let dir = glam::DVec3::new(0.5377, 0.6147, 0.5771).normalize();
-    let eye = camera.eye.as_dvec3();
+    let dir = glam::Vec3::new(0.5377, 0.6147, 0.5771).normalize();
+    let eye = camera.eye;
     let mut crossings: BTreeMap<u32, u32> = BTreeMap::new();
     for t in &tables.triangles {
-        if tables.materials[t.material as usize].has_interior_medium() && crosses(eye, dir, t) {
+        let (p0, e1, e2) = (t.p0.into(), t.edge1.into(), t.edge2.into());
+        if tables.materials[t.material as usize].has_interior_medium()
+            && intersect_triangle(eye, dir, p0, e1, e2, 0.0, f32::INFINITY) >= 0.0
+        {
             *crossings.entry(t.material).or_insert(0) += 1;
         }
     }
@@ -239,24 +240,4 @@ pub(super) fn camera_outside_media(
         return inside_error(format!("a closed mesh of material '{name}'"));
     }
     Ok(())
-}
-
-/// Whether the ray `origin + s dir`, s > 0, crosses triangle `t` (Moller-Trumbore in f64).
-fn crosses(origin: glam::DVec3, dir: glam::DVec3, t: &kernel::scene::Triangle) -> bool {
-    let (p0, e1, e2) = (
-        glam::Vec3::from(t.p0).as_dvec3(),
-        glam::Vec3::from(t.edge1).as_dvec3(),
-        glam::Vec3::from(t.edge2).as_dvec3(),
-    );
-    let p = dir.cross(e2);
-    let det = e1.dot(p);
-    if det == 0.0 {
-        return false;
-    }
-    let tv = origin - p0;
-    let u = tv.dot(p) / det;
-    let q = tv.cross(e1);
-    let v = dir.dot(q) / det;
-    let s = e2.dot(q) / det;
-    (0.0..=1.0).contains(&u) && v >= 0.0 && u + v <= 1.0 && s > 0.0
 }
