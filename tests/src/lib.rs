@@ -53,6 +53,25 @@ pub fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, usize, f64) {
     (stat, dof, p)
 }
 
+/// Asserts that `observed` counts fit `expected` ones ([`chi_square`]) at the significance of
+/// one of `tests` chi-square tests sharing the family-wise level `alpha` (Sidak's split), and
+/// prints the statistic under `name`.
+pub fn assert_chi_square_fits(
+    name: &str,
+    observed: &[f64],
+    expected: &[f64],
+    alpha: f64,
+    tests: f64,
+) {
+    let (stat, dof, p) = chi_square(observed, expected);
+    let threshold = 1.0 - (1.0 - alpha).powf(1.0 / tests);
+    println!("{name}: chi2 = {stat:.1}, dof = {dof}, p = {p:.4}");
+    assert!(
+        p > threshold,
+        "{name}: samples do not follow the pdf (chi2 {stat:.1}, dof {dof}, p {p:.2e} < {threshold:.2e})"
+    );
+}
+
 /// Parses scene text as if it were the file `name` in the `scenes/` folder.
 pub fn scene_from_toml(text: &str) -> SceneFile {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/test.toml");

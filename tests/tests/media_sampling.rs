@@ -16,13 +16,7 @@ const TESTS: f64 = 10.0;
 const SAMPLES: u32 = 1_000_000;
 
 fn assert_fits(name: &str, observed: &[f64], expected: &[f64]) {
-    let (stat, dof, p) = chi_square(observed, expected);
-    let threshold = 1.0 - (1.0 - ALPHA).powf(1.0 / TESTS);
-    println!("{name}: chi2 = {stat:.1}, dof = {dof}, p = {p:.4}");
-    assert!(
-        p > threshold,
-        "{name}: samples do not follow the pdf (chi2 {stat:.1}, dof {dof}, p {p:.2e} < {threshold:.2e})"
-    );
+    twinpath_tests::assert_chi_square_fits(name, observed, expected, ALPHA, TESTS);
 }
 
 fn rng(stream: u32) -> SampleRng {
