@@ -6,7 +6,7 @@ OUT/mitsuba_ref_meta.json: what tests/tests/mitsuba.rs compares twinpath with.
 
 Usage: mitsuba_reference.py SCENE OUTDIR [--spp 8192] [--chunk 512] [--variant llvm_ad_rgb]
 SCENE: cornell_materials (scenes/cornell_materials.toml), cornell_fog (scenes/cornell_fog.toml,
-Mitsuba's volpathmis).
+Mitsuba's volpathmis), cornell_smoke (scenes/cornell_smoke.toml, a density grid, volpathmis).
 """
 
 import argparse
@@ -22,7 +22,7 @@ import peer_mitsuba
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("scene", choices=["cornell_materials", "cornell_fog"])
+    ap.add_argument("scene", choices=["cornell_materials", "cornell_fog", "cornell_smoke"])
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=8192)
     ap.add_argument("--chunk", type=int, default=512)
@@ -30,7 +30,8 @@ def main():
     args = ap.parse_args()
     mi.set_variant(args.variant)
     build = {"cornell_materials": peer_mitsuba.cornell_materials_dict,
-             "cornell_fog": peer_mitsuba.cornell_fog_dict}[args.scene]
+             "cornell_fog": peer_mitsuba.cornell_fog_dict,
+             "cornell_smoke": peer_mitsuba.cornell_smoke_dict}[args.scene]
     os.makedirs(args.out, exist_ok=True)
     chunks = max(2, args.spp // args.chunk)
     chunks += chunks % 2

@@ -45,7 +45,7 @@ pub struct Flight {
 
 /// The component `channel` (0, 1 or 2) of `v`.
 #[inline]
-fn component(v: Vec3, channel: u32) -> f32 {
+pub fn component(v: Vec3, channel: u32) -> f32 {
     if channel == 0 {
         v.x
     } else if channel == 1 {

@@ -11,6 +11,8 @@
 pub mod adaptive;
 pub mod bsdf;
 pub mod camera;
+pub mod delta_tracking;
+pub mod density_grid;
 pub mod environment;
 pub mod features;
 pub mod film_sample;

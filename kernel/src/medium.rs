@@ -1,6 +1,7 @@
-//! Homogeneous participating media (TOML `[media]`, `interior`, `[scene] medium`; glTF's
-//! `KHR_materials_volume`): their records, the transmittance of a segment, and which medium a
-//! ray is in.
+//! Participating media (TOML `[media]`, `interior`, `[scene] medium`; glTF's
+//! `KHR_materials_volume`): their records, the transmittance of a homogeneous segment, and
+//! which medium a ray is in. A medium with a density grid (`crate::density_grid`) has its
+//! coefficients per unit density and is tracked by `crate::delta_tracking`.
 //!
 //! A medium of absorption coefficient sigma_a and scattering coefficient sigma_s (per unit
 //! length, per channel) has extinction sigma_t = sigma_a + sigma_s; light travelling a distance
@@ -38,8 +39,9 @@ use spirv_std::glam::Vec3;
 /// The media table's record 0: no medium (every coefficient zero).
 pub const VACUUM: u32 = 0;
 
-/// A homogeneous medium: coefficients per scene unit of length, linear RGB, and the
-/// Henyey-Greenstein asymmetry of its phase function (`crate::phase`). 32 bytes.
+/// A medium: coefficients per scene unit of length (per unit density where it has a grid),
+/// linear RGB, the Henyey-Greenstein asymmetry of its phase function (`crate::phase`), and its
+/// density grid. 32 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
@@ -50,7 +52,9 @@ pub struct Medium {
     pub g: f32,
     /// The scattering coefficient sigma_s.
     pub sigma_s: [f32; 3],
-    pub _pad: u32,
+    /// The word of its density grid's record in the grid table (`crate::density_grid`), or 0:
+    /// homogeneous (density 1 everywhere).
+    pub grid: u32,
 }
 
 impl Medium {
@@ -63,8 +67,22 @@ impl Medium {
             sigma_a,
             g,
             sigma_s,
-            _pad: 0,
+            grid: 0,
         }
+    }
+
+    /// This medium with the density grid whose record is at word `record` of the grid table.
+    pub const fn with_grid(self, record: u32) -> Self {
+        Self {
+            grid: record,
+            ..self
+        }
+    }
+
+    /// Whether its density varies (a grid), else it is homogeneous.
+    #[inline]
+    pub fn has_grid(&self) -> bool {
+        self.grid != 0
     }
 
     /// sigma_t = sigma_a + sigma_s per channel.
@@ -97,8 +115,8 @@ pub fn transmittance(sigma_t: Vec3, distance: f32) -> Vec3 {
     )
 }
 
-/// The transmittance of the segment from `from` to `to` in medium `medium` of `media` (a
-/// segment between surfaces lies in one medium): 1 in vacuum. Exact for a homogeneous medium,
+/// The transmittance of the segment from `from` to `to` in homogeneous medium `medium` of
+/// `media` (a segment between surfaces lies in one medium): 1 in vacuum. Exact for a homogeneous medium,
 /// so a shadow segment needs no estimate of it (ratio tracking estimates what has no closed
 /// form). Out of line on the CPU: only scenes with media call it.
 #[cfg_attr(not(target_arch = "spirv"), inline(never))]

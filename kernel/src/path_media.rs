@@ -1,21 +1,24 @@
 //! A path in participating media (`crate::medium`): the [`PathState`] steps that only scenes
 //! with the `MEDIA` feature bit take. A ray crossing a medium that only absorbs takes its
 //! transmittance; one crossing a medium that scatters draws a free flight
-//! (`crate::free_flight`), and a collision is a medium vertex, where next-event estimation and
-//! the extension use the phase function (`crate::phase`); an interface is no vertex (extension
-//! rays and shadow segments pass it); a shadow segment takes the transmittance of each medium
-//! it crosses. Out of line on the CPU: scenes without media never call these.
+//! (`crate::free_flight`; in a density grid `crate::delta_tracking`), and a collision is a
+//! medium vertex, where next-event estimation and the extension use the phase function
+//! (`crate::phase`); an interface is no vertex (extension rays and shadow segments pass it); a
+//! shadow segment takes the transmittance of each medium it crosses. Out of line on the CPU:
+//! scenes without media never call these.
 
+use crate::delta_tracking::{self, TrackingStream};
+use crate::density_grid::{self, DensityGrid};
 use crate::features::FeatureSet;
 use crate::free_flight;
 use crate::hit::SurfaceHit;
 use crate::light::{self, LightKinds};
-use crate::medium;
+use crate::medium::{self, Medium};
 use crate::path::{beyond_surface, light_sample_weight, light_sampling_of, PathState};
 use crate::phase;
 use crate::scene::{Material, RenderParams};
 use crate::scene_view::SceneView;
-use crate::vertex_samples::{VertexQuery, VertexSamples, FLIGHT_DIMENSION};
+use crate::vertex_samples::{VertexQuery, VertexSamples, FLIGHT_DIMENSION, GRID_DIMENSION};
 use spirv_std::glam::Vec3;
 
 /// [`PathState::flights`]: the mask of the flight count (bits 2..30, shifted down) and the
@@ -33,38 +36,90 @@ impl PathState {
 
     /// The ray just traced crosses the medium it travels in up to `hit` (or out of the scene).
     /// In a medium that only absorbs, the throughput takes the segment's transmittance
-    /// (`medium`); in one that scatters, a free flight is sampled (`crate::free_flight`: the
-    /// path's hero channel from the number at `FLIGHT_DIMENSION`, drawn at its first flight,
-    /// the k-th distance from the one at `FLIGHT_DIMENSION + 1 + k`) and its weight taken.
-    /// Returns whether the ray scattered
-    /// before `hit`: then `ray_origin` is the collision, a medium vertex (`scattered`). Out of
-    /// line on the CPU: only scenes with media call it.
+    /// (`medium`; in a grid from its exact optical depth, `density_grid::optical_depth`); in
+    /// one that scatters, a free flight is sampled (the path's hero channel from the number at
+    /// `FLIGHT_DIMENSION`, drawn at its first flight; the k-th flight's distance from the
+    /// number at `FLIGHT_DIMENSION + 1 + k`, `crate::free_flight`, or in a grid by delta
+    /// tracking from the stream seeded at `GRID_DIMENSION + k`, `crate::delta_tracking`) and
+    /// its weight taken. Returns whether the ray scattered before `hit`: then `ray_origin` is
+    /// the collision, a medium vertex (`scattered`). Out of line on the CPU: only scenes with
+    /// media call it.
     #[cfg_attr(not(target_arch = "spirv"), inline(never))]
     pub(crate) fn fly(&mut self, scene: &SceneView, hit: &SurfaceHit) -> bool {
         let m = &scene.media[self.medium as usize];
+        if m.has_grid() {
+            return self.fly_grid(scene, m, hit);
+        }
         let sigma_t = m.extinction();
         if !(sigma_t.max_element() > 0.0) {
             return false;
         }
-        let distance = if hit.is_hit() {
-            (hit.position - self.ray_origin).length()
-        } else {
-            f32::MAX
-        };
+        let distance = self.distance_to(hit);
         if !m.scatters() {
             self.throughput *= medium::transmittance(sigma_t, distance);
             return false;
         }
+        let (count, hero) = self.hero_channel();
+        self.rng.seek(FLIGHT_DIMENSION + 1 + count);
+        let u = self.rng.next_f32();
+        let sigma_s = Vec3::from(m.sigma_s);
+        let flight = free_flight::sample(sigma_t, sigma_s, distance, hero, u, self.ratios);
+        self.take_flight(&flight, count, hero)
+    }
+
+    /// [`PathState::fly`] in grid medium `m`: the transmittance from the exact optical depth
+    /// (`density_grid::optical_depth`) where it only absorbs, else delta tracking
+    /// (`crate::delta_tracking`) from the stream seeded by the number at `GRID_DIMENSION + k`
+    /// for the path's k-th flight. Out of line on the CPU: a homogeneous medium's flight does
+    /// not carry its code.
+    #[cfg_attr(not(target_arch = "spirv"), inline(never))]
+    fn fly_grid(&mut self, scene: &SceneView, m: &Medium, hit: &SurfaceHit) -> bool {
+        let sigma_t = m.extinction();
+        if !(sigma_t.max_element() > 0.0) {
+            return false;
+        }
+        let distance = self.distance_to(hit);
+        if !m.scatters() {
+            let (origin, dir) = (self.ray_origin, self.ray_dir);
+            self.throughput *= grid_transmittance(scene, m, origin, dir, distance);
+            return false;
+        }
+        let (count, hero) = self.hero_channel();
+        self.rng.seek(GRID_DIMENSION + count);
+        let mut stream = TrackingStream::new(self.rng.next_u32(), count);
+        let grid = DensityGrid::at(scene.grids, m.grid);
+        let ray = (self.ray_origin, self.ray_dir, distance);
+        let sigmas = (sigma_t, Vec3::from(m.sigma_s));
+        let flight = delta_tracking::flight(sigmas, &grid, ray, hero, &mut stream, self.ratios);
+        self.take_flight(&flight, count, hero)
+    }
+
+    /// The distance along the ray to `hit`, `f32::MAX` where it left the scene.
+    #[inline]
+    fn distance_to(&self, hit: &SurfaceHit) -> f32 {
+        if hit.is_hit() {
+            (hit.position - self.ray_origin).length()
+        } else {
+            f32::MAX
+        }
+    }
+
+    /// The number of flights the path has sampled and its hero channel, drawn from the number
+    /// at `FLIGHT_DIMENSION` at its first flight.
+    #[inline]
+    fn hero_channel(&mut self) -> (u32, u32) {
         let count = (self.flights >> 2) & FLIGHT_COUNT;
         if count == 0 {
             self.rng.seek(FLIGHT_DIMENSION);
             self.flights = free_flight::hero_channel(self.rng.next_f32());
         }
-        let hero = self.flights & 3;
-        self.rng.seek(FLIGHT_DIMENSION + 1 + count);
-        let u = self.rng.next_f32();
-        let sigma_s = Vec3::from(m.sigma_s);
-        let flight = free_flight::sample(sigma_t, sigma_s, distance, hero, u, self.ratios);
+        (count, self.flights & 3)
+    }
+
+    /// Takes the path's `count`-th flight, drawn by channel `hero`: its weight and ratios, and
+    /// its collision as the next vertex where it scattered (returned).
+    #[inline]
+    fn take_flight(&mut self, flight: &free_flight::Flight, count: u32, hero: u32) -> bool {
         self.throughput *= flight.weight;
         self.ratios = flight.ratios;
         self.flights = (((count + 1) & FLIGHT_COUNT) << 2) | hero;
@@ -183,9 +238,8 @@ impl PathState {
     /// on the CPU: only scenes with media call it.
     #[cfg_attr(not(target_arch = "spirv"), inline(never))]
     pub fn shadow_passes(&mut self, scene: &SceneView, blocker: &SurfaceHit) -> bool {
-        let media = scene.media;
         if !blocker.is_hit() {
-            let t = medium::along(media, self.shadow_medium, self.shadow_from, self.shadow_to);
+            let t = self.shadow_transmittance(scene, self.shadow_to);
             self.radiance += self.shadow_radiance * t;
             self.shadow = false;
             return false;
@@ -196,17 +250,31 @@ impl PathState {
             return false;
         }
         let dir = self.shadow_to - self.shadow_from;
-        self.shadow_radiance *= medium::along(
-            media,
-            self.shadow_medium,
-            self.shadow_from,
-            blocker.position,
-        );
+        let t = self.shadow_transmittance(scene, blocker.position);
+        self.shadow_radiance *= t;
         let outside = scene.params.environment.medium;
         self.shadow_medium =
             medium::beyond(material, blocker.normal, dir, self.shadow_medium, outside);
         self.shadow_from = beyond_surface(blocker, dir);
         true
+    }
+
+    /// The transmittance of the shadow segment's piece from `shadow_from` to `to` in
+    /// `shadow_medium`: exact in a homogeneous medium (`medium::along`) and in a grid
+    /// (exp(-sigma_t tau), `density_grid::optical_depth`).
+    #[inline]
+    fn shadow_transmittance(&self, scene: &SceneView, to: Vec3) -> Vec3 {
+        let (from, medium) = (self.shadow_from, self.shadow_medium);
+        let m = &scene.media[medium as usize];
+        if !m.has_grid() {
+            return medium::along(scene.media, medium, from, to);
+        }
+        let d = to - from;
+        let length = d.length();
+        if !(length > 0.0) {
+            return Vec3::ONE;
+        }
+        grid_transmittance(scene, m, from, d / length, length)
     }
 
     /// The extension ray met an interface at `hit` (its transmittance up to there already
@@ -220,4 +288,14 @@ impl PathState {
         self.ray_origin = beyond_surface(hit, self.ray_dir);
         self.extend = true;
     }
+}
+
+/// The transmittance of ray `origin + t dir` (`dir` of unit length) for t in [0, `length`]
+/// through grid medium `m`: exp(-sigma_t tau), tau its exact optical depth
+/// (`density_grid::optical_depth`). Out of line on the CPU, as [`PathState::fly_grid`].
+#[cfg_attr(not(target_arch = "spirv"), inline(never))]
+fn grid_transmittance(scene: &SceneView, m: &Medium, origin: Vec3, dir: Vec3, length: f32) -> Vec3 {
+    let grid = DensityGrid::at(scene.grids, m.grid);
+    let tau = density_grid::optical_depth(&grid, origin, dir, length);
+    medium::transmittance(m.extinction(), tau)
 }

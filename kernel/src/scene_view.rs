@@ -21,4 +21,6 @@ pub struct SceneView<'a> {
     pub instances: &'a [Instance],
     /// The media table (`crate::medium`; record 0 is vacuum).
     pub media: &'a [Medium],
+    /// The grid table (`crate::density_grid`; one word when no medium has a grid).
+    pub grids: &'a [u32],
 }

@@ -9,7 +9,8 @@
 //! 9 the environment table (`crate::environment`; one number when there is no map),
 //! 10 the shading table (`ShadingTriangle`s; one zero record when there is none),
 //! 11 the texture table (`crate::texture`), 12 the instance table (`Instance`s; one zero record
-//! when there is none), 13 the media table (`crate::medium`; record 0, vacuum, always there).
+//! when there is none), 13 the media table (`crate::medium`; record 0, vacuum, always there),
+//! 14 the grid table (`crate::density_grid`; one word when no medium has a grid).
 //! Specialization constant 0: the feature bits of `crate::features` (0: generic path).
 //! Hit groups: 0 triangles (closest hit), then 1 spheres (intersection + closest hit), then
 //! instanced triangles (closest hit), each present only where the scene has that geometry;
@@ -176,6 +177,7 @@ pub fn raygen(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] textures: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] instances: &[Instance],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 13)] media: &[Medium],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 14)] grids: &[u32],
     #[spirv(descriptor_set = 0, binding = 7)] accum_m2: &Image!(
         2D,
         format = rgba32f,
@@ -223,6 +225,7 @@ pub fn raygen(
         textures,
         instances,
         media,
+        grids,
     };
     let mut s = 0;
     while s < params.samples.count {

@@ -37,11 +37,14 @@ pub const LOBE_DIMENSION: u32 = 1 << 31;
 /// vertex's block and below the lobe choices, so pinhole renders draw exactly what they drew
 /// before lenses existed.
 pub const LENS_DIMENSION: u32 = LOBE_DIMENSION - 2;
-/// The pair of the k-th free flight a path samples in a medium that scatters
-/// (`crate::free_flight`: the channel and the distance) is dimensions `FLIGHT_DIMENSION + 2 k`
-/// and the next: outside every vertex's block and above the lobe choices, so scenes without
-/// such a medium draw exactly the numbers they drew before media existed.
+/// A path's hero channel in media (`crate::free_flight`) is dimension `FLIGHT_DIMENSION`, the
+/// distance of its k-th free flight in a homogeneous medium that scatters `FLIGHT_DIMENSION +
+/// 1 + k`: outside every vertex's block and above the lobe choices, so scenes without such a
+/// medium draw exactly the numbers they drew before media existed.
 pub const FLIGHT_DIMENSION: u32 = LOBE_DIMENSION + (1 << 30);
+/// The seed of the k-th flight's tracking stream in a grid medium (`crate::delta_tracking`)
+/// is dimension `GRID_DIMENSION + k` (between the lobe choices and the flights).
+pub const GRID_DIMENSION: u32 = LOBE_DIMENSION + (1 << 29);
 /// In [`VertexQuery::dimensions`]: a number the vertex does not read.
 pub const NO_DIMENSION: u32 = u32::MAX;
 

@@ -133,6 +133,7 @@ pub fn shade_at(
         textures,
         instances,
         media: &[kernel::medium::Medium::VACUUM],
+        grids: &[0],
     };
     let hit = kernel::SurfaceHit {
         material,

@@ -288,15 +288,25 @@ fn media_and_interiors_are_checked_where_they_are_written() {
         e.contains("sphere[0].interior") && e.contains("not a dielectric"),
         "{e}"
     );
-    // Not rendered yet, refused by name: grids.
+    // Grids: a file that is not there, a scale without a grid or below 0.
     let e = error_of(&base.replace(
         "juice = { sigma_a",
-        "juice = { grid = \"smoke.vdb\", sigma_a",
+        "juice = { grid = \"no_such_smoke.vdb\", sigma_a",
     ));
     assert!(
-        e.contains("media.juice.grid") && e.contains("not rendered yet"),
+        e.contains("media.juice.grid") && e.contains("no_such_smoke.vdb"),
         "{e}"
     );
+    let e = error_of(&base.replace("juice = { sigma_a", "juice = { scale = 2.0, sigma_a"));
+    assert!(
+        e.contains("media.juice.scale") && e.contains("no grid"),
+        "{e}"
+    );
+    let e = error_of(&base.replace(
+        "juice = { sigma_a",
+        "juice = { grid = \"smoke.vol\", scale = -1.0, sigma_a",
+    ));
+    assert!(e.contains("media.juice.scale"), "{e}");
     // g is a mean cosine, in (-1, 1); an unknown scene medium lists the known ones.
     let e = error_of(&base.replace("juice = { sigma_a", "juice = { g = 1.0, sigma_a"));
     assert!(e.contains("media.juice.g") && e.contains("(-1, 1)"), "{e}");
@@ -537,3 +547,4 @@ interior = "juice"
     );
     parse_scene(&text([0.0, 0.0, 3.2]), &path).expect("a camera outside the mesh");
 }
+

@@ -434,6 +434,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
             textures: &[],
             instances: &[],
             media: &[kernel::medium::Medium::VACUUM],
+            grids: &[0],
         };
         for (lane, entry) in queries.iter().enumerate() {
             let Some((rng, q)) = entry else { continue };

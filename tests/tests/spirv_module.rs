@@ -229,7 +229,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
         (
             "Medium",
             binding::MEDIA,
-            host_layout!(Medium, [sigma_a, g, sigma_s, _pad], true),
+            host_layout!(Medium, [sigma_a, g, sigma_s, grid], true),
         ),
     ];
     for (name, b, host) in cases {

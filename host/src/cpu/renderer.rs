@@ -33,6 +33,8 @@ pub struct CpuRenderer {
     pub textures: Vec<u32>,
     /// The media table (`kernel::medium`).
     pub media: Vec<Medium>,
+    /// The grid table (`kernel::density_grid`).
+    pub grids: Vec<u32>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path).
     pub features: u32,
     /// How a tile's samples are computed, chosen once when the renderer is built.
@@ -153,6 +155,7 @@ impl CpuRenderer {
             shading: scene.shading_table(),
             textures: scene.textures.words.clone(),
             media: scene.media.clone(),
+            grids: scene.grids.words.clone(),
             features: with_all_extended(scene.features(settings)),
             tiles,
             holes,
@@ -205,6 +208,7 @@ impl CpuRenderer {
             textures: &self.textures,
             instances: self.bvh.instances(),
             media: &self.media,
+            grids: &self.grids,
         }
     }
 

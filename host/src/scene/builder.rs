@@ -2,6 +2,7 @@
 //! records, lights and textures. The TOML format and glTF files feed the same builder, so a
 //! triangle becomes the same kernel records (and a light) whichever file it came from.
 
+use super::density_grid::GridTable;
 use super::environment::EnvironmentMap;
 use super::ggx_albedo;
 use super::instancing::{instance_box, instance_record, instances_box, mesh_box, MAX_INSTANCES};
@@ -47,6 +48,8 @@ pub(super) struct SceneTables {
     /// ([`SceneTables::add_medium`]), and the medium filling the scene (0: vacuum).
     pub media: Vec<Medium>,
     pub scene_medium: u32,
+    /// The media's density grids (`kernel::density_grid`).
+    pub grids: GridTable,
 }
 
 /// Records of the media table: a material holds an index in 16 bits, and the exterior's plus 1.
@@ -507,6 +510,7 @@ impl SceneTables {
                 self.media
             },
             medium: self.scene_medium,
+            grids: self.grids,
             notes: Vec::new(),
             inputs: Vec::new(),
         }

@@ -5,6 +5,7 @@
 //! probabilities). The settings are not part of the scene: a file's `[render]` table is read
 //! beside it (`super::SceneFile`).
 
+use super::density_grid::GridTable;
 use super::environment;
 use super::inputs;
 use super::instancing;
@@ -144,6 +145,8 @@ pub struct Scene {
     /// filling the scene outside every closed shape, the camera's (0: vacuum).
     pub media: Vec<kernel::medium::Medium>,
     pub medium: u32,
+    /// The media's density grids (`kernel::density_grid`; word 0 alone where there are none).
+    pub grids: GridTable,
     /// What the loader approximated or ignored (glTF features twinpath does not read yet):
     /// shown to the user before a render.
     pub notes: Vec<String>,
@@ -258,9 +261,9 @@ impl Scene {
     }
 
     /// Bytes of the scene's tables on either backend: triangles, spheres, shading records,
-    /// materials, lights, textures, the environment map, instances and media (what
-    /// `twinpath info` reports).
-    pub fn table_bytes(&self) -> [(&'static str, usize); 9] {
+    /// materials, lights, textures, the environment map, instances, media and density grids
+    /// (what `twinpath info` reports).
+    pub fn table_bytes(&self) -> [(&'static str, usize); 10] {
         use std::mem::size_of;
         [
             ("triangles", self.triangles.len() * size_of::<Triangle>()),
@@ -274,6 +277,7 @@ impl Scene {
                 "media",
                 self.media.len() * size_of::<kernel::medium::Medium>(),
             ),
+            ("grids", 4 * self.grids.words.len()),
             (
                 "environment",
                 self.environment.as_ref().map_or(0, |m| 4 * m.table_len()),
@@ -303,6 +307,7 @@ impl Scene {
             // The media table holds vacuum alone in a scene without media: not worth a word.
             .filter(|t| t.1 > 0 && (t.0 != "textures" || !self.textures.textures.is_empty()))
             .filter(|t| t.0 != "media" || self.media.len() > 1)
+            .filter(|t| t.0 != "grids" || !self.grids.is_empty())
             .map(|(name, b)| format!("{name} {}", size(*b)))
             .collect();
         if !images.is_empty() {

@@ -6,6 +6,7 @@
 
 mod builder;
 mod closed_surface;
+pub mod density_grid;
 pub mod environment;
 mod error;
 mod flat_scene;

@@ -125,6 +125,7 @@ impl GpuRenderer {
                 STORAGE,
             )?,
             ctx.upload_buffer("media", bytemuck::cast_slice(&scene.media), STORAGE)?,
+            ctx.upload_buffer("grids", bytemuck::cast_slice(&scene.grids.words), STORAGE)?,
         ];
         let accum = ctx.create_storage_image("accum", w, h)?;
         let accum_sq = ctx.create_storage_image("accum_sq", w, h)?;
@@ -141,7 +142,7 @@ impl GpuRenderer {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 10,
+                descriptor_count: 11,
             },
         ];
         let (pool, set) = ctx.create_descriptor_set(pipeline.set_layout, &sizes)?;
@@ -173,6 +174,7 @@ impl GpuRenderer {
             buffer_info(&tables[6]),
             buffer_info(&tables[7]),
             buffer_info(&tables[8]),
+            buffer_info(&tables[9]),
         ];
         let buffer_bindings = [
             binding::PARAMS,
@@ -185,6 +187,7 @@ impl GpuRenderer {
             binding::TEXTURES,
             binding::INSTANCES,
             binding::MEDIA,
+            binding::GRIDS,
         ];
         let mut writes = vec![
             vk::WriteDescriptorSet::default()

@@ -34,6 +34,7 @@ pub mod binding {
     pub const TEXTURES: u32 = 11;
     pub const INSTANCES: u32 = 12;
     pub const MEDIA: u32 = 13;
+    pub const GRIDS: u32 = 14;
 }
 
 /// Which hit groups a pipeline has: a scene without world-space triangles (or spheres, or
@@ -143,6 +144,7 @@ impl RtPipeline {
             b(binding::TEXTURES, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::INSTANCES, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::MEDIA, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::GRIDS, vk::DescriptorType::STORAGE_BUFFER),
         ];
         let set_layout = unsafe {
             ctx.device.create_descriptor_set_layout(

@@ -5,18 +5,20 @@
 //! (exterior: `Material::interior_medium`, `Material::exterior_medium`, `kernel::medium`), one
 //! copy of the material per combination.
 //!
-//! What renders today: homogeneous media (`sigma_a`, `sigma_s` per scene unit of length, RGB;
-//! `g`, the Henyey-Greenstein asymmetry). Density grids (`grid`, `scale`) are read and refused
-//! with an error naming the field, rather than rendered without them.
+//! A medium is homogeneous (`sigma_a`, `sigma_s` per scene unit of length, RGB; `g`, the
+//! Henyey-Greenstein asymmetry) or has a density grid (`grid`, a `.vol` file, and `scale`, its
+//! densities' factor: then the coefficients are per unit density).
 
 use super::checker::{Checker, V3};
 use crate::scene::builder::SceneTables;
+use crate::scene::density_grid::DenseGrid;
 use crate::scene::SceneError;
 use kernel::geometry::intersect_triangle;
 use kernel::medium::Medium;
 use kernel::scene::{material_kind, Material};
 use serde::Deserialize;
 use std::collections::BTreeMap;
+use std::path::Path;
 use toml::Spanned;
 
 /// One `[media]` entry.
@@ -73,25 +75,14 @@ pub(super) fn parse_media(
     ck: &Checker,
     media: &BTreeMap<String, Spanned<MediumFile>>,
     scene: Option<&Spanned<SceneSection>>,
+    base_dir: &Path,
     tables: &mut SceneTables,
 ) -> Result<Media, SceneError> {
     let mut out = Media::default();
     for (name, m) in media {
         let field = format!("media.{name}");
         let mf = m.get_ref();
-        let not_yet = |span: std::ops::Range<usize>, key: &str, what: &str| {
-            Err(ck.err(
-                span,
-                &format!("{field}.{key}"),
-                format!("{what} is not rendered yet: only homogeneous media are"),
-            ))
-        };
-        if let Some(grid) = &mf.grid {
-            return not_yet(grid.span(), "grid", "a density grid");
-        }
-        if let Some(scale) = &mf.scale {
-            return not_yet(scale.span(), "scale", "a density grid's scale");
-        }
+        let grid = density_grid(ck, mf, &field, base_dir, tables)?;
         let coefficient = |v: &Option<V3>, key: &str| match v {
             Some(v) => ck.color(v, &format!("{field}.{key}"), None),
             None => Ok(glam::Vec3::ZERO),
@@ -114,7 +105,7 @@ pub(super) fn parse_media(
             Some(g) => *g.get_ref(),
             None => 0.0,
         };
-        let medium = Medium::new(sigma_a.to_array(), sigma_s.to_array(), g);
+        let medium = Medium::new(sigma_a.to_array(), sigma_s.to_array(), g).with_grid(grid);
         let Some(index) = tables.add_medium(medium) else {
             return Err(ck.err(m.span(), &field, "more than 65534 media: the table is full"));
         };
@@ -124,6 +115,47 @@ pub(super) fn parse_media(
         tables.scene_medium = out.get(ck, medium, "scene.medium")?;
     }
     Ok(out)
+}
+
+/// The density grid of medium `mf` (`field`: `media.NAME`), its `grid` file (relative to
+/// `base_dir`) read with its `scale` and added to the grid table: the word of its record, or
+/// 0 for a homogeneous medium.
+fn density_grid(
+    ck: &Checker,
+    mf: &MediumFile,
+    field: &str,
+    base_dir: &Path,
+    tables: &mut SceneTables,
+) -> Result<u32, SceneError> {
+    let scale = match &mf.scale {
+        Some(s) if mf.grid.is_none() => {
+            return Err(ck.err(
+                s.span(),
+                &format!("{field}.scale"),
+                "scales a density grid's densities, and the medium has no grid (a homogeneous \
+                 medium's coefficients are its own)",
+            ));
+        }
+        Some(s) if !(s.get_ref().is_finite() && *s.get_ref() >= 0.0) => {
+            return Err(ck.err(
+                s.span(),
+                &format!("{field}.scale"),
+                format!("{} is not a finite non-negative number", s.get_ref()),
+            ));
+        }
+        Some(s) => *s.get_ref(),
+        None => 1.0,
+    };
+    let Some(grid) = &mf.grid else {
+        return Ok(0);
+    };
+    let key = format!("{field}.grid");
+    let path = base_dir.join(grid.get_ref());
+    let dense = DenseGrid::read(&path, scale).map_err(|e| ck.err(grid.span(), &key, e))?;
+    tables
+        .grids
+        .add(&dense)
+        .ok_or_else(|| ck.err(grid.span(), &key, "the grid table passes 2^32 words"))
 }
 
 /// The material of a closed shape whose material is `material` (named by `material_name`)

@@ -82,7 +82,7 @@ pub fn parse_scene_with_camera(
     let settings = settings::render_settings(&ck, &file.render)?;
     let mut tables = SceneTables::default();
     materials::add_materials(&ck, &file.materials, base_dir, &mut tables)?;
-    let media = media::parse_media(&ck, &file.media, file.scene.as_ref(), &mut tables)?;
+    let media = media::parse_media(&ck, &file.media, file.scene.as_ref(), base_dir, &mut tables)?;
     shapes::add_spheres(&ck, &file.sphere, &media, &mut tables)?;
     shapes::add_quads(&ck, &file.quad, &mut tables)?;
     meshes::add_meshes(&ck, &file.mesh, &media, base_dir, &mut tables)?;
