@@ -26,6 +26,16 @@ use spirv_std::glam::Vec3;
 const FLIGHT_COUNT: u32 = (1 << 29) - 1;
 const SCATTERED: u32 = 1 << 31;
 
+/// The largest probability with which roulette keeps a path at a medium vertex. A medium that
+/// does not absorb (albedo 1 in some channel) keeps a path's throughput, and throughput
+/// roulette (survival min(throughput, 1)) would then never end it; in a medium without bound
+/// (a fog filling the scene, around an open room) a path that wanders off is a random walk in
+/// three dimensions, which does not come back, so it never ended (a render hung). Ending at
+/// least 1% of paths at each medium vertex bounds every walk (about 100 vertices more at
+/// most, on average) and stays unbiased: the survivors' throughput is divided by the same
+/// probability (Mitsuba 3 caps every vertex at 0.95).
+pub const MAX_MEDIUM_SURVIVAL: f32 = 0.99;
+
 impl PathState {
     /// Whether the vertex [`PathState::advance`] reached is a medium vertex, at `ray_origin`
     /// (see [`PathState::flights`]).
@@ -155,7 +165,7 @@ impl PathState {
         params: &RenderParams,
     ) -> VertexQuery {
         let light_count = self.light_count(features, params, true);
-        let survival = self.survival(features, params);
+        let survival = self.survival(features, params).min(MAX_MEDIUM_SURVIVAL);
         VertexQuery {
             depth: self.depth,
             x: self.ray_origin,

@@ -548,3 +548,60 @@ interior = "juice"
     parse_scene(&text([0.0, 0.0, 3.2]), &path).expect("a camera outside the mesh");
 }
 
+/// Paths end in a medium without bound that does not absorb. In a fog of albedo 1 filling the
+/// world, with nothing else, a path's throughput stays 1, so throughput roulette alone never
+/// ends it, and its walk never comes back: a render of such a fog around an open scene hung.
+/// Roulette keeps a path at a medium vertex with probability at most
+/// `MAX_MEDIUM_SURVIVAL` (0.99), so the number of extension rays per sample is geometric with
+/// mean 1 / (1 - 0.99) = 100 (z-test); without that bound every path runs to `max_depth`
+/// (set to 100000 here so that the test fails instead of hanging).
+#[test]
+fn paths_end_in_a_fog_of_albedo_one_without_bound() {
+    let q = kernel::path_media::MAX_MEDIUM_SURVIVAL as f64;
+    let file = scene_from_toml(
+        r#"
+[camera]
+eye = [0.0, 0.0, 0.0]
+look_at = [0.0, 0.0, -1.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40.0
+width = 4
+height = 4
+
+[render]
+seed = 5
+roulette = "throughput"
+rr_start_depth = 1
+max_depth = 100000
+sampler = "independent"
+
+[media]
+fog = { sigma_s = [1.0, 1.0, 1.0], g = 0.3 }
+
+[scene]
+medium = "fog"
+
+[materials]
+grey = { kd = [0.5, 0.5, 0.5] }
+
+[[sphere]] # far beyond any flight: never reached
+center = [0.0, 0.0, -1.0e6]
+radius = 1.0
+material = "grey"
+"#,
+    );
+    let spp = 64;
+    let out = twinpath_tests::render_output(&file, Backend::Cpu, spp);
+    let rays = out.rays.expect("the CPU backend counts rays");
+    let samples = out.film.total_samples() as f64;
+    let mean = rays.closest as f64 / samples;
+    let z = (mean - 1.0 / (1.0 - q)) / (q / (1.0 - q).powi(2) / samples).sqrt();
+    println!(
+        "{mean:.2} extension rays per sample (want {:.0}), z = {z:+.2}",
+        1.0 / (1.0 - q)
+    );
+    assert!(
+        z.abs() < z_critical(1e-3, 1),
+        "{mean} rays per sample, z = {z:.2}"
+    );
+}
