@@ -11,7 +11,9 @@
 
 use twinpath::render::Backend;
 use twinpath::scene::{parse_scene, SceneFile};
-use twinpath_tests::{pixel_quadrature, render_film, scene_from_toml, z_critical};
+use twinpath_tests::{
+    assert_backends_agree_with, pixel_quadrature, render_film, scene_from_toml, z_critical,
+};
 
 const L: f64 = 0.8;
 const SIGMA: [f64; 3] = [0.3, 0.9, 2.0];
@@ -112,61 +114,6 @@ fn a_sphere_of_absorbing_medium_transmits_exp_of_minus_sigma_times_the_chord() {
         mean[centre]
     );
     assert!(exact[centre].expect("the centre is inside")[2] < 0.1 * L);
-}
-
-/// Renders `file` with `spp` samples per pixel on the CPU (packets and one path) and the GPU,
-/// and z-tests every pixel with a closed form in `exact` (`None`: not tested) per channel at
-/// a family-wise level of 1e-3, and the sum over the tested pixels per channel.
-fn assert_backends_agree_with(file: &SceneFile, exact: &[Option<[f64; 3]>], spp: u32) {
-    let tested = exact.iter().flatten().count();
-    let mut one_path = file.clone();
-    one_path.settings.packets = false;
-    for (label, scene, backend) in [
-        ("cpu packets", file, Backend::Cpu),
-        ("cpu one path", &one_path, Backend::Cpu),
-        ("gpu", file, Backend::Gpu),
-    ] {
-        let film = render_film(scene, backend, spp);
-        assert_eq!(film.discarded, 0);
-        let (mean, var) = (film.mean(), film.variance_of_mean());
-        let z_max = z_critical(1e-3, 3 * tested);
-        // Pooled per channel: a path's channels are correlated, so summing over them would
-        // understate the variance of the sum.
-        let (mut sum_d, mut sum_v, mut worst) = ([0.0; 3], [0.0; 3], 0f64);
-        for ((want, m), v) in exact.iter().zip(&mean).zip(&var) {
-            let Some(want) = want else { continue };
-            for c in 0..3 {
-                let d = m[c] as f64 - want[c];
-                let v = v[c] as f64;
-                if v == 0.0 {
-                    // Every sample alike (a ray that meets only the environment): the value
-                    // itself, to f32's rounding.
-                    assert!(
-                        d.abs() <= 1e-6 * want[c].abs().max(1.0),
-                        "{label}: pixel reads {} vs {:.7} in channel {c} with no variance",
-                        m[c],
-                        want[c]
-                    );
-                    continue;
-                }
-                let z = d / v.sqrt();
-                worst = worst.max(z.abs());
-                assert!(
-                    z.abs() < z_max,
-                    "{label}: pixel reads {} vs {:.5} in channel {c} (z = {z:.2})",
-                    m[c],
-                    want[c]
-                );
-                sum_d[c] += d;
-                sum_v[c] += v;
-            }
-        }
-        let z_all: Vec<f64> = (0..3).map(|c| sum_d[c] / sum_v[c].sqrt()).collect();
-        println!("{label}: worst |z| {worst:.2}, all pixels together z = {z_all:+.2?} (r, g, b)");
-        for z in z_all {
-            assert!(z.abs() < z_critical(1e-3, 3), "{label}: z = {z:.2}");
-        }
-    }
 }
 
 /// The length of the part of the segment from `o` to `o + t_end d` (`d` unit) inside the

@@ -15,11 +15,11 @@ use glam::{DVec3, Vec3};
 use kernel::delta_tracking::{self, TrackingStream};
 use kernel::density_grid::{optical_depth, DensityGrid, MajorantWalk};
 use kernel::free_flight::hero_channel;
-use twinpath::render::Backend;
 use twinpath::scene::density_grid::{DenseGrid, GridTable};
 use twinpath::scene::SceneFile;
 use twinpath_tests::{
-    assert_chi_square_fits, pixel_quadrature, render_film, scene_from_toml, z_critical,
+    assert_backends_agree_with, assert_chi_square_fits, pixel_quadrature, scene_from_toml,
+    z_critical,
 };
 
 /// The linear ramp a + sum b_axis u_axis of the module's documentation over the box `min` to
@@ -541,55 +541,6 @@ medium = "smoke"
 radiance = [{L}, {L}, {L}]
 "#
     ))
-}
-
-/// Renders `file` on the CPU (packets and one path) and the GPU and z-tests every pixel
-/// against `exact` per channel (family-wise 1e-3), and each channel's sum over the image.
-fn assert_backends_agree_with(file: &SceneFile, exact: &[Option<[f64; 3]>], spp: u32) {
-    let mut one_path = file.clone();
-    one_path.settings.packets = false;
-    for (label, scene, backend) in [
-        ("cpu packets", file, Backend::Cpu),
-        ("cpu one path", &one_path, Backend::Cpu),
-        ("gpu", file, Backend::Gpu),
-    ] {
-        let film = render_film(scene, backend, spp);
-        assert_eq!(film.discarded, 0);
-        let (mean, var) = (film.mean(), film.variance_of_mean());
-        let z_max = z_critical(1e-3, 3 * exact.iter().flatten().count());
-        let (mut sum_d, mut sum_v, mut worst) = ([0.0; 3], [0.0; 3], 0f64);
-        for ((want, m), v) in exact.iter().zip(&mean).zip(&var) {
-            let Some(want) = want else { continue };
-            for c in 0..3 {
-                let d = m[c] as f64 - want[c];
-                let v = v[c] as f64;
-                if v == 0.0 {
-                    assert!(
-                        d.abs() <= 1e-6,
-                        "{label}: {} vs {:.7} with no variance",
-                        m[c],
-                        want[c]
-                    );
-                    continue;
-                }
-                let z = d / v.sqrt();
-                worst = worst.max(z.abs());
-                assert!(
-                    z.abs() < z_max,
-                    "{label}: {} vs {:.5} in channel {c} (z = {z:.2})",
-                    m[c],
-                    want[c]
-                );
-                sum_d[c] += d;
-                sum_v[c] += v;
-            }
-        }
-        let z_all: Vec<f64> = (0..3).map(|c| sum_d[c] / sum_v[c].sqrt()).collect();
-        println!("{label}: worst |z| {worst:.2}, all pixels together z = {z_all:+.2?}");
-        for z in z_all {
-            assert!(z.abs() < z_critical(1e-3, 3), "{label}: z = {z:.2}");
-        }
-    }
 }
 
 /// A camera in an absorbing grid medium (the scene's) sees the environment through it:
