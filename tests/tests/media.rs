@@ -493,6 +493,27 @@ interior = "juice"
         "{e}"
     );
     parse_scene(&text([0.0, 0.0, 3.2]), &path).expect("a camera outside the mesh");
+    // The same mesh placed twice is one mesh and two instances; the eye inside the second
+    // (scaled by 2, moved to x = -5) is found in its object space.
+    let placed = |eye: [f32; 3]| {
+        text(eye).replace(
+            "interior = \"juice\"\n",
+            "interior = \"juice\"\ntranslate = [5.0, 0.0, 0.0]\n\n[[mesh]]\n\
+             file = \"meshes/icosphere.obj\"\nmaterial = \"boundary\"\ninterior = \"juice\"\n\
+             scale = 2.0\ntranslate = [-5.0, 0.0, 0.0]\n",
+        )
+    };
+    let outside = parse_scene(&placed([0.0, 0.0, 3.2]), &path).expect("a camera outside both");
+    assert_eq!(
+        outside.scene.instances.len(),
+        2,
+        "the two placements are instances"
+    );
+    let e = match parse_scene(&placed([-5.9, 0.3, 0.2]), &path) {
+        Ok(_) => panic!("a camera inside an instance was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("camera.eye") && e.contains("instance 1"), "{e}");
 }
 
 /// Paths end in a medium without bound that does not absorb. In a fog of albedo 1 filling the

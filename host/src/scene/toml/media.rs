@@ -229,8 +229,8 @@ pub(super) fn interface_material(
 /// medium: a path starts in the scene's medium (`kernel::medium`), so a camera inside such a
 /// shape would see its inside as if it were outside. A mesh's inside is found by parity: a ray
 /// from the eye crosses the closed surfaces of a material an odd number of times when the eye
-/// is inside one of them (closed shapes do not overlap). Instanced meshes are not tested
-/// (docs/media.md). `span` is the `[camera]` table's.
+/// is inside one of them (closed shapes do not overlap); an instanced mesh likewise in its
+/// instance's object space. `span` is the `[camera]` table's.
 pub(super) fn camera_outside_media(
     ck: &Checker,
     span: std::ops::Range<usize>,
@@ -270,6 +270,37 @@ pub(super) fn camera_outside_media(
     if let Some((&m, _)) = crossings.iter().find(|(_, &n)| n % 2 == 1) {
         let name = &tables.material_names[m as usize];
         return inside_error(format!("a closed mesh of material '{name}'"));
+    }
+    // Instanced meshes: the same parity in each instance's object space (the eye and the
+    // direction mapped by its world-to-object matrix; crossings keep their count).
+    for (i, (record, &mesh)) in tables
+        .instances
+        .iter()
+        .zip(&tables.instance_meshes)
+        .enumerate()
+    {
+        let m = &record.world_to_object;
+        let map = |v: glam::Vec3, w: f32| {
+            glam::Vec3::new(
+                m[0] * v.x + m[1] * v.y + m[2] * v.z + m[3] * w,
+                m[4] * v.x + m[5] * v.y + m[6] * v.z + m[7] * w,
+                m[8] * v.x + m[9] * v.y + m[10] * v.z + m[11] * w,
+            )
+        };
+        let (o, d) = (map(eye, 1.0), map(dir, 0.0));
+        let mut crossings: BTreeMap<u32, u32> = BTreeMap::new();
+        for t in &tables.mesh_triangles[tables.meshes[mesh as usize].range.clone()] {
+            let (p0, e1, e2) = (t.p0.into(), t.edge1.into(), t.edge2.into());
+            if tables.materials[t.material as usize].has_interior_medium()
+                && intersect_triangle(o, d, p0, e1, e2, 0.0, f32::INFINITY) >= 0.0
+            {
+                *crossings.entry(t.material).or_insert(0) += 1;
+            }
+        }
+        if let Some((&m, _)) = crossings.iter().find(|(_, &n)| n % 2 == 1) {
+            let name = &tables.material_names[m as usize];
+            return inside_error(format!("instance {i}, a closed mesh of material '{name}'"));
+        }
     }
     Ok(())
 }
