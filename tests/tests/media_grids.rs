@@ -596,3 +596,33 @@ fn a_grid_medium_that_only_scatters_is_invisible_in_a_uniform_environment() {
     let exact = vec![Some([L; 3]); (SIZE * SIZE) as usize];
     assert_backends_agree_with(&file, &exact, 64);
 }
+
+/// A grid file is one of the scene's inputs (`twinpath::scene::inputs`), whichever its format:
+/// part files record it, so that parts rendered from different grids do not merge.
+#[test]
+fn grid_files_are_recorded_as_the_scenes_inputs() {
+    for name in ["inputs.vol", "inputs.vdb"] {
+        let grid = if name.ends_with(".vol") {
+            ramp_file(name)
+        } else {
+            twinpath_tests::repo_root().join("tests/fixtures/grid_ramp.vdb")
+        };
+        // Beside the temporary grids, never in the repository.
+        let scene_path = ramp_file("inputs.vol").with_file_name(format!("{name}.toml"));
+        std::fs::write(
+            &scene_path,
+            format!(
+                "[camera]\neye = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
+                 vfov = 40.0\nwidth = 4\nheight = 4\n\n[media]\nsmoke = {{ grid = {grid:?}, \
+                 sigma_a = [1.0, 1.0, 1.0] }}\n\n[scene]\nmedium = \"smoke\"\n"
+            ),
+        )
+        .unwrap();
+        let file = SceneFile::load(&scene_path).expect("loads");
+        let read: Vec<_> = file.scene.inputs.iter().map(|f| f.path.clone()).collect();
+        assert!(
+            read.contains(&grid),
+            "{name}: inputs {read:?} lack {grid:?}"
+        );
+    }
+}

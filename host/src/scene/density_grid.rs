@@ -8,7 +8,7 @@
 //! x, y, z, in world units), then the values, x fastest, then y, then z. twinpath places the
 //! grid in the file's box (Mitsuba 3 does so with `use_grid_bbox = true`). OpenVDB files
 //! (`.vdb`, what Blender's volume caches are) are read by the `vdb-rs` crate, their "density"
-//! grid made dense ([`DenseGrid::read_vdb`]).
+//! grid made dense ([`DenseGrid::parse_vdb`]).
 
 use glam::Vec3;
 use kernel::density_grid::{
@@ -36,15 +36,8 @@ const MAX_MAJORANT_CELLS: u32 = 64;
 const MAX_VOXELS: u64 = 1 << 28;
 
 impl DenseGrid {
-    /// Reads a `.vol` file (see the module's documentation), its densities multiplied by
-    /// `scale`. The error says what is wrong and where in the file.
-    pub fn read_vol(path: &Path, scale: f32) -> Result<Self, String> {
-        let bytes =
-            std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-        Self::parse_vol(&bytes, scale).map_err(|e| format!("{}: {e}", path.display()))
-    }
-
-    /// [`DenseGrid::read_vol`] of the file's bytes.
+    /// A `.vol` file's bytes (see the module's documentation) as a grid, its densities
+    /// multiplied by `scale`. The error says what is wrong and where in the file.
     pub fn parse_vol(bytes: &[u8], scale: f32) -> Result<Self, String> {
         const HEADER: usize = 48;
         if bytes.len() < HEADER || &bytes[..3] != b"VOL" {
@@ -132,20 +125,13 @@ impl DenseGrid {
         })
     }
 
-    /// Reads the float grid named "density" of an OpenVDB file (the `vdb-rs` crate; Blender's
-    /// volume caches hold one), its densities multiplied by `scale`. The sparse grid becomes a
-    /// dense one over the box of its active voxels and tiles with one inactive voxel (0, the
-    /// background of a density) more on every side, so the filter fades to 0 at the edge as
-    /// OpenVDB's trilinear sampler does. Placement: the grid's own transform (a voxel's
-    /// index (i, j, k) is its centre, at scale x (i, j, k) + translation); transforms other
-    /// than scale and translation are refused.
-    pub fn read_vdb(path: &Path, scale: f32) -> Result<Self, String> {
-        let bytes = super::inputs::read(path)
-            .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-        Self::parse_vdb(&bytes, scale).map_err(|e| format!("{}: {e}", path.display()))
-    }
-
-    /// [`DenseGrid::read_vdb`] of the file's bytes.
+    /// The float grid named "density" of an OpenVDB file's bytes (the `vdb-rs` crate;
+    /// Blender's volume caches hold one), its densities multiplied by `scale`. The sparse grid
+    /// becomes a dense one over the box of its active voxels and tiles with one inactive voxel
+    /// (0, the background of a density) more on every side, so the filter fades to 0 at the
+    /// edge as OpenVDB's trilinear sampler does. Placement: the grid's own transform (a
+    /// voxel's index (i, j, k) is its centre, at scale x (i, j, k) + translation); transforms
+    /// other than scale and translation are refused.
     pub fn parse_vdb(bytes: &[u8], scale: f32) -> Result<Self, String> {
         use vdb_rs::{Map, VdbReader};
         // The reader panics on transforms it does not know rather than returning an error.
@@ -250,17 +236,23 @@ impl DenseGrid {
         })
     }
 
-    /// Reads the grid file at `path` by its extension: `.vol` ([`DenseGrid::read_vol`]) or
-    /// `.vdb` ([`DenseGrid::read_vdb`]).
+    /// Reads the grid file at `path` (recorded as one of the scene's inputs, `super::inputs`)
+    /// by its extension: `.vol` ([`DenseGrid::parse_vol`]) or `.vdb`
+    /// ([`DenseGrid::parse_vdb`]), its densities multiplied by `scale`.
     pub fn read(path: &Path, scale: f32) -> Result<Self, String> {
-        match path.extension().and_then(|e| e.to_str()) {
-            Some(e) if e.eq_ignore_ascii_case("vol") => Self::read_vol(path, scale),
-            Some(e) if e.eq_ignore_ascii_case("vdb") => Self::read_vdb(path, scale),
-            _ => Err(format!(
-                "{}: a grid file is a .vol (Mitsuba's dense grid) or a .vdb (OpenVDB)",
-                path.display()
-            )),
-        }
+        let parse = match path.extension().and_then(|e| e.to_str()) {
+            Some(e) if e.eq_ignore_ascii_case("vol") => Self::parse_vol,
+            Some(e) if e.eq_ignore_ascii_case("vdb") => Self::parse_vdb,
+            _ => {
+                return Err(format!(
+                    "{}: a grid file is a .vol (Mitsuba's dense grid) or a .vdb (OpenVDB)",
+                    path.display()
+                ))
+            }
+        };
+        let bytes = super::inputs::read(path)
+            .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        parse(&bytes, scale).map_err(|e| format!("{}: {e}", path.display()))
     }
 
     /// The `.vol` bytes of this grid (f32 encoding): what [`DenseGrid::parse_vol`] reads.
@@ -347,12 +339,13 @@ impl GridTable {
         if first_majorant + majorants.len() > u32::MAX as usize {
             return None;
         }
+        let majorant_resolution = grid.majorant_resolution();
         let mut head = [0u32; RECORD_WORDS];
         for k in 0..3 {
             head[MIN + k] = grid.min[k].to_bits();
             head[MAX + k] = grid.max[k].to_bits();
             head[RESOLUTION + k] = grid.resolution[k];
-            head[MAJORANT_RESOLUTION + k] = grid.majorant_resolution()[k];
+            head[MAJORANT_RESOLUTION + k] = majorant_resolution[k];
         }
         head[VOXELS] = voxels as u32;
         head[MAJORANTS] = first_majorant as u32;
