@@ -6,8 +6,8 @@
 //! copy of the material per combination.
 //!
 //! A medium is homogeneous (`sigma_a`, `sigma_s` per scene unit of length, RGB; `g`, the
-//! Henyey-Greenstein asymmetry) or has a density grid (`grid`, a `.vol` file, and `scale`, its
-//! densities' factor: then the coefficients are per unit density).
+//! Henyey-Greenstein asymmetry) or has a density grid (`grid`, a `.vol` or `.vdb` file, and
+//! `scale`, its densities' factor: then the coefficients are per unit density).
 
 use super::checker::{Checker, V3};
 use crate::scene::builder::SceneTables;
@@ -258,16 +258,7 @@ pub(super) fn camera_outside_media(
     // vertices with probability zero.
     let dir = glam::Vec3::new(0.5377, 0.6147, 0.5771).normalize();
     let eye = camera.eye;
-    let mut crossings: BTreeMap<u32, u32> = BTreeMap::new();
-    for t in &tables.triangles {
-        let (p0, e1, e2) = (t.p0.into(), t.edge1.into(), t.edge2.into());
-        if tables.materials[t.material as usize].has_interior_medium()
-            && intersect_triangle(eye, dir, p0, e1, e2, 0.0, f32::INFINITY) >= 0.0
-        {
-            *crossings.entry(t.material).or_insert(0) += 1;
-        }
-    }
-    if let Some((&m, _)) = crossings.iter().find(|(_, &n)| n % 2 == 1) {
+    if let Some(m) = odd_crossings(tables, &tables.triangles, eye, dir) {
         let name = &tables.material_names[m as usize];
         return inside_error(format!("a closed mesh of material '{name}'"));
     }
@@ -287,20 +278,34 @@ pub(super) fn camera_outside_media(
                 m[8] * v.x + m[9] * v.y + m[10] * v.z + m[11] * w,
             )
         };
-        let (o, d) = (map(eye, 1.0), map(dir, 0.0));
-        let mut crossings: BTreeMap<u32, u32> = BTreeMap::new();
-        for t in &tables.mesh_triangles[tables.meshes[mesh as usize].range.clone()] {
-            let (p0, e1, e2) = (t.p0.into(), t.edge1.into(), t.edge2.into());
-            if tables.materials[t.material as usize].has_interior_medium()
-                && intersect_triangle(o, d, p0, e1, e2, 0.0, f32::INFINITY) >= 0.0
-            {
-                *crossings.entry(t.material).or_insert(0) += 1;
-            }
-        }
-        if let Some((&m, _)) = crossings.iter().find(|(_, &n)| n % 2 == 1) {
+        let triangles = &tables.mesh_triangles[tables.meshes[mesh as usize].range.clone()];
+        if let Some(m) = odd_crossings(tables, triangles, map(eye, 1.0), map(dir, 0.0)) {
             let name = &tables.material_names[m as usize];
             return inside_error(format!("instance {i}, a closed mesh of material '{name}'"));
         }
     }
     Ok(())
+}
+
+/// The first material holding a medium whose `triangles` the ray `o + t d` (t >= 0) crosses an
+/// odd number of times: the one whose closed surface encloses `o`, if any.
+fn odd_crossings(
+    tables: &SceneTables,
+    triangles: &[kernel::scene::Triangle],
+    o: glam::Vec3,
+    d: glam::Vec3,
+) -> Option<u32> {
+    let mut crossings: BTreeMap<u32, u32> = BTreeMap::new();
+    for t in triangles {
+        let (p0, e1, e2) = (t.p0.into(), t.edge1.into(), t.edge2.into());
+        if tables.materials[t.material as usize].has_interior_medium()
+            && intersect_triangle(o, d, p0, e1, e2, 0.0, f32::INFINITY) >= 0.0
+        {
+            *crossings.entry(t.material).or_insert(0) += 1;
+        }
+    }
+    crossings
+        .into_iter()
+        .find(|&(_, n)| n % 2 == 1)
+        .map(|(m, _)| m)
 }
