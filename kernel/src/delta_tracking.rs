@@ -37,7 +37,7 @@
 //! sample's stream gives it and a counter), not the sample's dimensions one by one.
 
 use crate::density_grid::{DensityGrid, MajorantWalk};
-use crate::free_flight::{component, Flight};
+use crate::free_flight::{self, component, Flight};
 use crate::hash::pcg4d;
 use crate::medium::transmittance as majorant_transmittance;
 use crate::rng::u32_to_unit_f32;
@@ -77,13 +77,12 @@ fn exponential(u: f32) -> f32 {
     -(1.0 - u).ln()
 }
 
-/// The path's weight and ratios after an event of densities `p` and contribution `f`
-/// (`crate::free_flight`'s update).
+/// The path's flight weight and ratios after an event of densities `p` and contribution `f`
+/// (`free_flight::weigh`).
 #[inline]
 fn weigh(weight: Vec3, ratios: Vec3, p: Vec3, f: Vec3) -> (Vec3, Vec3) {
-    let q = ratios * p;
-    let m = (q.x + q.y + q.z) * (1.0 / 3.0);
-    (weight * (f / m), q / m)
+    let (w, r) = free_flight::weigh(ratios, p, f);
+    (weight * w, r)
 }
 
 /// The free flight of ray `origin + t dir` (`dir` of unit length) through a grid medium of

@@ -88,12 +88,22 @@ pub fn sample(sigma_t: Vec3, sigma_s: Vec3, d: f32, hero: u32, u: f32, ratios: V
     } else {
         (tr, tr)
     };
-    let q = ratios * p;
-    let m = (q.x + q.y + q.z) * (1.0 / 3.0);
+    let (weight, ratios) = weigh(ratios, p, f);
     Flight {
         scattered,
         t: at,
-        weight: f / m,
-        ratios: q / m,
+        weight,
+        ratios,
     }
+}
+
+/// The weight of an event of technique densities `p` and contribution `f` for a path whose
+/// ratios are `ratios`, and the path's new ratios: f / mean(r p) and r p / mean(r p) (see the
+/// module's documentation). Delta tracking's events take the same update
+/// (`crate::delta_tracking`).
+#[inline]
+pub fn weigh(ratios: Vec3, p: Vec3, f: Vec3) -> (Vec3, Vec3) {
+    let q = ratios * p;
+    let m = (q.x + q.y + q.z) * (1.0 / 3.0);
+    (f / m, q / m)
 }

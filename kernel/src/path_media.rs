@@ -57,14 +57,14 @@ impl PathState {
     #[cfg_attr(not(target_arch = "spirv"), inline(never))]
     pub(crate) fn fly(&mut self, scene: &SceneView, hit: &SurfaceHit) -> bool {
         let m = &scene.media[self.medium as usize];
-        if m.has_grid() {
-            return self.fly_grid(scene, m, hit);
-        }
         let sigma_t = m.extinction();
         if !(sigma_t.max_element() > 0.0) {
             return false;
         }
         let distance = self.distance_to(hit);
+        if m.has_grid() {
+            return self.fly_grid(scene, m, distance);
+        }
         if !m.scatters() {
             self.throughput *= medium::transmittance(sigma_t, distance);
             return false;
@@ -77,18 +77,15 @@ impl PathState {
         self.take_flight(&flight, count, hero)
     }
 
-    /// [`PathState::fly`] in grid medium `m`: the transmittance from the exact optical depth
+    /// [`PathState::fly`] in grid medium `m` whose surface lies at `distance`: the
+    /// transmittance from the exact optical depth
     /// (`density_grid::optical_depth`) where it only absorbs, else delta tracking
     /// (`crate::delta_tracking`) from the stream seeded by the number at `GRID_DIMENSION + k`
     /// for the path's k-th flight. Out of line on the CPU: a homogeneous medium's flight does
     /// not carry its code.
     #[cfg_attr(not(target_arch = "spirv"), inline(never))]
-    fn fly_grid(&mut self, scene: &SceneView, m: &Medium, hit: &SurfaceHit) -> bool {
+    fn fly_grid(&mut self, scene: &SceneView, m: &Medium, distance: f32) -> bool {
         let sigma_t = m.extinction();
-        if !(sigma_t.max_element() > 0.0) {
-            return false;
-        }
-        let distance = self.distance_to(hit);
         if !m.scatters() {
             let (origin, dir) = (self.ray_origin, self.ray_dir);
             self.throughput *= grid_transmittance(scene, m, origin, dir, distance);
