@@ -125,16 +125,22 @@ fn rays() -> Vec<(DVec3, DVec3, f64)> {
     ]
 }
 
-/// A grid of random densities (seeded by `seed`) with empty regions and spikes, over the box
-/// (-1, -2, 0.5) to (2, 1, 1.5).
-fn random_grid(seed: u64) -> DenseGrid {
+/// A stream of uniform numbers in [0, 1) from `seed` (a 64-bit linear congruential generator,
+/// Knuth's MMIX constants): the tests' random grids and rays.
+fn uniforms(seed: u64) -> impl FnMut() -> f64 {
     let mut state = seed;
-    let mut next = || {
+    move || {
         state = state
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
         ((state >> 33) as f64) / (1u64 << 31) as f64
-    };
+    }
+}
+
+/// A grid of random densities (seeded by `seed`) with empty regions and spikes, over the box
+/// (-1, -2, 0.5) to (2, 1, 1.5).
+fn random_grid(seed: u64) -> DenseGrid {
+    let mut next = uniforms(seed);
     let n = [17u32, 9, 13];
     let voxels: Vec<f32> = (0..n[0] * n[1] * n[2])
         .map(|_| {
@@ -163,13 +169,7 @@ fn random_grid(seed: u64) -> DenseGrid {
 #[test]
 fn the_majorant_walk_bounds_the_density_and_tiles_the_ray() {
     let grid = random_grid(12345);
-    let mut state = 4242u64;
-    let mut next = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 33) as f64) / (1u64 << 31) as f64
-    };
+    let mut next = uniforms(4242u64);
     let (table, record) = table(&grid);
     let view = DensityGrid::at(&table.words, record);
     let max = grid.voxels.iter().fold(0f32, |a, &b| a.max(b));
@@ -244,13 +244,7 @@ fn the_optical_depth_of_a_random_grid_matches_a_fine_quadrature() {
     let grid = random_grid(777);
     let (table, record) = table(&grid);
     let view = DensityGrid::at(&table.words, record);
-    let mut state = 99u64;
-    let mut next = move || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 33) as f64) / (1u64 << 31) as f64
-    };
+    let mut next = uniforms(99u64);
     for r in 0..12 {
         let o = Vec3::new(-2.0, (next() * 3.0 - 2.0) as f32, (next() + 0.5) as f32);
         let target = Vec3::new(3.0, (next() * 3.0 - 2.0) as f32, (next() + 0.5) as f32);
