@@ -46,7 +46,7 @@ use crate::Float;
 use spirv_std::glam::Vec3;
 
 /// A stream of uniform numbers for one tracking loop: number n is the first word of
-/// pcg4d(seed, key, n, constant), mapped to [0, 1).
+/// pcg4d(seed, key, n, constant), mapped to (0, 1).
 #[derive(Clone, Copy, Debug)]
 pub struct TrackingStream {
     seed: u32,
@@ -62,7 +62,7 @@ impl TrackingStream {
         Self { seed, key, n: 0 }
     }
 
-    /// The next number, uniform in [0, 1).
+    /// The next number, uniform in (0, 1).
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
         let bits = pcg4d([self.seed, self.key, self.n, 0x2545_f491])[0];

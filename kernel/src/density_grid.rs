@@ -25,8 +25,6 @@
 //!   first voxel and the word of the first majorant cell, two unused words;
 //! - voxels and majorant cells: f32 bits, x fastest, then y, then z.
 
-#[cfg(target_arch = "spirv")]
-use crate::Float;
 use spirv_std::glam::{IVec3, UVec3, Vec3};
 
 /// Words per grid record.

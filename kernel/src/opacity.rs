@@ -49,7 +49,7 @@ pub struct CandidateRay {
 }
 
 impl CandidateRay {
-    /// The candidate's uniform number in [0, 1): two rounds of `pcg4d`, over the origin's bits
+    /// The candidate's uniform number in (0, 1): two rounds of `pcg4d`, over the origin's bits
     /// and the triangle, then with the direction's bits and the instance mixed in.
     #[inline]
     pub fn draw(&self) -> f32 {

@@ -65,10 +65,11 @@ pub trait Tracer {
 ///    p_brdf = cos(theta_x)/pi and multiply the path throughput by `f cos(theta_x) / p_brdf`,
 ///    which is exactly Kd. No direction ends the path. (The seed ends it where p_brdf < 1e-6,
 ///    which looks harmless in the continuum, 1e-11 of the cosine-weighted measure; but the
-///    uniform numbers are discrete, u1 = 0 has probability 2^-24 and gave the tangent direction,
-///    pdf 0, so the cut-off lost 2^-24 of the paths at every bounce. The sampler now reads
-///    u1 = 0 as the midpoint of its interval, `sampling::U1_FLOOR`, so p_brdf >= 5.5e-5 and no
-///    extension is tangent; a tangent ray could graze into a sphere and be trapped inside.)
+///    uniform numbers are discrete, u1 = 0 had probability 2^-24 and gave the tangent direction,
+///    pdf 0, so the cut-off lost 2^-24 of the paths at every bounce. The uniform numbers are now
+///    in the open interval (0, 1), `rng::u32_to_unit_f32`, so cos(theta) >= 2^-12, p_brdf >=
+///    7.8e-5 and no extension is tangent; a tangent ray could graze into a sphere and be trapped
+///    inside.)
 /// 4. **Russian roulette** decides whether the extension of step 3 happens: with probability q
 ///    it does and the throughput is divided by q, else the path ends. Everything found after the
 ///    decision (the BRDF-sampled light hit, later vertices' light samples) is therefore divided

@@ -17,11 +17,15 @@ pub fn independent_bits<W: Word>(seed: W, pixel: W, sample: W, dimension: W) -> 
     pcg4d([pixel, sample, dimension, seed])[0]
 }
 
-/// Maps 32 random bits to a float uniform in [0, 1): the top 24 bits times 2^-24, so every value
-/// is exactly representable and 1.0 is never returned.
+/// Maps 32 random bits to a float uniform in the open interval (0, 1): the top 23 bits k as
+/// (k + 1/2) 2^-23, the midpoint of the k-th of 2^23 equal intervals. Every step is exact in f32
+/// under any rounding mode (k + 1/2 needs 24 bits; the scale is a power of two), the values run
+/// from 2^-24 to 1 - 2^-24 and are symmetric (1 - u is one of them), so no sampler ever sees 0
+/// or 1 (a tangent direction, a zero-length flight, the log of 0) and none needs a guard of its
+/// own. (24 bits cannot do this: 1 - 2^-25 is not an `f32`.)
 #[inline]
 pub fn u32_to_unit_f32(x: u32) -> f32 {
-    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+    ((x >> 9) as f32 + 0.5) * (1.0 / 8_388_608.0)
 }
 
 /// The random stream of one sample of one pixel; each call to [`SampleRng::next_f32`] consumes
@@ -64,7 +68,7 @@ impl SampleRng {
         x
     }
 
-    /// A float uniform in [0, 1), then advances the dimension. With the Sobol sampler it is
+    /// A float uniform in (0, 1) ([`u32_to_unit_f32`]), then advances the dimension. With the Sobol sampler it is
     /// the first coordinate of the dimension's pair (a stratified 1D sequence per pixel).
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
@@ -77,7 +81,7 @@ impl SampleRng {
         }
     }
 
-    /// Two floats uniform in [0, 1) for one 2D decision (a point on a light, a direction),
+    /// Two floats uniform in (0, 1) for one 2D decision (a point on a light, a direction),
     /// then advances two dimensions. Independent: two calls of [`SampleRng::next_f32`], the
     /// same numbers. Sobol: one point of the pair's scrambled (0,2)-sequence.
     #[inline]

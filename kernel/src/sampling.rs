@@ -38,26 +38,18 @@ fn lobe_direction_v3<R: real::Real>(a: V3<R>, c: R, cos_phi: R, sin_phi: R) -> V
 /// Cosine-weighted direction in the hemisphere around unit `n` from two uniform numbers
 /// (cos(theta) = sqrt(u1), phi = 2 pi u2); its solid-angle pdf is [`pdf_cosine_hemisphere`].
 ///
-/// The direction is never tangent: u1 = 0 is read as [`U1_FLOOR`]. The uniform numbers are
-/// multiples of 2^-24 (`rng::u32_to_unit_f32`), each standing for the interval up to the next
-/// one; 0 is the only one whose left end maps to the hemisphere's rim, where the pdf is 0 and a
-/// ray leaving along the surface can graze into a sphere and be trapped inside. Reading it as
-/// its interval's midpoint moves that sample within its own interval (the estimator's weight,
-/// Kd, is the same for every direction) and leaves every other sample as it was.
+/// The direction is never tangent: the uniform numbers are in the open interval (0, 1)
+/// (`rng::u32_to_unit_f32`), so cos(theta) >= sqrt(2^-24) = 2^-12 and the pdf >= 7.8e-5.
 #[inline]
 pub fn sample_cosine_hemisphere(n: Vec3, u1: f32, u2: f32) -> Vec3 {
     sample_cosine_hemisphere_v3(V3::from(n), u1, u2).into()
 }
 
-/// The smallest u1 [`sample_cosine_hemisphere`] uses: 2^-25, the midpoint of [0, 2^-24), so
-/// cos(theta) >= 2^-12.5 (about 1.7e-4) and the pdf >= 5.5e-5.
-pub const U1_FLOOR: f32 = 1.0 / 33_554_432.0;
-
 /// [`sample_cosine_hemisphere`] for one normal or one per lane ([`real::Real`]).
 #[inline]
 pub fn sample_cosine_hemisphere_v3<R: real::Real>(n: V3<R>, u1: R, u2: R) -> V3<R> {
     let (cos_phi, sin_phi) = cos_sin_turns(u2);
-    lobe_direction_v3(n, u1.max(R::splat(U1_FLOOR)).sqrt(), cos_phi, sin_phi)
+    lobe_direction_v3(n, u1.sqrt(), cos_phi, sin_phi)
 }
 
 /// Solid-angle density of [`sample_cosine_hemisphere`]: max(0, n . w) / pi.

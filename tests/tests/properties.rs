@@ -410,13 +410,34 @@ proptest! {
     }
 
     #[test]
-    fn random_numbers_are_in_the_unit_interval(w in any::<[u32; 4]>()) {
+    fn random_numbers_are_in_the_open_unit_interval(w in any::<[u32; 4]>()) {
         let h = pcg4d(w);
         for x in h {
             let u = u32_to_unit_f32(x);
-            prop_assert!((0.0..1.0).contains(&u));
+            prop_assert!(u > 0.0 && u < 1.0, "{x:#x} -> {u}");
         }
     }
+}
+
+/// Every one of the 2^23 numbers the root gives (`rng::u32_to_unit_f32` reads the top 23 bits)
+/// is the exact midpoint (k + 1/2) 2^-23 of its interval, strictly inside (0, 1), and its
+/// mirror 1 - u is one of them too: no sampler can be handed 0 or 1, whatever it does with u.
+#[test]
+fn every_random_number_is_an_exact_midpoint_strictly_inside_the_unit_interval() {
+    for k in 0u32..1 << 23 {
+        let (low, high) = (u32_to_unit_f32(k << 9), u32_to_unit_f32(k << 9 | 0x1ff));
+        assert_eq!(
+            low.to_bits(),
+            high.to_bits(),
+            "bits below the top 23 matter at k = {k}"
+        );
+        assert_eq!(low as f64, (k as f64 + 0.5) / 8_388_608.0, "k = {k}");
+        assert!(low > 0.0 && low < 1.0);
+        let mirror = u32_to_unit_f32(((1 << 23) - 1 - k) << 9);
+        assert_eq!(1.0 - low, mirror, "k = {k}");
+    }
+    assert_eq!(u32_to_unit_f32(0), 2f32.powi(-24));
+    assert_eq!(u32_to_unit_f32(u32::MAX), 1.0 - 2f32.powi(-24));
 }
 
 /// The case `ray_triangle_returns_barycentrics_inside` found (CI, 2026-11-22): a sliver whose

@@ -6,7 +6,7 @@ use glam::Vec3;
 use kernel::bsdf::lambert::{pdf_brdf, sample_brdf};
 use kernel::light::choose_light;
 use kernel::light::sphere::{pdf_area, sample_area};
-use kernel::rng::SampleRng;
+use kernel::rng::{u32_to_unit_f32, SampleRng};
 use kernel::sampling::{
     pdf_sphere_area, pdf_sphere_cone, sample_lobe, sample_sphere, sample_sphere_cone,
 };
@@ -109,32 +109,30 @@ fn sample_lobe_has_the_requested_cosine_and_uniform_azimuth() {
 }
 
 #[test]
-fn sample_brdf_is_never_tangent_and_moves_only_the_first_interval() {
-    // u1 = 0 (one value of 2^24) is read as its interval's midpoint 2^-25: cos(theta) = 2^-12.5
-    // and a pdf far above 0; every other u1 keeps cos(theta) = sqrt(u1) (at u1 = 2^-24 a shift
-    // of every u1 by 2^-25 would move it by 5e-5).
+fn sample_brdf_is_never_tangent_for_any_number_the_root_gives() {
+    // Every uniform number is in [2^-24, 1 - 2^-24] (`rng::u32_to_unit_f32`, the midpoints of
+    // 2^23 intervals): the smallest, from the all-zero word, gives cos(theta) = sqrt(2^-24) =
+    // 2^-12 exactly and a pdf far above 0; every u1 keeps cos(theta) = sqrt(u1).
     let normals = [
         Vec3::Z,
         -Vec3::Z,
         Vec3::new(0.6, 0.0, 0.8),
         Vec3::new(0.0, -0.6, 0.8),
     ];
+    let smallest = u32_to_unit_f32(0);
+    assert_eq!(smallest, 2f32.powi(-24));
     for n in normals {
         for k in 0..64u32 {
-            let u2 = k as f32 / 64.0;
-            let w = sample_brdf(n, 0.0, u2);
+            let u2 = u32_to_unit_f32(k << 26);
+            let w = sample_brdf(n, smallest, u2);
             let cos = n.dot(w);
             assert!(
-                (cos - 2f32.powf(-12.5)).abs() < 1e-6,
-                "u1 = 0, n {n}: cos {cos}"
+                (cos - 2f32.powi(-12)).abs() < 1e-6,
+                "u1 = 2^-24, n {n}: cos {cos}"
             );
-            assert!(pdf_brdf(n, w) > 5e-5);
-            for u1 in [
-                1.0 / 16_777_216.0,
-                2.0 / 16_777_216.0,
-                0.25,
-                1.0 - 1.0 / 16_777_216.0,
-            ] {
+            assert!(pdf_brdf(n, w) > 7e-5);
+            for word in [0, 1 << 9, 2 << 9, 1 << 30, u32::MAX] {
+                let u1 = u32_to_unit_f32(word);
                 let cos = n.dot(sample_brdf(n, u1, u2));
                 assert!(
                     (cos - u1.sqrt()).abs() < 2e-6,
