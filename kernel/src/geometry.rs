@@ -1,6 +1,7 @@
 //! Ray/primitive intersection, the geometry factor, and where a new ray starts.
 
 use crate::intersect;
+use crate::real::{self, abs, select, V3};
 use crate::scene::Triangle;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -67,13 +68,22 @@ pub fn intersect_sphere(
 /// of its rounding error (pbrt-v4 `Sphere::InteractionFromIntersection`).
 #[inline]
 pub fn reproject_to_sphere(p: Vec3, center: Vec3, radius: f32) -> Vec3 {
+    reproject_to_sphere_v3(V3::from(p), V3::from(center), radius).into()
+}
+
+/// [`reproject_to_sphere`] over any [`real::Real`] (the kernel's `f32`, or a test's model of a
+/// device's arithmetic).
+#[inline]
+pub fn reproject_to_sphere_v3<R: real::Real>(p: V3<R>, center: V3<R>, radius: R) -> V3<R> {
     let v = p - center;
-    let len = v.length();
-    if len > 0.0 {
-        center + v * (radius / len)
-    } else {
-        p
-    }
+    let len = v.dot(v).sqrt();
+    let off_centre = len.greater_than(R::splat(0.0));
+    let moved = center + v * (radius / len);
+    V3::new(
+        select(off_centre, moved.x, p.x),
+        select(off_centre, moved.y, p.y),
+        select(off_centre, moved.z, p.z),
+    )
 }
 
 /// A ray/triangle hit: distance and barycentric coordinates of p0 + u edge1 + v edge2.
@@ -154,7 +164,19 @@ pub fn intersect_triangle(
 /// error off the plane, which grows with the distance travelled.
 #[inline]
 pub fn triangle_point(p0: Vec3, edge1: Vec3, edge2: Vec3, u: f32, v: f32) -> Vec3 {
-    p0 + (u * edge1 + v * edge2)
+    triangle_point_v3(V3::from(p0), V3::from(edge1), V3::from(edge2), u, v).into()
+}
+
+/// [`triangle_point`] over any [`real::Real`].
+#[inline]
+pub fn triangle_point_v3<R: real::Real>(
+    p0: V3<R>,
+    edge1: V3<R>,
+    edge2: V3<R>,
+    u: R,
+    v: R,
+) -> V3<R> {
+    p0 + (edge1 * u + edge2 * v)
 }
 
 /// The barycentrics (u, v) of point `p` of the triangle's plane, p = p0 + u edge1 + v edge2,
@@ -191,17 +213,28 @@ pub fn triangle_normal(edge1: Vec3, edge2: Vec3) -> Vec3 {
 }
 
 /// Bound on the rounding error of [`triangle_point`], in units of eps times the magnitudes of
-/// its terms: four roundings (two products, two sums), with a factor of two to spare (pbrt-v4
-/// bounds its barycentric interpolation by gamma(7) = 3.5 eps).
+/// its terms. Four roundings (two products, two sums) give, per component, to first order,
+/// u |p0| plus 3 u times the edge terms |u e1| and |v e2|, with u the unit roundoff: eps / 2
+/// under IEEE rounding to nearest, eps under a Vulkan device that may round toward zero (fusing
+/// a product into its sum only removes a rounding). So 1 eps |p0| and 3 eps of the terms on any
+/// conformant device; 8 leaves more than a factor of two (docs/robustness.md, "Under Vulkan's
+/// arithmetic").
 pub const TRIANGLE_ERROR_EPS: f32 = 8.0;
-/// Bound on the rounding error of a point re-projected onto a sphere, c + r v/|v|, in units of
-/// eps (|c| + r): a handful of operations (Haines et al., RTG ch. 7; pbrt-v4 uses gamma(5)).
-pub const SPHERE_ERROR_EPS: f32 = 8.0;
+/// Bound on the rounding error of a point re-projected onto a sphere, c + v r / |v|, in units
+/// of eps (|c| + r), per component. The component v_i r / |v| carries v_i's rounding (u), the
+/// dot product's error halved by the root (1.5 u), the square root's, the division's and the
+/// product's (u), and the sum with c_i one u of |c_i| + r: under IEEE (u = eps / 2, root and
+/// quotient correctly rounded) 3.25 eps r + 0.5 eps |c|; under Vulkan (u = eps for a device
+/// that rounds toward zero, sqrt as 1 / inversesqrt within 4.5 eps relative, a quotient within
+/// 2.5 ULP) 11.5 eps r + 1 eps |c|, which the IEEE-sized 8 did not cover (with a bound of 3, a
+/// tenth of a percent of rays leaving a sphere hit it again under a model of such a device).
+/// 16 covers it with a factor of 1.4 to spare (docs/robustness.md, "Under Vulkan's arithmetic").
+pub const SPHERE_ERROR_EPS: f32 = 16.0;
 
 /// Largest absolute component of `v`.
 #[inline]
-fn max_abs(v: Vec3) -> f32 {
-    v.abs().max_element()
+fn max_abs<R: real::Real>(v: V3<R>) -> R {
+    abs(v.x).max(abs(v.y)).max(abs(v.z))
 }
 
 /// Absolute error bound (per component) of [`triangle_point`]`(p0, edge1, edge2, u, v)` with
@@ -261,16 +294,35 @@ pub fn triangle_point_error_conditioned(
     v: f32,
     condition: f32,
 ) -> f32 {
-    TRIANGLE_ERROR_EPS
-        * f32::EPSILON
-        * (max_abs(p0) + (max_abs(u * edge1) + max_abs(v * edge2)) * condition)
+    let (p0, edge1, edge2) = (V3::from(p0), V3::from(edge1), V3::from(edge2));
+    triangle_point_error_v3(p0, edge1, edge2, u, v, condition)
+}
+
+/// [`triangle_point_error_conditioned`] over any [`real::Real`].
+#[inline]
+pub fn triangle_point_error_v3<R: real::Real>(
+    p0: V3<R>,
+    edge1: V3<R>,
+    edge2: V3<R>,
+    u: R,
+    v: R,
+    condition: R,
+) -> R {
+    R::splat(TRIANGLE_ERROR_EPS * f32::EPSILON)
+        * (max_abs(p0) + (max_abs(edge1 * u) + max_abs(edge2 * v)) * condition)
 }
 
 /// Absolute error bound of a point on a sphere (centre `center`, radius `radius`), re-projected
 /// or sampled as c + r n.
 #[inline]
 pub fn sphere_point_error(center: Vec3, radius: f32) -> f32 {
-    SPHERE_ERROR_EPS * f32::EPSILON * (max_abs(center) + radius)
+    sphere_point_error_v3(V3::from(center), radius)
+}
+
+/// [`sphere_point_error`] over any [`real::Real`].
+#[inline]
+pub fn sphere_point_error_v3<R: real::Real>(center: V3<R>, radius: R) -> R {
+    R::splat(SPHERE_ERROR_EPS * f32::EPSILON) * (max_abs(center) + radius)
 }
 
 /// The origin for a ray leaving a surface at `p` toward the side of unit normal `n`, where `p`
@@ -285,9 +337,15 @@ pub fn sphere_point_error(center: Vec3, radius: f32) -> f32 {
 /// Rays then start at t = 0 with no epsilon of their own.
 #[inline]
 pub fn offset_ray_origin(p: Vec3, n: Vec3, error: f32) -> Vec3 {
-    let d = error * (n.x.abs() + n.y.abs() + n.z.abs());
-    let q = p + d * n;
-    Vec3::new(
+    offset_ray_origin_v3(V3::from(p), V3::from(n), error).into()
+}
+
+/// [`offset_ray_origin`] over any scalar [`real::Real`].
+#[inline]
+pub fn offset_ray_origin_v3<R: real::Real<Bits = u32>>(p: V3<R>, n: V3<R>, error: R) -> V3<R> {
+    let d = error * (abs(n.x) + abs(n.y) + abs(n.z));
+    let q = p + n * d;
+    V3::new(
         step_away(q.x, n.x),
         step_away(q.y, n.y),
         step_away(q.z, n.z),
@@ -295,25 +353,28 @@ pub fn offset_ray_origin(p: Vec3, n: Vec3, error: f32) -> Vec3 {
 }
 
 /// `x` moved one ULP in the direction of the sign of `dir` (unchanged for dir = 0), through the
-/// integer representation of the float, as Wachter and Binder step.
+/// integer representation of the float, as Wachter and Binder step. Below the smallest normal
+/// float (zero or denormal) it goes to the smallest normal on `dir`'s side instead: a Vulkan
+/// device may flush denormals to zero, which would undo a step that ends on one.
 #[inline]
-fn step_away(x: f32, dir: f32) -> f32 {
-    if dir == 0.0 || !x.is_finite() {
+fn step_away<R: real::Real<Bits = u32>>(x: R, dir: R) -> R {
+    let zero = R::splat(0.0);
+    if dir.not_equal(zero) == 0 || x.finite() == 0 {
         return x;
     }
-    if x == 0.0 {
-        // The smallest subnormal on the side of dir.
-        let tiny = f32::from_bits(1);
-        return if dir > 0.0 { tiny } else { -tiny };
+    let toward_positive = dir.greater_than(zero) != 0;
+    if abs(x).less_than(R::splat(f32::MIN_POSITIVE)) != 0 {
+        let smallest = R::splat(f32::MIN_POSITIVE);
+        return if toward_positive { smallest } else { -smallest };
     }
     let bits = x.to_bits();
     // Away from zero if x and dir have the same sign, toward zero otherwise.
-    let moved = if (x > 0.0) == (dir > 0.0) {
+    let moved = if (x.greater_than(zero) != 0) == toward_positive {
         bits + 1
     } else {
         bits - 1
     };
-    f32::from_bits(moved)
+    R::from_bits(moved)
 }
 
 /// Relative shortening of shadow rays: a ray/surface intersection's `t` is only known to a few
@@ -334,7 +395,21 @@ pub const SHADOW_RAY_LIFT_EPS: f32 = 16.0;
 /// [`SHADOW_RAY_SHORTENING`].
 #[inline]
 pub fn shadow_ray_end(origin: Vec3, target: Vec3, target_normal: Vec3, target_error: f32) -> Vec3 {
-    let lift = target_error + SHADOW_RAY_LIFT_EPS * f32::EPSILON * (target - origin).length();
-    let end = offset_ray_origin(target, target_normal, lift);
-    end - (end - origin) * SHADOW_RAY_SHORTENING
+    let (origin, target, normal) = (V3::from(origin), V3::from(target), V3::from(target_normal));
+    shadow_ray_end_v3(origin, target, normal, target_error).into()
+}
+
+/// [`shadow_ray_end`] over any scalar [`real::Real`].
+#[inline]
+pub fn shadow_ray_end_v3<R: real::Real<Bits = u32>>(
+    origin: V3<R>,
+    target: V3<R>,
+    target_normal: V3<R>,
+    target_error: R,
+) -> V3<R> {
+    let to_target = target - origin;
+    let distance = to_target.dot(to_target).sqrt();
+    let lift = target_error + R::splat(SHADOW_RAY_LIFT_EPS * f32::EPSILON) * distance;
+    let end = offset_ray_origin_v3(target, target_normal, lift);
+    end - (end - origin) * R::splat(SHADOW_RAY_SHORTENING)
 }

@@ -48,6 +48,12 @@ pub trait Real:
     fn from_i32_bits(bits: Self::Bits) -> Self;
 }
 
+/// |x| of each lane: the sign bit cleared (exact under any arithmetic).
+#[inline]
+pub fn abs<R: Real>(x: R) -> R {
+    R::from_bits(x.to_bits() & R::Bits::splat(0x7fff_ffff))
+}
+
 /// `yes` in the lanes where `mask` is all ones, `no` where it is zero.
 #[inline]
 pub fn select<R: Real>(mask: R::Bits, yes: R, no: R) -> R {

@@ -155,6 +155,7 @@ pub mod reference_bsdf;
 pub mod sheen_fit;
 pub mod spirv;
 pub mod stats;
+pub mod vulkan_arithmetic;
 
 /// Renders `scene` at `spp` on `backend` (the GPU with validation layers on).
 pub fn render_film(

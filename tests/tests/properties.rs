@@ -224,7 +224,7 @@ proptest! {
         prop_assert!(omc > 0.0 && omc <= 1.0);
         // The sampled point faces the receiver (up to the point's rounding).
         let to_x = x - s.point.position;
-        prop_assert!(s.point.normal.dot(to_x) >= -2.0 * sphere_point_error(c, r));
+        prop_assert!(s.point.normal.dot(to_x) >= -sphere_point_error(c, r));
     }
 
     /// Triangle lights of any shape and size (edges along the same or nearly the same axis,

@@ -41,6 +41,13 @@ fn gpu() {
                     "  [{}] {} ({:?}, Vulkan {ma}.{mi}.{pa}): {status}",
                     d.index, d.name, d.device_type
                 );
+                if !d.driver.is_empty() {
+                    println!("      driver: {}", d.driver);
+                }
+                println!(
+                    "      32-bit float controls offered: {} (the kernel's bounds assume none)",
+                    d.float_controls.describe()
+                );
             }
         }
         Err(e) => println!("gpu backend: unavailable: {e:#}"),

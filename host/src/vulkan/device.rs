@@ -56,6 +56,49 @@ pub struct DeviceInfo {
     pub missing: Vec<String>,
     /// Whether it offers `VK_KHR_ray_query` (not needed by twinpath; reported by `info`).
     pub ray_query: bool,
+    /// The driver's name and version string (`VkPhysicalDeviceDriverProperties`), or empty.
+    pub driver: String,
+    /// What it promises about 32-bit float arithmetic (`VkPhysicalDeviceFloatControlsProperties`).
+    pub float_controls: FloatControls,
+}
+
+/// The 32-bit float controls a device offers (Vulkan 1.2 core, `VK_KHR_shader_float_controls`):
+/// whether a module may ask it to keep denormals, to keep the sign of zero, infinities and NaNs,
+/// and to round to nearest even or toward zero. Without them a Vulkan device may flush
+/// denormals, lose the sign of zero and round either way; the kernel's error bounds assume all
+/// of that (docs/robustness.md, "Under Vulkan's arithmetic").
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FloatControls {
+    pub denorm_preserve: bool,
+    pub denorm_flush_to_zero: bool,
+    pub signed_zero_inf_nan_preserve: bool,
+    pub rounding_mode_rte: bool,
+    pub rounding_mode_rtz: bool,
+}
+
+impl FloatControls {
+    /// The controls as `info` lists them ("none" if it offers none).
+    pub fn describe(&self) -> String {
+        let offered: Vec<&str> = [
+            (self.denorm_preserve, "denormals preserved"),
+            (self.denorm_flush_to_zero, "denormals flushed"),
+            (
+                self.signed_zero_inf_nan_preserve,
+                "signed zero/inf/NaN preserved",
+            ),
+            (self.rounding_mode_rte, "round to nearest even"),
+            (self.rounding_mode_rtz, "round toward zero"),
+        ]
+        .iter()
+        .filter(|(on, _)| *on)
+        .map(|(_, name)| *name)
+        .collect();
+        if offered.is_empty() {
+            "none".to_string()
+        } else {
+            offered.join(", ")
+        }
+    }
 }
 
 impl DeviceInfo {
@@ -147,7 +190,7 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> D
         .filter(|want| !offers(want))
         .map(|e| e.to_string_lossy().into_owned())
         .collect();
-    DeviceInfo {
+    let mut info = DeviceInfo {
         index,
         name: props
             .device_name_as_c_str()
@@ -161,7 +204,38 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> D
         ),
         missing,
         ray_query: offers(khr::ray_query::NAME),
+        driver: String::new(),
+        float_controls: FloatControls::default(),
+    };
+    // Vulkan 1.2 core properties: only asked of a device that reports 1.2 or later.
+    if props.api_version >= vk::API_VERSION_1_2 {
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut controls = vk::PhysicalDeviceFloatControlsProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default()
+            .push_next(&mut driver)
+            .push_next(&mut controls);
+        unsafe { instance.get_physical_device_properties2(pd, &mut props2) };
+        let text = |name: Result<&CStr, _>| {
+            name.map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        };
+        info.driver = format!(
+            "{} {}",
+            text(driver.driver_name_as_c_str()),
+            text(driver.driver_info_as_c_str())
+        )
+        .trim()
+        .to_string();
+        info.float_controls = FloatControls {
+            denorm_preserve: controls.shader_denorm_preserve_float32 == vk::TRUE,
+            denorm_flush_to_zero: controls.shader_denorm_flush_to_zero_float32 == vk::TRUE,
+            signed_zero_inf_nan_preserve: controls.shader_signed_zero_inf_nan_preserve_float32
+                == vk::TRUE,
+            rounding_mode_rte: controls.shader_rounding_mode_rte_float32 == vk::TRUE,
+            rounding_mode_rtz: controls.shader_rounding_mode_rtz_float32 == vk::TRUE,
+        };
     }
+    info
 }
 
 /// Every Vulkan device on this machine, with what each lacks for the backend.

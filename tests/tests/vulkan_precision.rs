@@ -1,0 +1,502 @@
+//! The kernel's numerical guarantees under the arithmetic Vulkan allows, not only IEEE-754's:
+//! the kernel's generic numerics (`kernel::real::Real`) run on [`Vk32`], which rounds toward
+//! zero or to nearest, fuses multiplies into adds, divides and takes square roots within the
+//! specification's ULP allowances, and flushes denormals, each on a coin flip per operation
+//! (`twinpath_tests::vulkan_arithmetic`). Derivations: `docs/robustness.md`, "Under Vulkan's
+//! arithmetic".
+//!
+//! The guarantees: rays leaving a triangle or a sphere never hit it again, shadow rays never hit
+//! the light they sample, the orthonormal frame is orthonormal and the samplers stay in their
+//! domains, all within the bounds derived for Vulkan; and [`Vk32`] itself returns only what a
+//! conformant device may, and does take its liberties (else the rest would prove nothing).
+
+use glam::Vec3;
+use kernel::frame::orthonormal_basis_v3;
+use kernel::geometry::{
+    offset_ray_origin_v3, reproject_to_sphere_v3, shadow_ray_end_v3, sphere_point_error,
+    sphere_point_error_v3, triangle_point_error_v3, triangle_point_v3, TRIANGLE_ERROR_EPS,
+};
+use kernel::intersect;
+use kernel::real::{Real, V3};
+use kernel::sampling::{sample_cosine_hemisphere_v3, sample_sphere_cone_v3};
+use twinpath_tests::vulkan_arithmetic::{lean, seed, set_model, ulp, Model, Vk32};
+use twinpath_tests::SplitMix;
+
+type V = V3<Vk32>;
+
+fn v(x: Vec3) -> V {
+    V3::new(x.x.into(), x.y.into(), x.z.into())
+}
+
+fn f(x: f32) -> Vk32 {
+    Vk32::new(x)
+}
+
+fn back(x: V) -> Vec3 {
+    Vec3::new(x.x.value, x.y.value, x.z.value)
+}
+
+/// The device a case runs on: in turn Vulkan's liberties taken at random ([`Model::VULKAN`]),
+/// and all of them at their largest, one way and the other ([`Model::VULKAN_WORST`]).
+fn any_device(case: usize) {
+    match case % 3 {
+        0 => set_model(Model::VULKAN),
+        k => {
+            set_model(Model::VULKAN_WORST);
+            lean(if k == 1 { 1 } else { -1 });
+        }
+    }
+}
+
+/// Cases per test: 2 x 10^5 by default; `VULKAN_PRECISION_CASES` for longer runs.
+fn cases() -> usize {
+    std::env::var("VULKAN_PRECISION_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(200_000)
+}
+
+/// Scene inputs (in `f32`: the scene is data, not device arithmetic) as reintersection.rs draws
+/// them: scales 10^U(-4, 5), translations up to 10^3 times the scale.
+struct Gen(SplitMix);
+impl Gen {
+    fn unit(&mut self) -> f32 {
+        self.0.unit()
+    }
+    fn pow10(&mut self, lo: f32, hi: f32) -> f32 {
+        10f32.powf(lo + (hi - lo) * self.unit())
+    }
+    fn dir(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(
+                2.0 * self.unit() - 1.0,
+                2.0 * self.unit() - 1.0,
+                2.0 * self.unit() - 1.0,
+            );
+            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+    fn placement(&mut self) -> (f32, Vec3) {
+        let s = self.pow10(-4.0, 5.0);
+        let t = self.dir() * s * self.pow10(-4.0, 5.0).min(1e3);
+        (s, t)
+    }
+}
+
+/// The unit vector along `x`, as the kernel normalises (x / |x|, under Vulkan's arithmetic).
+fn normalize(x: V) -> V {
+    x / x.dot(x).sqrt()
+}
+
+/// Whether a continuation ray and a shadow ray spawned at `p` (leaving normal `n_side`, error
+/// bound `err`, surface size `size`) hit their surface again (`hits`), all under [`Vk32`].
+fn spawned_self_hits(
+    g: &mut Gen,
+    p: V,
+    n_side: V,
+    err: Vk32,
+    size: f32,
+    hits: &dyn Fn(V, V, Vk32) -> bool,
+) -> (bool, bool) {
+    let o = offset_ray_origin_v3(p, n_side, err);
+    let w = sample_cosine_hemisphere_v3(n_side, f(g.unit()), f(g.unit()));
+    let continuation = w.dot(n_side).value > 0.0 && hits(o, w, f(f32::INFINITY));
+    let (pe, ne) = (back(p), back(n_side));
+    let target = pe + (ne * g.unit().max(1e-3) + g.dir() * 0.5) * size * g.pow10(-2.0, 1.0);
+    let shadow = (target - pe).dot(ne) > err.value && hits(o, v(target) - o, f(1.0));
+    (continuation, shadow)
+}
+
+#[test]
+fn vk32_returns_only_what_vulkan_allows_and_takes_its_liberties() {
+    set_model(Model::VULKAN);
+    seed(1);
+    let mut g = SplitMix(11);
+    let (mut rz, mut fused, mut div_off, mut sqrt_off, mut flushed) = (0, 0, 0, 0, 0);
+    for _ in 0..100_000 {
+        let pick = |g: &mut SplitMix| {
+            let m = 1.0 + g.unit();
+            let e = (g.unit() * 60.0) as i32 - 30;
+            let s = if g.unit() < 0.5 { -1.0 } else { 1.0 };
+            s * m * 2f32.powi(e)
+        };
+        let (a, b, c) = (pick(&mut g), pick(&mut g), pick(&mut g));
+        // Correctly rounded in one of two modes: within 1 ULP of the exact result, and either
+        // the nearest or the one toward zero.
+        let sum = (f(a) + f(b)).value;
+        let exact = a as f64 + b as f64;
+        assert!((sum as f64 - exact).abs() < ulp(exact), "{a} + {b} = {sum}");
+        rz += (sum != a + b) as usize;
+        // A product feeding an add: rounded once (fused) or twice, in either mode.
+        let mad = (f(a) * f(b) + f(c)).value;
+        let exact = a as f64 * b as f64 + c as f64;
+        let twice = (a as f64 * b as f64) as f32 as f64 + c as f64;
+        let slack = ulp(exact) + ulp(a as f64 * b as f64);
+        assert!(
+            (mad as f64 - exact).abs() <= slack,
+            "{a} * {b} + {c} = {mad}"
+        );
+        fused += (mad != a.mul_add(b, c) || mad as f64 != twice as f32 as f64) as usize;
+        let q = (f(a) / f(b)).value;
+        let exact = a as f64 / b as f64;
+        assert!(
+            (q as f64 - exact).abs() <= 2.5 * ulp(exact),
+            "{a} / {b} = {q}"
+        );
+        div_off += (q != a / b) as usize;
+        let r = f(a.abs()).sqrt().value;
+        let exact = (a.abs() as f64).sqrt();
+        // 1 / inversesqrt: y = x^-1/2 (1 + d1), |d1| <= 2 ULP / y <= 2 eps, then 1 / y within
+        // 2.5 ULP, relatively 2.5 eps: sqrt(x) (1 + d2) / (1 + d1), within 4.5 eps relative
+        // (first order; 4.6 covers the second), which is up to 9 ULP at the top of a binade.
+        let relative = SQRT_RELATIVE_EPS * f32::EPSILON as f64;
+        assert!(
+            (r as f64 - exact).abs() <= relative * exact,
+            "sqrt {a} = {r}"
+        );
+        sqrt_off += (r != a.abs().sqrt()) as usize;
+        let tiny = f32::from_bits(1 + (g.0 % 1000) as u32);
+        flushed += ((f(tiny) * f(1.0)).value == 0.0) as usize;
+    }
+    println!("of 1e5: {rz} sums not to nearest, {fused} multiply-adds fused or toward zero, {div_off} quotients and {sqrt_off} roots off the IEEE result, {flushed} denormals flushed");
+    for (what, n) in [
+        ("sums rounded toward zero", rz),
+        ("multiply-adds fused", fused),
+        ("quotients off", div_off),
+        ("roots off", sqrt_off),
+        ("denormals flushed", flushed),
+    ] {
+        assert!(n > 10_000, "{what}: only {n} of 1e5");
+    }
+    // And under the IEEE model it is f32 exactly.
+    set_model(Model::IEEE);
+    for _ in 0..10_000 {
+        let (a, b, c) = (g.unit() * 3.0 - 1.5, g.unit() + 0.25, g.unit());
+        assert_eq!((f(a) * f(b) + f(c)).value, a * b + c);
+        assert_eq!((f(a) / f(b)).value, a / b);
+        assert_eq!(f(b).sqrt().value, b.sqrt());
+    }
+    set_model(Model::VULKAN);
+}
+
+#[test]
+fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
+    set_model(Model::VULKAN);
+    seed(2);
+    let mut g = Gen(SplitMix(21));
+    let (mut tested, mut cont_fail, mut shadow_fail) = (0, 0, 0);
+    for case in 0..cases() {
+        any_device(case);
+        let (s, t) = g.placement();
+        let p0 = t + g.dir() * s;
+        let (e1, e2) = (
+            g.dir() * s * g.pow10(-1.0, 0.0),
+            g.dir() * s * g.pow10(-1.0, 0.0),
+        );
+        if !e1.cross(e2).normalize().is_finite() {
+            continue;
+        }
+        let quad = case % 2 == 0;
+        let (a, b) = (g.unit(), g.unit());
+        let (a, b) = if !quad && a + b > 1.0 {
+            (1.0 - a, 1.0 - b)
+        } else {
+            (a, b)
+        };
+        let target = p0 + e1 * a + e2 * b;
+        let origin = target + g.dir() * s * g.pow10(-1.0, 2.0);
+        let dir = (target - origin).normalize();
+        let tris = if quad {
+            vec![(p0, e1, e1 + e2), (p0, e1 + e2, e2)]
+        } else {
+            vec![(p0, e1, e2)]
+        };
+        let hit = |o: V, d: V, t_max: Vk32| {
+            tris.iter().any(|&(q, f1, f2)| {
+                let (t, _, _) = intersect::triangle(o, d, v(q), v(f1), v(f2), f(0.0), t_max);
+                t.value >= 0.0
+            })
+        };
+        let best = tris
+            .iter()
+            .map(|&(q, f1, f2)| {
+                let h = intersect::triangle(
+                    v(origin),
+                    v(dir),
+                    v(q),
+                    v(f1),
+                    v(f2),
+                    f(0.0),
+                    f(f32::INFINITY),
+                );
+                (h, q, f1, f2)
+            })
+            .filter(|(h, ..)| h.0.value >= 0.0)
+            .min_by(|a, b| a.0 .0.value.total_cmp(&b.0 .0.value));
+        let Some(((_, hu, hv), q, f1, f2)) = best else {
+            continue;
+        };
+        tested += 1;
+        let (q, f1, f2) = (v(q), v(f1), v(f2));
+        let p = triangle_point_v3(q, f1, f2, hu, hv);
+        let nn = normalize(f1.cross(f2));
+        let n_side = if nn.dot(v(dir)).value < 0.0 { nn } else { -nn };
+        let condition = condition(f1, f2);
+        let err = triangle_point_error_v3(q, f1, f2, hu, hv, condition);
+        let (c, sh) = spawned_self_hits(&mut g, p, n_side, err, s, &hit);
+        cont_fail += c as usize;
+        shadow_fail += sh as usize;
+    }
+    println!("triangles/quads under Vulkan arithmetic: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
+    assert!(tested > cases() / 2);
+    assert_eq!((cont_fail, shadow_fail), (0, 0));
+}
+
+/// `geometry::triangle_error_condition` under [`Vk32`]: max(1, 1 / sin(theta)).
+fn condition(e1: V, e2: V) -> Vk32 {
+    let c = e1.cross(e2);
+    let sin = c.dot(c).sqrt() / (e1.dot(e1).sqrt() * e2.dot(e2).sqrt());
+    if sin.value > 0.0 {
+        (f(1.0) / sin).min(f(f32::MAX)).max(f(1.0))
+    } else {
+        f(1.0)
+    }
+}
+
+#[test]
+fn rays_leaving_spheres_never_hit_them_again_under_vulkan_arithmetic() {
+    set_model(Model::VULKAN);
+    seed(3);
+    let mut g = Gen(SplitMix(31));
+    let (mut tested, mut cont_fail, mut shadow_fail) = (0, 0, 0);
+    for case in 0..cases() {
+        any_device(case);
+        let (s, t) = g.placement();
+        let (c, r) = (t, s);
+        let target = c + g.dir() * r;
+        let origin = target + g.dir() * r * g.pow10(-1.0, 2.0);
+        let dir = (target - origin).normalize();
+        let (c, r, o, d) = (v(c), f(r), v(origin), v(dir));
+        let th = intersect::sphere(o, d, c, r, f(0.0), f(f32::INFINITY));
+        if th.value < 0.0 {
+            continue;
+        }
+        tested += 1;
+        // As `SurfaceHit::sphere` builds the record.
+        let p = reproject_to_sphere_v3(o + d * th, c, r);
+        let n = (p - c) / r;
+        let n_side = if n.dot(d).value < 0.0 { n } else { -n };
+        let err = sphere_point_error_v3(c, r);
+        let inward = n_side.dot(n).value < 0.0;
+        let hits = |o: V, d: V, tm: Vk32| {
+            let t = intersect::sphere(o, d, c, r, f(0.0), tm);
+            if inward {
+                t.value >= 0.0 && (t * d.dot(d).sqrt()).value <= 4.0 * err.value
+            } else {
+                t.value >= 0.0
+            }
+        };
+        let (cf, sf) = spawned_self_hits(&mut g, p, n_side, err, s, &hits);
+        cont_fail += cf as usize;
+        shadow_fail += sf as usize;
+    }
+    println!("spheres under Vulkan arithmetic: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
+    assert!(tested > cases() / 2);
+    assert_eq!((cont_fail, shadow_fail), (0, 0));
+}
+
+#[test]
+fn shadow_rays_never_hit_the_sphere_light_they_sample_under_vulkan_arithmetic() {
+    set_model(Model::VULKAN);
+    seed(4);
+    let mut g = Gen(SplitMix(41));
+    let (mut fails, mut tested) = (0, 0);
+    for case in 0..cases() {
+        any_device(case);
+        let (s, t) = g.placement();
+        let x = t + g.dir() * s * (1.0 + g.pow10(-3.0, 4.0));
+        let (c, r, x) = (v(t), f(s), v(x));
+        let sample = sample_sphere_cone_v3(c, r, x, f(g.unit()), f(g.unit()));
+        let (position, normal) = (sample.position, sample.normal);
+        if !(back(position).is_finite() && back(normal).is_finite()) {
+            continue;
+        }
+        tested += 1;
+        let end = shadow_ray_end_v3(x, position, normal, sphere_point_error_v3(c, r));
+        if intersect::sphere(x, end - x, c, r, f(0.0), f(1.0)).value >= 0.0 {
+            fails += 1;
+        }
+    }
+    println!("sphere light samples under Vulkan arithmetic: {fails} of {tested} shadow rays hit their own light");
+    assert!(tested > cases() * 9 / 10);
+    assert_eq!(fails, 0);
+}
+
+#[test]
+fn orthonormal_basis_is_orthonormal_under_vulkan_arithmetic() {
+    set_model(Model::VULKAN);
+    seed(5);
+    let mut g = Gen(SplitMix(51));
+    let mut worst = 0f64;
+    for k in 0..cases() {
+        any_device(k);
+        // Favour the branch's edge (n.z near 0) and the pole -Z, where 1 / (1 + n.z) is large.
+        let n = match k % 3 {
+            0 => g.dir(),
+            1 => Vec3::new(g.unit() - 0.5, g.unit() - 0.5, 1e-4 * (g.unit() - 0.5)).normalize(),
+            _ => Vec3::new(1e-3 * (g.unit() - 0.5), 1e-3 * (g.unit() - 0.5), -1.0).normalize(),
+        };
+        let (t, b) = orthonormal_basis_v3(v(n));
+        let (t, b) = (back(t).as_dvec3(), back(b).as_dvec3());
+        let n = n.as_dvec3();
+        let err = [
+            (t.length() - 1.0).abs(),
+            (b.length() - 1.0).abs(),
+            t.dot(b).abs(),
+            t.dot(n).abs(),
+            b.dot(n).abs(),
+            (t.cross(b) - n).length(),
+        ]
+        .into_iter()
+        .fold(0f64, f64::max);
+        worst = worst.max(err);
+    }
+    let eps = f32::EPSILON as f64;
+    println!(
+        "orthonormal_basis under Vulkan arithmetic: worst defect {:.1} eps",
+        worst / eps
+    );
+    assert!(worst <= ORTHONORMAL_BASIS_EPS * eps, "{} eps", worst / eps);
+}
+
+/// A square root's relative error under Vulkan, in eps (derived where it is tested).
+const SQRT_RELATIVE_EPS: f64 = 4.6;
+
+/// The orthonormal frame's defect under Vulkan arithmetic, in eps, derived in
+/// `docs/robustness.md`.
+const ORTHONORMAL_BASIS_EPS: f64 = 16.0;
+
+#[test]
+fn cosine_samples_stay_in_the_hemisphere_under_vulkan_arithmetic() {
+    set_model(Model::VULKAN);
+    seed(6);
+    let mut g = Gen(SplitMix(61));
+    for case in 0..cases() {
+        any_device(case);
+        let n = g.dir();
+        let u1 = kernel::rng::u32_to_unit_f32((g.0.u64() as u32) & 0x3ff_ffff);
+        let (u1, u2) = if g.unit() < 0.5 {
+            (u1, g.unit())
+        } else {
+            (g.unit(), g.unit())
+        };
+        let w = sample_cosine_hemisphere_v3(v(n), f(u1), f(u2));
+        let w = back(w);
+        assert!(w.dot(n) > 0.0, "n {n}, u {u1} {u2}: {w}");
+        assert!((w.length() - 1.0).abs() < 16.0 * f32::EPSILON, "{w}");
+    }
+}
+
+#[test]
+fn cone_samples_face_the_receiver_with_finite_pdf_under_vulkan_arithmetic() {
+    set_model(Model::VULKAN);
+    seed(7);
+    let mut g = Gen(SplitMix(71));
+    for case in 0..cases() {
+        any_device(case);
+        let (s, t) = g.placement();
+        let x = t + g.dir() * s * (1.0 + g.pow10(-5.0, 6.0));
+        let sample = sample_sphere_cone_v3(v(t), f(s), v(x), f(g.unit()), f(g.unit()));
+        let (p, nrm) = (back(sample.position), back(sample.normal));
+        let pdf = sample.pdf_solid_angle.value;
+        assert!(pdf.is_finite() && pdf > 0.0, "pdf {pdf}");
+        assert!(p.is_finite() && nrm.is_finite());
+        assert!((nrm.length() - 1.0).abs() <= 16.0 * f32::EPSILON, "{nrm}");
+        // The sampled point faces the receiver, up to the point's rounding (as properties.rs
+        // asks under IEEE arithmetic).
+        let bound = sphere_point_error(t, s);
+        assert!(nrm.dot(x - p) >= -bound, "{p} {nrm} {x}");
+    }
+}
+
+/// How far the kernel's hit points fall from the exact surface, worst over random triangles and
+/// spheres, as fractions of two bounds: the one the kernel gives them (`triangle_point_error`,
+/// `sphere_point_error`) and the first-order bound of IEEE arithmetic (docs/robustness.md):
+/// eps (|p0| / 2 + 3 / 2 (|u e1| + |v e2|)) for a triangle point, eps (3.25 r + |c| / 2) for a
+/// re-projected sphere point (per component, against the exact re-projection of the same point). Returns [kernel triangle, kernel sphere, IEEE triangle, IEEE sphere].
+fn worst_hit_point_error(model: Model, lean_up: bool, n: usize) -> [f64; 4] {
+    set_model(model);
+    lean(if lean_up { 1 } else { -1 });
+    seed(8);
+    let mut g = Gen(SplitMix(81));
+    let eps = f32::EPSILON as f64;
+    let mut worst = [0f64; 4];
+    for _ in 0..n {
+        let (s, t) = g.placement();
+        // A triangle point at barycentrics (u, v): the device's point against the exact one.
+        let (p0, e1, e2) = (t + g.dir() * s, g.dir() * s, g.dir() * s);
+        let (u, w) = (g.unit(), g.unit());
+        let (u, w) = if u + w > 1.0 {
+            (1.0 - u, 1.0 - w)
+        } else {
+            (u, w)
+        };
+        let p = back(triangle_point_v3(v(p0), v(e1), v(e2), f(u), f(w))).as_dvec3();
+        let (p0, e1, e2) = (p0.as_dvec3(), e1.as_dvec3(), e2.as_dvec3());
+        let exact = p0 + e1 * u as f64 + e2 * w as f64;
+        let off = (p - exact).abs().max_element();
+        let terms = (e1 * u as f64).abs().max_element() + (e2 * w as f64).abs().max_element();
+        let kernel = TRIANGLE_ERROR_EPS as f64 * eps * (p0.abs().max_element() + terms);
+        let ieee = eps * (0.5 * p0.abs().max_element() + 1.5 * terms);
+        worst[0] = worst[0].max(off / kernel);
+        worst[2] = worst[2].max(off / ieee);
+        // A point o + t d near a sphere, re-projected: its distance from the surface.
+        let (c, r) = (t, s);
+        let near = c + g.dir() * r * (1.0 + 1e-6 * (g.unit() - 0.5));
+        let q = back(reproject_to_sphere_v3(v(near), v(c), f(r))).as_dvec3();
+        let (cd, to) = (c.as_dvec3(), near.as_dvec3() - c.as_dvec3());
+        let off = (q - (cd + to * (r as f64 / to.length())))
+            .abs()
+            .max_element();
+        let kernel = sphere_point_error_v3(v(c), f(r)).value as f64;
+        let ieee = eps * (3.25 * r as f64 + 0.5 * c.abs().max_element() as f64);
+        worst[1] = worst[1].max(off / kernel);
+        worst[3] = worst[3].max(off / ieee);
+    }
+    set_model(Model::VULKAN);
+    worst
+}
+
+/// Hit points stay within the kernel's bounds under every arithmetic; and the bounds must be
+/// wider than IEEE's: under IEEE arithmetic the points stay within IEEE's first-order bounds
+/// (which are sharp: measured 0.99 and 0.97 of them), under Vulkan's they go to twice those
+/// (rounding toward zero doubles u), so a bound sized for IEEE would fail here.
+#[test]
+fn hit_points_stay_within_their_error_bounds_under_every_arithmetic() {
+    let mut vulkan_beyond_ieee = [0f64; 2];
+    for (name, model, up) in [
+        ("IEEE", Model::IEEE, true),
+        ("Vulkan, random", Model::VULKAN, true),
+        ("Vulkan, worst, up", Model::VULKAN_WORST, true),
+        ("Vulkan, worst, down", Model::VULKAN_WORST, false),
+    ] {
+        let [tri, sph, tri_ieee, sph_ieee] = worst_hit_point_error(model, up, cases());
+        println!("{name:<20} of the kernel's bound: triangle points {tri:.3}, sphere points {sph:.3}; of IEEE's: {tri_ieee:.3}, {sph_ieee:.3}");
+        assert!(tri <= 1.0 && sph <= 1.0, "{name}: {tri} {sph}");
+        if model == Model::IEEE {
+            assert!(
+                tri_ieee <= 1.0 && sph_ieee <= 1.0,
+                "{name}: {tri_ieee} {sph_ieee}"
+            );
+        } else {
+            vulkan_beyond_ieee[0] = vulkan_beyond_ieee[0].max(tri_ieee);
+            vulkan_beyond_ieee[1] = vulkan_beyond_ieee[1].max(sph_ieee);
+        }
+    }
+    assert!(
+        vulkan_beyond_ieee.iter().all(|&w| w > 1.5),
+        "{vulkan_beyond_ieee:?}"
+    );
+}
