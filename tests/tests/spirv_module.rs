@@ -101,6 +101,78 @@ fn modules_pass_spirv_val() {
     }
 }
 
+/// Where a device offers float controls the module is loaded with them
+/// (`vulkan::float_controls::request`): with every one requested, each entry point of both
+/// modules sets DenormPreserve, SignedZeroInfNanPreserve and RoundingModeRTE for 32 bits, the
+/// capabilities are declared, the rest of the module is unchanged, and spirv-val accepts it
+/// (lavapipe, which offers the last two, renders every GPU test with them). Nothing requested
+/// leaves the module as it is; a malformed module is an error, not a panic.
+#[test]
+fn modules_with_float_controls_requested_set_them_on_every_entry_point_and_pass_spirv_val() {
+    use twinpath::vulkan::float_controls::{request, Requested};
+    for (name, module) in [
+        ("kernel", twinpath::KERNEL_SPV),
+        ("probe", twinpath::PROBE_SPV),
+    ] {
+        let words: Vec<u32> = module
+            .as_chunks::<4>()
+            .0
+            .iter()
+            .map(|w| u32::from_le_bytes(*w))
+            .collect();
+        assert_eq!(request(&words, Requested::default()).unwrap(), words);
+        let patched = request(&words, Requested::ALL).unwrap();
+        // (opcode, operands) of every instruction.
+        let instructions = |w: &[u32]| {
+            let (mut at, mut out) = (5, Vec::new());
+            while at < w.len() {
+                let count = (w[at] >> 16) as usize;
+                out.push((w[at] & 0xffff, w[at + 1..at + count].to_vec()));
+                at += count;
+            }
+            out
+        };
+        let (before, after) = (instructions(&words), instructions(&patched));
+        let entries: Vec<u32> = after
+            .iter()
+            .filter(|(op, _)| *op == 15)
+            .map(|(_, o)| o[1])
+            .collect();
+        assert!(!entries.is_empty());
+        for cap in [4464, 4466, 4467] {
+            assert!(after.contains(&(17, vec![cap])), "{name}: capability {cap}");
+        }
+        for &entry in &entries {
+            for mode in [4459, 4461, 4462] {
+                assert!(
+                    after.contains(&(16, vec![entry, mode, 32])),
+                    "{name}: entry {entry} mode {mode}"
+                );
+            }
+        }
+        assert_eq!(after.len(), before.len() + 3 + 3 * entries.len());
+        let added = |i: &(u32, Vec<u32>)| {
+            (i.0 == 17 && [4464, 4466, 4467].contains(&i.1[0]))
+                || (i.0 == 16 && [4459, 4461, 4462].contains(&i.1[1]) && i.1.len() == 3)
+        };
+        let kept: Vec<_> = after.iter().filter(|i| !added(i)).cloned().collect();
+        assert_eq!(kept, before, "{name}: the rest of the module is unchanged");
+        let bytes: Vec<u8> = patched.iter().flat_map(|w| w.to_le_bytes()).collect();
+        spirv_val(&format!("{name}-float-controls"), &bytes);
+        // Cut inside the first entry point: its word count reaches past the end.
+        let first_entry = (5..words.len())
+            .scan(5usize, |at, _| {
+                let here = *at;
+                *at += (words.get(here)? >> 16) as usize;
+                Some(here)
+            })
+            .find(|&at| words[at] & 0xffff == 15)
+            .unwrap();
+        let truncated = &words[..first_entry + 2];
+        assert!(request(truncated, Requested::ALL).is_err(), "{name}");
+    }
+}
+
 fn spirv_val(name: &str, module: &[u8]) {
     let path = std::env::temp_dir().join(format!("twinpath-{name}-{}.spv", std::process::id()));
     std::fs::write(&path, module).unwrap();

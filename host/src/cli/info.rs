@@ -45,8 +45,9 @@ fn gpu() {
                     println!("      driver: {}", d.driver);
                 }
                 println!(
-                    "      32-bit float controls offered: {} (the kernel's bounds assume none)",
-                    d.float_controls.describe()
+                    "      32-bit float controls offered: {}; requested by the kernel: {} (its error bounds assume none)",
+                    d.float_controls.describe(),
+                    d.float_controls.requested().describe()
                 );
             }
         }

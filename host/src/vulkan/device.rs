@@ -1,5 +1,6 @@
 //! Vulkan instance, device selection and the logical device with the ray-tracing extensions.
 
+use super::float_controls::FloatControls;
 use super::limits::DeviceLimits;
 use anyhow::{anyhow, bail, Context as _, Result};
 use ash::{ext, khr, vk};
@@ -58,47 +59,8 @@ pub struct DeviceInfo {
     pub ray_query: bool,
     /// The driver's name and version string (`VkPhysicalDeviceDriverProperties`), or empty.
     pub driver: String,
-    /// What it promises about 32-bit float arithmetic (`VkPhysicalDeviceFloatControlsProperties`).
+    /// What it offers for 32-bit float arithmetic (`VkPhysicalDeviceFloatControlsProperties`).
     pub float_controls: FloatControls,
-}
-
-/// The 32-bit float controls a device offers (Vulkan 1.2 core, `VK_KHR_shader_float_controls`):
-/// whether a module may ask it to keep denormals, to keep the sign of zero, infinities and NaNs,
-/// and to round to nearest even or toward zero. Without them a Vulkan device may flush
-/// denormals, lose the sign of zero and round either way; the kernel's error bounds assume all
-/// of that (docs/robustness.md, "Under Vulkan's arithmetic").
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct FloatControls {
-    pub denorm_preserve: bool,
-    pub denorm_flush_to_zero: bool,
-    pub signed_zero_inf_nan_preserve: bool,
-    pub rounding_mode_rte: bool,
-    pub rounding_mode_rtz: bool,
-}
-
-impl FloatControls {
-    /// The controls as `info` lists them ("none" if it offers none).
-    pub fn describe(&self) -> String {
-        let offered: Vec<&str> = [
-            (self.denorm_preserve, "denormals preserved"),
-            (self.denorm_flush_to_zero, "denormals flushed"),
-            (
-                self.signed_zero_inf_nan_preserve,
-                "signed zero/inf/NaN preserved",
-            ),
-            (self.rounding_mode_rte, "round to nearest even"),
-            (self.rounding_mode_rtz, "round toward zero"),
-        ]
-        .iter()
-        .filter(|(on, _)| *on)
-        .map(|(_, name)| *name)
-        .collect();
-        if offered.is_empty() {
-            "none".to_string()
-        } else {
-            offered.join(", ")
-        }
-    }
 }
 
 impl DeviceInfo {
@@ -134,6 +96,9 @@ pub struct Context {
     debug: Option<(ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     pub physical_device: vk::PhysicalDevice,
     pub device_name: String,
+    /// What the device offers for 32-bit floats; the kernel's module asks for it
+    /// (`super::float_controls`).
+    pub float_controls: FloatControls,
     pub device: ash::Device,
     pub queue: vk::Queue,
     pub queue_family: u32,
@@ -226,14 +191,7 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> D
         )
         .trim()
         .to_string();
-        info.float_controls = FloatControls {
-            denorm_preserve: controls.shader_denorm_preserve_float32 == vk::TRUE,
-            denorm_flush_to_zero: controls.shader_denorm_flush_to_zero_float32 == vk::TRUE,
-            signed_zero_inf_nan_preserve: controls.shader_signed_zero_inf_nan_preserve_float32
-                == vk::TRUE,
-            rounding_mode_rte: controls.shader_rounding_mode_rte_float32 == vk::TRUE,
-            rounding_mode_rtz: controls.shader_rounding_mode_rtz_float32 == vk::TRUE,
-        };
+        info.float_controls = FloatControls::from_properties(&controls);
     }
     info
 }
@@ -397,6 +355,7 @@ impl Context {
             instance,
             debug,
             physical_device: pd,
+            float_controls: chosen.float_controls,
             device_name: chosen.name,
             device,
             queue,

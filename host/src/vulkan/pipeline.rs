@@ -94,9 +94,12 @@ fn align_up(x: u64, a: u64) -> u64 {
     x.div_ceil(a) * a
 }
 
-/// Creates a shader module from SPIR-V bytes.
+/// Creates a shader module from SPIR-V bytes, asking for the float controls the device offers
+/// (`super::float_controls`).
 pub fn shader_module(ctx: &Context, spv: &[u8]) -> Result<vk::ShaderModule> {
     let words = ash::util::read_spv(&mut std::io::Cursor::new(spv)).context("malformed SPIR-V")?;
+    let words = super::float_controls::request(&words, ctx.float_controls.requested())
+        .map_err(|e| anyhow!("cannot add float controls to the module: {e}"))?;
     unsafe {
         ctx.device
             .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)
