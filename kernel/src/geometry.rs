@@ -1,7 +1,7 @@
 //! Ray/primitive intersection, the geometry factor, and where a new ray starts.
 
 use crate::intersect;
-use crate::real::{self, abs, select, V3};
+use crate::real::{self, abs, V3};
 use crate::scene::Triangle;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -71,19 +71,21 @@ pub fn reproject_to_sphere(p: Vec3, center: Vec3, radius: f32) -> Vec3 {
     reproject_to_sphere_v3(V3::from(p), V3::from(center), radius).into()
 }
 
-/// [`reproject_to_sphere`] over any [`real::Real`] (the kernel's `f32`, or a test's model of a
+/// [`reproject_to_sphere`] over any scalar [`real::Real`] (the kernel's `f32`, or a test's model of a
 /// device's arithmetic).
 #[inline]
-pub fn reproject_to_sphere_v3<R: real::Real>(p: V3<R>, center: V3<R>, radius: R) -> V3<R> {
+pub fn reproject_to_sphere_v3<R: real::Real<Bits = u32>>(
+    p: V3<R>,
+    center: V3<R>,
+    radius: R,
+) -> V3<R> {
     let v = p - center;
     let len = v.dot(v).sqrt();
-    let off_centre = len.greater_than(R::splat(0.0));
-    let moved = center + v * (radius / len);
-    V3::new(
-        select(off_centre, moved.x, p.x),
-        select(off_centre, moved.y, p.y),
-        select(off_centre, moved.z, p.z),
-    )
+    if len.greater_than(R::splat(0.0)) != 0 {
+        center + v * (radius / len)
+    } else {
+        p
+    }
 }
 
 /// A ray/triangle hit: distance and barycentric coordinates of p0 + u edge1 + v edge2.
@@ -231,10 +233,12 @@ pub const TRIANGLE_ERROR_EPS: f32 = 8.0;
 /// 16 covers it with a factor of 1.4 to spare (docs/robustness.md, "Under Vulkan's arithmetic").
 pub const SPHERE_ERROR_EPS: f32 = 16.0;
 
-/// Largest absolute component of `v`.
+/// Largest absolute component of `v`, compared as glam's `max_element` compares (a plain
+/// `>`, which compiles to one instruction; `f32::max`'s NaN handling costs five).
 #[inline]
-fn max_abs<R: real::Real>(v: V3<R>) -> R {
-    abs(v.x).max(abs(v.y)).max(abs(v.z))
+fn max_abs<R: real::Real<Bits = u32>>(v: V3<R>) -> R {
+    let max = |a: R, b: R| if a.greater_than(b) != 0 { a } else { b };
+    max(abs(v.x), max(abs(v.y), abs(v.z)))
 }
 
 /// Absolute error bound (per component) of [`triangle_point`]`(p0, edge1, edge2, u, v)` with
@@ -298,9 +302,9 @@ pub fn triangle_point_error_conditioned(
     triangle_point_error_v3(p0, edge1, edge2, u, v, condition)
 }
 
-/// [`triangle_point_error_conditioned`] over any [`real::Real`].
+/// [`triangle_point_error_conditioned`] over any scalar [`real::Real`].
 #[inline]
-pub fn triangle_point_error_v3<R: real::Real>(
+pub fn triangle_point_error_v3<R: real::Real<Bits = u32>>(
     p0: V3<R>,
     edge1: V3<R>,
     edge2: V3<R>,
@@ -319,9 +323,9 @@ pub fn sphere_point_error(center: Vec3, radius: f32) -> f32 {
     sphere_point_error_v3(V3::from(center), radius)
 }
 
-/// [`sphere_point_error`] over any [`real::Real`].
+/// [`sphere_point_error`] over any scalar [`real::Real`].
 #[inline]
-pub fn sphere_point_error_v3<R: real::Real>(center: V3<R>, radius: R) -> R {
+pub fn sphere_point_error_v3<R: real::Real<Bits = u32>>(center: V3<R>, radius: R) -> R {
     R::splat(SPHERE_ERROR_EPS * f32::EPSILON) * (max_abs(center) + radius)
 }
 
@@ -359,22 +363,27 @@ pub fn offset_ray_origin_v3<R: real::Real<Bits = u32>>(p: V3<R>, n: V3<R>, error
 #[inline]
 fn step_away<R: real::Real<Bits = u32>>(x: R, dir: R) -> R {
     let zero = R::splat(0.0);
-    if dir.not_equal(zero) == 0 || x.finite() == 0 {
+    if dir.not_equal(zero) == 0 {
         return x;
     }
+    // Decided on the bits: |x| from the exponent and mantissa, the side from the sign bit.
+    let bits = x.to_bits();
+    let magnitude = bits & 0x7fff_ffff;
+    if magnitude >= 0x7f80_0000 {
+        return x; // infinite or NaN
+    }
     let toward_positive = dir.greater_than(zero) != 0;
-    if abs(x).less_than(R::splat(f32::MIN_POSITIVE)) != 0 {
+    if magnitude < 0x0080_0000 {
         let smallest = R::splat(f32::MIN_POSITIVE);
         return if toward_positive { smallest } else { -smallest };
     }
-    let bits = x.to_bits();
     // Away from zero if x and dir have the same sign, toward zero otherwise.
-    let moved = if (x.greater_than(zero) != 0) == toward_positive {
+    let positive = bits >> 31 == 0;
+    R::from_bits(if positive == toward_positive {
         bits + 1
     } else {
         bits - 1
-    };
-    R::from_bits(moved)
+    })
 }
 
 /// Relative shortening of shadow rays: a ray/surface intersection's `t` is only known to a few
