@@ -363,3 +363,15 @@ fn mask(b: bool) -> u32 {
         0
     }
 }
+
+/// How far apart the CPU's and a conformant Vulkan device's `orthonormal_basis` may be, per
+/// component, in eps (derived in `tests/tests/vulkan_precision.rs`; used by `gpu_functions.rs`
+/// for devices that are not IEEE).
+pub const BASIS_APART_EPS: f32 = 9.0;
+
+/// How far apart the CPU's and a conformant device's cone-sampled points (and normals) may be,
+/// relative to the size of the geometry: twice the square root of the 25 eps the cancelling
+/// ratio carries (derived in `tests/tests/vulkan_precision.rs`).
+pub fn cone_points_apart() -> f32 {
+    2.0 * (25.0 * f32::EPSILON).sqrt()
+}

@@ -522,6 +522,9 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let denom = 1.0 + g * g - 2.0 * g * (-v(1).dot(v(0)));
             value * ((8.0 + 6.0 * g.abs() / denom) * f32::EPSILON as f64) as f32
         }
+        // The cone's density (out0.w) is never held to more than 4 eps absolute, whatever the
+        // positions' bound (the Vulkan class's is a square root of eps: `vulkan_class`).
+        function::SAMPLE_SPHERE_CONE if k == 0 && j == 3 => b.abs.min(4.0 * f32::EPSILON),
         function::SAMPLE_SPHERE | function::SAMPLE_SPHERE_CONE if k == 0 && j < 3 => {
             let c = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2));
             b.abs * (c.length() + f(0, 3))
@@ -530,10 +533,42 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
     }
 }
 
+/// The bound of a function on a device whose arithmetic is not IEEE's, where one has been
+/// derived for any conformant Vulkan device (`docs/robustness.md`, "Under Vulkan's
+/// arithmetic"; checked against a model of such a device in `vulkan_precision.rs`, which gives
+/// 2.25 eps and 8.6e-4 x size where the NVIDIA H200 gave 0.75 eps and 5.9e-4 x size). The other
+/// functions keep the IEEE-class bound on every device until theirs is derived.
+fn vulkan_class(b: &Bound) -> Option<Bound> {
+    let eps = f32::EPSILON;
+    match b.func {
+        function::ORTHONORMAL_BASIS => Some(Bound {
+            max_ulps: 0,
+            abs: twinpath_tests::vulkan_arithmetic::BASIS_APART_EPS * eps,
+            why: "Vulkan class: a sum, a quotient within 2.5 ULP and products, rounded either way: 6.5 eps per component on a device, 2.5 on the CPU: 9 eps absolute",
+            ..*b
+        }),
+        function::SAMPLE_SPHERE_CONE => Some(Bound {
+            max_ulps: 40,
+            abs: twinpath_tests::vulkan_arithmetic::cone_points_apart(),
+            why: "Vulkan class: the point takes the square root of 1 - sin^2 / sin^2_max, which cancels at the cone's rim and carries 25 eps: 2 sqrt(25 eps) x size for positions and normals; the density a few quotients and roots, 18 eps relative: 40 ULP or 4 eps",
+            ..*b
+        }),
+        _ => None,
+    }
+}
+
 #[test]
 fn kernel_functions_agree_between_cpu_and_gpu() {
     let ctx = context().lock().unwrap();
     let runner = ProbeRunner::new(&ctx).unwrap();
+    // Device classes: lavapipe computes with LLVM's IEEE arithmetic, as the CPU does; any other
+    // device is held to the bounds derived for Vulkan's arithmetic where they exist.
+    let ieee_device = ctx.device_name.starts_with("llvmpipe");
+    println!(
+        "device {}: {} class",
+        ctx.device_name,
+        if ieee_device { "IEEE" } else { "Vulkan" }
+    );
     assert_eq!(
         BOUNDS.len() as u32,
         function::COUNT,
@@ -541,6 +576,8 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
     );
     let mut failures = Vec::new();
     for b in BOUNDS {
+        let vulkan_bound = vulkan_class(b).filter(|_| !ieee_device);
+        let b = vulkan_bound.as_ref().unwrap_or(b);
         let mut g = Gen(twinpath_tests::SplitMix(0x5eed_0000 + b.func as u64));
         let input = inputs(b.func, &mut g);
         let gpu = runner.run(&ctx, b.func, &input).unwrap();
