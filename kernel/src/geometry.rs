@@ -12,17 +12,30 @@ use spirv_std::glam::{Vec2, Vec3};
 /// two areas and the projected solid angle (Veach's thesis, eq. 8.4). Zero for coincident points.
 #[inline]
 pub fn geometry_factor(p_a: Vec3, n_a: Vec3, p_b: Vec3, n_b: Vec3) -> f32 {
+    let (p_a, n_a, p_b, n_b) = (V3::from(p_a), V3::from(n_a), V3::from(p_b), V3::from(n_b));
+    geometry_factor_v3(p_a, n_a, p_b, n_b)
+}
+
+/// [`geometry_factor`] over any scalar [`real::Real`].
+#[inline]
+pub fn geometry_factor_v3<R: real::Real<Bits = u32>>(
+    p_a: V3<R>,
+    n_a: V3<R>,
+    p_b: V3<R>,
+    n_b: V3<R>,
+) -> R {
+    let zero = R::splat(0.0);
     let d = p_a - p_b;
     let d2 = d.dot(d);
-    if d2 > 0.0 {
-        let g = (n_a.dot(d) * n_b.dot(d)).abs() / (d2 * d2);
-        if g.is_finite() {
+    if d2.greater_than(zero) != 0 {
+        let g = abs(n_a.dot(d) * n_b.dot(d)) / (d2 * d2);
+        if g.finite() != 0 {
             g
         } else {
-            0.0
+            zero
         }
     } else {
-        0.0
+        zero
     }
 }
 

@@ -375,3 +375,10 @@ pub const BASIS_APART_EPS: f32 = 9.0;
 pub fn cone_points_apart() -> f32 {
     2.0 * (25.0 * f32::EPSILON).sqrt()
 }
+
+/// How far apart the CPU's and a conformant device's `geometry_factor` G = |(n_a . d)(n_b . d)|
+/// / (d . d)^2 may be, for points |d|^2 = `d2` apart (derived in
+/// `tests/tests/vulkan_precision.rs`): 12 eps / |d|^2 + 21 eps G.
+pub fn geometry_factor_apart(d2: f64, g: f64) -> f64 {
+    f32::EPSILON as f64 * (12.0 / d2 + 21.0 * g)
+}

@@ -13,14 +13,16 @@
 use glam::Vec3;
 use kernel::frame::orthonormal_basis_v3;
 use kernel::geometry::{
-    offset_ray_origin_v3, reproject_to_sphere_v3, shadow_ray_end_v3, sphere_point_error,
-    sphere_point_error_v3, triangle_point_error_v3, triangle_point_v3, TRIANGLE_ERROR_EPS,
+    geometry_factor_v3, offset_ray_origin_v3, reproject_to_sphere_v3, shadow_ray_end_v3,
+    sphere_point_error, sphere_point_error_v3, triangle_point_error_v3, triangle_point_v3,
+    TRIANGLE_ERROR_EPS,
 };
 use kernel::intersect;
 use kernel::real::{Real, V3};
 use kernel::sampling::{sample_cosine_hemisphere_v3, sample_sphere_cone_v3};
 use twinpath_tests::vulkan_arithmetic::{
-    cone_points_apart, lean, seed, set_model, ulp, Model, Vk32, BASIS_APART_EPS,
+    cone_points_apart, geometry_factor_apart, lean, seed, set_model, ulp, Model, Vk32,
+    BASIS_APART_EPS,
 };
 use twinpath_tests::SplitMix;
 
@@ -561,4 +563,49 @@ fn a_conformant_device_differs_from_the_cpu_within_the_vulkan_class_bounds() {
     // The cone's difference is a square root of a rounding, far beyond any ULP bound: a test
     // holding a device to the lavapipe-class 4 eps x size would fail on every conformant one.
     assert!(cone > 100.0 * eps, "{cone:e}");
+}
+
+/// `geometry_factor` on a device against the CPU. With u the unit roundoff and q the quotient's
+/// relative error: each cosine n . d (d rounded, three products, two sums) is off by at most
+/// 4 u |d| (for unit n), so their product by 8 u |d|^2 plus u of itself; (d . d)^2 carries 11 u
+/// relative; so |dG| <= 8 u / |d|^2 + (12 u + q) G: under IEEE (u = eps / 2, q = eps / 2)
+/// 4 eps / |d|^2 + 6.5 eps G, under Vulkan (u = eps, q = 2.5 eps) 8 eps / |d|^2 + 14.5 eps G;
+/// apart by 12 eps / |d|^2 + 21 eps G. Where a cosine nearly vanishes (a grazing pair) the
+/// absolute term dominates and the relative difference is unbounded: the H200's 3711 ULP
+/// against the lavapipe-class 8. This test finds such differences beyond 8 ULP too.
+#[test]
+fn geometry_factors_differ_from_the_cpu_within_the_vulkan_class_bound() {
+    let mut g = Gen(SplitMix(101));
+    seed(10);
+    let (mut worst, mut beyond_8_ulp) = (0f64, 0usize);
+    for k in 0..cases() {
+        let (s, t) = g.placement();
+        let p_a = t + g.dir() * s;
+        let p_b = t + g.dir() * s;
+        let d = p_a - p_b;
+        // Every third pair grazing: n_a nearly perpendicular to d.
+        let n_a = if k % 3 == 0 {
+            (d.normalize().any_orthonormal_vector() + d.normalize() * 1e-4 * (g.unit() - 0.5))
+                .normalize()
+        } else {
+            g.dir()
+        };
+        let n_b = g.dir();
+        if !(n_a.is_finite() && d.length_squared() > 0.0) {
+            continue;
+        }
+        set_model(Model::IEEE);
+        let cpu = geometry_factor_v3(v(p_a), v(n_a), v(p_b), v(n_b)).value;
+        any_device(k);
+        let gpu = geometry_factor_v3(v(p_a), v(n_a), v(p_b), v(n_b)).value;
+        let d2 = d.as_dvec3().length_squared();
+        let bound = geometry_factor_apart(d2, cpu.max(gpu) as f64);
+        worst = worst.max((cpu as f64 - gpu as f64).abs() / bound);
+        let ulps = (cpu.to_bits() as i64 - gpu.to_bits() as i64).unsigned_abs();
+        beyond_8_ulp += (ulps > 8) as usize;
+    }
+    set_model(Model::VULKAN);
+    println!("geometry_factor, a device against the CPU: worst {worst:.3} of the bound, {beyond_8_ulp} of {} beyond 8 ULP", cases());
+    assert!(worst <= 1.0, "{worst}");
+    assert!(beyond_8_ulp > 0);
 }
