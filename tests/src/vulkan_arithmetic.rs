@@ -382,3 +382,98 @@ pub fn cone_points_apart() -> f32 {
 pub fn geometry_factor_apart(d2: f64, g: f64) -> f64 {
     f32::EPSILON as f64 * (12.0 / d2 + 21.0 * g)
 }
+
+/// The roundoff of one IEEE and one Vulkan computation added: u (eps / 2 and eps) and a
+/// quotient's relative error (eps / 2 and 2.5 eps). A quantity computed by both is apart by at
+/// most its error bound with these.
+const APART_U: f64 = 1.5 * f32::EPSILON as f64;
+const APART_Q: f64 = 3.0 * f32::EPSILON as f64;
+
+fn d3(v: [f32; 3]) -> glam::DVec3 {
+    glam::Vec3::from_array(v).as_dvec3()
+}
+
+/// Whether `kernel::intersect::triangle` (Moller-Trumbore) of this ray may say hit on one device
+/// and miss on another: a barycentric, their sum, or t within rounding of its limit, or the
+/// determinant within rounding of 0. Exact values in `f64` from the `f32` inputs; error bounds
+/// of each computation (u its unit roundoff, q its quotient's error): the cross products within
+/// 3 u |a||b| (and tvec's own rounding u), so U = tvec . pvec within 7 u |tvec||d||e2|, V = d .
+/// qvec within 7 u |d||tvec||e1|, T = e2 . qvec within 7 u |e2||tvec||e1|, det within 6 u
+/// |e1||d||e2|; a barycentric X / det within (dX + |X / det| d(det)) / |det| + (q + u) |X / det|.
+pub fn triangle_hit_may_flip(
+    origin: [f32; 3],
+    dir: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
+    t_min: f32,
+    t_max: f32,
+) -> bool {
+    let (o, d, p0, e1, e2) = (d3(origin), d3(dir), d3(p0), d3(e1), d3(e2));
+    let (u, q) = (APART_U, APART_Q);
+    let pvec = d.cross(e2);
+    let det = e1.dot(pvec);
+    let tvec = o - p0;
+    let qvec = tvec.cross(e1);
+    let (nd, ne1, ne2, nt) = (d.length(), e1.length(), e2.length(), tvec.length());
+    let d_det = 6.0 * u * ne1 * nd * ne2;
+    if det.abs() <= d_det {
+        return true;
+    }
+    let quotient = |x: f64, dx: f64| {
+        let value = x / det;
+        (
+            value,
+            (dx + value.abs() * d_det) / det.abs() + (q + u) * value.abs(),
+        )
+    };
+    let (bu, du) = quotient(tvec.dot(pvec), 7.0 * u * nt * nd * ne2);
+    let (bv, dv) = quotient(d.dot(qvec), 7.0 * u * nd * nt * ne1);
+    let (t, dt) = quotient(e2.dot(qvec), 7.0 * u * ne2 * nt * ne1);
+    let dsum = du + dv + u * (bu + bv).abs();
+    bu.abs() <= du
+        || (1.0 - bu).abs() <= du
+        || bv.abs() <= dv
+        || (1.0 - bu - bv).abs() <= dsum
+        || (t - t_min as f64).abs() <= dt
+        || (t_max as f64 - t).abs() <= dt
+}
+
+/// Whether `kernel::intersect::sphere` of this ray may say hit on one device and miss on
+/// another: the ray within rounding of tangent, or a root within rounding of t_min or t_max.
+/// Exact values in `f64`; error bounds of each computation: f = o - c within u |f|, the
+/// perpendicular f - d (f . d) / (d . d) within 6 u |f| (a dot product, a quotient, a product
+/// and a difference), so the margin r^2 - |perp|^2 within 2 r 6 u |f| + 4 u r^2 near tangency;
+/// a root, at half = sqrt(margin / a) from the closest point, within 16 (u + q) (|f| + r) / |d|
+/// (the stable quadratic: a square root and two quotients) plus the margin's error times
+/// d(half)/d(margin) = 1 / (2 a half), which grows without bound toward tangency.
+pub fn sphere_hit_may_flip(
+    origin: [f32; 3],
+    dir: [f32; 3],
+    center: [f32; 3],
+    radius: f32,
+    t_min: f32,
+    t_max: f32,
+) -> bool {
+    let (o, d, c, r) = (d3(origin), d3(dir), d3(center), radius as f64);
+    let (u, q) = (APART_U, APART_Q);
+    let f = o - c;
+    let a = d.dot(d);
+    let perp = f - d * (f.dot(d) / a);
+    let margin = r * r - perp.length_squared();
+    let d_margin = 12.0 * u * r * f.length() + 4.0 * u * r * r;
+    if margin.abs() <= d_margin {
+        return true;
+    }
+    if margin < 0.0 {
+        return false;
+    }
+    // The roots along -/+ half, half = sqrt(margin / a): the margin's error moves half by
+    // d_margin / (2 a half) (near tangency this dominates), the rest by 16 (u + q) of the sizes.
+    let along = -f.dot(d) / a;
+    let half = (margin / a).sqrt();
+    let dt = 16.0 * (u + q) * (f.length() + r) / a.sqrt() + d_margin / (2.0 * a * half);
+    [along - half, along + half]
+        .iter()
+        .any(|&t| (t - t_min as f64).abs() <= dt || (t_max as f64 - t).abs() <= dt)
+}
