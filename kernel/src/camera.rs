@@ -1,5 +1,6 @@
 //! The camera: pixel and sub-pixel position to a primary ray, through a pinhole or a thin lens.
 
+use crate::real::{Real, V3};
 use crate::sampling::sample_concentric_disk;
 use crate::scene::Camera;
 use spirv_std::glam::Vec3;
@@ -18,12 +19,30 @@ pub fn camera_ray_direction(
     u: f32,
     v: f32,
 ) -> Vec3 {
-    let x = 2.0 * ((px as f32 + u) / width as f32) - 1.0;
-    let y = 1.0 - 2.0 * ((py as f32 + v) / height as f32);
-    let forward = Vec3::new(camera.forward[0], camera.forward[1], camera.forward[2]);
-    let right = Vec3::new(camera.right[0], camera.right[1], camera.right[2]);
-    let up = Vec3::new(camera.up[0], camera.up[1], camera.up[2]);
-    (forward + x * right + y * up).normalize()
+    let vec = |a: [f32; 4]| V3::new(a[0], a[1], a[2]);
+    let (forward, right, up) = (vec(camera.forward), vec(camera.right), vec(camera.up));
+    let size = (width as f32, height as f32);
+    image_plane_direction(forward, right, up, size, (px as f32, py as f32), (u, v)).into()
+}
+
+/// The unit direction through position `offset` inside pixel `pixel` (column and row from the
+/// top left, as floats) of an image of `size` pixels, for a camera of axes `forward`, `right`,
+/// `up`: the arithmetic of [`camera_ray_direction`], over any [`Real`] (the kernel's `f32`, or a
+/// test's model of a device's arithmetic). Normalised as glam normalises (times 1 / length).
+#[inline]
+pub fn image_plane_direction<R: Real>(
+    forward: V3<R>,
+    right: V3<R>,
+    up: V3<R>,
+    size: (f32, f32),
+    pixel: (f32, f32),
+    offset: (R, R),
+) -> V3<R> {
+    let (one, two) = (R::splat(1.0), R::splat(2.0));
+    let x = two * ((R::splat(pixel.0) + offset.0) / R::splat(size.0)) - one;
+    let y = one - two * ((R::splat(pixel.1) + offset.1) / R::splat(size.1));
+    let d = forward + right * x + up * y;
+    d * (one / d.dot(d).sqrt())
 }
 
 /// The camera's position.

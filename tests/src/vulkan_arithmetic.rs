@@ -477,3 +477,20 @@ pub fn sphere_hit_may_flip(
         .iter()
         .any(|&t| (t - t_min as f64).abs() <= dt || (t_max as f64 - t).abs() <= dt)
 }
+
+/// How far apart the CPU's and a conformant device's `camera_ray_direction` may be, per
+/// component, for camera axes `forward`, `right`, `up` and image-plane position (x, y) in
+/// [-1, 1] (derived in `tests/tests/vulkan_precision.rs`): eps ([10.5 (|right| + |up|) +
+/// 4.5 S] / |v| + 11.85), S = |forward| + |x||right| + |y||up|, v the unnormalised direction.
+pub fn camera_direction_apart(
+    forward: [f32; 3],
+    right: [f32; 3],
+    up: [f32; 3],
+    x: f64,
+    y: f64,
+) -> f64 {
+    let (f, r, u) = (d3(forward), d3(right), d3(up));
+    let v = f + r * x + u * y;
+    let s = f.length() + x.abs() * r.length() + y.abs() * u.length();
+    f32::EPSILON as f64 * ((10.5 * (r.length() + u.length()) + 4.5 * s) / v.length() + 11.85)
+}

@@ -371,6 +371,8 @@ struct Bound {
     /// Records whose outputs are ill-conditioned in their inputs (a rounding difference in an
     /// intermediate moves them far), and the relative difference allowed there instead.
     ill_conditioned: Option<(IsIllConditioned, f32)>,
+    /// Whether this is the bound of a device that is not IEEE (`vulkan_class`).
+    vulkan: bool,
     why: &'static str,
 }
 
@@ -424,25 +426,25 @@ fn sharply_sampled_or_index_matched(r: &[[u32; 4]; 4]) -> bool {
 }
 
 const BOUNDS: &[Bound] = &[
-    Bound { name: "rng (pcg4d, u32 -> float, scrambled Sobol)", func: function::RNG, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, why: "integer arithmetic: bit-exact" },
-    Bound { name: "offset_ray_origin / shadow_ray_end", func: function::OFFSET_RAY_ORIGIN, max_ulps: 1, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, why: "integer ULP steps are exact; p + s n may be fused into one FMA on the GPU: 1 ULP" },
-    Bound { name: "orthonormal_basis", func: function::ORTHONORMAL_BASIS, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "a few multiply-adds (FMA contraction): 4 ULP, or 4 eps absolute near zero" },
-    Bound { name: "sample_lobe", func: function::SAMPLE_LOBE, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "sin/cos differ by 1 ULP (GLSL.std.450 vs libm) plus the frame: 8 eps absolute on unit vectors" },
-    Bound { name: "sample_sphere", func: function::SAMPLE_SPHERE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "cos_sin_turns' polynomials under FMA contraction: normals 4 eps, positions 4 eps x (|centre| + radius)" },
-    Bound { name: "sample_sphere_cone", func: function::SAMPLE_SPHERE_CONE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "cos_sin_turns and dot products under FMA contraction: pdf 4 ULP, normals 4 eps, positions 4 eps x (|centre| + radius)" },
-    Bound { name: "geometry_factor", func: function::GEOMETRY_FACTOR, max_ulps: 8, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, why: "dot products (FMA contraction): 8 ULP" },
-    Bound { name: "intersect_sphere (+ re-projection)", func: function::INTERSECT_SPHERE, max_ulps: 64, abs: 0.0, flip_fraction: 1e-3, ill_conditioned: None, why: "sqrt and FMA contraction; hit/miss may flip for rays within rounding of tangent or of the origin's surface" },
-    Bound { name: "intersect_triangle (t, u, v, point, error bound)", func: function::INTERSECT_TRIANGLE, max_ulps: 64, abs: 4.0 * f32::EPSILON, flip_fraction: 1e-3, ill_conditioned: None, why: "cross/dot products under FMA contraction: 64 ULP, u and v 4 eps, points 4 eps x (|p0| + |e1| + |e2|); hit/miss may flip for rays within rounding of an edge" },
-    Bound { name: "eval_scattering / pdf_brdf / sample_brdf", func: function::BRDF, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "cos_sin_turns and sqrt in sampling (FMA contraction): 8 eps absolute on unit vectors and pdfs <= 1/pi" },
-    Bound { name: "fresnel (conductor, dielectric, schlick)", func: function::FRESNEL, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "reflectances <= 1 with cancelling terms (FMA contraction): 8 ULP, or 8 eps absolute" },
-    Bound { name: "microfacet (visible normal, D, G1, pdf)", func: function::MICROFACET, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "square roots and normalisations (FMA contraction): 64 ULP or 64 eps; alpha < 0.01: 1% relative" },
-    Bound { name: "bsdf::eval", func: function::BSDF_EVAL, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), why: "D, G1, Fresnel and the refraction Jacobian (FMA contraction): 64 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: 1% relative" },
-    Bound { name: "bsdf::sample", func: function::BSDF_SAMPLE, max_ulps: 2048, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharply_sampled_or_index_matched, 5e-2)), why: "the visible-normal sampler, Fresnel choice and pdf (FMA contraction); weights of grazing directions carry G1 ~ n . wi, whose rounding moves them relatively (measured 648 ULP): 2048 ULP or 64 eps; alpha < 0.045 or |eta - 1| < 1e-3: the sampler's stretch by alpha magnifies the rounding of wo by up to 1/alpha, and the density is read at the sampled wi on a lobe alpha wide (4 eps / alpha^2 relative, 3354 ULP measured at alpha 0.016 under a clear coat), down to a thousandth of a radian (measured 2.6% where a 0.9-metallic glTF material picks the sharp lobe 9 times in 10): 5% relative" },
-    Bound { name: "sample_triangle_light / solid_angle", func: function::TRIANGLE_LIGHT, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "atan2_turns, normalisations and the ray/plane step (FMA contraction): 64 eps relative to the solid angle, density and geometry size, divided by h, the receiver's elevation above the light's plane (all are 0 / 0 in it); normals 64 eps" },
-    Bound { name: "texture footprint and bilerp", func: function::TEXTURE, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, why: "the same texels and weights bit for bit: wrapping, clamping and the blend" },
-    Bound { name: "phase::sample / eval, free_flight::sample", func: function::MEDIUM, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "the phase sampler's cos/sin of the azimuth, sqrt and normalisation (FMA contraction): 8 eps on a unit vector; its density a rational function of one dot product, 8 ULP; a flight's t = -ln(1 - u) / sigma under Vulkan's log (2^-21 absolute on [0.5, 2]) and its weights, quotients of exponentials (3 + 2 |x| ULP) whose exponents carry t's error, denormals flushed: derived per record in `allowed_abs`" },
-    Bound { name: "surface::mapped_normal", func: function::MAPPED_NORMAL, max_ulps: 8, abs: 16.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "a blend, one Gram-Schmidt step, a cross product and two normalisations of unit-scale vectors (FMA contraction, sqrt): 16 eps on a unit vector" },
-    Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
+    Bound { name: "rng (pcg4d, u32 -> float, scrambled Sobol)", func: function::RNG, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "integer arithmetic: bit-exact" },
+    Bound { name: "offset_ray_origin / shadow_ray_end", func: function::OFFSET_RAY_ORIGIN, max_ulps: 1, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "integer ULP steps are exact; p + s n may be fused into one FMA on the GPU: 1 ULP" },
+    Bound { name: "orthonormal_basis", func: function::ORTHONORMAL_BASIS, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "a few multiply-adds (FMA contraction): 4 ULP, or 4 eps absolute near zero" },
+    Bound { name: "sample_lobe", func: function::SAMPLE_LOBE, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "sin/cos differ by 1 ULP (GLSL.std.450 vs libm) plus the frame: 8 eps absolute on unit vectors" },
+    Bound { name: "sample_sphere", func: function::SAMPLE_SPHERE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "cos_sin_turns' polynomials under FMA contraction: normals 4 eps, positions 4 eps x (|centre| + radius)" },
+    Bound { name: "sample_sphere_cone", func: function::SAMPLE_SPHERE_CONE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "cos_sin_turns and dot products under FMA contraction: pdf 4 ULP, normals 4 eps, positions 4 eps x (|centre| + radius)" },
+    Bound { name: "geometry_factor", func: function::GEOMETRY_FACTOR, max_ulps: 8, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "dot products (FMA contraction): 8 ULP" },
+    Bound { name: "intersect_sphere (+ re-projection)", func: function::INTERSECT_SPHERE, max_ulps: 64, abs: 0.0, flip_fraction: 1e-3, ill_conditioned: None, vulkan: false, why: "sqrt and FMA contraction; hit/miss may flip for rays within rounding of tangent or of the origin's surface" },
+    Bound { name: "intersect_triangle (t, u, v, point, error bound)", func: function::INTERSECT_TRIANGLE, max_ulps: 64, abs: 4.0 * f32::EPSILON, flip_fraction: 1e-3, ill_conditioned: None, vulkan: false, why: "cross/dot products under FMA contraction: 64 ULP, u and v 4 eps, points 4 eps x (|p0| + |e1| + |e2|); hit/miss may flip for rays within rounding of an edge" },
+    Bound { name: "eval_scattering / pdf_brdf / sample_brdf", func: function::BRDF, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "cos_sin_turns and sqrt in sampling (FMA contraction): 8 eps absolute on unit vectors and pdfs <= 1/pi" },
+    Bound { name: "fresnel (conductor, dielectric, schlick)", func: function::FRESNEL, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "reflectances <= 1 with cancelling terms (FMA contraction): 8 ULP, or 8 eps absolute" },
+    Bound { name: "microfacet (visible normal, D, G1, pdf)", func: function::MICROFACET, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), vulkan: false, why: "square roots and normalisations (FMA contraction): 64 ULP or 64 eps; alpha < 0.01: 1% relative" },
+    Bound { name: "bsdf::eval", func: function::BSDF_EVAL, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharp_or_index_matched, 1e-2)), vulkan: false, why: "D, G1, Fresnel and the refraction Jacobian (FMA contraction): 64 ULP or 64 eps; alpha < 0.01 or |eta - 1| < 1e-3: 1% relative" },
+    Bound { name: "bsdf::sample", func: function::BSDF_SAMPLE, max_ulps: 2048, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: Some((sharply_sampled_or_index_matched, 5e-2)), vulkan: false, why: "the visible-normal sampler, Fresnel choice and pdf (FMA contraction); weights of grazing directions carry G1 ~ n . wi, whose rounding moves them relatively (measured 648 ULP): 2048 ULP or 64 eps; alpha < 0.045 or |eta - 1| < 1e-3: the sampler's stretch by alpha magnifies the rounding of wo by up to 1/alpha, and the density is read at the sampled wi on a lobe alpha wide (4 eps / alpha^2 relative, 3354 ULP measured at alpha 0.016 under a clear coat), down to a thousandth of a radian (measured 2.6% where a 0.9-metallic glTF material picks the sharp lobe 9 times in 10): 5% relative" },
+    Bound { name: "sample_triangle_light / solid_angle", func: function::TRIANGLE_LIGHT, max_ulps: 64, abs: 64.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "atan2_turns, normalisations and the ray/plane step (FMA contraction): 64 eps relative to the solid angle, density and geometry size, divided by h, the receiver's elevation above the light's plane (all are 0 / 0 in it); normals 64 eps" },
+    Bound { name: "texture footprint and bilerp", func: function::TEXTURE, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "the same texels and weights bit for bit: wrapping, clamping and the blend" },
+    Bound { name: "phase::sample / eval, free_flight::sample", func: function::MEDIUM, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "the phase sampler's cos/sin of the azimuth, sqrt and normalisation (FMA contraction): 8 eps on a unit vector; its density a rational function of one dot product, 8 ULP; a flight's t = -ln(1 - u) / sigma under Vulkan's log (2^-21 absolute on [0.5, 2]) and its weights, quotients of exponentials (3 + 2 |x| ULP) whose exponents carry t's error, denormals flushed: derived per record in `allowed_abs`" },
+    Bound { name: "surface::mapped_normal", func: function::MAPPED_NORMAL, max_ulps: 8, abs: 16.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "a blend, one Gram-Schmidt step, a cross product and two normalisations of unit-scale vectors (FMA contraction, sqrt): 16 eps on a unit vector" },
+    Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
 
 /// The absolute error allowed for output component (k, j) of record `r` under bound `b`, whose
@@ -522,9 +524,16 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let denom = 1.0 + g * g - 2.0 * g * (-v(1).dot(v(0)));
             value * ((8.0 + 6.0 * g.abs() / denom) * f32::EPSILON as f64) as f32
         }
-        // The Vulkan class's geometry factor (`vulkan_class`: abs > 0), per record: 12 eps /
-        // |d|^2 + 21 eps G (the lavapipe class has abs 0 and 8 ULP).
-        function::GEOMETRY_FACTOR if b.abs > 0.0 => {
+        // The Vulkan class's camera direction, per record (`camera_direction_apart`).
+        function::CAMERA_RAY if b.vulkan => {
+            let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
+            let (w, h, px, py) = (r[0][3], r[1][3], r[2][3], r[3][2]);
+            let x = 2.0 * ((px as f64 + f(3, 0) as f64) / w as f64) - 1.0;
+            let y = 1.0 - 2.0 * ((py as f64 + f(3, 1) as f64) / h as f64);
+            twinpath_tests::vulkan_arithmetic::camera_direction_apart(v(0), v(1), v(2), x, y) as f32
+        }
+        // The Vulkan class's geometry factor, per record: 12 eps / |d|^2 + 21 eps G.
+        function::GEOMETRY_FACTOR if b.vulkan => {
             let d = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2)).as_dvec3()
                 - glam::Vec3::new(f(2, 0), f(2, 1), f(2, 2)).as_dvec3();
             twinpath_tests::vulkan_arithmetic::geometry_factor_apart(
@@ -570,19 +579,29 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
         function::ORTHONORMAL_BASIS => Some(Bound {
             max_ulps: 0,
             abs: twinpath_tests::vulkan_arithmetic::BASIS_APART_EPS * eps,
+            vulkan: true,
             why: "Vulkan class: a sum, a quotient within 2.5 ULP and products, rounded either way: 6.5 eps per component on a device, 2.5 on the CPU: 9 eps absolute",
             ..*b
         }),
         function::SAMPLE_SPHERE_CONE => Some(Bound {
             max_ulps: 40,
             abs: twinpath_tests::vulkan_arithmetic::cone_points_apart(),
+            vulkan: true,
             why: "Vulkan class: the point takes the square root of 1 - sin^2 / sin^2_max, which cancels at the cone's rim and carries 25 eps: 2 sqrt(25 eps) x size for positions and normals; the density a few quotients and roots, 18 eps relative: 40 ULP or 4 eps",
             ..*b
         }),
         function::GEOMETRY_FACTOR => Some(Bound {
             max_ulps: 0,
-            abs: eps,
+            abs: 0.0,
+            vulkan: true,
             why: "Vulkan class: cosines off by 4 u |d|, (d . d)^2 by 11 u, a quotient within 2.5 ULP: 12 eps / |d|^2 + 21 eps G apart from the CPU, per record (`allowed_abs`)",
+            ..*b
+        }),
+        function::CAMERA_RAY => Some(Bound {
+            max_ulps: 0,
+            abs: 0.0,
+            vulkan: true,
+            why: "Vulkan class: the image-plane position (a sum, a quotient within 2.5 ULP, a difference), the direction's multiply-adds and its normalisation (a root within 4.6 eps): per record, eps ([10.5 (|right| + |up|) + 4.5 S] / |v| + 11.85) (`allowed_abs`)",
             ..*b
         }),
         _ => None,

@@ -751,3 +751,56 @@ fn hits_differ_from_the_cpu_only_within_rounding_of_an_edge_or_a_tangent() {
         ));
     }
 }
+
+/// `camera_ray_direction` on a device against the CPU. x = 2 ((px + u) / W) - 1 carries the
+/// sum's and the quotient's errors twice over and the difference's: 2 (u + q) + u, 2.5 eps
+/// under IEEE and 8 under Vulkan, 10.5 apart (y alike); v = f + x r + y up then 3 u of its
+/// terms' sizes S; the normalisation v (1 / sqrt(v . v)) 1.5 u + the root's + q + u relative:
+/// 2.25 eps and 9.6 eps. Apart per component: eps ([10.5 (|r| + |up|) + 4.5 S] / |v| + 11.85)
+/// (`camera_direction_apart`). The H200 differed by 1.0e-6, over the lavapipe-class 8 eps.
+#[test]
+fn camera_directions_differ_from_the_cpu_within_the_vulkan_class_bound() {
+    use kernel::camera::image_plane_direction;
+    use twinpath_tests::vulkan_arithmetic::camera_direction_apart;
+    let mut g = Gen(SplitMix(121));
+    seed(12);
+    let (mut worst, mut beyond) = (0f64, 0usize);
+    for k in 0..cases() {
+        let forward = g.dir();
+        let right = forward.any_orthonormal_vector() * g.pow10(-1.0, 0.5);
+        let up = right.cross(forward).normalize() * g.pow10(-1.0, 0.5);
+        let size = ((1 + g.0.u64() % 4096) as f32, (1 + g.0.u64() % 4096) as f32);
+        let pixel = (
+            (g.0.u64() % size.0 as u64) as f32,
+            (g.0.u64() % size.1 as u64) as f32,
+        );
+        let offset = (g.unit(), g.unit());
+        let direction = |model| {
+            set_model(model);
+            lean(if k % 2 == 0 { 1 } else { -1 });
+            back(image_plane_direction(
+                v(forward),
+                v(right),
+                v(up),
+                size,
+                pixel,
+                (f(offset.0), f(offset.1)),
+            ))
+        };
+        let cpu = direction(Model::IEEE);
+        let gpu = direction(if k % 3 == 0 {
+            Model::VULKAN_WORST
+        } else {
+            Model::VULKAN
+        });
+        let x = 2.0 * ((pixel.0 as f64 + offset.0 as f64) / size.0 as f64) - 1.0;
+        let y = 1.0 - 2.0 * ((pixel.1 as f64 + offset.1 as f64) / size.1 as f64);
+        let bound = camera_direction_apart(forward.into(), right.into(), up.into(), x, y);
+        let apart = (cpu - gpu).abs().max_element() as f64;
+        worst = worst.max(apart / bound);
+        beyond += (apart > 8.0 * f32::EPSILON as f64) as usize;
+    }
+    set_model(Model::VULKAN);
+    println!("camera_ray_direction, a device against the CPU: worst {worst:.3} of the bound, {beyond} beyond 8 eps");
+    assert!(worst <= 1.0, "{worst}");
+}
