@@ -31,6 +31,13 @@ fn lobe_direction_v3<R: real::Real>(a: V3<R>, c: R, cos_phi: R, sin_phi: R) -> V
     let one = R::splat(1.0);
     let c = c.max(-one).min(one);
     let s = (one - c * c).max(R::splat(0.0)).sqrt();
+    lobe_direction_cs_v3(a, c, s, cos_phi, sin_phi)
+}
+
+/// The direction at cosine `c` and sine `s` from the axis `a`, azimuth (cos_phi, sin_phi) in
+/// `a`'s orthonormal frame.
+#[inline]
+fn lobe_direction_cs_v3<R: real::Real>(a: V3<R>, c: R, s: R, cos_phi: R, sin_phi: R) -> V3<R> {
     let (t, b) = orthonormal_basis_v3(a);
     t * (s * cos_phi) + b * (s * sin_phi) + a * c
 }
@@ -49,7 +56,11 @@ pub fn sample_cosine_hemisphere(n: Vec3, u1: f32, u2: f32) -> Vec3 {
 #[inline]
 pub fn sample_cosine_hemisphere_v3<R: real::Real>(n: V3<R>, u1: R, u2: R) -> V3<R> {
     let (cos_phi, sin_phi) = cos_sin_turns(u2);
-    lobe_direction_v3(n, u1.sqrt(), cos_phi, sin_phi)
+    // sin(theta) = sqrt(1 - u1), not sqrt(1 - cos^2): the latter cancels as u1 nears 1 (where
+    // cos^2 carries a few eps, the root a square root of them: u1 = 1 - 2^-24 gave sin 0, the
+    // normal itself, for 2^-12), while 1 - u1 is exact for u1 >= 1/2.
+    let one = R::splat(1.0);
+    lobe_direction_cs_v3(n, u1.sqrt(), (one - u1).sqrt(), cos_phi, sin_phi)
 }
 
 /// Solid-angle density of [`sample_cosine_hemisphere`]: max(0, n . w) / pi.

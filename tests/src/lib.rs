@@ -151,6 +151,7 @@ pub mod ggx_table;
 pub mod gltf_writer;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+pub mod placements;
 pub mod reference_bsdf;
 pub mod sheen_fit;
 pub mod spirv;

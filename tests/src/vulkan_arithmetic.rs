@@ -494,3 +494,15 @@ pub fn camera_direction_apart(
     let s = f.length() + x.abs() * r.length() + y.abs() * u.length();
     f32::EPSILON as f64 * ((10.5 * (r.length() + u.length()) + 4.5 * s) / v.length() + 11.85)
 }
+
+/// How far apart the CPU's and a conformant device's cosine-sampled direction (per component)
+/// and its density may be, for uniform number `u1` (c = sqrt(u1), s = sqrt(1 - u1); derived in
+/// `tests/tests/vulkan_precision.rs`): eps (33 s + 11.1 c) and 21 eps.
+pub fn cosine_sample_apart(u1: f32) -> (f64, f64) {
+    let u1 = u1 as f64;
+    let eps = f32::EPSILON as f64;
+    (
+        eps * (33.0 * (1.0 - u1).sqrt() + 11.1 * u1.sqrt()),
+        21.0 * eps,
+    )
+}

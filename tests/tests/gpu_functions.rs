@@ -532,6 +532,13 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let y = 1.0 - 2.0 * ((py as f64 + f(3, 1) as f64) / h as f64);
             twinpath_tests::vulkan_arithmetic::camera_direction_apart(v(0), v(1), v(2), x, y) as f32
         }
+        // The Vulkan class's cosine sample (out1.xyz) and its density (out1.w), per record
+        // (`cosine_sample_apart` of u1 = in3.x); eval_scattering and pdf_brdf keep 8 eps.
+        function::BRDF if b.vulkan && k == 1 => {
+            let (direction, density) =
+                twinpath_tests::vulkan_arithmetic::cosine_sample_apart(f(3, 0));
+            (if j < 3 { direction } else { density }) as f32
+        }
         // The Vulkan class's geometry factor, per record: 12 eps / |d|^2 + 21 eps G.
         function::GEOMETRY_FACTOR if b.vulkan => {
             let d = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2)).as_dvec3()
@@ -595,6 +602,11 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
             abs: 0.0,
             vulkan: true,
             why: "Vulkan class: cosines off by 4 u |d|, (d . d)^2 by 11 u, a quotient within 2.5 ULP: 12 eps / |d|^2 + 21 eps G apart from the CPU, per record (`allowed_abs`)",
+            ..*b
+        }),
+        function::BRDF => Some(Bound {
+            vulkan: true,
+            why: "Vulkan class: eval_scattering and pdf_brdf a dot product, a product and the albedo: 8 eps; the cosine sample from the frame (9 eps), sqrt(u1), sqrt(1 - u1), the azimuth's polynomials and four roundings: eps (33 s + 11.1 c) per component, its density 21 eps (`allowed_abs`)",
             ..*b
         }),
         function::CAMERA_RAY => Some(Bound {

@@ -16,34 +16,7 @@ use kernel::geometry::{
 };
 use kernel::sampling::{sample_cosine_hemisphere, sample_sphere_cone};
 
-/// Edge-favouring inputs on top of the shared splitmix64 generator.
-struct Gen(twinpath_tests::SplitMix);
-impl Gen {
-    fn unit(&mut self) -> f32 {
-        self.0.unit()
-    }
-    fn pow10(&mut self, lo: f32, hi: f32) -> f32 {
-        10f32.powf(lo + (hi - lo) * self.unit())
-    }
-    fn dir(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(
-                2.0 * self.unit() - 1.0,
-                2.0 * self.unit() - 1.0,
-                2.0 * self.unit() - 1.0,
-            );
-            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
-                return v.normalize();
-            }
-        }
-    }
-    /// A random placement: scale 10^U(-4, 5), translated by up to 10^3 times that.
-    fn placement(&mut self) -> (f32, Vec3) {
-        let s = self.pow10(-4.0, 5.0);
-        let t = self.dir() * s * self.pow10(-4.0, 5.0).min(1e3);
-        (s, t)
-    }
-}
+use twinpath_tests::placements::Placements as Gen;
 
 /// Cases per test: 10^6 by default; `REINTERSECT_CASES=10000000` for the long run.
 fn cases() -> usize {
@@ -79,31 +52,11 @@ fn rays_leaving_triangles_and_quads_never_hit_them_again() {
     let mut g = Gen(twinpath_tests::SplitMix(1));
     let (mut tested, mut cont_fail, mut shadow_fail) = (0, 0, 0);
     for case in 0..cases() {
-        let (s, t) = g.placement();
-        let p0 = t + g.dir() * s;
-        let (e1, e2) = (
-            g.dir() * s * g.pow10(-1.0, 0.0),
-            g.dir() * s * g.pow10(-1.0, 0.0),
-        );
-        if !e1.cross(e2).normalize().is_finite() {
-            continue;
-        }
         // A quad is two triangles sharing the diagonal, as the scene loader makes it.
-        let quad = case % 2 == 0;
-        let (a, b) = (g.unit(), g.unit());
-        let (a, b) = if !quad && a + b > 1.0 {
-            (1.0 - a, 1.0 - b)
-        } else {
-            (a, b)
+        let Some(c) = g.triangle_case(case % 2 == 0) else {
+            continue;
         };
-        let target = p0 + e1 * a + e2 * b;
-        let origin = target + g.dir() * s * g.pow10(-1.0, 2.0);
-        let dir = (target - origin).normalize();
-        let tris = if quad {
-            vec![(p0, e1, e1 + e2), (p0, e1 + e2, e2)]
-        } else {
-            vec![(p0, e1, e2)]
-        };
+        let (s, origin, dir, tris) = (c.size, c.origin, c.dir, c.triangles);
         let hit = |o: Vec3, d: Vec3, t_max: f32| {
             tris.iter()
                 .any(|&(q, f1, f2)| intersect_triangle(o, d, q, f1, f2, 0.0, t_max) >= 0.0)

@@ -131,6 +131,11 @@ fn sample_brdf_is_never_tangent_for_any_number_the_root_gives() {
                 "u1 = 2^-24, n {n}: cos {cos}"
             );
             assert!(pdf_brdf(n, w) > 7e-5);
+            // The largest number is not the normal itself: sin(theta) = sqrt(2^-24) = 2^-12
+            // (from sqrt(1 - u1); sqrt(1 - cos^2) cancelled to 0 there).
+            let top = sample_brdf(n, u32_to_unit_f32(u32::MAX), u2);
+            let sin = (top - n * n.dot(top)).length();
+            assert!((sin - 2f32.powi(-12)).abs() < 1e-6, "n {n}: sin {sin}");
             for word in [0, 1 << 9, 2 << 9, 1 << 30, u32::MAX] {
                 let u1 = u32_to_unit_f32(word);
                 let cos = n.dot(sample_brdf(n, u1, u2));

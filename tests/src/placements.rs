@@ -1,0 +1,80 @@
+//! Random geometry for the robustness tests (`reintersection.rs` under IEEE arithmetic,
+//! `vulkan_precision.rs` under a model of Vulkan's): placements at every scale and the ray
+//! toward a random point of a random triangle or quad, drawn the same way by both.
+
+use crate::SplitMix;
+use glam::Vec3;
+
+/// Edge-favouring inputs on top of [`SplitMix`].
+pub struct Placements(pub SplitMix);
+
+impl Placements {
+    pub fn unit(&mut self) -> f32 {
+        self.0.unit()
+    }
+    /// 10^U(lo, hi).
+    pub fn pow10(&mut self, lo: f32, hi: f32) -> f32 {
+        10f32.powf(lo + (hi - lo) * self.unit())
+    }
+    /// A unit direction, uniform on the sphere.
+    pub fn dir(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(
+                2.0 * self.unit() - 1.0,
+                2.0 * self.unit() - 1.0,
+                2.0 * self.unit() - 1.0,
+            );
+            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+    /// A random placement: scale 10^U(-4, 5), translated by up to 10^3 times that.
+    pub fn placement(&mut self) -> (f32, Vec3) {
+        let s = self.pow10(-4.0, 5.0);
+        let t = self.dir() * s * self.pow10(-4.0, 5.0).min(1e3);
+        (s, t)
+    }
+
+    /// A triangle (or, for a quad, the loader's two triangles sharing the diagonal) placed at
+    /// random, and a ray from 0.1 to 100 sizes away toward a random point of it: (size, origin,
+    /// unit direction, the triangles as (p0, edge1, edge2)). None for a degenerate shape.
+    pub fn triangle_case(&mut self, quad: bool) -> Option<TriangleCase> {
+        let (s, t) = self.placement();
+        let p0 = t + self.dir() * s;
+        let (e1, e2) = (
+            self.dir() * s * self.pow10(-1.0, 0.0),
+            self.dir() * s * self.pow10(-1.0, 0.0),
+        );
+        if !e1.cross(e2).normalize().is_finite() {
+            return None;
+        }
+        let (a, b) = (self.unit(), self.unit());
+        let (a, b) = if !quad && a + b > 1.0 {
+            (1.0 - a, 1.0 - b)
+        } else {
+            (a, b)
+        };
+        let target = p0 + e1 * a + e2 * b;
+        let origin = target + self.dir() * s * self.pow10(-1.0, 2.0);
+        let triangles = if quad {
+            vec![(p0, e1, e1 + e2), (p0, e1 + e2, e2)]
+        } else {
+            vec![(p0, e1, e2)]
+        };
+        Some(TriangleCase {
+            size: s,
+            origin,
+            dir: (target - origin).normalize(),
+            triangles,
+        })
+    }
+}
+
+/// A ray toward a random point of a triangle or a quad ([`Placements::triangle_case`]).
+pub struct TriangleCase {
+    pub size: f32,
+    pub origin: Vec3,
+    pub dir: Vec3,
+    pub triangles: Vec<(Vec3, Vec3, Vec3)>,
+}
