@@ -25,3 +25,19 @@ pub fn assert_validation_clean() {
         "validation layers reported errors/warnings (printed above)"
     );
 }
+
+/// Whether the test device computes with IEEE-754 arithmetic as the CPU does (lavapipe: LLVM's
+/// code for the host CPU), so that the two backends give the same numbers. Any other device is
+/// of the Vulkan class: its arithmetic is only what the specification allows, and equivalence
+/// is stated within the bounds derived for it (`docs/robustness.md`, "Under Vulkan's
+/// arithmetic") and in distribution.
+pub fn device_is_ieee() -> bool {
+    context()
+        .lock()
+        .unwrap()
+        .device_name
+        .starts_with(IEEE_DEVICE)
+}
+
+/// The name the IEEE-class device's name starts with (lavapipe).
+pub const IEEE_DEVICE: &str = "llvmpipe";

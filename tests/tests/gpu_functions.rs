@@ -626,7 +626,9 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
     let runner = ProbeRunner::new(&ctx).unwrap();
     // Device classes: lavapipe computes with LLVM's IEEE arithmetic, as the CPU does; any other
     // device is held to the bounds derived for Vulkan's arithmetic where they exist.
-    let ieee_device = ctx.device_name.starts_with("llvmpipe");
+    let ieee_device = ctx
+        .device_name
+        .starts_with(twinpath_tests::gpu::IEEE_DEVICE);
     println!(
         "device {}: {} class",
         ctx.device_name,

@@ -48,11 +48,18 @@ fn assert_scene_backends_agree(scene: &SceneFile, path: &str, spp: u32, toleranc
     for (x, y, c, g) in differing.iter().take(10) {
         println!("  pixel ({x}, {y}): cpu {c:?} gpu {g:?}");
     }
-    assert!(
-        fraction_equal >= 0.999,
-        "only {:.4}% equal",
-        100.0 * fraction_equal
-    );
+    // The same numbers only on a device of the CPU's arithmetic: elsewhere a ray within the
+    // rounding of an edge may hit on one backend and miss on the other and its path diverge,
+    // so there the images agree in distribution (below), not pixel for pixel.
+    if twinpath_tests::gpu::device_is_ieee() {
+        assert!(
+            fraction_equal >= 0.999,
+            "only {:.4}% equal",
+            100.0 * fraction_equal
+        );
+    } else {
+        println!("{path}: a Vulkan-class device: pixel equality reported, not asserted");
+    }
 
     // Independent seeds: the two backends' image means agree within their noise (independent
     // samples, so each image's noise is known from its own samples).

@@ -350,6 +350,7 @@ impl Context {
         .context("cannot create the memory allocator")?;
         let accel = khr::acceleration_structure::Device::new(&instance, &device);
         let rt = khr::ray_tracing_pipeline::Device::new(&instance, &device);
+        LIVE_CONTEXTS.fetch_add(1, Ordering::SeqCst);
         Ok(Context {
             entry,
             instance,
@@ -397,7 +398,7 @@ impl Context {
                 let r = self
                     .device
                     .queue_submit(self.queue, &submit, fence)
-                    .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX));
+                    .and_then(|_| self.wait_reporting(fence));
                 self.device.destroy_fence(fence, None);
                 r.context("queue submission failed (device lost?)")?;
             }
@@ -410,8 +411,36 @@ impl Context {
     }
 }
 
+impl Context {
+    /// Waits for `fence` without a time limit, saying on stderr every minute that the work has
+    /// not finished, with how many contexts this process holds: a hang reported on an NVIDIA
+    /// H200 (two GPU tests in two threads of one process, each with its own context; docs/gpu.md)
+    /// left no trace, and this is the trace the next run on such a device needs.
+    fn wait_reporting(&self, fence: vk::Fence) -> ash::prelude::VkResult<()> {
+        const STEP_NS: u64 = 60_000_000_000;
+        let mut waited = 0u64;
+        loop {
+            match unsafe { self.device.wait_for_fences(&[fence], true, STEP_NS) } {
+                Err(vk::Result::TIMEOUT) => {
+                    waited += 60;
+                    eprintln!(
+                        "twinpath: GPU work on {} not finished after {waited} s ({} Vulkan contexts open in this process)",
+                        self.device_name,
+                        LIVE_CONTEXTS.load(Ordering::SeqCst)
+                    );
+                }
+                other => return other,
+            }
+        }
+    }
+}
+
+/// How many [`Context`]s this process holds (for the report of [`Context::wait_reporting`]).
+static LIVE_CONTEXTS: AtomicUsize = AtomicUsize::new(0);
+
 impl Drop for Context {
     fn drop(&mut self) {
+        LIVE_CONTEXTS.fetch_sub(1, Ordering::SeqCst);
         unsafe {
             let _ = self.device.device_wait_idle();
             ManuallyDrop::drop(&mut self.allocator);
