@@ -530,23 +530,20 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let (w, h, px, py) = (r[0][3], r[1][3], r[2][3], r[3][2]);
             let x = 2.0 * ((px as f64 + f(3, 0) as f64) / w as f64) - 1.0;
             let y = 1.0 - 2.0 * ((py as f64 + f(3, 1) as f64) / h as f64);
-            twinpath_tests::vulkan_arithmetic::camera_direction_apart(v(0), v(1), v(2), x, y) as f32
+            twinpath_tests::device_class::camera_direction_apart(v(0), v(1), v(2), x, y) as f32
         }
         // The Vulkan class's cosine sample (out1.xyz) and its density (out1.w), per record
         // (`cosine_sample_apart` of u1 = in3.x); eval_scattering and pdf_brdf keep 8 eps.
         function::BRDF if b.vulkan && k == 1 => {
-            let (direction, density) =
-                twinpath_tests::vulkan_arithmetic::cosine_sample_apart(f(3, 0));
+            let (direction, density) = twinpath_tests::device_class::cosine_sample_apart(f(3, 0));
             (if j < 3 { direction } else { density }) as f32
         }
         // The Vulkan class's geometry factor, per record: 12 eps / |d|^2 + 21 eps G.
         function::GEOMETRY_FACTOR if b.vulkan => {
             let d = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2)).as_dvec3()
                 - glam::Vec3::new(f(2, 0), f(2, 1), f(2, 2)).as_dvec3();
-            twinpath_tests::vulkan_arithmetic::geometry_factor_apart(
-                d.length_squared(),
-                value as f64,
-            ) as f32
+            twinpath_tests::device_class::geometry_factor_apart(d.length_squared(), value as f64)
+                as f32
         }
         // The cone's density (out0.w) is never held to more than 4 eps absolute, whatever the
         // positions' bound (the Vulkan class's is a square root of eps: `vulkan_class`).
@@ -563,7 +560,7 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
 /// computations of a triangle's edge or a sphere's tangent or a t limit (the probe's layout:
 /// `kernel::probe`).
 fn hit_may_flip(func: u32, r: &[[u32; 4]; 4]) -> bool {
-    use twinpath_tests::vulkan_arithmetic::{sphere_hit_may_flip, triangle_hit_may_flip};
+    use twinpath_tests::device_class::{sphere_hit_may_flip, triangle_hit_may_flip};
     let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
     let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
     if func == function::INTERSECT_SPHERE {
@@ -585,14 +582,14 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
     match b.func {
         function::ORTHONORMAL_BASIS => Some(Bound {
             max_ulps: 0,
-            abs: twinpath_tests::vulkan_arithmetic::BASIS_APART_EPS * eps,
+            abs: twinpath_tests::device_class::BASIS_APART_EPS * eps,
             vulkan: true,
             why: "Vulkan class: a sum, a quotient within 2.5 ULP and products, rounded either way: 6.5 eps per component on a device, 2.5 on the CPU: 9 eps absolute",
             ..*b
         }),
         function::SAMPLE_SPHERE_CONE => Some(Bound {
             max_ulps: 40,
-            abs: twinpath_tests::vulkan_arithmetic::cone_points_apart(),
+            abs: twinpath_tests::device_class::cone_points_apart(),
             vulkan: true,
             why: "Vulkan class: the point takes the square root of 1 - sin^2 / sin^2_max, which cancels at the cone's rim and carries 25 eps: 2 sqrt(25 eps) x size for positions and normals; the density a few quotients and roots, 18 eps relative: 40 ULP or 4 eps",
             ..*b
@@ -662,7 +659,7 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
                 if (tc >= 0.0) != (tg >= 0.0) {
                     flips += 1;
                     // A device that is not IEEE may flip only rays within the rounding of an
-                    // edge, a tangent or a limit (derived in `vulkan_arithmetic`).
+                    // edge, a tangent or a limit (derived in `device_class`).
                     if !ieee_device && !hit_may_flip(b.func, r) {
                         bad += 1;
                         bad_records.insert(*r);

@@ -20,10 +20,11 @@ use kernel::geometry::{
 use kernel::intersect;
 use kernel::real::{Real, V3};
 use kernel::sampling::{sample_cosine_hemisphere_v3, sample_sphere_cone_v3};
-use twinpath_tests::vulkan_arithmetic::{
-    cone_points_apart, geometry_factor_apart, lean, seed, set_model, sphere_hit_may_flip,
-    triangle_hit_may_flip, ulp, Model, Vk32, BASIS_APART_EPS,
+use twinpath_tests::device_class::{
+    cone_points_apart, geometry_factor_apart, sphere_hit_may_flip, triangle_hit_may_flip,
+    BASIS_APART_EPS,
 };
+use twinpath_tests::vulkan_arithmetic::{lean, seed, set_model, ulp, Model, Vk32};
 use twinpath_tests::SplitMix;
 
 type V = V3<Vk32>;
@@ -716,7 +717,7 @@ fn hits_differ_from_the_cpu_only_within_rounding_of_an_edge_or_a_tangent() {
 #[test]
 fn camera_directions_differ_from_the_cpu_within_the_vulkan_class_bound() {
     use kernel::camera::image_plane_direction;
-    use twinpath_tests::vulkan_arithmetic::camera_direction_apart;
+    use twinpath_tests::device_class::camera_direction_apart;
     let mut g = Gen(SplitMix(121));
     seed(12);
     let (mut worst, mut beyond) = (0f64, 0usize);
@@ -770,7 +771,7 @@ fn camera_directions_differ_from_the_cpu_within_the_vulkan_class_bound() {
 /// The H200 differed by 2.9e-6 (24 eps) against the lavapipe-class 8 eps.
 #[test]
 fn cosine_samples_differ_from_the_cpu_within_the_vulkan_class_bound() {
-    use twinpath_tests::vulkan_arithmetic::cosine_sample_apart;
+    use twinpath_tests::device_class::cosine_sample_apart;
     let mut g = Gen(SplitMix(131));
     seed(13);
     let (mut worst, mut worst_pdf, mut beyond, mut worst_eps) = (0f64, 0f64, 0usize, 0f64);

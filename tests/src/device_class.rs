@@ -1,0 +1,150 @@
+//! How far a conformant Vulkan device's results may be from the CPU's, function by function:
+//! the bounds of the device classes of `gpu_functions.rs` (lavapipe, IEEE like the CPU, is held
+//! to tighter ones there). Each is derived for a pair of computations, one IEEE (unit roundoff
+//! eps / 2, quotients and roots correctly rounded) and one under Vulkan's precision rules
+//! (eps, quotients within 2.5 ULP, roots as 1 / inversesqrt), in the comment of the test that
+//! checks it against the model of such a device (`tests/tests/vulkan_precision.rs`, on
+//! [`crate::vulkan_arithmetic::Vk32`]), and collected in `docs/robustness.md`.
+
+/// How far apart the CPU's and a conformant Vulkan device's `orthonormal_basis` may be, per
+/// component, in eps (derived in `tests/tests/vulkan_precision.rs`; used by `gpu_functions.rs`
+/// for devices that are not IEEE).
+pub const BASIS_APART_EPS: f32 = 9.0;
+
+/// How far apart the CPU's and a conformant device's cone-sampled points (and normals) may be,
+/// relative to the size of the geometry: twice the square root of the 25 eps the cancelling
+/// ratio carries (derived in `tests/tests/vulkan_precision.rs`).
+pub fn cone_points_apart() -> f32 {
+    2.0 * (25.0 * f32::EPSILON).sqrt()
+}
+
+/// How far apart the CPU's and a conformant device's `geometry_factor` G = |(n_a . d)(n_b . d)|
+/// / (d . d)^2 may be, for points |d|^2 = `d2` apart (derived in
+/// `tests/tests/vulkan_precision.rs`): 12 eps / |d|^2 + 21 eps G.
+pub fn geometry_factor_apart(d2: f64, g: f64) -> f64 {
+    f32::EPSILON as f64 * (12.0 / d2 + 21.0 * g)
+}
+
+/// The roundoff of one IEEE and one Vulkan computation added: u (eps / 2 and eps) and a
+/// quotient's relative error (eps / 2 and 2.5 eps). A quantity computed by both is apart by at
+/// most its error bound with these.
+const APART_U: f64 = 1.5 * f32::EPSILON as f64;
+const APART_Q: f64 = 3.0 * f32::EPSILON as f64;
+
+fn d3(v: [f32; 3]) -> glam::DVec3 {
+    glam::Vec3::from_array(v).as_dvec3()
+}
+
+/// Whether `kernel::intersect::triangle` (Moller-Trumbore) of this ray may say hit on one device
+/// and miss on another: a barycentric, their sum, or t within rounding of its limit, or the
+/// determinant within rounding of 0. Exact values in `f64` from the `f32` inputs; error bounds
+/// of each computation (u its unit roundoff, q its quotient's error): the cross products within
+/// 3 u |a||b| (and tvec's own rounding u), so U = tvec . pvec within 7 u |tvec||d||e2|, V = d .
+/// qvec within 7 u |d||tvec||e1|, T = e2 . qvec within 7 u |e2||tvec||e1|, det within 6 u
+/// |e1||d||e2|; a barycentric X / det within (dX + |X / det| d(det)) / |det| + (q + u) |X / det|.
+pub fn triangle_hit_may_flip(
+    origin: [f32; 3],
+    dir: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
+    t_min: f32,
+    t_max: f32,
+) -> bool {
+    let (o, d, p0, e1, e2) = (d3(origin), d3(dir), d3(p0), d3(e1), d3(e2));
+    let (u, q) = (APART_U, APART_Q);
+    let pvec = d.cross(e2);
+    let det = e1.dot(pvec);
+    let tvec = o - p0;
+    let qvec = tvec.cross(e1);
+    let (nd, ne1, ne2, nt) = (d.length(), e1.length(), e2.length(), tvec.length());
+    let d_det = 6.0 * u * ne1 * nd * ne2;
+    if det.abs() <= d_det {
+        return true;
+    }
+    let quotient = |x: f64, dx: f64| {
+        let value = x / det;
+        (
+            value,
+            (dx + value.abs() * d_det) / det.abs() + (q + u) * value.abs(),
+        )
+    };
+    let (bu, du) = quotient(tvec.dot(pvec), 7.0 * u * nt * nd * ne2);
+    let (bv, dv) = quotient(d.dot(qvec), 7.0 * u * nd * nt * ne1);
+    let (t, dt) = quotient(e2.dot(qvec), 7.0 * u * ne2 * nt * ne1);
+    let dsum = du + dv + u * (bu + bv).abs();
+    bu.abs() <= du
+        || (1.0 - bu).abs() <= du
+        || bv.abs() <= dv
+        || (1.0 - bu - bv).abs() <= dsum
+        || (t - t_min as f64).abs() <= dt
+        || (t_max as f64 - t).abs() <= dt
+}
+
+/// Whether `kernel::intersect::sphere` of this ray may say hit on one device and miss on
+/// another: the ray within rounding of tangent, or a root within rounding of t_min or t_max.
+/// Exact values in `f64`; error bounds of each computation: f = o - c within u |f|, the
+/// perpendicular f - d (f . d) / (d . d) within 6 u |f| (a dot product, a quotient, a product
+/// and a difference), so the margin r^2 - |perp|^2 within 2 r 6 u |f| + 4 u r^2 near tangency;
+/// a root, at half = sqrt(margin / a) from the closest point, within 16 (u + q) (|f| + r) / |d|
+/// (the stable quadratic: a square root and two quotients) plus the margin's error times
+/// d(half)/d(margin) = 1 / (2 a half), which grows without bound toward tangency.
+pub fn sphere_hit_may_flip(
+    origin: [f32; 3],
+    dir: [f32; 3],
+    center: [f32; 3],
+    radius: f32,
+    t_min: f32,
+    t_max: f32,
+) -> bool {
+    let (o, d, c, r) = (d3(origin), d3(dir), d3(center), radius as f64);
+    let (u, q) = (APART_U, APART_Q);
+    let f = o - c;
+    let a = d.dot(d);
+    let perp = f - d * (f.dot(d) / a);
+    let margin = r * r - perp.length_squared();
+    let d_margin = 12.0 * u * r * f.length() + 4.0 * u * r * r;
+    if margin.abs() <= d_margin {
+        return true;
+    }
+    if margin < 0.0 {
+        return false;
+    }
+    // The roots along -/+ half, half = sqrt(margin / a): the margin's error moves half by
+    // d_margin / (2 a half) (near tangency this dominates), the rest by 16 (u + q) of the sizes.
+    let along = -f.dot(d) / a;
+    let half = (margin / a).sqrt();
+    let dt = 16.0 * (u + q) * (f.length() + r) / a.sqrt() + d_margin / (2.0 * a * half);
+    [along - half, along + half]
+        .iter()
+        .any(|&t| (t - t_min as f64).abs() <= dt || (t_max as f64 - t).abs() <= dt)
+}
+
+/// How far apart the CPU's and a conformant device's `camera_ray_direction` may be, per
+/// component, for camera axes `forward`, `right`, `up` and image-plane position (x, y) in
+/// [-1, 1] (derived in `tests/tests/vulkan_precision.rs`): eps ([10.5 (|right| + |up|) +
+/// 4.5 S] / |v| + 11.85), S = |forward| + |x||right| + |y||up|, v the unnormalised direction.
+pub fn camera_direction_apart(
+    forward: [f32; 3],
+    right: [f32; 3],
+    up: [f32; 3],
+    x: f64,
+    y: f64,
+) -> f64 {
+    let (f, r, u) = (d3(forward), d3(right), d3(up));
+    let v = f + r * x + u * y;
+    let s = f.length() + x.abs() * r.length() + y.abs() * u.length();
+    f32::EPSILON as f64 * ((10.5 * (r.length() + u.length()) + 4.5 * s) / v.length() + 11.85)
+}
+
+/// How far apart the CPU's and a conformant device's cosine-sampled direction (per component)
+/// and its density may be, for uniform number `u1` (c = sqrt(u1), s = sqrt(1 - u1); derived in
+/// `tests/tests/vulkan_precision.rs`): eps (33 s + 11.1 c) and 21 eps.
+pub fn cosine_sample_apart(u1: f32) -> (f64, f64) {
+    let u1 = u1 as f64;
+    let eps = f32::EPSILON as f64;
+    (
+        eps * (33.0 * (1.0 - u1).sqrt() + 11.1 * u1.sqrt()),
+        21.0 * eps,
+    )
+}
