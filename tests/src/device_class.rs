@@ -121,16 +121,20 @@ pub fn sphere_hit_may_flip(
 }
 
 /// How far apart the CPU's and a conformant device's `camera_ray_direction` may be, per
-/// component, for camera axes `forward`, `right`, `up` and image-plane position (x, y) in
-/// [-1, 1] (derived in `tests/tests/vulkan_precision.rs`): eps ([10.5 (|right| + |up|) +
-/// 4.5 S] / |v| + 11.85), S = |forward| + |x||right| + |y||up|, v the unnormalised direction.
+/// component, for camera axes `forward`, `right`, `up` and the position `offset` inside pixel
+/// `pixel` of an image of `size` pixels (derived in `tests/tests/vulkan_precision.rs`): eps
+/// ([10.5 (|right| + |up|) + 4.5 S] / |v| + 11.85), S = |forward| + |x||right| + |y||up|, with
+/// (x, y) the image-plane position in [-1, 1] and v the unnormalised direction.
 pub fn camera_direction_apart(
     forward: [f32; 3],
     right: [f32; 3],
     up: [f32; 3],
-    x: f64,
-    y: f64,
+    size: (f32, f32),
+    pixel: (f32, f32),
+    offset: (f32, f32),
 ) -> f64 {
+    let x = 2.0 * ((pixel.0 as f64 + offset.0 as f64) / size.0 as f64) - 1.0;
+    let y = 1.0 - 2.0 * ((pixel.1 as f64 + offset.1 as f64) / size.1 as f64);
     let (f, r, u) = (d3(forward), d3(right), d3(up));
     let v = f + r * x + u * y;
     let s = f.length() + x.abs() * r.length() + y.abs() * u.length();

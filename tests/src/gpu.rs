@@ -26,18 +26,17 @@ pub fn assert_validation_clean() {
     );
 }
 
-/// Whether the test device computes with IEEE-754 arithmetic as the CPU does (lavapipe: LLVM's
+/// Whether the test device computes with IEEE-754 arithmetic as the CPU does
+/// ([`is_ieee_device`] of the test binary's context).
+pub fn device_is_ieee() -> bool {
+    is_ieee_device(&context().lock().unwrap())
+}
+
+/// Whether `ctx`'s device computes with IEEE-754 arithmetic as the CPU does (lavapipe: LLVM's
 /// code for the host CPU), so that the two backends give the same numbers. Any other device is
 /// of the Vulkan class: its arithmetic is only what the specification allows, and equivalence
 /// is stated within the bounds derived for it (`docs/robustness.md`, "Under Vulkan's
 /// arithmetic") and in distribution.
-pub fn device_is_ieee() -> bool {
-    context()
-        .lock()
-        .unwrap()
-        .device_name
-        .starts_with(IEEE_DEVICE)
+pub fn is_ieee_device(ctx: &Context) -> bool {
+    ctx.device_name.starts_with("llvmpipe")
 }
-
-/// The name the IEEE-class device's name starts with (lavapipe).
-pub const IEEE_DEVICE: &str = "llvmpipe";

@@ -527,10 +527,17 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
         // The Vulkan class's camera direction, per record (`camera_direction_apart`).
         function::CAMERA_RAY if b.vulkan => {
             let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
-            let (w, h, px, py) = (r[0][3], r[1][3], r[2][3], r[3][2]);
-            let x = 2.0 * ((px as f64 + f(3, 0) as f64) / w as f64) - 1.0;
-            let y = 1.0 - 2.0 * ((py as f64 + f(3, 1) as f64) / h as f64);
-            twinpath_tests::device_class::camera_direction_apart(v(0), v(1), v(2), x, y) as f32
+            let size = (r[0][3] as f32, r[1][3] as f32);
+            let pixel = (r[2][3] as f32, r[3][2] as f32);
+            let offset = (f(3, 0), f(3, 1));
+            twinpath_tests::device_class::camera_direction_apart(
+                v(0),
+                v(1),
+                v(2),
+                size,
+                pixel,
+                offset,
+            ) as f32
         }
         // The Vulkan class's cosine sample (out1.xyz) and its density (out1.w), per record
         // (`cosine_sample_apart` of u1 = in3.x); eval_scattering and pdf_brdf keep 8 eps.
@@ -623,9 +630,7 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
     let runner = ProbeRunner::new(&ctx).unwrap();
     // Device classes: lavapipe computes with LLVM's IEEE arithmetic, as the CPU does; any other
     // device is held to the bounds derived for Vulkan's arithmetic where they exist.
-    let ieee_device = ctx
-        .device_name
-        .starts_with(twinpath_tests::gpu::IEEE_DEVICE);
+    let ieee_device = twinpath_tests::gpu::is_ieee_device(&ctx);
     println!(
         "device {}: {} class",
         ctx.device_name,

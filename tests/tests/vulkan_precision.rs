@@ -749,9 +749,8 @@ fn camera_directions_differ_from_the_cpu_within_the_vulkan_class_bound() {
         } else {
             Model::VULKAN
         });
-        let x = 2.0 * ((pixel.0 as f64 + offset.0 as f64) / size.0 as f64) - 1.0;
-        let y = 1.0 - 2.0 * ((pixel.1 as f64 + offset.1 as f64) / size.1 as f64);
-        let bound = camera_direction_apart(forward.into(), right.into(), up.into(), x, y);
+        let (forward, right, up) = (forward.into(), right.into(), up.into());
+        let bound = camera_direction_apart(forward, right, up, size, pixel, offset);
         let apart = (cpu - gpu).abs().max_element() as f64;
         worst = worst.max(apart / bound);
         beyond += (apart > 8.0 * f32::EPSILON as f64) as usize;
