@@ -122,17 +122,19 @@ fn modules_with_float_controls_requested_set_them_on_every_entry_point_and_pass_
             .collect();
         assert_eq!(request(&words, Requested::default()).unwrap(), words);
         let patched = request(&words, Requested::ALL).unwrap();
-        // (opcode, operands) of every instruction.
+        // (word offset, (opcode, operands)) of every instruction.
         let instructions = |w: &[u32]| {
             let (mut at, mut out) = (5, Vec::new());
             while at < w.len() {
                 let count = (w[at] >> 16) as usize;
-                out.push((w[at] & 0xffff, w[at + 1..at + count].to_vec()));
+                out.push((at, (w[at] & 0xffff, w[at + 1..at + count].to_vec())));
                 at += count;
             }
             out
         };
-        let (before, after) = (instructions(&words), instructions(&patched));
+        let (located, patched_located) = (instructions(&words), instructions(&patched));
+        let before: Vec<_> = located.iter().map(|(_, i)| i.clone()).collect();
+        let after: Vec<_> = patched_located.into_iter().map(|(_, i)| i).collect();
         let entries: Vec<u32> = after
             .iter()
             .filter(|(op, _)| *op == 15)
@@ -160,14 +162,7 @@ fn modules_with_float_controls_requested_set_them_on_every_entry_point_and_pass_
         let bytes: Vec<u8> = patched.iter().flat_map(|w| w.to_le_bytes()).collect();
         spirv_val(&format!("{name}-float-controls"), &bytes);
         // Cut inside the first entry point: its word count reaches past the end.
-        let first_entry = (5..words.len())
-            .scan(5usize, |at, _| {
-                let here = *at;
-                *at += (words.get(here)? >> 16) as usize;
-                Some(here)
-            })
-            .find(|&at| words[at] & 0xffff == 15)
-            .unwrap();
+        let first_entry = located.iter().find(|(_, (op, _))| *op == 15).unwrap().0;
         let truncated = &words[..first_entry + 2];
         assert!(request(truncated, Requested::ALL).is_err(), "{name}");
     }
