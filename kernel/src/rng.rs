@@ -68,8 +68,9 @@ impl SampleRng {
         x
     }
 
-    /// A float uniform in (0, 1) ([`u32_to_unit_f32`]), then advances the dimension. With the Sobol sampler it is
-    /// the first coordinate of the dimension's pair (a stratified 1D sequence per pixel).
+    /// A float uniform in (0, 1) ([`u32_to_unit_f32`]), then advances the dimension. With the
+    /// Sobol sampler it is the first coordinate of the dimension's pair (a stratified 1D
+    /// sequence per pixel).
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
         if self.sampler == sampler::SOBOL {

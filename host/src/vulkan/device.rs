@@ -417,12 +417,15 @@ impl Context {
     /// H200 (two GPU tests in two threads of one process, each with its own context; docs/gpu.md)
     /// left no trace, and this is the trace the next run on such a device needs.
     fn wait_reporting(&self, fence: vk::Fence) -> ash::prelude::VkResult<()> {
-        const STEP_NS: u64 = 60_000_000_000;
+        const STEP_S: u64 = 60;
         let mut waited = 0u64;
         loop {
-            match unsafe { self.device.wait_for_fences(&[fence], true, STEP_NS) } {
+            match unsafe {
+                self.device
+                    .wait_for_fences(&[fence], true, STEP_S * 1_000_000_000)
+            } {
                 Err(vk::Result::TIMEOUT) => {
-                    waited += 60;
+                    waited += STEP_S;
                     eprintln!(
                         "twinpath: GPU work on {} not finished after {waited} s ({} Vulkan contexts open in this process)",
                         self.device_name,
