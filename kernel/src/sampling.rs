@@ -125,26 +125,63 @@ pub struct ConeSample {
     pub pdf_solid_angle: f32,
 }
 
+/// The cone a sphere of `radius` subtends from a point at squared distance `dist2` from its
+/// centre: sin^2(theta_max) = r^2 / d^2 (at most 1), cos^2(theta_max) = 1 - sin^2(theta_max) and
+/// cos(theta_max). Every quantity of the cone sampler is formed from these without a further
+/// difference of nearly equal numbers.
+#[inline]
+pub fn cone_extent<R: real::Real>(radius: R, dist2: R) -> ConeExtent<R> {
+    let one = R::splat(1.0);
+    let sin2_max = (radius * radius / dist2).min(one);
+    let cos2_max = one - sin2_max;
+    ConeExtent {
+        sin2_max,
+        cos2_max,
+        cos_max: cos2_max.sqrt(),
+    }
+}
+
+/// [`cone_extent`]'s squared sine, squared cosine and cosine of the cone's half-angle.
+#[derive(Clone, Copy, Debug)]
+pub struct ConeExtent<R> {
+    pub sin2_max: R,
+    pub cos2_max: R,
+    pub cos_max: R,
+}
+
 /// 1 - cos(theta_max) of the cone a sphere of `radius` subtends from a point at squared
 /// distance `dist2` from its centre, as sin^2 / (1 + cos): the same value as 1 - cos without
 /// its cancellation, accurate for cones of any size (pbrt-v4 switches to a Taylor expansion
 /// below 1.5 degrees instead; this form needs no branch).
 #[inline]
 pub fn cone_one_minus_cos<R: real::Real>(radius: R, dist2: R) -> R {
-    let one = R::splat(1.0);
-    let sin2_max = (radius * radius / dist2).min(one);
-    sin2_max / (one + (one - sin2_max).sqrt())
+    let cone = cone_extent(radius, dist2);
+    cone.sin2_max / (R::splat(1.0) + cone.cos_max)
 }
 
 /// Samples the sphere (center, radius) as seen from outside point `p`: a direction uniform in
 /// the cone the sphere subtends (cos theta = 1 - u1 (1 - cos theta_max), phi = 2 pi u2) and the
 /// point where it first meets the sphere (pbrt-v4 6.2.4 `Sphere::Sample`). The point is placed
-/// by its angle alpha at the centre, measured from the axis toward `p`:
-/// with d the distance to the centre and the near intersection at distance
-/// s = d cos(theta) - sqrt(r^2 - d^2 sin^2(theta)), cos(alpha) = (d - s cos(theta)) / r
-/// = sin^2(theta) / sin(theta_max) + cos(theta) sqrt(1 - sin^2(theta) / sin^2(theta_max)),
-/// which avoids intersecting a ray with the sphere. Density: 1 / (2 pi (1 - cos theta_max)).
-/// `p` must be outside the sphere (see [`pdf_sphere_cone`] for the caller's fallback).
+/// by its angle alpha at the centre, measured from the axis toward `p`, without intersecting a
+/// ray with the sphere. In the triangle (p, centre, point) the angle at the point is
+/// pi - beta with beta = theta + alpha, and the law of sines gives
+/// sin(beta) = (d / r) sin(theta) = sin(theta) / sin(theta_max) (beta <= pi / 2 at the near
+/// intersection), so
+///
+/// - cos(beta) = sqrt(1 - sin^2(theta) / sin^2(theta_max)), and with 1 - cos theta = u1 m,
+///   m = 1 - cos theta_max: 1 - sin^2 / sin^2_max = (1 - u1)((1 - u1) + cos theta_max (1 + u1))
+///   / (1 + cos theta_max), a product of non-negative terms (the difference cancelled at the
+///   cone's rim, u1 near 1, by the square root of a rounding: ~sqrt(eps) of the radius);
+/// - cos(alpha) = cos(beta - theta) = sin^2(theta) / sin(theta_max) + cos(theta) cos(beta);
+/// - sin(alpha) = sin(beta - theta) = (sin^2 beta - sin^2 theta) / (sin beta cos theta
+///   + cos beta sin theta) = sin(theta) cos^2(theta_max) / (sin(theta_max) (cos(theta)
+///   + sin(theta_max) cos(beta))) (sqrt(1 - cos^2 alpha) cancelled near the axis).
+///
+/// Both are sums and products of non-negative terms, accurate to a few eps relative; the
+/// smaller of the two is kept and the other taken as sqrt(1 - x^2) of it (no cancellation for
+/// x <= 1 / sqrt 2), so the normal is of unit length to the rounding of one root. Density:
+/// 1 / (2 pi (1 - cos theta_max)). `p` must be outside the sphere (see [`pdf_sphere_cone`] for
+/// the caller's fallback); `u1` in (0, 1) (`rng`).
 #[inline]
 pub fn sample_sphere_cone(center: Vec3, radius: f32, p: Vec3, u1: f32, u2: f32) -> ConeSample {
     let s = sample_sphere_cone_v3(V3::from(center), radius, V3::from(p), u1, u2);
@@ -166,22 +203,30 @@ pub fn sample_sphere_cone_v3<R: real::Real>(
     u1: R,
     u2: R,
 ) -> ConeSampleV3<R> {
-    let (zero, one, two) = (R::splat(0.0), R::splat(1.0), R::splat(2.0));
+    let (one, two) = (R::splat(1.0), R::splat(2.0));
     let to_center = center - p;
     let dist2 = to_center.dot(to_center);
     let dist = dist2.sqrt();
     let axis = to_center / dist;
     let sin_max = radius / dist;
-    let sin2_max = sin_max * sin_max;
-    let one_minus_cos_max = cone_one_minus_cos(radius, dist2);
+    let cone = cone_extent(radius, dist2);
+    let one_minus_cos_max = cone.sin2_max / (one + cone.cos_max);
     // Uniform in 1 - cos(theta); sin^2 = (1 - cos)(1 + cos) keeps full precision in tiny cones.
     let one_minus_cos = u1 * one_minus_cos_max;
     let cos = one - one_minus_cos;
     let sin2 = one_minus_cos * (two - one_minus_cos);
-    let cos_alpha = (sin2 / sin_max + cos * (one - sin2 / sin2_max).max(zero).sqrt())
-        .max(-one)
-        .min(one);
-    let sin_alpha = (one - cos_alpha * cos_alpha).max(zero).sqrt();
+    let rest = one - u1;
+    let cos_beta = (rest * (rest + cone.cos_max * (one + u1)) / (one + cone.cos_max)).sqrt();
+    let cos_alpha = sin2 / sin_max + cos * cos_beta;
+    let sin_alpha = sin2.sqrt() * cone.cos2_max / (sin_max * (cos + sin_max * cos_beta));
+    // The smaller is at most 1 / sqrt(2) (to rounding): 1 - x^2 >= 1 / 2 does not cancel.
+    let smaller = sin_alpha.min(cos_alpha);
+    let larger = (one - smaller * smaller).sqrt();
+    let sin_is_smaller = sin_alpha.less_than(cos_alpha);
+    let (cos_alpha, sin_alpha) = (
+        real::select(sin_is_smaller, larger, cos_alpha),
+        real::select(sin_is_smaller, sin_alpha, larger),
+    );
     let (cos_phi, sin_phi) = cos_sin_turns(u2);
     let (t, b) = orthonormal_basis_v3(axis);
     let normal = t * (sin_alpha * cos_phi) + b * (sin_alpha * sin_phi) - axis * cos_alpha;

@@ -11,11 +11,47 @@
 /// for devices that are not IEEE).
 pub const BASIS_APART_EPS: f32 = 9.0;
 
-/// How far apart the CPU's and a conformant device's cone-sampled points (and normals) may be,
-/// relative to the size of the geometry: twice the square root of the 25 eps the cancelling
-/// ratio carries (derived in `tests/tests/vulkan_precision.rs`).
-pub fn cone_points_apart() -> f32 {
-    2.0 * (25.0 * f32::EPSILON).sqrt()
+/// First-order error of one computation of `kernel::sampling::sample_sphere_cone_v3`'s normal
+/// (and of its point, in radii), for unit roundoff `u`, quotient error `q` and root error `w`,
+/// every rounding aligned, where `sin_over_cos` is tan(theta_max) of the cone:
+///
+/// - the axis (c - p) / |c - p|: the difference u, |.|^2 5 u so its root 2.5 u + w, the
+///   quotient q: a = 3.5 u + w + q, in direction and length;
+/// - the frame of that axis: its own error 4 u + q (`BASIS_APART_EPS`'s derivation), and it
+///   follows the axis with a Lipschitz constant below 2.3 (t.x = 1 + s x^2 a with |x a| <= 1
+///   and |x^2 a^2| <= 1): 4 u + q + 2.3 a;
+/// - sin(alpha) and cos(alpha), sums and products of non-negative terms: cos(beta) 4 u + q in
+///   its square and w, sin(alpha) 7 u + 1.5 q + 2 w, and the other one's root of 1 - x^2
+///   (x <= 1 / sqrt 2) adds u + w: 8 u + 1.5 q + 3 w;
+/// - sin^2(theta_max) = r^2 / d^2 is off by 6 u + q relative (r^2, |c - p|^2, the quotient): it
+///   moves theta by theta / 2 of that (at most 0.8 of it; beta does not move to first order),
+///   and cos(theta_max) = sqrt(1 - sin^2) by sin^2 (6 u + q) / (2 cos), which turns the point at
+///   the rim by that over sin(theta_max): (6 u + q) / 2 x tan(theta_max). This is the input's
+///   conditioning (a receiver a gap g of the radius outside sees tan ~ 1 / sqrt(2 g)), which no
+///   form of the sampler removes;
+/// - the azimuth's cosine and sine 4 u, the normal's three products and two sums 4 u.
+pub fn cone_normal_error(u: f64, q: f64, w: f64, sin_over_cos: f64) -> f64 {
+    let axis = 3.5 * u + w + q;
+    let frame = 4.0 * u + q + 2.3 * axis;
+    let alpha = 8.0 * u + 1.5 * q + 3.0 * w;
+    let cone = 0.8 * (6.0 * u + q) + 0.5 * (6.0 * u + q) * sin_over_cos;
+    axis + frame + alpha + cone + 8.0 * u
+}
+
+/// How far apart the CPU's and a conformant device's `sample_sphere_cone` may be for the sphere
+/// (`center`, `radius`) seen from `p`: (normals, positions per component), the sum of
+/// [`cone_normal_error`] for an IEEE and a Vulkan computation (eps 24.6 and 81.2 plus 1.75 and
+/// 4.25 of tan(theta_max)); a position c + r n adds r times that and its own roundings,
+/// u (|c| + 2 r) per computation.
+pub fn cone_points_apart(center: [f32; 3], radius: f32, p: [f32; 3]) -> (f64, f64) {
+    let eps = f32::EPSILON as f64;
+    let (c, r) = (d3(center), radius as f64);
+    let sin2_max = (r * r / (c - d3(p)).length_squared()).min(1.0);
+    let tan_max = (sin2_max / (1.0 - sin2_max)).sqrt();
+    let normal = cone_normal_error(0.5 * eps, 0.5 * eps, 0.5 * eps, tan_max)
+        + cone_normal_error(eps, 2.5 * eps, 4.5 * eps, tan_max);
+    let position = normal * r + 1.5 * eps * (c.abs().max_element() + 2.0 * r);
+    (normal, position)
 }
 
 /// How far apart the CPU's and a conformant device's `geometry_factor` G = |(n_a . d)(n_b . d)|
