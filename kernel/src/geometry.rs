@@ -224,7 +224,15 @@ pub fn blend2(a: Vec2, b: Vec2, c: Vec2, bary: Vec2) -> Vec2 {
 /// Unit geometric normal of a triangle, (edge1 x edge2) normalised.
 #[inline]
 pub fn triangle_normal(edge1: Vec3, edge2: Vec3) -> Vec3 {
-    edge1.cross(edge2).normalize()
+    triangle_normal_v3(V3::from(edge1), V3::from(edge2)).into()
+}
+
+/// [`triangle_normal`] over any [`real::Real`]: the cross product times the reciprocal of its
+/// length, as glam normalises (so the `f32` instance is glam's `normalize` bit for bit).
+#[inline]
+pub fn triangle_normal_v3<R: real::Real>(edge1: V3<R>, edge2: V3<R>) -> V3<R> {
+    let c = edge1.cross(edge2);
+    c * (R::splat(1.0) / c.dot(c).sqrt())
 }
 
 /// Bound on the rounding error of [`triangle_point`], in units of eps times the magnitudes of
@@ -273,13 +281,21 @@ pub fn triangle_point_error(p0: Vec3, edge1: Vec3, edge2: Vec3, u: f32, v: f32) 
 /// compute it once per triangle (the CPU backend does).
 #[inline]
 pub fn triangle_error_condition(edge1: Vec3, edge2: Vec3) -> f32 {
-    let sin_theta = edge1.cross(edge2).length() / (edge1.length() * edge2.length());
-    let condition = if sin_theta > 0.0 {
-        (1.0 / sin_theta).min(f32::MAX)
-    } else {
-        1.0
-    };
-    condition.max(1.0)
+    triangle_error_condition_v3(V3::from(edge1), V3::from(edge2))
+}
+
+/// [`triangle_error_condition`] over any [`real::Real`].
+#[inline]
+pub fn triangle_error_condition_v3<R: real::Real>(edge1: V3<R>, edge2: V3<R>) -> R {
+    let one = R::splat(1.0);
+    let c = edge1.cross(edge2);
+    let sin_theta = c.dot(c).sqrt() / (edge1.dot(edge1).sqrt() * edge2.dot(edge2).sqrt());
+    let condition = real::select(
+        sin_theta.greater_than(R::splat(0.0)),
+        (one / sin_theta).min(R::splat(f32::MAX)),
+        one,
+    );
+    condition.max(one)
 }
 
 /// What a triangle's hit records need that depends on its shape alone: its unit normal

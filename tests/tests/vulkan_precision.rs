@@ -14,8 +14,8 @@ use glam::Vec3;
 use kernel::frame::orthonormal_basis_v3;
 use kernel::geometry::{
     geometry_factor_v3, offset_ray_origin_v3, reproject_to_sphere_v3, shadow_ray_end_v3,
-    sphere_point_error, sphere_point_error_v3, triangle_point_error_v3, triangle_point_v3,
-    TRIANGLE_ERROR_EPS,
+    sphere_point_error, sphere_point_error_v3, triangle_error_condition_v3, triangle_normal_v3,
+    triangle_point_error_v3, triangle_point_v3, TRIANGLE_ERROR_EPS,
 };
 use kernel::intersect;
 use kernel::real::{Real, V3};
@@ -64,11 +64,6 @@ fn cases() -> usize {
 /// Scene inputs (in `f32`: the scene is data, not device arithmetic), drawn as reintersection.rs
 /// draws them.
 use twinpath_tests::placements::Placements as Gen;
-
-/// The unit vector along `x`, as the kernel normalises (x / |x|, under Vulkan's arithmetic).
-fn normalize(x: V) -> V {
-    x / x.dot(x).sqrt()
-}
 
 /// Whether a continuation ray and a shadow ray spawned at `p` (leaving normal `n_side`, error
 /// bound `err`, surface size `size`) hit their surface again (`hits`), all under [`Vk32`].
@@ -201,9 +196,9 @@ fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
         tested += 1;
         let (q, f1, f2) = (v(q), v(f1), v(f2));
         let p = triangle_point_v3(q, f1, f2, hu, hv);
-        let nn = normalize(f1.cross(f2));
+        let nn = triangle_normal_v3(f1, f2);
         let n_side = if nn.dot(v(dir)).value < 0.0 { nn } else { -nn };
-        let condition = condition(f1, f2);
+        let condition = triangle_error_condition_v3(f1, f2);
         let err = triangle_point_error_v3(q, f1, f2, hu, hv, condition);
         let (c, sh) = spawned_self_hits(&mut g, p, n_side, err, s, &hit);
         cont_fail += c as usize;
@@ -212,17 +207,6 @@ fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
     println!("triangles/quads under Vulkan arithmetic: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
     assert!(tested > cases() / 2);
     assert_eq!((cont_fail, shadow_fail), (0, 0));
-}
-
-/// `geometry::triangle_error_condition` under [`Vk32`]: max(1, 1 / sin(theta)).
-fn condition(e1: V, e2: V) -> Vk32 {
-    let c = e1.cross(e2);
-    let sin = c.dot(c).sqrt() / (e1.dot(e1).sqrt() * e2.dot(e2).sqrt());
-    if sin.value > 0.0 {
-        (f(1.0) / sin).min(f(f32::MAX)).max(f(1.0))
-    } else {
-        f(1.0)
-    }
 }
 
 #[test]
