@@ -22,6 +22,7 @@
 //! for the density it reports.
 
 use crate::frame::orthonormal_basis;
+use crate::turns::cos_sin_turns;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
 use core::f32::consts::PI;
@@ -57,21 +58,39 @@ pub fn eval(g: f32, wo: Vec3, wi: Vec3) -> f32 {
 }
 
 /// A direction `wi` drawn with density [`eval`]`(g, wo, wi)` from uniform numbers `u1` (the
-/// angle) and `u2` (the azimuth) in [0, 1).
-#[inline]
+/// angle) and `u2` (the azimuth) in (0, 1).
+///
+/// The sine of the scattering angle is sqrt((1 - mu)(1 + mu)) with both factors written without
+/// a difference of nearly equal numbers: with d = 1 - g + 2 g u1 = (1 - g)(1 - u1) + (1 + g) u1
+/// and s = (1 - g)(1 + g) / d, the module's mu gives 1 - mu = (1 - g)(1 - u1)(s + 1 - g) / d and
+/// 1 + mu = (1 + g) u1 (1 + g + s) / d (isotropic: 2 u1 and 2 (1 - u1)), so the angle keeps its
+/// precision where the direction nears the axis of travel (sqrt(1 - mu^2) took the square root
+/// of a rounding there) and for strong asymmetry (1 - g^2 and d cancelled for |g| near 1); mu
+/// is taken from the smaller factor. The azimuth is [`cos_sin_turns`] of u2: sums and products only, so a Vulkan device,
+/// whose `sin` and `cos` may be off by 2^-11 (absolute), turns it as the CPU does.
+#[inline(always)]
 pub fn sample(g: f32, wo: Vec3, u1: f32, u2: f32) -> Vec3 {
     let g = effective(g);
-    let mu = if g == 0.0 {
-        1.0 - 2.0 * u1
+    let (one_minus_mu, one_plus_mu) = if g == 0.0 {
+        (2.0 * u1, 2.0 * (1.0 - u1))
     } else {
-        let s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u1);
-        (1.0 + g * g - s * s) / (2.0 * g)
-    }
-    .clamp(-1.0, 1.0);
-    let sin = (1.0 - mu * mu).max(0.0).sqrt();
-    let phi = 2.0 * PI * u2;
+        let (minus, plus) = (1.0 - g, 1.0 + g);
+        let d = minus * (1.0 - u1) + plus * u1;
+        let s = minus * plus / d;
+        (
+            minus * (1.0 - u1) * (s + minus) / d,
+            plus * u1 * (plus + s) / d,
+        )
+    };
+    let mu = if one_minus_mu < one_plus_mu {
+        1.0 - one_minus_mu
+    } else {
+        one_plus_mu - 1.0
+    };
+    let sin = (one_minus_mu * one_plus_mu).sqrt();
+    let (cos_phi, sin_phi) = cos_sin_turns(u2);
     // About the direction of travel -wo: mu = cos theta = -wi . wo.
     let travel = -wo;
     let (t, b) = orthonormal_basis(travel);
-    (travel * mu + (t * phi.cos() + b * phi.sin()) * sin).normalize()
+    (travel * mu + (t * cos_phi + b * sin_phi) * sin).normalize()
 }

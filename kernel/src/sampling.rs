@@ -78,11 +78,13 @@ pub struct SurfacePoint {
 
 /// Seed: `SampleSphere(C, R)`. A point uniformly distributed over the sphere's area
 /// (z = 2 u1 - 1, phi = 2 pi u2; Archimedes' hat-box theorem makes z uniform), with density
-/// 1 / (4 pi R^2) per unit area.
+/// 1 / (4 pi R^2) per unit area. The radius of its circle of latitude is sqrt(1 - z^2) =
+/// 2 sqrt(u1 (1 - u1)): the product keeps its precision toward the poles, where 1 - z^2 lost
+/// z^2's rounding (z = 2 u1 - 1 and 1 - u1 are exact for u1 of the form (k + 1/2) 2^-23, `rng`).
 #[inline]
 pub fn sample_sphere(center: Vec3, radius: f32, u1: f32, u2: f32) -> SurfacePoint {
     let z = 2.0 * u1 - 1.0;
-    let r = (1.0 - z * z).max(0.0).sqrt();
+    let r = 2.0 * (u1 * (1.0 - u1)).max(0.0).sqrt();
     let (cos_phi, sin_phi) = cos_sin_turns(u2);
     let normal = Vec3::new(r * cos_phi, r * sin_phi, z);
     SurfacePoint {
