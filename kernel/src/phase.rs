@@ -18,10 +18,11 @@
 //! section 11.3.1, derived here from the CDF). Below |g| = 1e-3 the formula cancels badly and
 //! the distribution is isotropic to within 0.3% (its ratio to the isotropic density lies between
 //! (1 - g) / (1 + g)^2 and (1 + g) / (1 - g)^2);
-//! there [`eval`] and [`sample`] both take g as 0 (mu = 1 - 2 xi), so the sampler stays exact
+//! there [`eval`] and [`sample`] both take g as 0 (mu = 2 xi - 1), so the sampler stays exact
 //! for the density it reports.
 
-use crate::frame::orthonormal_basis;
+use crate::frame::orthonormal_basis_v3;
+use crate::real::{self, abs, V3};
 use crate::turns::cos_sin_turns;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -63,34 +64,40 @@ pub fn eval(g: f32, wo: Vec3, wi: Vec3) -> f32 {
 /// The sine of the scattering angle is sqrt((1 - mu)(1 + mu)) with both factors written without
 /// a difference of nearly equal numbers: with d = 1 - g + 2 g u1 = (1 - g)(1 - u1) + (1 + g) u1
 /// and s = (1 - g)(1 + g) / d, the module's mu gives 1 - mu = (1 - g)(1 - u1)(s + 1 - g) / d and
-/// 1 + mu = (1 + g) u1 (1 + g + s) / d (isotropic: 2 u1 and 2 (1 - u1)), so the angle keeps its
-/// precision where the direction nears the axis of travel (sqrt(1 - mu^2) took the square root
-/// of a rounding there) and for strong asymmetry (1 - g^2 and d cancelled for |g| near 1); mu
-/// is taken from the smaller factor. The azimuth is [`cos_sin_turns`] of u2: sums and products only, so a Vulkan device,
-/// whose `sin` and `cos` may be off by 2^-11 (absolute), turns it as the CPU does.
+/// 1 + mu = (1 + g) u1 (1 + g + s) / d, so the angle keeps its precision where the direction
+/// nears the axis of travel (sqrt(1 - mu^2) took the square root of a rounding there) and for
+/// strong asymmetry (1 - g^2 and d cancelled for |g| near 1); mu is taken from the smaller
+/// factor. These hold at g = 0 too (1 - mu = 2 (1 - u1), 1 + mu = 2 u1: mu = 2 u1 - 1, the
+/// isotropic sampler), so no branch is needed where [`eval`] takes g as 0. The azimuth is
+/// [`cos_sin_turns`] of u2: sums and products only, so a Vulkan device, whose `sin` and `cos`
+/// may be off by 2^-11 (absolute), turns it as the CPU does.
 #[inline(always)]
 pub fn sample(g: f32, wo: Vec3, u1: f32, u2: f32) -> Vec3 {
-    let g = effective(g);
-    let (one_minus_mu, one_plus_mu) = if g == 0.0 {
-        (2.0 * u1, 2.0 * (1.0 - u1))
-    } else {
-        let (minus, plus) = (1.0 - g, 1.0 + g);
-        let d = minus * (1.0 - u1) + plus * u1;
-        let s = minus * plus / d;
-        (
-            minus * (1.0 - u1) * (s + minus) / d,
-            plus * u1 * (plus + s) / d,
-        )
-    };
-    let mu = if one_minus_mu < one_plus_mu {
-        1.0 - one_minus_mu
-    } else {
-        one_plus_mu - 1.0
-    };
+    sample_v3(g, V3::from(wo), u1, u2).into()
+}
+
+/// [`sample`] over any [`real::Real`] (the tests run it under a model of Vulkan's arithmetic).
+#[inline(always)]
+pub fn sample_v3<R: real::Real>(g: R, wo: V3<R>, u1: R, u2: R) -> V3<R> {
+    let one = R::splat(1.0);
+    let isotropic = abs(g).less_than(R::splat(ISOTROPIC_G));
+    let g = real::select(isotropic, R::splat(0.0), g);
+    let (minus, plus, rest) = (one - g, one + g, one - u1);
+    let d = minus * rest + plus * u1;
+    let s = minus * plus / d;
+    let one_minus_mu = minus * rest * (s + minus) / d;
+    let one_plus_mu = plus * u1 * (plus + s) / d;
+    let mu = real::select(
+        one_minus_mu.less_than(one_plus_mu),
+        one - one_minus_mu,
+        one_plus_mu - one,
+    );
     let sin = (one_minus_mu * one_plus_mu).sqrt();
     let (cos_phi, sin_phi) = cos_sin_turns(u2);
     // About the direction of travel -wo: mu = cos theta = -wi . wo.
     let travel = -wo;
-    let (t, b) = orthonormal_basis(travel);
-    (travel * mu + (t * cos_phi + b * sin_phi) * sin).normalize()
+    let (t, b) = orthonormal_basis_v3(travel);
+    let v = travel * mu + (t * cos_phi + b * sin_phi) * sin;
+    // As glam normalises: times the reciprocal of the length.
+    v * (one / v.dot(v).sqrt())
 }

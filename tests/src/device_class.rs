@@ -54,6 +54,26 @@ pub fn cone_points_apart(center: [f32; 3], radius: f32, p: [f32; 3]) -> (f64, f6
     (normal, position)
 }
 
+/// First-order error of one computation of `kernel::phase::sample_v3`'s unit direction, per
+/// component, for unit roundoff `u`, quotient error `q` and root error `w`, every rounding
+/// aligned: 1 - g and 1 + g u each; d = (1 - g)(1 - u1) + (1 + g) u1 3 u; s = (1 - g)(1 + g) / d
+/// 6 u + q; 1 - mu and 1 + mu (a product of three factors over d) 13 u + 2 q each; the sine
+/// their product's root, 13.5 u + 2 q + w; mu = 1 - x (x <= 1) 14 u + 2 q absolute; the frame
+/// 4 u + q, the azimuth's polynomials 4 u, t cos + b sin and its product with the sine 24.5 u
+/// + 3 q + w; with travel mu and the sum 40.5 u + 5 q + w; the normalisation 2.5 u + q + w.
+pub fn phase_direction_error(u: f64, q: f64, w: f64) -> f64 {
+    43.0 * u + 6.0 * q + 2.0 * w
+}
+
+/// How far apart the CPU's and a conformant device's phase-sampled directions may be, per
+/// component: [`phase_direction_error`] for one IEEE and one Vulkan computation (25.5 and 67
+/// eps).
+pub fn phase_directions_apart() -> f64 {
+    let eps = f32::EPSILON as f64;
+    phase_direction_error(0.5 * eps, 0.5 * eps, 0.5 * eps)
+        + phase_direction_error(eps, 2.5 * eps, 4.5 * eps)
+}
+
 /// How far apart the CPU's and a conformant device's `geometry_factor` G = |(n_a . d)(n_b . d)|
 /// / (d . d)^2 may be, for points |d|^2 = `d2` apart (derived in
 /// `tests/tests/vulkan_precision.rs`): 12 eps / |d|^2 + 21 eps G.

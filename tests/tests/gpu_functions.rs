@@ -545,6 +545,10 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let (direction, density) = twinpath_tests::device_class::cosine_sample_apart(f(3, 0));
             (if j < 3 { direction } else { density }) as f32
         }
+        // The Vulkan class's phase-sampled direction (out0.xyz of the medium's record).
+        function::MEDIUM if b.vulkan && k == 0 && j < 3 => {
+            twinpath_tests::device_class::phase_directions_apart() as f32
+        }
         // The Vulkan class's geometry factor, per record: 12 eps / |d|^2 + 21 eps G.
         function::GEOMETRY_FACTOR if b.vulkan => {
             let d = glam::Vec3::new(f(0, 0), f(0, 1), f(0, 2)).as_dvec3()
@@ -605,6 +609,11 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
             abs: 4.0 * eps,
             vulkan: true,
             why: "Vulkan class: the axis, its frame, sin and cos of alpha (cancellation-free), the cone's extent and the azimuth, every rounding of one IEEE and one Vulkan computation: ~106 eps plus 6 eps of tan(theta_max) for normals, times the radius plus 1.5 eps (|c| + 2 r) for points, per record (`allowed_abs`); the density a few quotients and roots, 18 eps relative: 40 ULP or 4 eps",
+            ..*b
+        }),
+        function::MEDIUM => Some(Bound {
+            vulkan: true,
+            why: "Vulkan class: the phase direction's factored sine and mu (quotients within 2.5 ULP, a root), the frame, the azimuth's polynomials and the normalisation, for one IEEE and one Vulkan computation: 92.5 eps per component (`phase_directions_apart`); its density and the flights as derived per record for any device (`allowed_abs`)",
             ..*b
         }),
         function::GEOMETRY_FACTOR => Some(Bound {

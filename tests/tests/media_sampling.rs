@@ -144,16 +144,11 @@ fn phase_samples_keep_their_angle_near_the_axis_of_travel() {
             };
             let wi = phase::sample(g, wo, u1, r.next_f32()).as_dvec3();
             let (gd, u) = (g as f64, u1 as f64);
-            let (one_minus_mu, one_plus_mu) = if g == 0.0 {
-                (2.0 * u, 2.0 * (1.0 - u))
-            } else {
-                let d = 1.0 - gd + 2.0 * gd * u;
-                let s = (1.0 - gd * gd) / d;
-                (
-                    (1.0 - gd) * (1.0 - u) * (s + 1.0 - gd) / d,
-                    (1.0 + gd) * u * (1.0 + gd + s) / d,
-                )
-            };
+            // The module's factors (isotropic: g = 0 in them, mu = 2 u1 - 1).
+            let d = (1.0 - gd) * (1.0 - u) + (1.0 + gd) * u;
+            let s = (1.0 - gd) * (1.0 + gd) / d;
+            let one_minus_mu = (1.0 - gd) * (1.0 - u) * (s + 1.0 - gd) / d;
+            let one_plus_mu = (1.0 + gd) * u * (1.0 + gd + s) / d;
             let exact = (one_minus_mu * one_plus_mu)
                 .sqrt()
                 .atan2((one_plus_mu - one_minus_mu) / 2.0);

@@ -445,6 +445,100 @@ fn cone_points_are_within_their_error_of_the_exact_point_under_every_arithmetic(
     assert!(worst_normal.iter().all(|&w| w <= 1.0), "{worst_normal:?}");
 }
 
+/// The direction `phase::sample_v3` means for (g, wo, u1, u2), in `f64` from the same `f32`
+/// inputs: mu and the sine from the exact factors 1 - mu and 1 + mu (the module's inverse CDF),
+/// the azimuth 2 pi u2, in the frame `orthonormal_basis` builds around the direction of travel.
+fn phase_direction_exact(g: f32, wo: Vec3, u1: f32, u2: f32) -> glam::DVec3 {
+    use glam::DVec3;
+    let g = if g.abs() < kernel::phase::ISOTROPIC_G {
+        0.0
+    } else {
+        g as f64
+    };
+    let (u1, u2) = (u1 as f64, u2 as f64);
+    let d = (1.0 - g) * (1.0 - u1) + (1.0 + g) * u1;
+    let s = (1.0 - g) * (1.0 + g) / d;
+    let one_minus_mu = (1.0 - g) * (1.0 - u1) * (s + 1.0 - g) / d;
+    let one_plus_mu = (1.0 + g) * u1 * (1.0 + g + s) / d;
+    let mu = (one_plus_mu - one_minus_mu) / 2.0;
+    let sin = (one_minus_mu * one_plus_mu).sqrt();
+    let travel = -wo.as_dvec3();
+    let sign = if travel.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + travel.z);
+    let b = travel.x * travel.y * a;
+    let t = DVec3::new(
+        1.0 + sign * travel.x * travel.x * a,
+        sign * b,
+        -sign * travel.x,
+    );
+    let bt = DVec3::new(b, sign + travel.y * travel.y * a, -travel.y);
+    let (sin_phi, cos_phi) = (std::f64::consts::TAU * u2).sin_cos();
+    (travel * mu + (t * cos_phi + bt * sin_phi) * sin).normalize()
+}
+
+/// Phase-sampled directions under IEEE arithmetic and every Vulkan model are within their
+/// first-order error of the exact direction (`device_class::phase_direction_error`), and a
+/// device's within `phase_directions_apart` of the CPU's (the bound `gpu_functions.rs` holds a
+/// device that is not IEEE to). Inputs: g over (-1, 1) with its ends and the isotropic range,
+/// u1 at its extremes, unit directions of travel (the frame's branch at z = 0 excluded: a
+/// rounding may take the other, equally valid, frame).
+#[test]
+fn phase_directions_are_within_their_error_under_every_arithmetic() {
+    use twinpath_tests::device_class::{phase_direction_error, phase_directions_apart};
+    let eps = f32::EPSILON as f64;
+    let mut g_ = Gen(SplitMix(23));
+    seed(23);
+    let (mut worst, mut apart) = ([0f64; 4], 0f64);
+    let extremes = [2f32.powi(-24), 1e-4, 1.0 - 1e-4, 1.0 - 2f32.powi(-24)];
+    for case in 0..cases() {
+        let wo = g_.dir();
+        if wo.z.abs() < 1e-4 {
+            continue;
+        }
+        let g = match case % 5 {
+            0 => 0.0,
+            1 => 5e-4,
+            2 => 0.99 * (2.0 * g_.unit() - 1.0).signum(),
+            _ => 0.999 * (2.0 * g_.unit() - 1.0),
+        };
+        let u1 = if case % 7 == 0 {
+            extremes[(case / 7) % 4]
+        } else {
+            g_.unit()
+        };
+        let u2 = g_.unit();
+        let exact = phase_direction_exact(g, wo, u1, u2);
+        let run = |model: usize| {
+            if model == 0 {
+                set_model(Model::IEEE);
+            } else {
+                any_device(model - 1);
+            }
+            back(kernel::phase::sample_v3(f(g), v(wo), f(u1), f(u2)))
+        };
+        let cpu = run(0);
+        for (model, worst) in worst.iter_mut().enumerate() {
+            let (u, q, w) = if model == 0 {
+                (0.5 * eps, 0.5 * eps, 0.5 * eps)
+            } else {
+                (eps, 2.5 * eps, 4.5 * eps)
+            };
+            let got = if model == 0 { cpu } else { run(model) };
+            let error = (got.as_dvec3() - exact).abs().max_element();
+            *worst = worst.max(error / phase_direction_error(u, q, w));
+            apart = apart.max((got - cpu).abs().max_element() as f64);
+        }
+    }
+    set_model(Model::VULKAN);
+    println!(
+        "phase directions against the exact one, of their bound: IEEE, Vulkan, worst up, worst down {worst:.3?}; a device against the CPU {:.2} eps (bound {:.1})",
+        apart / eps,
+        phase_directions_apart() / eps
+    );
+    assert!(worst.iter().all(|&w| w <= 1.0), "{worst:?}");
+    assert!(apart <= phase_directions_apart(), "{} eps", apart / eps);
+}
+
 /// How far the kernel's hit points fall from the exact surface, worst over random triangles and
 /// spheres, as fractions of two bounds: the one the kernel gives them (`triangle_point_error`,
 /// `sphere_point_error`) and the first-order bound of IEEE arithmetic (docs/robustness.md):
