@@ -11,26 +11,23 @@ use spirv_std::glam::Vec3;
 
 /// Seed: `SampleLobe(A, c, phi)`. The unit direction whose cosine with the unit axis `a` is `c`
 /// (clamped to [-1, 1]) and whose azimuth around `a` is `phi`: `K = (s cos phi, s sin phi, c)`
-/// with `s = sqrt(1 - c^2)`, expressed in an orthonormal frame whose third axis is `a`.
-/// The frame is Duff et al.'s (see [`crate::frame::orthonormal_basis`]), which stays accurate
-/// near -Z where the seed special-cases the poles.
+/// with `s = sqrt(1 - c^2) = sqrt((1 - c)(1 + c))` (the product keeps its precision where |c|
+/// nears 1), expressed in an orthonormal frame whose third axis is `a`. The frame is Duff et
+/// al.'s (see [`crate::frame::orthonormal_basis`]), which stays accurate near -Z where the
+/// seed special-cases the poles. The azimuth is [`cos_sin_turns`] of phi / (2 pi), not the
+/// device's `sin` and `cos`, whose precision Vulkan leaves undefined.
 #[inline]
 pub fn sample_lobe(a: Vec3, c: f32, phi: f32) -> Vec3 {
-    lobe_direction(a, c, phi.cos(), phi.sin())
+    sample_lobe_v3(V3::from(a), c, phi).into()
 }
 
-/// [`sample_lobe`] with the azimuth given by its cosine and sine.
+/// [`sample_lobe`] for one axis or one per lane ([`real::Real`]).
 #[inline]
-fn lobe_direction(a: Vec3, c: f32, cos_phi: f32, sin_phi: f32) -> Vec3 {
-    lobe_direction_v3(V3::from(a), c, cos_phi, sin_phi).into()
-}
-
-/// [`lobe_direction`] for one axis or one per lane ([`real::Real`]).
-#[inline]
-fn lobe_direction_v3<R: real::Real>(a: V3<R>, c: R, cos_phi: R, sin_phi: R) -> V3<R> {
+pub fn sample_lobe_v3<R: real::Real>(a: V3<R>, c: R, phi: R) -> V3<R> {
     let one = R::splat(1.0);
     let c = c.max(-one).min(one);
-    let s = (one - c * c).max(R::splat(0.0)).sqrt();
+    let s = ((one - c) * (one + c)).sqrt();
+    let (cos_phi, sin_phi) = cos_sin_turns(phi * R::splat(0.5 / PI));
     lobe_direction_cs_v3(a, c, s, cos_phi, sin_phi)
 }
 
@@ -83,14 +80,22 @@ pub struct SurfacePoint {
 /// z^2's rounding (z = 2 u1 - 1 and 1 - u1 are exact for u1 of the form (k + 1/2) 2^-23, `rng`).
 #[inline]
 pub fn sample_sphere(center: Vec3, radius: f32, u1: f32, u2: f32) -> SurfacePoint {
-    let z = 2.0 * u1 - 1.0;
-    let r = 2.0 * (u1 * (1.0 - u1)).max(0.0).sqrt();
-    let (cos_phi, sin_phi) = cos_sin_turns(u2);
-    let normal = Vec3::new(r * cos_phi, r * sin_phi, z);
+    let (position, normal) = sample_sphere_v3(V3::from(center), radius, u1, u2);
     SurfacePoint {
-        position: center + radius * normal,
-        normal,
+        position: position.into(),
+        normal: normal.into(),
     }
+}
+
+/// [`sample_sphere`] over any [`real::Real`]: (position, normal).
+#[inline]
+pub fn sample_sphere_v3<R: real::Real>(center: V3<R>, radius: R, u1: R, u2: R) -> (V3<R>, V3<R>) {
+    let (one, two) = (R::splat(1.0), R::splat(2.0));
+    let z = two * u1 - one;
+    let r = two * (u1 * (one - u1)).max(R::splat(0.0)).sqrt();
+    let (cos_phi, sin_phi) = cos_sin_turns(u2);
+    let normal = V3::new(r * cos_phi, r * sin_phi, z);
+    (center + normal * radius, normal)
 }
 
 /// Area density of [`sample_sphere`]: 1 / (4 pi R^2).

@@ -74,6 +74,46 @@ pub fn phase_directions_apart() -> f64 {
         + phase_direction_error(eps, 2.5 * eps, 4.5 * eps)
 }
 
+/// First-order error of one computation of `kernel::sampling::sample_sphere_v3`'s unit normal,
+/// per component, for unit roundoff `u` and root error `w`: z = 2 u1 - 1 and 1 - u1 are exact
+/// (u1 = (k + 1/2) 2^-23); the latitude's radius 2 sqrt(u1 (1 - u1)) u / 2 + w relative;
+/// `cos_sin_turns` 4 u absolute (its reduction exact, its polynomials' roundings); their
+/// product u: 5.5 u + w.
+pub fn sphere_normal_error(u: f64, w: f64) -> f64 {
+    5.5 * u + w
+}
+
+/// How far apart the CPU's and a conformant device's `sample_sphere` may be for the sphere
+/// (`center`, `radius`): (normals, positions per component), [`sphere_normal_error`] for one
+/// IEEE and one Vulkan computation (3.25 and 10 eps); a position c + r n adds r times that and
+/// its own roundings, u (|c| + 2 r) per computation.
+pub fn sphere_points_apart(center: [f32; 3], radius: f32) -> (f64, f64) {
+    let eps = f32::EPSILON as f64;
+    let normal = sphere_normal_error(0.5 * eps, 0.5 * eps) + sphere_normal_error(eps, 4.5 * eps);
+    let c = d3(center).abs().max_element();
+    let r = radius as f64;
+    (normal, normal * r + 1.5 * eps * (c + 2.0 * r))
+}
+
+/// First-order error of one computation of `kernel::sampling::sample_lobe_v3`'s direction, per
+/// component, for unit roundoff `u`, quotient error `q`, root error `w` and azimuth `phi`: the
+/// sine sqrt((1 - c)(1 + c)) 1.5 u + w; the azimuth phi / (2 pi) rounded (|phi| u in angle,
+/// beside the constant's rounding, which every device shares) and `cos_sin_turns` 4 u; the
+/// frame 4 u + q; the products and sums 4 u: 13.5 u + q + w + |phi| u.
+pub fn lobe_direction_error(u: f64, q: f64, w: f64, phi: f64) -> f64 {
+    13.5 * u + q + w + phi.abs() * u
+}
+
+/// How far apart the CPU's and a conformant device's `sample_lobe` may be at azimuth `phi`, per
+/// component: [`lobe_direction_error`] for one IEEE and one Vulkan computation
+/// (28.25 + 1.5 |phi| eps).
+pub fn lobe_directions_apart(phi: f32) -> f64 {
+    let eps = f32::EPSILON as f64;
+    let phi = phi as f64;
+    lobe_direction_error(0.5 * eps, 0.5 * eps, 0.5 * eps, phi)
+        + lobe_direction_error(eps, 2.5 * eps, 4.5 * eps, phi)
+}
+
 /// How far apart the CPU's and a conformant device's `geometry_factor` G = |(n_a . d)(n_b . d)|
 /// / (d . d)^2 may be, for points |d|^2 = `d2` apart (derived in
 /// `tests/tests/vulkan_precision.rs`): 12 eps / |d|^2 + 21 eps G.

@@ -429,7 +429,7 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "rng (pcg4d, u32 -> float, scrambled Sobol)", func: function::RNG, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "integer arithmetic: bit-exact" },
     Bound { name: "offset_ray_origin / shadow_ray_end", func: function::OFFSET_RAY_ORIGIN, max_ulps: 1, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "integer ULP steps are exact; p + s n may be fused into one FMA on the GPU: 1 ULP" },
     Bound { name: "orthonormal_basis", func: function::ORTHONORMAL_BASIS, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "a few multiply-adds (FMA contraction): 4 ULP, or 4 eps absolute near zero" },
-    Bound { name: "sample_lobe", func: function::SAMPLE_LOBE, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "sin/cos differ by 1 ULP (GLSL.std.450 vs libm) plus the frame: 8 eps absolute on unit vectors" },
+    Bound { name: "sample_lobe", func: function::SAMPLE_LOBE, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "cos_sin_turns of phi / (2 pi) on both sides, the sine and the frame (FMA contraction): 8 eps absolute on unit vectors" },
     Bound { name: "sample_sphere", func: function::SAMPLE_SPHERE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "cos_sin_turns' polynomials under FMA contraction: normals 4 eps, positions 4 eps x (|centre| + radius)" },
     Bound { name: "sample_sphere_cone", func: function::SAMPLE_SPHERE_CONE, max_ulps: 4, abs: 4.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "cos_sin_turns and dot products under FMA contraction: pdf 4 ULP, normals 4 eps, positions 4 eps x (|centre| + radius)" },
     Bound { name: "geometry_factor", func: function::GEOMETRY_FACTOR, max_ulps: 8, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "dot products (FMA contraction): 8 ULP" },
@@ -545,6 +545,16 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let (direction, density) = twinpath_tests::device_class::cosine_sample_apart(f(3, 0));
             (if j < 3 { direction } else { density }) as f32
         }
+        // The Vulkan class's uniform sphere points (out0.xyz) and normals (out1.xyz), and the
+        // seed lobe's direction (out0.xyz), per record.
+        function::SAMPLE_SPHERE if b.vulkan && j < 3 => {
+            let c = [f(0, 0), f(0, 1), f(0, 2)];
+            let (normal, position) = twinpath_tests::device_class::sphere_points_apart(c, f(0, 3));
+            (if k == 0 { position } else { normal }) as f32
+        }
+        function::SAMPLE_LOBE if b.vulkan && k == 0 && j < 3 => {
+            twinpath_tests::device_class::lobe_directions_apart(f(1, 1)) as f32
+        }
         // The Vulkan class's phase-sampled direction (out0.xyz of the medium's record).
         function::MEDIUM if b.vulkan && k == 0 && j < 3 => {
             twinpath_tests::device_class::phase_directions_apart() as f32
@@ -609,6 +619,18 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
             abs: 4.0 * eps,
             vulkan: true,
             why: "Vulkan class: the axis, its frame, sin and cos of alpha (cancellation-free), the cone's extent and the azimuth, every rounding of one IEEE and one Vulkan computation: ~106 eps plus 6 eps of tan(theta_max) for normals, times the radius plus 1.5 eps (|c| + 2 r) for points, per record (`allowed_abs`); the density a few quotients and roots, 18 eps relative: 40 ULP or 4 eps",
+            ..*b
+        }),
+        function::SAMPLE_SPHERE => Some(Bound {
+            max_ulps: 0,
+            vulkan: true,
+            why: "Vulkan class: the latitude's radius (a product and a root) and cos_sin_turns' polynomials, for one IEEE and one Vulkan computation: 13.25 eps for normals, times the radius plus 1.5 eps (|c| + 2 r) for points, per record (`allowed_abs`)",
+            ..*b
+        }),
+        function::SAMPLE_LOBE => Some(Bound {
+            max_ulps: 0,
+            vulkan: true,
+            why: "Vulkan class: the sine sqrt((1 - c)(1 + c)), phi / (2 pi) and cos_sin_turns, the frame, products and sums, for one IEEE and one Vulkan computation: 28.25 + 1.5 |phi| eps per component, per record (`allowed_abs`)",
             ..*b
         }),
         function::MEDIUM => Some(Bound {

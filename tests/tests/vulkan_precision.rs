@@ -539,6 +539,95 @@ fn phase_directions_are_within_their_error_under_every_arithmetic() {
     assert!(apart <= phase_directions_apart(), "{} eps", apart / eps);
 }
 
+/// The seed's samplers `sample_sphere` and `sample_lobe` under IEEE arithmetic and every
+/// Vulkan model: within their first-order errors of the exact normal and direction
+/// (`device_class::sphere_normal_error`, `lobe_direction_error`), and a device's within the sum
+/// of an IEEE and a Vulkan computation of the CPU's (the bounds `gpu_functions.rs` holds a
+/// device that is not IEEE to). u1 at its extremes, cosines near +-1, azimuths over a turn.
+#[test]
+fn sphere_and_lobe_samples_are_within_their_error_under_every_arithmetic() {
+    use glam::DVec3;
+    use kernel::sampling::{sample_lobe_v3, sample_sphere_v3};
+    use twinpath_tests::device_class::{
+        lobe_direction_error, lobe_directions_apart, sphere_normal_error, sphere_points_apart,
+    };
+    let eps = f32::EPSILON as f64;
+    let mut g = Gen(SplitMix(29));
+    seed(29);
+    // Per model (IEEE, Vulkan, worst up, worst down): sphere normals, lobe directions.
+    let (mut worst, mut apart) = ([[0f64; 2]; 4], [0f64; 3]);
+    for case in 0..cases() {
+        let (s, t) = g.placement();
+        let u1 = if case % 5 == 0 {
+            [2f32.powi(-24), 1.0 - 2f32.powi(-24)][case / 5 % 2]
+        } else {
+            g.unit()
+        };
+        let u2 = g.unit();
+        let z = 2.0 * u1 as f64 - 1.0;
+        let r = (1.0 - z * z).sqrt();
+        let (sin_phi, cos_phi) = (std::f64::consts::TAU * u2 as f64).sin_cos();
+        let sphere_exact = DVec3::new(r * cos_phi, r * sin_phi, z);
+        let axis = g.dir();
+        let c = if case % 3 == 0 {
+            1.0 - 1e-6 * g.unit()
+        } else {
+            2.0 * g.unit() - 1.0
+        };
+        let phi = std::f32::consts::TAU * g.unit();
+        let lobe_exact = {
+            let a = axis.as_dvec3();
+            let sign = if a.z >= 0.0 { 1.0 } else { -1.0 };
+            let k = -1.0 / (sign + a.z);
+            let b = a.x * a.y * k;
+            let tt = DVec3::new(1.0 + sign * a.x * a.x * k, sign * b, -sign * a.x);
+            let bt = DVec3::new(b, sign + a.y * a.y * k, -a.y);
+            let (c, sn) = (c as f64, (1.0 - (c as f64).powi(2)).sqrt());
+            let (sp, cp) = (phi as f64).sin_cos();
+            tt * (sn * cp) + bt * (sn * sp) + a * c
+        };
+        if axis.z.abs() < 1e-4 {
+            continue;
+        }
+        let run = |model: usize| {
+            if model == 0 {
+                set_model(Model::IEEE);
+            } else {
+                any_device(model - 1);
+            }
+            let (p, n) = sample_sphere_v3(v(t), f(s), f(u1), f(u2));
+            (
+                back(p),
+                back(n),
+                back(sample_lobe_v3(v(axis), f(c), f(phi))),
+            )
+        };
+        let cpu = run(0);
+        let (normal_apart, position_apart) = sphere_points_apart(t.into(), s);
+        for (model, worst) in worst.iter_mut().enumerate() {
+            let (u, q, w) = if model == 0 {
+                (0.5 * eps, 0.5 * eps, 0.5 * eps)
+            } else {
+                (eps, 2.5 * eps, 4.5 * eps)
+            };
+            let got = if model == 0 { cpu } else { run(model) };
+            let sphere_error = (got.1.as_dvec3() - sphere_exact).abs().max_element();
+            worst[0] = worst[0].max(sphere_error / sphere_normal_error(u, w));
+            let lobe_error = (got.2.as_dvec3() - lobe_exact).abs().max_element();
+            let lobe_bound = lobe_direction_error(u, q, w, phi as f64);
+            worst[1] = worst[1].max(lobe_error / lobe_bound);
+            let d = |a: Vec3, b: Vec3| (a - b).abs().max_element() as f64;
+            apart[0] = apart[0].max(d(got.1, cpu.1) / normal_apart);
+            apart[1] = apart[1].max(d(got.0, cpu.0) / position_apart);
+            apart[2] = apart[2].max(d(got.2, cpu.2) / lobe_directions_apart(phi));
+        }
+    }
+    set_model(Model::VULKAN);
+    println!("against the exact one, of their bounds, per model (IEEE, Vulkan, worst up, worst down) [sphere normals, lobe directions]: {worst:.3?}; a device against the CPU, of the bounds: sphere normals {:.3}, points {:.3}, lobe directions {:.3}", apart[0], apart[1], apart[2]);
+    assert!(worst.iter().flatten().all(|&w| w <= 1.0), "{worst:?}");
+    assert!(apart.iter().all(|&a| a <= 1.0), "{apart:?}");
+}
+
 /// How far the kernel's hit points fall from the exact surface, worst over random triangles and
 /// spheres, as fractions of two bounds: the one the kernel gives them (`triangle_point_error`,
 /// `sphere_point_error`) and the first-order bound of IEEE arithmetic (docs/robustness.md):
