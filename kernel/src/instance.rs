@@ -6,33 +6,36 @@
 //! Every map is written out component by component in a fixed order (three products summed left
 //! to right, then the translation), so both backends compute the same `f32`s.
 
+use crate::real::{self, V3};
 use crate::scene::Instance;
 use spirv_std::glam::Vec3;
 
 /// The linear part of the row-major 3 x 4 matrix `m` applied to `v`.
 #[inline]
-fn linear(m: &[f32; 12], v: Vec3) -> Vec3 {
-    Vec3::new(
-        m[0] * v.x + m[1] * v.y + m[2] * v.z,
-        m[4] * v.x + m[5] * v.y + m[6] * v.z,
-        m[8] * v.x + m[9] * v.y + m[10] * v.z,
+fn linear<R: real::Real>(m: &[f32; 12], v: V3<R>) -> V3<R> {
+    let e = |i: usize| R::splat(m[i]);
+    V3::new(
+        e(0) * v.x + e(1) * v.y + e(2) * v.z,
+        e(4) * v.x + e(5) * v.y + e(6) * v.z,
+        e(8) * v.x + e(9) * v.y + e(10) * v.z,
     )
 }
 
 /// The transpose of `m`'s linear part applied to `v`.
 #[inline]
-fn linear_transposed(m: &[f32; 12], v: Vec3) -> Vec3 {
-    Vec3::new(
-        m[0] * v.x + m[4] * v.y + m[8] * v.z,
-        m[1] * v.x + m[5] * v.y + m[9] * v.z,
-        m[2] * v.x + m[6] * v.y + m[10] * v.z,
+fn linear_transposed<R: real::Real>(m: &[f32; 12], v: V3<R>) -> V3<R> {
+    let e = |i: usize| R::splat(m[i]);
+    V3::new(
+        e(0) * v.x + e(4) * v.y + e(8) * v.z,
+        e(1) * v.x + e(5) * v.y + e(9) * v.z,
+        e(2) * v.x + e(6) * v.y + e(10) * v.z,
     )
 }
 
 /// `m` applied to point `p`: its linear part, then its translation.
 #[inline]
-fn affine(m: &[f32; 12], p: Vec3) -> Vec3 {
-    linear(m, p) + Vec3::new(m[3], m[7], m[11])
+fn affine<R: real::Real>(m: &[f32; 12], p: V3<R>) -> V3<R> {
+    linear(m, p) + V3::new(R::splat(m[3]), R::splat(m[7]), R::splat(m[11]))
 }
 
 /// The largest absolute translation component of `m`.
@@ -43,20 +46,27 @@ fn translation_norm(m: &[f32; 12]) -> f32 {
 
 /// Largest absolute component of `v`.
 #[inline]
-fn max_abs(v: Vec3) -> f32 {
-    v.abs().max_element()
+fn max_abs<R: real::Real>(v: V3<R>) -> R {
+    real::abs(v.x).max(real::abs(v.y)).max(real::abs(v.z))
 }
 
 /// The world-space image of object-space point `p`.
 #[inline]
 pub fn point_to_world(instance: &Instance, p: Vec3) -> Vec3 {
+    point_to_world_v3(instance, V3::from(p)).into()
+}
+
+/// [`point_to_world`] over any [`real::Real`] (the tests run the instance maps under a model
+/// of Vulkan's arithmetic).
+#[inline]
+pub fn point_to_world_v3<R: real::Real>(instance: &Instance, p: V3<R>) -> V3<R> {
     affine(&instance.object_to_world, p)
 }
 
 /// The world-space image of object-space direction `v` (a tangent: it maps like an edge).
 #[inline]
 pub fn vector_to_world(instance: &Instance, v: Vec3) -> Vec3 {
-    linear(&instance.object_to_world, v)
+    linear(&instance.object_to_world, V3::from(v)).into()
 }
 
 /// The world-space normal of a surface whose object-space normal is `n`: the inverse transpose
@@ -64,6 +74,12 @@ pub fn vector_to_world(instance: &Instance, v: Vec3) -> Vec3 {
 /// normalised. It points to the side of the surface `n` points to, mirroring or not.
 #[inline]
 pub fn normal_to_world(instance: &Instance, n: Vec3) -> Vec3 {
+    normal_to_world_v3(instance, V3::from(n)).into()
+}
+
+/// [`normal_to_world`] over any [`real::Real`].
+#[inline]
+pub fn normal_to_world_v3<R: real::Real>(instance: &Instance, n: V3<R>) -> V3<R> {
     linear_transposed(&instance.world_to_object, n)
 }
 
@@ -72,6 +88,17 @@ pub fn normal_to_world(instance: &Instance, n: Vec3) -> Vec3 {
 /// spaces). The CPU's BVH traces instances this way; the GPU maps rays by its own inverse.
 #[inline]
 pub fn ray_to_object(instance: &Instance, origin: Vec3, dir: Vec3) -> (Vec3, Vec3) {
+    let (o, d) = ray_to_object_v3(instance, V3::from(origin), V3::from(dir));
+    (o.into(), d.into())
+}
+
+/// [`ray_to_object`] over any [`real::Real`].
+#[inline]
+pub fn ray_to_object_v3<R: real::Real>(
+    instance: &Instance,
+    origin: V3<R>,
+    dir: V3<R>,
+) -> (V3<R>, V3<R>) {
     (
         affine(&instance.world_to_object, origin),
         linear(&instance.world_to_object, dir),
@@ -107,10 +134,28 @@ pub fn world_point_error(
     object_error: f32,
     p_world: Vec3,
 ) -> f32 {
-    let m = instance.forward_norm;
-    let w = instance.inverse_norm;
-    let carried = m * object_error * (1.0 + INSTANCE_ERROR_EPS * f32::EPSILON);
-    let forward = m * max_abs(p_object) + translation_norm(&instance.object_to_world);
-    let round_trip = m * (w * max_abs(p_world) + translation_norm(&instance.world_to_object));
-    carried + INSTANCE_ERROR_EPS * f32::EPSILON * (forward + round_trip)
+    world_point_error_v3(
+        instance,
+        V3::from(p_object),
+        object_error,
+        V3::from(p_world),
+    )
+}
+
+/// [`world_point_error`] over any [`real::Real`].
+#[inline]
+pub fn world_point_error_v3<R: real::Real>(
+    instance: &Instance,
+    p_object: V3<R>,
+    object_error: R,
+    p_world: V3<R>,
+) -> R {
+    let m = R::splat(instance.forward_norm);
+    let w = R::splat(instance.inverse_norm);
+    let eps = R::splat(INSTANCE_ERROR_EPS * f32::EPSILON);
+    let carried = m * object_error * (R::splat(1.0) + eps);
+    let forward = m * max_abs(p_object) + R::splat(translation_norm(&instance.object_to_world));
+    let round_trip =
+        m * (w * max_abs(p_world) + R::splat(translation_norm(&instance.world_to_object)));
+    carried + eps * (forward + round_trip)
 }
