@@ -455,12 +455,23 @@ fn cone_samples_face_the_receiver_with_finite_pdf_under_vulkan_arithmetic() {
     }
 }
 
+/// `kernel::frame::orthonormal_basis` (Duff et al.'s frame) in `f64`: the exact frame of the
+/// exact direction, for the samplers' exact references.
+fn exact_frame(n: glam::DVec3) -> (glam::DVec3, glam::DVec3) {
+    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        glam::DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        glam::DVec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
 /// The point `sample_sphere_cone_v3` means for sphere (c, r), receiver p and (u1, u2), in
 /// `f64` from the same `f32` inputs: the direction at angle theta (1 - cos theta = u1 (1 -
 /// cos theta_max)) meets the sphere where alpha = beta - theta, beta = atan2(sin theta /
 /// sin theta_max, cos beta), in the frame `orthonormal_basis` builds around the axis.
 fn cone_point_exact(c: Vec3, r: f32, p: Vec3, u1: f32, u2: f32) -> glam::DVec3 {
-    use glam::DVec3;
     let (c, r, p, u1, u2) = (c.as_dvec3(), r as f64, p.as_dvec3(), u1 as f64, u2 as f64);
     let axis = (c - p).normalize();
     let sin2_max = (r * r / (c - p).length_squared()).min(1.0);
@@ -470,11 +481,7 @@ fn cone_point_exact(c: Vec3, r: f32, p: Vec3, u1: f32, u2: f32) -> glam::DVec3 {
     let rest = 1.0 - u1;
     let cos_beta = (rest * (rest + cos_max * (1.0 + u1)) / (1.0 + cos_max)).sqrt();
     let alpha = (sin / sin2_max.sqrt()).atan2(cos_beta) - sin.atan2(1.0 - one_minus_cos);
-    let sign = if axis.z >= 0.0 { 1.0 } else { -1.0 };
-    let a = -1.0 / (sign + axis.z);
-    let b = axis.x * axis.y * a;
-    let t = DVec3::new(1.0 + sign * axis.x * axis.x * a, sign * b, -sign * axis.x);
-    let bt = DVec3::new(b, sign + axis.y * axis.y * a, -axis.y);
+    let (t, bt) = exact_frame(axis);
     let (cos_phi, sin_phi) = (
         (std::f64::consts::TAU * u2).cos(),
         (std::f64::consts::TAU * u2).sin(),
@@ -539,7 +546,6 @@ fn cone_points_are_within_their_error_of_the_exact_point_under_every_arithmetic(
 /// inputs: mu and the sine from the exact factors 1 - mu and 1 + mu (the module's inverse CDF),
 /// the azimuth 2 pi u2, in the frame `orthonormal_basis` builds around the direction of travel.
 fn phase_direction_exact(g: f32, wo: Vec3, u1: f32, u2: f32) -> glam::DVec3 {
-    use glam::DVec3;
     let g = if g.abs() < kernel::phase::ISOTROPIC_G {
         0.0
     } else {
@@ -553,15 +559,7 @@ fn phase_direction_exact(g: f32, wo: Vec3, u1: f32, u2: f32) -> glam::DVec3 {
     let mu = (one_plus_mu - one_minus_mu) / 2.0;
     let sin = (one_minus_mu * one_plus_mu).sqrt();
     let travel = -wo.as_dvec3();
-    let sign = if travel.z >= 0.0 { 1.0 } else { -1.0 };
-    let a = -1.0 / (sign + travel.z);
-    let b = travel.x * travel.y * a;
-    let t = DVec3::new(
-        1.0 + sign * travel.x * travel.x * a,
-        sign * b,
-        -sign * travel.x,
-    );
-    let bt = DVec3::new(b, sign + travel.y * travel.y * a, -travel.y);
+    let (t, bt) = exact_frame(travel);
     let (sin_phi, cos_phi) = (std::f64::consts::TAU * u2).sin_cos();
     (travel * mu + (t * cos_phi + bt * sin_phi) * sin).normalize()
 }
@@ -667,11 +665,7 @@ fn sphere_and_lobe_samples_are_within_their_error_under_every_arithmetic() {
         let phi = std::f32::consts::TAU * g.unit();
         let lobe_exact = {
             let a = axis.as_dvec3();
-            let sign = if a.z >= 0.0 { 1.0 } else { -1.0 };
-            let k = -1.0 / (sign + a.z);
-            let b = a.x * a.y * k;
-            let tt = DVec3::new(1.0 + sign * a.x * a.x * k, sign * b, -sign * a.x);
-            let bt = DVec3::new(b, sign + a.y * a.y * k, -a.y);
+            let (tt, bt) = exact_frame(a);
             let (c, sn) = (c as f64, (1.0 - (c as f64).powi(2)).sqrt());
             let (sp, cp) = (phi as f64).sin_cos();
             tt * (sn * cp) + bt * (sn * sp) + a * c
