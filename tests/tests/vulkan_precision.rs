@@ -53,6 +53,20 @@ fn any_device(case: usize) {
     }
 }
 
+/// Sets the arithmetic of the next computations to model `k` of four (0: IEEE, the CPU; 1 to 3:
+/// [`any_device`]`(k - 1)`) and returns its (unit roundoff, quotient error, root error): eps / 2
+/// each under IEEE; eps, 2.5 eps and 4.5 eps under Vulkan.
+fn use_model(k: usize) -> (f64, f64, f64) {
+    let eps = f32::EPSILON as f64;
+    if k == 0 {
+        set_model(Model::IEEE);
+        (0.5 * eps, 0.5 * eps, 0.5 * eps)
+    } else {
+        any_device(k - 1);
+        (eps, 2.5 * eps, 4.5 * eps)
+    }
+}
+
 /// Cases per test: 2 x 10^5 by default; `VULKAN_PRECISION_CASES` for longer runs.
 fn cases() -> usize {
     std::env::var("VULKAN_PRECISION_CASES")
@@ -498,7 +512,6 @@ fn cone_point_exact(c: Vec3, r: f32, p: Vec3, u1: f32, u2: f32) -> glam::DVec3 {
 #[test]
 fn cone_points_are_within_their_error_of_the_exact_point_under_every_arithmetic() {
     use twinpath_tests::device_class::cone_normal_error;
-    let eps = f32::EPSILON as f64;
     let mut g = Gen(SplitMix(17));
     seed(17);
     // IEEE, Vulkan at random, the worst model leaning up and down.
@@ -515,13 +528,7 @@ fn cone_points_are_within_their_error_of_the_exact_point_under_every_arithmetic(
         let sin2_max = (s as f64 / (t - x).as_dvec3().length()).powi(2).min(1.0);
         let tan_max = (sin2_max / (1.0 - sin2_max)).sqrt();
         let model = case % 4;
-        let (u, q, w) = if model == 0 {
-            set_model(Model::IEEE);
-            (0.5 * eps, 0.5 * eps, 0.5 * eps)
-        } else {
-            any_device(model - 1);
-            (eps, 2.5 * eps, 4.5 * eps)
-        };
+        let (u, q, w) = use_model(model);
         let sample = sample_sphere_cone_v3(v(t), f(s), v(x), f(u1), f(u2));
         let bound = cone_normal_error(u, q, w, tan_max) * s as f64
             + u * (t.abs().max_element() as f64 + 2.0 * s as f64);
@@ -596,22 +603,12 @@ fn phase_directions_are_within_their_error_under_every_arithmetic() {
         };
         let u2 = g_.unit();
         let exact = phase_direction_exact(g, wo, u1, u2);
-        let run = |model: usize| {
-            if model == 0 {
-                set_model(Model::IEEE);
-            } else {
-                any_device(model - 1);
-            }
-            back(kernel::phase::sample_v3(f(g), v(wo), f(u1), f(u2)))
-        };
-        let cpu = run(0);
+        let run = || back(kernel::phase::sample_v3(f(g), v(wo), f(u1), f(u2)));
+        use_model(0);
+        let cpu = run();
         for (model, worst) in worst.iter_mut().enumerate() {
-            let (u, q, w) = if model == 0 {
-                (0.5 * eps, 0.5 * eps, 0.5 * eps)
-            } else {
-                (eps, 2.5 * eps, 4.5 * eps)
-            };
-            let got = if model == 0 { cpu } else { run(model) };
+            let (u, q, w) = use_model(model);
+            let got = if model == 0 { cpu } else { run() };
             let error = (got.as_dvec3() - exact).abs().max_element();
             *worst = worst.max(error / phase_direction_error(u, q, w));
             apart = apart.max((got - cpu).abs().max_element() as f64);
@@ -639,7 +636,6 @@ fn sphere_and_lobe_samples_are_within_their_error_under_every_arithmetic() {
     use twinpath_tests::device_class::{
         lobe_direction_error, lobe_directions_apart, sphere_normal_error, sphere_points_apart,
     };
-    let eps = f32::EPSILON as f64;
     let mut g = Gen(SplitMix(29));
     seed(29);
     // Per model (IEEE, Vulkan, worst up, worst down): sphere normals, lobe directions.
@@ -673,12 +669,7 @@ fn sphere_and_lobe_samples_are_within_their_error_under_every_arithmetic() {
         if axis.z.abs() < 1e-4 {
             continue;
         }
-        let run = |model: usize| {
-            if model == 0 {
-                set_model(Model::IEEE);
-            } else {
-                any_device(model - 1);
-            }
+        let run = || {
             let (p, n) = sample_sphere_v3(v(t), f(s), f(u1), f(u2));
             (
                 back(p),
@@ -686,15 +677,12 @@ fn sphere_and_lobe_samples_are_within_their_error_under_every_arithmetic() {
                 back(sample_lobe_v3(v(axis), f(c), f(phi))),
             )
         };
-        let cpu = run(0);
+        use_model(0);
+        let cpu = run();
         let (normal_apart, position_apart) = sphere_points_apart(t.into(), s);
         for (model, worst) in worst.iter_mut().enumerate() {
-            let (u, q, w) = if model == 0 {
-                (0.5 * eps, 0.5 * eps, 0.5 * eps)
-            } else {
-                (eps, 2.5 * eps, 4.5 * eps)
-            };
-            let got = if model == 0 { cpu } else { run(model) };
+            let (u, q, w) = use_model(model);
+            let got = if model == 0 { cpu } else { run() };
             let sphere_error = (got.1.as_dvec3() - sphere_exact).abs().max_element();
             worst[0] = worst[0].max(sphere_error / sphere_normal_error(u, w));
             let lobe_error = (got.2.as_dvec3() - lobe_exact).abs().max_element();
