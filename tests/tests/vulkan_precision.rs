@@ -700,6 +700,41 @@ fn sphere_and_lobe_samples_are_within_their_error_under_every_arithmetic() {
     assert!(apart.iter().all(|&a| a <= 1.0), "{apart:?}");
 }
 
+/// `cos_sin_turns`, the azimuth of every sampler, is within 4 u of the exact cosine and sine
+/// under IEEE arithmetic (u = eps / 2) and every Vulkan model (u = eps): the assumption of the
+/// samplers' derived bounds (`device_class`). Its range reduction is exact in any rounding
+/// mode (4 u and the nearest integer are exact, the remainder by Sterbenz's lemma), and the
+/// polynomials' roundings stay below a few u of results of magnitude <= 1.
+#[test]
+fn cos_sin_turns_is_within_four_roundings_under_every_arithmetic() {
+    use kernel::turns::cos_sin_turns;
+    let mut g = SplitMix(43);
+    seed(43);
+    let mut worst = [0f64; 4];
+    for k in 0..cases() {
+        let x = if k < 1 << 12 {
+            // Both sides of every eighth of a turn, where the reduction's quadrant changes.
+            let edge = (k >> 6) as f32 / 8.0 - 4.0;
+            let step = ((k & 63) as i32 - 32) as f32 * f32::EPSILON;
+            edge + step * edge.abs().max(1.0)
+        } else {
+            g.unit()
+        };
+        let (sin64, cos64) = (std::f64::consts::TAU * x as f64).sin_cos();
+        for (model, worst) in worst.iter_mut().enumerate() {
+            let (u, _, _) = use_model(model);
+            let (c, s) = cos_sin_turns(f(x));
+            let error = (c.value as f64 - cos64)
+                .abs()
+                .max((s.value as f64 - sin64).abs());
+            *worst = worst.max(error / (4.0 * u));
+        }
+    }
+    set_model(Model::VULKAN);
+    println!("cos_sin_turns against f64, of 4 u (IEEE, Vulkan, worst up, worst down): {worst:.3?}");
+    assert!(worst.iter().all(|&w| w <= 1.0), "{worst:?}");
+}
+
 /// How far the kernel's hit points fall from the exact surface, worst over random triangles and
 /// spheres, as fractions of two bounds: the one the kernel gives them (`triangle_point_error`,
 /// `sphere_point_error`) and the first-order bound of IEEE arithmetic (docs/robustness.md):
