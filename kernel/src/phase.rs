@@ -34,12 +34,8 @@ pub const ISOTROPIC_G: f32 = 1e-3;
 
 /// g as the sampler and the density use it: 0 below [`ISOTROPIC_G`].
 #[inline]
-fn effective(g: f32) -> f32 {
-    if g.abs() < ISOTROPIC_G {
-        0.0
-    } else {
-        g
-    }
+fn effective<R: real::Real>(g: R) -> R {
+    real::select(abs(g).less_than(R::splat(ISOTROPIC_G)), R::splat(0.0), g)
 }
 
 /// The phase function of asymmetry `g` at `cos_theta` (the cosine of the scattering angle),
@@ -80,8 +76,7 @@ pub fn sample(g: f32, wo: Vec3, u1: f32, u2: f32) -> Vec3 {
 #[inline(always)]
 pub fn sample_v3<R: real::Real>(g: R, wo: V3<R>, u1: R, u2: R) -> V3<R> {
     let one = R::splat(1.0);
-    let isotropic = abs(g).less_than(R::splat(ISOTROPIC_G));
-    let g = real::select(isotropic, R::splat(0.0), g);
+    let g = effective(g);
     let (minus, plus, rest) = (one - g, one + g, one - u1);
     let d = minus * rest + plus * u1;
     let s = minus * plus / d;

@@ -156,14 +156,21 @@ pub struct ConeExtent<R> {
     pub cos_max: R,
 }
 
+impl<R: real::Real> ConeExtent<R> {
+    /// 1 - cos(theta_max) as sin^2 / (1 + cos): the same value as 1 - cos without its
+    /// cancellation, accurate for cones of any size (pbrt-v4 switches to a Taylor expansion
+    /// below 1.5 degrees instead; this form needs no branch).
+    #[inline]
+    pub fn one_minus_cos(self) -> R {
+        self.sin2_max / (R::splat(1.0) + self.cos_max)
+    }
+}
+
 /// 1 - cos(theta_max) of the cone a sphere of `radius` subtends from a point at squared
-/// distance `dist2` from its centre, as sin^2 / (1 + cos): the same value as 1 - cos without
-/// its cancellation, accurate for cones of any size (pbrt-v4 switches to a Taylor expansion
-/// below 1.5 degrees instead; this form needs no branch).
+/// distance `dist2` from its centre ([`ConeExtent::one_minus_cos`]).
 #[inline]
 pub fn cone_one_minus_cos<R: real::Real>(radius: R, dist2: R) -> R {
-    let cone = cone_extent(radius, dist2);
-    cone.sin2_max / (R::splat(1.0) + cone.cos_max)
+    cone_extent(radius, dist2).one_minus_cos()
 }
 
 /// Samples the sphere (center, radius) as seen from outside point `p`: a direction uniform in
@@ -217,7 +224,7 @@ pub fn sample_sphere_cone_v3<R: real::Real>(
     let axis = to_center / dist;
     let sin_max = radius / dist;
     let cone = cone_extent(radius, dist2);
-    let one_minus_cos_max = cone.sin2_max / (one + cone.cos_max);
+    let one_minus_cos_max = cone.one_minus_cos();
     // Uniform in 1 - cos(theta); sin^2 = (1 - cos)(1 + cos) keeps full precision in tiny cones.
     let one_minus_cos = u1 * one_minus_cos_max;
     let cos = one - one_minus_cos;
