@@ -11,6 +11,21 @@
 /// for devices that are not IEEE).
 pub const BASIS_APART_EPS: f32 = 9.0;
 
+/// (unit roundoff u, quotient error q, root error w) of a computation in IEEE-754 single
+/// precision, relative: eps / 2 each (correctly rounded).
+pub const IEEE_ROUNDOFF: (f64, f64, f64) = (0.5 * EPS, 0.5 * EPS, 0.5 * EPS);
+/// The same under Vulkan's precision rules: u = eps (rounding toward zero allowed), quotients
+/// within 2.5 ULP, roots as 1 / inversesqrt within 4.5 eps.
+pub const VULKAN_ROUNDOFF: (f64, f64, f64) = (EPS, 2.5 * EPS, 4.5 * EPS);
+
+const EPS: f64 = f32::EPSILON as f64;
+
+/// How far apart one IEEE and one Vulkan computation may be, for a first-order `error` bound of
+/// one computation given its (u, q, w): the sum of the two.
+fn apart(error: impl Fn((f64, f64, f64)) -> f64) -> f64 {
+    error(IEEE_ROUNDOFF) + error(VULKAN_ROUNDOFF)
+}
+
 /// First-order error of one computation of `kernel::sampling::sample_sphere_cone_v3`'s normal
 /// (and of its point, in radii), for unit roundoff `u`, quotient error `q` and root error `w`,
 /// every rounding aligned, where `sin_over_cos` is tan(theta_max) of the cone:
@@ -44,13 +59,11 @@ pub fn cone_normal_error(u: f64, q: f64, w: f64, sin_over_cos: f64) -> f64 {
 /// 4.25 of tan(theta_max)); a position c + r n adds r times that and its own roundings,
 /// u (|c| + 2 r) per computation.
 pub fn cone_points_apart(center: [f32; 3], radius: f32, p: [f32; 3]) -> (f64, f64) {
-    let eps = f32::EPSILON as f64;
     let (c, r) = (d3(center), radius as f64);
     let sin2_max = (r * r / (c - d3(p)).length_squared()).min(1.0);
     let tan_max = (sin2_max / (1.0 - sin2_max)).sqrt();
-    let normal = cone_normal_error(0.5 * eps, 0.5 * eps, 0.5 * eps, tan_max)
-        + cone_normal_error(eps, 2.5 * eps, 4.5 * eps, tan_max);
-    let position = normal * r + 1.5 * eps * (c.abs().max_element() + 2.0 * r);
+    let normal = apart(|(u, q, w)| cone_normal_error(u, q, w, tan_max));
+    let position = normal * r + APART_U * (c.abs().max_element() + 2.0 * r);
     (normal, position)
 }
 
@@ -69,9 +82,7 @@ pub fn phase_direction_error(u: f64, q: f64, w: f64) -> f64 {
 /// component: [`phase_direction_error`] for one IEEE and one Vulkan computation (25.5 and 67
 /// eps).
 pub fn phase_directions_apart() -> f64 {
-    let eps = f32::EPSILON as f64;
-    phase_direction_error(0.5 * eps, 0.5 * eps, 0.5 * eps)
-        + phase_direction_error(eps, 2.5 * eps, 4.5 * eps)
+    apart(|(u, q, w)| phase_direction_error(u, q, w))
 }
 
 /// First-order error of one computation of `kernel::sampling::sample_sphere_v3`'s unit normal,
@@ -88,11 +99,10 @@ pub fn sphere_normal_error(u: f64, w: f64) -> f64 {
 /// IEEE and one Vulkan computation (3.25 and 10 eps); a position c + r n adds r times that and
 /// its own roundings, u (|c| + 2 r) per computation.
 pub fn sphere_points_apart(center: [f32; 3], radius: f32) -> (f64, f64) {
-    let eps = f32::EPSILON as f64;
-    let normal = sphere_normal_error(0.5 * eps, 0.5 * eps) + sphere_normal_error(eps, 4.5 * eps);
+    let normal = apart(|(u, _, w)| sphere_normal_error(u, w));
     let c = d3(center).abs().max_element();
     let r = radius as f64;
-    (normal, normal * r + 1.5 * eps * (c + 2.0 * r))
+    (normal, normal * r + APART_U * (c + 2.0 * r))
 }
 
 /// First-order error of one computation of `kernel::sampling::sample_lobe_v3`'s direction, per
@@ -108,10 +118,7 @@ pub fn lobe_direction_error(u: f64, q: f64, w: f64, phi: f64) -> f64 {
 /// component: [`lobe_direction_error`] for one IEEE and one Vulkan computation
 /// (28.25 + 1.5 |phi| eps).
 pub fn lobe_directions_apart(phi: f32) -> f64 {
-    let eps = f32::EPSILON as f64;
-    let phi = phi as f64;
-    lobe_direction_error(0.5 * eps, 0.5 * eps, 0.5 * eps, phi)
-        + lobe_direction_error(eps, 2.5 * eps, 4.5 * eps, phi)
+    apart(|(u, q, w)| lobe_direction_error(u, q, w, phi as f64))
 }
 
 /// How far apart the CPU's and a conformant device's `geometry_factor` G = |(n_a . d)(n_b . d)|
@@ -124,8 +131,8 @@ pub fn geometry_factor_apart(d2: f64, g: f64) -> f64 {
 /// The roundoff of one IEEE and one Vulkan computation added: u (eps / 2 and eps) and a
 /// quotient's relative error (eps / 2 and 2.5 eps). A quantity computed by both is apart by at
 /// most its error bound with these.
-const APART_U: f64 = 1.5 * f32::EPSILON as f64;
-const APART_Q: f64 = 3.0 * f32::EPSILON as f64;
+const APART_U: f64 = IEEE_ROUNDOFF.0 + VULKAN_ROUNDOFF.0;
+const APART_Q: f64 = IEEE_ROUNDOFF.1 + VULKAN_ROUNDOFF.1;
 
 fn d3(v: [f32; 3]) -> glam::DVec3 {
     glam::Vec3::from_array(v).as_dvec3()

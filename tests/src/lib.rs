@@ -148,6 +148,7 @@ pub fn shade_at(
 
 pub mod cubature;
 pub mod device_class;
+pub mod exact;
 pub mod ggx_table;
 pub mod gltf_writer;
 #[cfg(feature = "gpu")]

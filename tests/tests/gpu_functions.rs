@@ -602,8 +602,8 @@ fn hit_may_flip(func: u32, r: &[[u32; 4]; 4]) -> bool {
 /// arithmetic"; checked against a model of such a device in `vulkan_precision.rs`, which gives
 /// 2.25 eps for the basis where the NVIDIA H200 gave 0.75 eps, cone points within 0.62 of
 /// their bound, and the geometry factor within a fifth of its bound where the H200 was 3711
-/// ULP off). The other
-/// functions keep the IEEE-class bound on every device until theirs is derived.
+/// ULP off). The other functions keep the IEEE-class bound on every device until theirs is
+/// derived.
 fn vulkan_class(b: &Bound) -> Option<Bound> {
     let eps = f32::EPSILON;
     match b.func {

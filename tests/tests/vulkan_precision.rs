@@ -22,7 +22,7 @@ use kernel::real::{Real, V3};
 use kernel::sampling::{sample_cosine_hemisphere_v3, sample_sphere_cone_v3};
 use twinpath_tests::device_class::{
     cone_points_apart, geometry_factor_apart, sphere_hit_may_flip, triangle_hit_may_flip,
-    BASIS_APART_EPS,
+    BASIS_APART_EPS, IEEE_ROUNDOFF, VULKAN_ROUNDOFF,
 };
 use twinpath_tests::vulkan_arithmetic::{lean, seed, set_model, ulp, Model, Vk32};
 use twinpath_tests::SplitMix;
@@ -57,13 +57,12 @@ fn any_device(case: usize) {
 /// [`any_device`]`(k - 1)`) and returns its (unit roundoff, quotient error, root error): eps / 2
 /// each under IEEE; eps, 2.5 eps and 4.5 eps under Vulkan.
 fn use_model(k: usize) -> (f64, f64, f64) {
-    let eps = f32::EPSILON as f64;
     if k == 0 {
         set_model(Model::IEEE);
-        (0.5 * eps, 0.5 * eps, 0.5 * eps)
+        IEEE_ROUNDOFF
     } else {
         any_device(k - 1);
-        (eps, 2.5 * eps, 4.5 * eps)
+        VULKAN_ROUNDOFF
     }
 }
 
@@ -558,16 +557,13 @@ fn phase_direction_exact(g: f32, wo: Vec3, u1: f32, u2: f32) -> glam::DVec3 {
     } else {
         g as f64
     };
-    let (u1, u2) = (u1 as f64, u2 as f64);
-    let d = (1.0 - g) * (1.0 - u1) + (1.0 + g) * u1;
-    let s = (1.0 - g) * (1.0 + g) / d;
-    let one_minus_mu = (1.0 - g) * (1.0 - u1) * (s + 1.0 - g) / d;
-    let one_plus_mu = (1.0 + g) * u1 * (1.0 + g + s) / d;
+    let (one_minus_mu, one_plus_mu) =
+        twinpath_tests::exact::henyey_greenstein_factors(g, u1 as f64);
     let mu = (one_plus_mu - one_minus_mu) / 2.0;
     let sin = (one_minus_mu * one_plus_mu).sqrt();
     let travel = -wo.as_dvec3();
     let (t, bt) = exact_frame(travel);
-    let (sin_phi, cos_phi) = (std::f64::consts::TAU * u2).sin_cos();
+    let (sin_phi, cos_phi) = (std::f64::consts::TAU * u2 as f64).sin_cos();
     (travel * mu + (t * cos_phi + bt * sin_phi) * sin).normalize()
 }
 
