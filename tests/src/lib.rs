@@ -335,6 +335,20 @@ impl SplitMix {
     pub fn unit_f64(&mut self) -> f64 {
         (self.u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
+    /// A unit direction, uniform on the sphere (a point of the cube kept inside the unit ball,
+    /// away from its centre, then normalised).
+    pub fn direction(&mut self) -> glam::Vec3 {
+        loop {
+            let v = glam::Vec3::new(
+                2.0 * self.unit() - 1.0,
+                2.0 * self.unit() - 1.0,
+                2.0 * self.unit() - 1.0,
+            );
+            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
 }
 
 /// Each pixel's variance of the mean for `film`'s sample counts, from the per-sample variance of

@@ -16,18 +16,9 @@ impl Placements {
     pub fn pow10(&mut self, lo: f32, hi: f32) -> f32 {
         10f32.powf(lo + (hi - lo) * self.unit())
     }
-    /// A unit direction, uniform on the sphere.
+    /// A unit direction, uniform on the sphere ([`SplitMix::direction`]).
     pub fn dir(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(
-                2.0 * self.unit() - 1.0,
-                2.0 * self.unit() - 1.0,
-                2.0 * self.unit() - 1.0,
-            );
-            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
-                return v.normalize();
-            }
-        }
+        self.0.direction()
     }
     /// A random placement: scale 10^U(-4, 5), translated by up to 10^3 times that.
     pub fn placement(&mut self) -> (f32, Vec3) {

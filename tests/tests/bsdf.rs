@@ -250,16 +250,7 @@ fn rough_samplers_follow_their_pdfs() {
 
 /// Random unit vectors (the tests' own generator).
 fn unit(g: &mut SplitMix) -> Vec3 {
-    loop {
-        let v = Vec3::new(
-            2.0 * g.unit() - 1.0,
-            2.0 * g.unit() - 1.0,
-            2.0 * g.unit() - 1.0,
-        );
-        if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
-            return v.normalize();
-        }
-    }
+    g.direction()
 }
 
 /// Materials for the pointwise comparisons: roughness from 0.01 to 1 and indices away from 1
