@@ -9,13 +9,15 @@ the reference EXR with the definitions of `twinpath diff`:
 relMSE = mean over pixels and channels of (a - b)^2 / (b^2 + 0.01).
 
 Usage: peer_mitsuba.py REFERENCE.exr OUT.csv [--variant llvm_ad_rgb] [--max-spp 1024]
-       [--max-seconds 60] [--sampler independent] [--mesh KNOT.ply] [--once SPP]
+       [--max-seconds 60] [--sampler independent] [--scene cornell|materials] [--mesh KNOT.ply]
+       [--once SPP]
 --sampler picks Mitsuba's sampler (the reference's is `independent`; `ldsampler` is its
 low-discrepancy one, `multijitter` / `stratified` its stratified ones); names other than
 independent are added to the variant column. --mesh replaces the two spheres by a PLY mesh in
 white, flat-shaded (scripts/knot_scenes.py's scenes); its file name is added to the variant.
+--scene materials builds scenes/cornell_materials.toml (cornell_materials_dict) instead.
 --once SPP renders once (seed 1, no warm-up), writes the image to OUT and prints its relMSE and
-its number of samples: scripts/mesh_table.sh times whole processes with it, and
+its number of samples: scripts/peer_table.sh times whole processes with it, and
 scripts/traversal_floor.sh counts its rays.
 Install: pip install mitsuba numpy (scripts/peer_mitsuba.sh does it in a venv).
 """
@@ -183,6 +185,8 @@ def main():
     ap.add_argument("--max-seconds", type=float, default=60.0)
     ap.add_argument("--sampler", default="independent")
     ap.add_argument("--mesh", help="a PLY mesh in place of the spheres (scripts/knot_scenes.py)")
+    ap.add_argument("--scene", default="cornell", choices=["cornell", "materials"],
+                    help="materials: scenes/cornell_materials.toml (cornell_materials_dict)")
     ap.add_argument("--once", type=int, metavar="SPP",
                     help="render once at SPP (seed 1, no warm-up: what a user's process does), "
                          "write the image to OUT (EXR) and print its relMSE; for timing whole "
@@ -190,7 +194,8 @@ def main():
     args = ap.parse_args()
 
     def make_dict(spp, seed):
-        d = scene_dict(spp, seed, args.sampler)
+        build = cornell_materials_dict if args.scene == "materials" else scene_dict
+        d = build(spp, seed, args.sampler)
         if args.mesh:
             del d["sphere_left"], d["sphere_right"]
             d["mesh"] = {"type": "ply", "filename": args.mesh, "face_normals": True,
@@ -206,37 +211,47 @@ def main():
         mi.Bitmap(img).write(args.out)
         print(f"relmse {relmse(np.array(img, dtype=np.float64), ref):.6e}")
         width, height = scene.sensors()[0].film().size()
-        print(f"samples {width * height * args.once}")
+        print(f"samples {width * height * scene.sensors()[0].sampler().sample_count()}")
         return
     rows = []
     spp = 1
+    measured = set()
     while spp <= args.max_spp:
-        seeds = 4 if spp <= 4 else (2 if spp <= 32 else 1)
+        # The samples Mitsuba takes: `ldsampler` rounds a count up to a power of 4 (2 -> 4,
+        # 8 -> 16, ...); rows record those, and a count already measured is not measured again.
+        actual = mi.load_dict(make_dict(spp, 1)).sensors()[0].sampler().sample_count()
+        if actual in measured:
+            spp *= 2
+            continue
+        measured.add(actual)
+        seeds = 4 if actual <= 4 else (2 if actual <= 32 else 1)
         for k in range(seeds):
             t0 = time.perf_counter()
-            scene = mi.load_dict(make_dict(spp, 1 + k))
+            scene = mi.load_dict(make_dict(actual, 1 + k))
             setup = time.perf_counter() - t0
             # Warm-up render: the llvm variants compile a kernel for each new sample count (a
             # set-up cost, cached afterwards); it is timed as set-up, not render.
             if k == 0:
                 t0 = time.perf_counter()
-                np.array(mi.render(scene, spp=spp, seed=1000))
+                np.array(mi.render(scene, spp=actual, seed=1000))
                 setup += time.perf_counter() - t0
             t0 = time.perf_counter()
-            img = np.array(mi.render(scene, spp=spp, seed=1 + k), dtype=np.float64)
+            img = np.array(mi.render(scene, spp=actual, seed=1 + k), dtype=np.float64)
             render_s = time.perf_counter() - t0
             d = img - ref
             rel = relmse(img, ref)
             rmse = float(np.sqrt(np.mean(d * d)))
-            rows.append((spp, 1 + k, setup, render_s, rel, rmse, 1.0 / (rel * render_s)))
-            print(f"mitsuba {args.variant} {args.sampler} spp {spp} seed {1 + k}: {render_s:.3f} s, "
-                  f"relMSE {rel:.4e}", file=sys.stderr)
+            rows.append((actual, 1 + k, setup, render_s, rel, rmse, 1.0 / (rel * render_s)))
+            print(f"mitsuba {args.variant} {args.sampler} spp {actual} seed {1 + k}: "
+                  f"{render_s:.3f} s, relMSE {rel:.4e}", file=sys.stderr)
         if render_s > args.max_seconds:
             break
         spp *= 2
     name = args.variant if args.sampler == "independent" else f"{args.variant}-{args.sampler}"
     if args.mesh:
         name += "-" + args.mesh.rsplit("/", 1)[-1].removesuffix(".ply")
+    if args.scene != "cornell":
+        name += "-" + args.scene
     with open(args.out, "w") as f:
         f.write("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n")
         for spp, seed, setup, render_s, rel, rmse, eff in rows:

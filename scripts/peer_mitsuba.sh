@@ -13,6 +13,6 @@ if [ ! -e "$llvm" ]; then
     ${SUDO:-} apt-get install -y libllvm19
 fi
 # The reference image: Mitsuba's converged Cornell render, or $TWINPATH_PEER_REFERENCE (for the
-# mesh scenes of scripts/mesh_table.sh).
+# mesh scenes of scripts/peer_table.sh).
 reference=${TWINPATH_PEER_REFERENCE:-tests/reference/cornell_spheres/mitsuba_ref.exr}
 DRJIT_LIBLLVM_PATH=$llvm "$venv/bin/python" scripts/peer_mitsuba.py "$reference" "$out" "$@"

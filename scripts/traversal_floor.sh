@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Where a sample's time goes, twinpath's CPU backend against Mitsuba 3 (llvm_ad_rgb, the `path`
-# integrator of scripts/peer_mitsuba.py), on the scenes of scripts/mesh_table.sh: one render
+# integrator of scripts/peer_mitsuba.py), on the mesh scenes of scripts/peer_table.sh: one render
 # each under `perf record` (cpu-clock, both threads), with
 #   - the rays traced per sample: twinpath counts its own (`twinpath render` prints them),
 #     Mitsuba's are counted by scripts/embree_ray_count.c, preloaded over its Embree calls;

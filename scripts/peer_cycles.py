@@ -1,0 +1,407 @@
+#!/usr/bin/env python3
+"""Blender's Cycles (CPU) on the Cornell scene: time against error, in the CSV columns of
+`twinpath bench`, the peer of scripts/peer_mitsuba.py.
+
+Builds the scene of tests/reference/cornell_spheres/scene.md through bpy with the same numbers
+as scenes/cornell.toml, in twinpath's frame (y up) under an empty turned +90 degrees about x
+(Blender's z up): the walls as two-triangle meshes, the two spheres as exact spheres (a point
+cloud of one point each, which Cycles intersects as a sphere, not a tessellation), Diffuse BSDF
+materials (Lambertian, both sides). The light, a sphere of radius 0.3 and radiance 10 that
+reflects nothing, is a Cycles point light of that radius with `use_soft_falloff` off (a sphere
+light, sampled in the cone it subtends: Cycles' best for it), power P = L 4 pi^2 r^2 = 35.53 W,
+visible to the camera. Cycles' lights are transparent to the rays that hit them, so a black
+sphere 0.1% smaller sits inside it: what twinpath's and Mitsuba's emitting sphere blocks, it
+blocks. Unbiased settings: no clamping, no denoising, no adaptive sampling, no glossy filter,
+bounce limits 1024, box pixel filter of width 1, black world, view transform Standard; the
+image is Cycles' linear result, read back as float.
+
+It renders at 1, 2, 4, ... spp, several seeds per point at low spp, and writes the CSV columns
+of `twinpath bench`: set-up seconds (a 1-spp render of a 1%-size image: the scene's sync and
+BVH build, which every render call repeats) and render seconds (the render call's wall time
+less that set-up), relMSE and RMSE against the reference with the definitions of
+`twinpath diff`: relMSE = mean over pixels and channels of (a - b)^2 / (b^2 + 0.01).
+
+Usage: peer_cycles.py REFERENCE.exr OUT.csv [--max-spp 1024] [--max-seconds 60]
+       [--pattern AUTOMATIC] [--scene cornell|materials] [--mesh KNOT.ply] [--once SPP]
+       [--validate SPP]
+--scene materials: scenes/cornell_materials.toml, the left sphere rough gold (GGX alpha 0.2,
+Au's RGB eta and k, Cycles' Metallic BSDF as a physical conductor) and the right smooth glass
+of index 1.5 (Glass BSDF, roughness 0).
+--pattern picks Cycles' sampling pattern (its name is added to the variant column unless
+AUTOMATIC, the default). --mesh replaces the two spheres by a PLY mesh in white, flat-shaded
+(scripts/knot_scenes.py's and scripts/bunny_scene.py's scenes). --once SPP renders once (seed
+1), writes the image to OUT (EXR) and prints its relMSE, for timing whole processes.
+--validate SPP renders two independent halves (seeds 1 and 2) of SPP samples each and prints
+how far their mean is from the reference against the noise the halves show (16 x 16 blocks of
+pixels: z-scores of the block means), so that a scene built differently shows before it is
+timed; OUT is then the mean image (EXR).
+Install: Python 3.13 and `pip install bpy numpy` (scripts/peer_cycles.sh does it in a venv).
+"""
+
+import argparse
+import math
+import os
+import sys
+import tempfile
+import time
+
+import bpy
+import numpy as np
+
+WHITE, RED, GREEN, BLUE = (0.73, 0.73, 0.73), (0.65, 0.05, 0.05), (0.12, 0.45, 0.15), \
+    (0.25, 0.35, 0.75)
+GOLD_ETA = (0.143036, 0.375307, 1.44205)
+GOLD_K = (3.983, 2.38556, 1.60336)
+LIGHT_CENTER, LIGHT_RADIUS, LIGHT_RADIANCE = (0.0, 1.6, 0.0), 0.3, 10.0
+# The black sphere inside the light: smaller by this fraction of its radius.
+OCCLUDER_SHRINK = 1e-3
+
+
+def settings(scene, width, height):
+    """Cycles' unbiased settings (the task's list), on the CPU with all its threads."""
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.render.threads_mode = "AUTO"
+    scene.cycles.use_denoising = False
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.sample_clamp_direct = 0.0
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.cycles.blur_glossy = 0.0
+    for bounce in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+                   "volume_bounces", "transparent_max_bounces"):
+        setattr(scene.cycles, bounce, 1024)
+    scene.cycles.pixel_filter_type = "BOX"
+    scene.cycles.filter_width = 1.0
+    scene.render.resolution_x = width
+    scene.render.resolution_y = height
+    scene.render.resolution_percentage = 100
+    scene.render.film_transparent = False
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.image_settings.exr_codec = "NONE"
+    world = bpy.data.worlds.new("black")
+    world.color = (0.0, 0.0, 0.0)
+    if world.node_tree is not None:
+        for node in world.node_tree.nodes:
+            if node.type == "BACKGROUND":
+                node.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+                node.inputs["Strength"].default_value = 0.0
+    scene.world = world
+
+
+def diffuse(name, rgb):
+    """A material of one Diffuse BSDF (roughness 0: Lambertian) of reflectance `rgb`."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    for node in list(nodes):
+        nodes.remove(node)
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Color"].default_value = (*rgb, 1.0)
+    bsdf.inputs["Roughness"].default_value = 0.0
+    out = nodes.new("ShaderNodeOutputMaterial")
+    mat.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return mat
+
+
+def gold_ggx():
+    """scenes/cornell_materials.toml's gold: GGX alpha 0.2 (Blender's roughness is sqrt(alpha))
+    with Mitsuba's RGB eta and k of Au (twinpath's named "gold"), Cycles' Metallic BSDF as a
+    physical conductor, single scattering."""
+    mat = bpy.data.materials.new("gold")
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    for node in list(nodes):
+        nodes.remove(node)
+    bsdf = nodes.new("ShaderNodeBsdfMetallic")
+    bsdf.fresnel_type = "PHYSICAL_CONDUCTOR"
+    bsdf.distribution = "GGX"
+    bsdf.inputs["IOR"].default_value = GOLD_ETA
+    bsdf.inputs["Extinction"].default_value = GOLD_K
+    bsdf.inputs["Roughness"].default_value = math.sqrt(0.2)
+    out = nodes.new("ShaderNodeOutputMaterial")
+    mat.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return mat
+
+
+def glass():
+    """scenes/cornell_materials.toml's glass: a smooth dielectric of index 1.5 (Glass BSDF,
+    roughness 0, white)."""
+    mat = bpy.data.materials.new("glass")
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    for node in list(nodes):
+        nodes.remove(node)
+    bsdf = nodes.new("ShaderNodeBsdfGlass")
+    # Roughness 0: Cycles' singular (sharp) glass.
+    bsdf.distribution = "GGX"
+    bsdf.inputs["Roughness"].default_value = 0.0
+    bsdf.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    bsdf.inputs["IOR"].default_value = 1.5
+    out = nodes.new("ShaderNodeOutputMaterial")
+    mat.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return mat
+
+
+def link(scene, obj, parent):
+    scene.collection.objects.link(obj)
+    obj.parent = parent
+
+
+def quad(scene, parent, name, corner, edge1, edge2, material):
+    """scenes/cornell.toml's quad: corner, corner + edge1, corner + edge1 + edge2, corner + edge2
+    (front normal edge1 x edge2), two triangles."""
+    c, e1, e2 = (np.array(v, dtype=float) for v in (corner, edge1, edge2))
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(c), tuple(c + e1), tuple(c + e1 + e2), tuple(c + e2)], [],
+                     [(0, 1, 2), (0, 2, 3)])
+    mesh.materials.append(material)
+    link(scene, bpy.data.objects.new(name, mesh), parent)
+
+
+def sphere(scene, parent, name, center, radius, material):
+    """An exact sphere: a point cloud of one point, which Cycles intersects as a sphere."""
+    cloud = bpy.data.pointclouds.new(name)
+    cloud.resize(1)
+    cloud.attributes["position"].data[0].vector = center
+    radius_attribute = cloud.attributes.get("radius") or \
+        cloud.attributes.new("radius", "FLOAT", "POINT")
+    radius_attribute.data[0].value = radius
+    cloud.materials.append(material)
+    link(scene, bpy.data.objects.new(name, cloud), parent)
+
+
+def mesh_sphere(scene, parent, name, center, radius, material, segments=512, rings=256):
+    """A smooth-shaded UV sphere of `segments` x `rings` (512 x 256: 262k triangles, whose flat
+    facets stay within 2e-5 of the radius from the exact sphere, and whose normals are the
+    exact sphere's at the vertices). For glass: Cycles' point-cloud spheres report where a ray
+    enters them, not where it leaves, so a refracted ray would not find the way out. Built
+    from arrays (Blender's primitive operator takes seconds at this size)."""
+    theta = np.linspace(0.0, np.pi, rings + 1)[1:-1]
+    phi = np.linspace(0.0, 2.0 * np.pi, segments, endpoint=False)
+    ring = np.stack([np.outer(np.sin(theta), np.cos(phi)), np.outer(np.sin(theta), np.sin(phi)),
+                     np.repeat(np.cos(theta)[:, None], segments, axis=1)], axis=-1)
+    points = np.concatenate([[[0.0, 0.0, 1.0]], ring.reshape(-1, 3), [[0.0, 0.0, -1.0]]])
+    points = np.asarray(center) + radius * points
+    r, j = np.meshgrid(np.arange(rings - 2), np.arange(segments), indexing="ij")
+    a = 1 + r * segments + j
+    b = 1 + r * segments + (j + 1) % segments
+    c, d = b + segments, a + segments
+    quads = np.stack([a, d, c, b], axis=-1).reshape(-1, 4)
+    j = np.arange(segments)
+    top = np.stack([np.zeros_like(j), 1 + j, 1 + (j + 1) % segments], axis=-1)
+    last = len(points) - 1
+    first_of_bottom = 1 + (rings - 2) * segments
+    bottom = np.stack([np.full_like(j, last), first_of_bottom + (j + 1) % segments,
+                       first_of_bottom + j], axis=-1)
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(points.tolist(), [], quads.tolist() + top.tolist() + bottom.tolist())
+    mesh.shade_smooth()
+    mesh.materials.append(material)
+    link(scene, bpy.data.objects.new(name, mesh), parent)
+
+
+def build(width=256, height=256, mesh=None, materials=False):
+    """The Cornell scene (or, with `mesh`, the room with that PLY in place of the spheres; with
+    `materials`, scenes/cornell_materials.toml: the left sphere gold, the right glass)."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    settings(scene, width, height)
+    # twinpath's frame (y up) into Blender's (z up): (x, y, z) -> (x, -z, y).
+    frame = bpy.data.objects.new("twinpath_frame", None)
+    scene.collection.objects.link(frame)
+    frame.rotation_euler = (math.pi / 2, 0.0, 0.0)
+    white, red, green, blue = (diffuse(n, c) for n, c in (
+        ("white", WHITE), ("red", RED), ("green", GREEN), ("blue", BLUE)))
+    quad(scene, frame, "floor", (-1, 0, 1), (2, 0, 0), (0, 0, -2), white)
+    quad(scene, frame, "ceiling", (-1, 2, -1), (2, 0, 0), (0, 0, 2), white)
+    quad(scene, frame, "back", (-1, 0, -1), (2, 0, 0), (0, 2, 0), white)
+    quad(scene, frame, "left", (-1, 0, 1), (0, 0, -2), (0, 2, 0), red)
+    quad(scene, frame, "right", (1, 0, -1), (0, 0, 2), (0, 2, 0), green)
+    if mesh is None:
+        left, right = (gold_ggx(), glass()) if materials else (white, blue)
+        sphere(scene, frame, "sphere_left", (-0.45, 0.4, -0.3), 0.4, left)
+        (mesh_sphere if materials else sphere)(scene, frame, "sphere_right", (0.5, 0.3, 0.35),
+                                               0.3, right)
+    else:
+        # The file's coordinates as they are (twinpath's frame), flat-shaded as twinpath and
+        # Mitsuba (`face_normals`) shade it.
+        bpy.ops.wm.ply_import(filepath=mesh, forward_axis="Y", up_axis="Z")
+        obj = bpy.context.selected_objects[0]
+        for polygon in obj.data.polygons:
+            polygon.use_smooth = False
+        obj.data.materials.clear()
+        obj.data.materials.append(white)
+        obj.parent = frame
+    sphere(scene, frame, "light_occluder", LIGHT_CENTER,
+           LIGHT_RADIUS * (1.0 - OCCLUDER_SHRINK), diffuse("black", (0.0, 0.0, 0.0)))
+    light = bpy.data.lights.new("light", "POINT")
+    light.shadow_soft_size = LIGHT_RADIUS
+    light.use_soft_falloff = False
+    light.energy = LIGHT_RADIANCE * 4.0 * math.pi ** 2 * LIGHT_RADIUS ** 2
+    light_obj = bpy.data.objects.new("light", light)
+    light_obj.location = LIGHT_CENTER
+    light_obj.visible_camera = True
+    link(scene, light_obj, frame)
+    camera = bpy.data.cameras.new("camera")
+    camera.sensor_fit = "VERTICAL"
+    camera.angle_y = math.radians(40.0)
+    camera.clip_start = 1e-4
+    camera_obj = bpy.data.objects.new("camera", camera)
+    # Blender's camera looks down its -z with +y up: twinpath's camera at (0, 1, 3.8) looking
+    # at (0, 1, 0) with y up, unturned in twinpath's frame.
+    camera_obj.location = (0.0, 1.0, 3.8)
+    link(scene, camera_obj, frame)
+    scene.camera = camera_obj
+    return scene
+
+
+def render(scene, spp, seed, path=None):
+    """One render: the image (height x width x 3, top row first, float64) and the render call's
+    wall time."""
+    scene.cycles.samples = spp
+    scene.cycles.seed = seed
+    t0 = time.perf_counter()
+    bpy.ops.render.render()
+    seconds = time.perf_counter() - t0
+    return read_render_result(path), seconds
+
+
+def read_render_result(path=None):
+    """The last render, saved as EXR (to `path`, or a temporary file) and read back."""
+    keep = path is not None
+    if not keep:
+        handle, path = tempfile.mkstemp(suffix=".exr")
+        os.close(handle)
+    bpy.data.images["Render Result"].save_render(path)
+    img = read_exr(path)
+    if not keep:
+        os.remove(path)
+    return img
+
+
+def read_exr(path):
+    image = bpy.data.images.load(path, check_existing=False)
+    width, height = image.size
+    pixels = np.array(image.pixels[:], dtype=np.float64).reshape(height, width, 4)[::-1, :, :3]
+    bpy.data.images.remove(image)
+    return np.ascontiguousarray(pixels)
+
+
+def write_exr(path, img):
+    height, width = img.shape[:2]
+    image = bpy.data.images.new("out", width, height, float_buffer=True, alpha=True)
+    rgba = np.ones((height, width, 4))
+    rgba[:, :, :3] = img
+    image.pixels = rgba[::-1].ravel()
+    image.filepath_raw = path
+    image.file_format = "OPEN_EXR"
+    image.save()
+    bpy.data.images.remove(image)
+
+
+def relmse(img, ref):
+    """`twinpath diff`'s relMSE: mean of (img - ref)^2 / (ref^2 + 0.01) over pixels and channels."""
+    d = img - ref
+    return float(np.mean(d * d / (ref * ref + 0.01)))
+
+
+def block_means(img, block=16):
+    h, w = img.shape[0] // block, img.shape[1] // block
+    return img[:h * block, :w * block].reshape(h, block, w, block, 3).mean(axis=(1, 3))
+
+
+def validate(scene, spp, ref, out):
+    """Two halves against the reference: each 16 x 16 block's mean of the halves' mean, against
+    the reference's, in units of its standard error. Per pixel, (a - b)^2 / 4 estimates the
+    variance of the halves' mean (one degree of freedom); a block's mean of them over n pixels,
+    divided by n, that of the block's mean (n degrees). The reference's own noise is left out
+    (it has many more samples)."""
+    a, _ = render(scene, spp, 1)
+    b, _ = render(scene, spp, 2)
+    mean = 0.5 * (a + b)
+    write_exr(out, mean)
+    n = 16 * 16
+    se = np.sqrt(block_means((a - b) ** 2 / 4.0) / n)
+    # Blocks without noise (inside the light, where both halves read the light's radiance):
+    # single precision's rounding instead.
+    se = np.maximum(se, 1e-6 * np.abs(block_means(ref)) + 1e-12)
+    z = (block_means(mean) - block_means(ref)) / se
+    channel = mean.mean(axis=(0, 1)) / ref.mean(axis=(0, 1))
+    print(f"validate {spp} spp x 2: channel means / reference {np.round(channel, 5).tolist()}")
+    print(f"  relMSE(half 1, half 2) / 4 = {relmse(a, b) / 4:.3e} (the mean's own noise), "
+          f"relMSE(mean, reference) = {relmse(mean, ref):.3e}")
+    print(f"  block z-scores ({z.size}): mean {z.mean():+.3f}, rms {np.sqrt(np.mean(z ** 2)):.3f}, "
+          f"max |z| {np.abs(z).max():.2f}, |z| > 4: {int(np.sum(np.abs(z) > 4))}")
+    for row, col, ch in np.argwhere(np.abs(z) > 4):
+        print(f"  block at pixel row {16 * row}, column {16 * col}, channel {ch}: "
+              f"z {z[row, col, ch]:+.2f}, mean {block_means(mean)[row, col, ch]:.5f} "
+              f"against {block_means(ref)[row, col, ch]:.5f}")
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
+    ap = argparse.ArgumentParser()
+    ap.add_argument("reference")
+    ap.add_argument("out")
+    ap.add_argument("--max-spp", type=int, default=1024)
+    ap.add_argument("--max-seconds", type=float, default=60.0)
+    ap.add_argument("--pattern", default="AUTOMATIC")
+    ap.add_argument("--mesh", help="a PLY mesh in place of the spheres")
+    ap.add_argument("--scene", default="cornell", choices=["cornell", "materials"])
+    ap.add_argument("--once", type=int, metavar="SPP")
+    ap.add_argument("--validate", type=int, metavar="SPP")
+    args = ap.parse_args(argv)
+
+    ref = read_exr(args.reference)
+    height, width = ref.shape[:2]
+    scene = build(width, height, args.mesh, args.scene == "materials")
+    scene.cycles.sampling_pattern = args.pattern
+    if args.validate:
+        validate(scene, args.validate, ref, args.out)
+        return
+    if args.once:
+        img, seconds = render(scene, args.once, 1, args.out)
+        print(f"relmse {relmse(img, ref):.6e}")
+        print(f"samples {width * height * args.once}")
+        return
+    # Set-up: what every render call repeats before its samples (sync, BVH), measured on a
+    # 1%-size image at 1 spp; the first call also loads Cycles' kernels (a warm-up).
+    scene.render.resolution_percentage = 1
+    render(scene, 1, 1000)
+    _, setup = render(scene, 1, 1000)
+    scene.render.resolution_percentage = 100
+    rows = []
+    spp = 1
+    while spp <= args.max_spp:
+        seeds = 4 if spp <= 4 else (2 if spp <= 32 else 1)
+        for k in range(seeds):
+            img, seconds = render(scene, spp, 1 + k)
+            render_s = max(seconds - setup, 1e-6)
+            d = img - ref
+            rel = relmse(img, ref)
+            rmse = float(np.sqrt(np.mean(d * d)))
+            rows.append((spp, 1 + k, setup, render_s, rel, rmse, 1.0 / (rel * render_s)))
+            print(f"cycles {args.pattern} spp {spp} seed {1 + k}: {render_s:.3f} s "
+                  f"(+{setup:.3f} s set-up), relMSE {rel:.4e}", file=sys.stderr)
+        if render_s > args.max_seconds:
+            break
+        spp *= 2
+    name = "cycles" if args.pattern == "AUTOMATIC" else f"cycles-{args.pattern.lower()}"
+    if args.mesh:
+        name += "-" + args.mesh.rsplit("/", 1)[-1].removesuffix(".ply")
+    if args.scene != "cornell":
+        name += "-" + args.scene
+    with open(args.out, "w") as f:
+        f.write("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n")
+        for spp, seed, setup, render_s, rel, rmse, eff in rows:
+            f.write(f"{name},Cpu,{spp},{seed},{setup:.6f},{render_s:.6f},"
+                    f"{rel:.6e},{rmse:.6e},{eff:.6e}\n")
+
+
+if __name__ == "__main__":
+    main()
