@@ -48,6 +48,9 @@ import time
 import bpy
 import numpy as np
 
+import cycles_fixtures
+from peer_rows import relmse, sweep, variant_name, write_csv
+
 WHITE, RED, GREEN, BLUE = (0.73, 0.73, 0.73), (0.65, 0.05, 0.05), (0.12, 0.45, 0.15), \
     (0.25, 0.35, 0.75)
 GOLD_ETA = (0.143036, 0.375307, 1.44205)
@@ -57,94 +60,60 @@ LIGHT_CENTER, LIGHT_RADIUS, LIGHT_RADIANCE = (0.0, 1.6, 0.0), 0.3, 10.0
 OCCLUDER_SHRINK = 1e-3
 
 
-def settings(scene, width, height):
-    """Cycles' unbiased settings (the task's list), on the CPU with all its threads."""
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
+def settings(width, height):
+    """A new scene with Cycles' unbiased settings (`cycles_fixtures.reset`: no clamping, no
+    denoising, no adaptive sampling, no glossy filter, bounce limits 1024, box filter of width 1,
+    view transform Standard, black world), at `width` x `height`, on the CPU with all its
+    threads, saving linear 32-bit EXR."""
+    scene = cycles_fixtures.reset()
     scene.render.threads_mode = "AUTO"
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.sample_clamp_direct = 0.0
-    scene.cycles.sample_clamp_indirect = 0.0
-    scene.cycles.blur_glossy = 0.0
-    for bounce in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
-                   "volume_bounces", "transparent_max_bounces"):
-        setattr(scene.cycles, bounce, 1024)
-    scene.cycles.pixel_filter_type = "BOX"
-    scene.cycles.filter_width = 1.0
     scene.render.resolution_x = width
     scene.render.resolution_y = height
-    scene.render.resolution_percentage = 100
-    scene.render.film_transparent = False
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-    scene.view_settings.exposure = 0.0
-    scene.view_settings.gamma = 1.0
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.image_settings.color_depth = "32"
     scene.render.image_settings.exr_codec = "NONE"
-    world = bpy.data.worlds.new("black")
-    world.color = (0.0, 0.0, 0.0)
-    if world.node_tree is not None:
-        for node in world.node_tree.nodes:
-            if node.type == "BACKGROUND":
-                node.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-                node.inputs["Strength"].default_value = 0.0
-    scene.world = world
+    return scene
 
 
-def diffuse(name, rgb):
-    """A material of one Diffuse BSDF (roughness 0: Lambertian) of reflectance `rgb`."""
+def one_bsdf(name, node_type, **inputs):
+    """A material of one BSDF node of `node_type`, its inputs set from `inputs` (an input name
+    with spaces written with underscores; `distribution` and `fresnel_type` are the node's
+    properties)."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nodes = mat.node_tree.nodes
     for node in list(nodes):
         nodes.remove(node)
-    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Color"].default_value = (*rgb, 1.0)
-    bsdf.inputs["Roughness"].default_value = 0.0
+    bsdf = nodes.new(node_type)
+    for key, value in inputs.items():
+        if key in ("distribution", "fresnel_type"):
+            setattr(bsdf, key, value)
+        else:
+            bsdf.inputs[key.replace("_", " ")].default_value = value
     out = nodes.new("ShaderNodeOutputMaterial")
     mat.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
     return mat
+
+
+def diffuse(name, rgb):
+    """One Diffuse BSDF (roughness 0: Lambertian) of reflectance `rgb`."""
+    return one_bsdf(name, "ShaderNodeBsdfDiffuse", Color=(*rgb, 1.0), Roughness=0.0)
 
 
 def gold_ggx():
     """scenes/cornell_materials.toml's gold: GGX alpha 0.2 (Blender's roughness is sqrt(alpha))
     with Mitsuba's RGB eta and k of Au (twinpath's named "gold"), Cycles' Metallic BSDF as a
     physical conductor, single scattering."""
-    mat = bpy.data.materials.new("gold")
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    for node in list(nodes):
-        nodes.remove(node)
-    bsdf = nodes.new("ShaderNodeBsdfMetallic")
-    bsdf.fresnel_type = "PHYSICAL_CONDUCTOR"
-    bsdf.distribution = "GGX"
-    bsdf.inputs["IOR"].default_value = GOLD_ETA
-    bsdf.inputs["Extinction"].default_value = GOLD_K
-    bsdf.inputs["Roughness"].default_value = math.sqrt(0.2)
-    out = nodes.new("ShaderNodeOutputMaterial")
-    mat.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-    return mat
+    return one_bsdf("gold", "ShaderNodeBsdfMetallic", fresnel_type="PHYSICAL_CONDUCTOR",
+                    distribution="GGX", IOR=GOLD_ETA, Extinction=GOLD_K,
+                    Roughness=math.sqrt(0.2))
 
 
 def glass():
     """scenes/cornell_materials.toml's glass: a smooth dielectric of index 1.5 (Glass BSDF,
-    roughness 0, white)."""
-    mat = bpy.data.materials.new("glass")
-    mat.use_nodes = True
-    nodes = mat.node_tree.nodes
-    for node in list(nodes):
-        nodes.remove(node)
-    bsdf = nodes.new("ShaderNodeBsdfGlass")
-    # Roughness 0: Cycles' singular (sharp) glass.
-    bsdf.distribution = "GGX"
-    bsdf.inputs["Roughness"].default_value = 0.0
-    bsdf.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    bsdf.inputs["IOR"].default_value = 1.5
-    out = nodes.new("ShaderNodeOutputMaterial")
-    mat.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-    return mat
+    roughness 0: Cycles' singular glass; white)."""
+    return one_bsdf("glass", "ShaderNodeBsdfGlass", distribution="GGX", Roughness=0.0,
+                    Color=(1.0, 1.0, 1.0, 1.0), IOR=1.5)
 
 
 def link(scene, obj, parent):
@@ -208,9 +177,7 @@ def mesh_sphere(scene, parent, name, center, radius, material, segments=512, rin
 def build(width=256, height=256, mesh=None, materials=False):
     """The Cornell scene (or, with `mesh`, the room with that PLY in place of the spheres; with
     `materials`, scenes/cornell_materials.toml: the left sphere gold, the right glass)."""
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    settings(scene, width, height)
+    scene = settings(width, height)
     # twinpath's frame (y up) into Blender's (z up): (x, y, z) -> (x, -z, y).
     frame = bpy.data.objects.new("twinpath_frame", None)
     scene.collection.objects.link(frame)
@@ -304,12 +271,6 @@ def write_exr(path, img):
     bpy.data.images.remove(image)
 
 
-def relmse(img, ref):
-    """`twinpath diff`'s relMSE: mean of (img - ref)^2 / (ref^2 + 0.01) over pixels and channels."""
-    d = img - ref
-    return float(np.mean(d * d / (ref * ref + 0.01)))
-
-
 def block_means(img, block=16):
     h, w = img.shape[0] // block, img.shape[1] // block
     return img[:h * block, :w * block].reshape(h, block, w, block, 3).mean(axis=(1, 3))
@@ -375,32 +336,14 @@ def main():
     render(scene, 1, 1000)
     _, setup = render(scene, 1, 1000)
     scene.render.resolution_percentage = 100
-    rows = []
-    spp = 1
-    while spp <= args.max_spp:
-        seeds = 4 if spp <= 4 else (2 if spp <= 32 else 1)
-        for k in range(seeds):
-            img, seconds = render(scene, spp, 1 + k)
-            render_s = max(seconds - setup, 1e-6)
-            d = img - ref
-            rel = relmse(img, ref)
-            rmse = float(np.sqrt(np.mean(d * d)))
-            rows.append((spp, 1 + k, setup, render_s, rel, rmse, 1.0 / (rel * render_s)))
-            print(f"cycles {args.pattern} spp {spp} seed {1 + k}: {render_s:.3f} s "
-                  f"(+{setup:.3f} s set-up), relMSE {rel:.4e}", file=sys.stderr)
-        if render_s > args.max_seconds:
-            break
-        spp *= 2
-    name = "cycles" if args.pattern == "AUTOMATIC" else f"cycles-{args.pattern.lower()}"
-    if args.mesh:
-        name += "-" + args.mesh.rsplit("/", 1)[-1].removesuffix(".ply")
-    if args.scene != "cornell":
-        name += "-" + args.scene
-    with open(args.out, "w") as f:
-        f.write("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n")
-        for spp, seed, setup, render_s, rel, rmse, eff in rows:
-            f.write(f"{name},Cpu,{spp},{seed},{setup:.6f},{render_s:.6f},"
-                    f"{rel:.6e},{rmse:.6e},{eff:.6e}\n")
+
+    def measure(spp, seed):
+        img, seconds = render(scene, spp, seed)
+        return img, setup, max(seconds - setup, 1e-6)
+
+    rows = sweep(measure, ref, args.max_spp, args.max_seconds, f"cycles {args.pattern}")
+    base = "cycles" if args.pattern == "AUTOMATIC" else f"cycles-{args.pattern.lower()}"
+    write_csv(args.out, variant_name(base, args.mesh, args.scene), rows)
 
 
 if __name__ == "__main__":

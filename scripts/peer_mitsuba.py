@@ -29,6 +29,8 @@ import time
 import mitsuba as mi
 import numpy as np
 
+from peer_rows import relmse, sweep, variant_name, write_csv
+
 
 def quad(p0, p1, p3, material):
     """A parallelogram p0, p1, p2 = p1 + p3 - p0, p3 as a two-triangle mesh."""
@@ -170,12 +172,6 @@ def scene_dict(spp, seed, sampler="independent"):
     }
 
 
-def relmse(img, ref):
-    """`twinpath diff`'s relMSE: mean of (img - ref)^2 / (ref^2 + 0.01) over pixels and channels."""
-    d = img - ref
-    return float(np.mean(d * d / (ref * ref + 0.01)))
-
-
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("reference")
@@ -213,50 +209,28 @@ def main():
         width, height = scene.sensors()[0].film().size()
         print(f"samples {width * height * scene.sensors()[0].sampler().sample_count()}")
         return
-    rows = []
-    spp = 1
-    measured = set()
-    while spp <= args.max_spp:
-        # The samples Mitsuba takes: `ldsampler` rounds a count up to a power of 4 (2 -> 4,
-        # 8 -> 16, ...); rows record those, and a count already measured is not measured again.
-        actual = mi.load_dict(make_dict(spp, 1)).sensors()[0].sampler().sample_count()
-        if actual in measured:
-            spp *= 2
-            continue
-        measured.add(actual)
-        seeds = 4 if actual <= 4 else (2 if actual <= 32 else 1)
-        for k in range(seeds):
+    def measure(spp, seed):
+        t0 = time.perf_counter()
+        scene = mi.load_dict(make_dict(spp, seed))
+        setup = time.perf_counter() - t0
+        # Warm-up render: the llvm variants compile a kernel for each new sample count (a
+        # set-up cost, cached afterwards); it is timed as set-up, not render.
+        if seed == 1:
             t0 = time.perf_counter()
-            scene = mi.load_dict(make_dict(actual, 1 + k))
-            setup = time.perf_counter() - t0
-            # Warm-up render: the llvm variants compile a kernel for each new sample count (a
-            # set-up cost, cached afterwards); it is timed as set-up, not render.
-            if k == 0:
-                t0 = time.perf_counter()
-                np.array(mi.render(scene, spp=actual, seed=1000))
-                setup += time.perf_counter() - t0
-            t0 = time.perf_counter()
-            img = np.array(mi.render(scene, spp=actual, seed=1 + k), dtype=np.float64)
-            render_s = time.perf_counter() - t0
-            d = img - ref
-            rel = relmse(img, ref)
-            rmse = float(np.sqrt(np.mean(d * d)))
-            rows.append((actual, 1 + k, setup, render_s, rel, rmse, 1.0 / (rel * render_s)))
-            print(f"mitsuba {args.variant} {args.sampler} spp {actual} seed {1 + k}: "
-                  f"{render_s:.3f} s, relMSE {rel:.4e}", file=sys.stderr)
-        if render_s > args.max_seconds:
-            break
-        spp *= 2
-    name = args.variant if args.sampler == "independent" else f"{args.variant}-{args.sampler}"
-    if args.mesh:
-        name += "-" + args.mesh.rsplit("/", 1)[-1].removesuffix(".ply")
-    if args.scene != "cornell":
-        name += "-" + args.scene
-    with open(args.out, "w") as f:
-        f.write("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n")
-        for spp, seed, setup, render_s, rel, rmse, eff in rows:
-            f.write(f"mitsuba-{name},Cpu,{spp},{seed},{setup:.6f},{render_s:.6f},"
-                    f"{rel:.6e},{rmse:.6e},{eff:.6e}\n")
+            np.array(mi.render(scene, spp=spp, seed=1000))
+            setup += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        img = np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float64)
+        return img, setup, time.perf_counter() - t0
+
+    def sample_count(spp):
+        # `ldsampler` rounds a count up to a power of 4 (2 -> 4, 8 -> 16, ...).
+        return mi.load_dict(make_dict(spp, 1)).sensors()[0].sampler().sample_count()
+
+    rows = sweep(measure, ref, args.max_spp, args.max_seconds,
+                 f"mitsuba {args.variant} {args.sampler}", sample_count)
+    base = args.variant if args.sampler == "independent" else f"{args.variant}-{args.sampler}"
+    write_csv(args.out, variant_name(f"mitsuba-{base}", args.mesh, args.scene), rows)
 
 
 if __name__ == "__main__":
