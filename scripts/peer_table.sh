@@ -17,7 +17,8 @@
 # processes as a user runs them at $WHOLE_SPP spp (default 256; Cycles at $CYCLES_MAX_SPP), timed
 # from the shell, each image's time to 0.002 at its efficiency. Everything lands in OUTDIR; the
 # table is OUTDIR/table.md (scripts/peer_table.py), the details OUTDIR/details.txt. Run from the
-# repository root on an otherwise idle machine; about 35 minutes for the default scenes.
+# repository root on an otherwise idle machine; about 40 minutes for the default scenes. The
+# binary is $TWINPATH, default target/release/twinpath (`cargo build --release -p twinpath`).
 set -euo pipefail
 out=${1:?usage: scripts/peer_table.sh OUTDIR [cornell | materials | N | bunnyL ...]}
 shift
