@@ -416,8 +416,11 @@ def render(scene, seed, path):
 
 
 def read_exr(path):
-    image = bpy.data.images.load(path)
-    pixels = np.array(image.pixels[:], dtype=np.float64).reshape(HEIGHT, WIDTH, 4)
+    """An image file's RGBA as Blender holds it (height x width x 4, bottom row first, float64);
+    loaded afresh, not from Blender's cache of a path read before."""
+    image = bpy.data.images.load(path, check_existing=False)
+    width, height = image.size
+    pixels = np.array(image.pixels[:], dtype=np.float64).reshape(height, width, 4)
     bpy.data.images.remove(image)
     return pixels
 

@@ -49,13 +49,11 @@ import bpy
 import numpy as np
 
 import cycles_fixtures
+from cornell_scene import (BLUE, EYE, GOLD_ALPHA, GOLD_ETA, GOLD_K, GREEN, LIGHT_CENTER,
+                           LIGHT_RADIANCE, LIGHT_RADIUS, LOOK_AT, RED, SPHERES, UP, VFOV, WALLS,
+                           WHITE)
 from peer_rows import relmse, sweep, variant_name, write_csv
 
-WHITE, RED, GREEN, BLUE = (0.73, 0.73, 0.73), (0.65, 0.05, 0.05), (0.12, 0.45, 0.15), \
-    (0.25, 0.35, 0.75)
-GOLD_ETA = (0.143036, 0.375307, 1.44205)
-GOLD_K = (3.983, 2.38556, 1.60336)
-LIGHT_CENTER, LIGHT_RADIUS, LIGHT_RADIANCE = (0.0, 1.6, 0.0), 0.3, 10.0
 # The black sphere inside the light: smaller by this fraction of its radius.
 OCCLUDER_SHRINK = 1e-3
 
@@ -106,7 +104,7 @@ def gold_ggx():
     physical conductor, single scattering."""
     return one_bsdf("gold", "ShaderNodeBsdfMetallic", fresnel_type="PHYSICAL_CONDUCTOR",
                     distribution="GGX", IOR=GOLD_ETA, Extinction=GOLD_K,
-                    Roughness=math.sqrt(0.2))
+                    Roughness=math.sqrt(GOLD_ALPHA))
 
 
 def glass():
@@ -182,18 +180,18 @@ def build(width=256, height=256, mesh=None, materials=False):
     frame = bpy.data.objects.new("twinpath_frame", None)
     scene.collection.objects.link(frame)
     frame.rotation_euler = (math.pi / 2, 0.0, 0.0)
-    white, red, green, blue = (diffuse(n, c) for n, c in (
-        ("white", WHITE), ("red", RED), ("green", GREEN), ("blue", BLUE)))
-    quad(scene, frame, "floor", (-1, 0, 1), (2, 0, 0), (0, 0, -2), white)
-    quad(scene, frame, "ceiling", (-1, 2, -1), (2, 0, 0), (0, 0, 2), white)
-    quad(scene, frame, "back", (-1, 0, -1), (2, 0, 0), (0, 2, 0), white)
-    quad(scene, frame, "left", (-1, 0, 1), (0, 0, -2), (0, 2, 0), red)
-    quad(scene, frame, "right", (1, 0, -1), (0, 0, 2), (0, 2, 0), green)
+    palette = {name: diffuse(name, c) for name, c in (
+        ("white", WHITE), ("red", RED), ("green", GREEN), ("blue", BLUE))}
+    white = palette["white"]
+    for name, corner, edge1, edge2, material in WALLS:
+        quad(scene, frame, name, corner, edge1, edge2, palette[material])
     if mesh is None:
-        left, right = (gold_ggx(), glass()) if materials else (white, blue)
-        sphere(scene, frame, "sphere_left", (-0.45, 0.4, -0.3), 0.4, left)
-        (mesh_sphere if materials else sphere)(scene, frame, "sphere_right", (0.5, 0.3, 0.35),
-                                               0.3, right)
+        # With `materials` the left sphere is gold and the right glass (on a mesh: see
+        # `mesh_sphere`).
+        kinds = [(gold_ggx(), sphere), (glass(), mesh_sphere)] if materials else \
+            [(palette[m], sphere) for *_, m in SPHERES]
+        for (name, center, radius, _), (material, make) in zip(SPHERES, kinds):
+            make(scene, frame, name, center, radius, material)
     else:
         # The file's coordinates as they are (twinpath's frame), flat-shaded as twinpath and
         # Mitsuba (`face_normals`) shade it.
@@ -216,12 +214,14 @@ def build(width=256, height=256, mesh=None, materials=False):
     link(scene, light_obj, frame)
     camera = bpy.data.cameras.new("camera")
     camera.sensor_fit = "VERTICAL"
-    camera.angle_y = math.radians(40.0)
+    camera.angle_y = math.radians(VFOV)
     camera.clip_start = 1e-4
     camera_obj = bpy.data.objects.new("camera", camera)
-    # Blender's camera looks down its -z with +y up: twinpath's camera at (0, 1, 3.8) looking
-    # at (0, 1, 0) with y up, unturned in twinpath's frame.
-    camera_obj.location = (0.0, 1.0, 3.8)
+    # Blender's camera looks down its -z with +y up: the scene's camera, which looks along -z
+    # with y up, unturned in twinpath's frame.
+    look = np.subtract(LOOK_AT, EYE)
+    assert look[0] == look[1] == 0 and look[2] < 0 and tuple(UP) == (0, 1, 0)
+    camera_obj.location = EYE
     link(scene, camera_obj, frame)
     scene.camera = camera_obj
     return scene
@@ -252,11 +252,8 @@ def read_render_result(path=None):
 
 
 def read_exr(path):
-    image = bpy.data.images.load(path, check_existing=False)
-    width, height = image.size
-    pixels = np.array(image.pixels[:], dtype=np.float64).reshape(height, width, 4)[::-1, :, :3]
-    bpy.data.images.remove(image)
-    return np.ascontiguousarray(pixels)
+    """An EXR's RGB, top row first (`cycles_fixtures.read_exr` holds it bottom row first)."""
+    return np.ascontiguousarray(cycles_fixtures.read_exr(path)[::-1, :, :3])
 
 
 def write_exr(path, img):

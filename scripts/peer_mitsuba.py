@@ -29,13 +29,15 @@ import time
 import mitsuba as mi
 import numpy as np
 
+from cornell_scene import (BLUE, EYE, GOLD_ALPHA, GOLD_ETA, GOLD_K, GREEN, HEIGHT, LIGHT_CENTER,
+                           LIGHT_RADIANCE, LIGHT_RADIUS, LOOK_AT, RED, SPHERES, UP, VFOV, WALLS,
+                           WHITE, WIDTH)
 from peer_rows import relmse, sweep, variant_name, write_csv
 
 
-def quad(p0, p1, p3, material):
-    """A parallelogram p0, p1, p2 = p1 + p3 - p0, p3 as a two-triangle mesh."""
-    p0, p1, p3 = (np.array(p, dtype=float) for p in (p0, p1, p3))
-    e1, e2 = p1 - p0, p3 - p0
+def quad(corner, edge1, edge2, material):
+    """The parallelogram corner, + edge1, + edge1 + edge2, + edge2 (front normal edge1 x edge2)."""
+    p0, e1, e2 = (np.array(p, dtype=float) for p in (corner, edge1, edge2))
     n = np.cross(e1, e2)
     n /= np.linalg.norm(n)
     center = p0 + 0.5 * (e1 + e2)
@@ -49,16 +51,13 @@ def quad(p0, p1, p3, material):
             "bsdf": {"type": "ref", "id": material}}
 
 
-GOLD_ETA = (0.143036, 0.375307, 1.44205)
-GOLD_K = (3.983, 2.38556, 1.60336)
-
-
 def cornell_materials_dict(spp, seed, sampler="independent"):
     """scenes/cornell_materials.toml: the Cornell scene with a rough gold left sphere (GGX alpha
     0.2, Mitsuba's RGB eta and k of Au, as twinpath's named "gold") and a smooth glass right
     sphere (index 1.5)."""
     d = scene_dict(spp, seed, sampler)
-    d["sphere_left"]["bsdf"] = {"type": "roughconductor", "distribution": "ggx", "alpha": 0.2,
+    d["sphere_left"]["bsdf"] = {"type": "roughconductor", "distribution": "ggx",
+                                "alpha": GOLD_ALPHA,
                                 "eta": {"type": "rgb", "value": GOLD_ETA},
                                 "k": {"type": "rgb", "value": GOLD_K}}
     d["sphere_right"]["bsdf"] = {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}
@@ -135,41 +134,36 @@ def cornell_smoke_dict(spp, seed, sampler="independent"):
     return d
 
 def scene_dict(spp, seed, sampler="independent"):
-    white, red, green, blue = (0.73, 0.73, 0.73), (0.65, 0.05, 0.05), (0.12, 0.45, 0.15), \
-        (0.25, 0.35, 0.75)
-
     def diffuse(rgb):
         return {"type": "twosided",
                 "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": rgb}}}
 
-    return {
+    d = {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5, "hide_emitters": False},
         "sensor": {
             "type": "perspective",
-            "fov": 40.0,
+            "fov": VFOV,
             "fov_axis": "y",
-            "to_world": mi.ScalarTransform4f().look_at(origin=[0, 1, 3.8], target=[0, 1, 0],
-                                                       up=[0, 1, 0]),
+            "to_world": mi.ScalarTransform4f().look_at(origin=list(EYE), target=list(LOOK_AT),
+                                                       up=list(UP)),
             "sampler": {"type": sampler, "sample_count": spp, "seed": seed},
-            "film": {"type": "hdrfilm", "width": 256, "height": 256, "pixel_format": "rgb",
+            "film": {"type": "hdrfilm", "width": WIDTH, "height": HEIGHT, "pixel_format": "rgb",
                      "rfilter": {"type": "box"}},
         },
-        "white": diffuse(white), "red": diffuse(red), "green": diffuse(green),
-        "blue": diffuse(blue),
-        "floor": quad((-1, 0, 1), (1, 0, 1), (-1, 0, -1), "white"),
-        "ceiling": quad((-1, 2, -1), (1, 2, -1), (-1, 2, 1), "white"),
-        "back": quad((-1, 0, -1), (1, 0, -1), (-1, 2, -1), "white"),
-        "left": quad((-1, 0, 1), (-1, 0, -1), (-1, 2, 1), "red"),
-        "right": quad((1, 0, -1), (1, 0, 1), (1, 2, -1), "green"),
-        "sphere_left": {"type": "sphere", "center": [-0.45, 0.4, -0.3], "radius": 0.4,
-                        "bsdf": {"type": "ref", "id": "white"}},
-        "sphere_right": {"type": "sphere", "center": [0.5, 0.3, 0.35], "radius": 0.3,
-                         "bsdf": {"type": "ref", "id": "blue"}},
-        "light": {"type": "sphere", "center": [0, 1.6, 0], "radius": 0.3,
+        "white": diffuse(WHITE), "red": diffuse(RED), "green": diffuse(GREEN),
+        "blue": diffuse(BLUE),
+        "light": {"type": "sphere", "center": list(LIGHT_CENTER), "radius": LIGHT_RADIUS,
                   "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": 0.0}},
-                  "emitter": {"type": "area", "radiance": {"type": "rgb", "value": 10.0}}},
+                  "emitter": {"type": "area",
+                              "radiance": {"type": "rgb", "value": LIGHT_RADIANCE}}},
     }
+    for name, corner, edge1, edge2, material in WALLS:
+        d[name] = quad(corner, edge1, edge2, material)
+    for name, center, radius, material in SPHERES:
+        d[name] = {"type": "sphere", "center": list(center), "radius": radius,
+                   "bsdf": {"type": "ref", "id": material}}
+    return d
 
 
 def main():
