@@ -2,10 +2,12 @@
 //! it (the spherical triangle they project to), for next-event estimation on triangle lights.
 //! Angles are computed in turns by `turns::atan2_turns` and turned into sines and cosines by
 //! `turns::cos_sin_turns`, so nothing a pdf depends on rests on the driver's `atan2` or `acos`.
+//! Written over [`Real`] (the kernel's instance is `f32`), so that
+//! `tests/tests/vulkan_precision.rs` can run the same arithmetic under the liberties a Vulkan
+//! device may take.
 
+use crate::real::{abs, select, Real, V3};
 use crate::turns::{atan2_turns, cos_sin_turns};
-#[cfg(target_arch = "spirv")]
-use crate::Float;
 use core::f32::consts::PI;
 use spirv_std::glam::Vec3;
 
@@ -23,48 +25,76 @@ pub const MAX_SOLID_ANGLE: f32 = 6.22;
 /// product and the solid angle they span, computed once for the sampler's decision, the sample
 /// and its density.
 #[derive(Clone, Copy, Debug)]
-pub struct SphericalTriangle {
+pub struct SphericalTriangle<R: Real = f32> {
     /// Unit directions from the receiver to p0, p1, p2.
-    dir: [Vec3; 3],
+    dir: [V3<R>; 3],
     /// The triple product of the unit directions, A . (B x C) = (p0 - x) . ((p1 - x) x (p2 - x))
     /// over the three distances, computed as A . (edge1 x edge2) / (|p1 - x| |p2 - x|): the
     /// identity (p0 - x) . ((p1 - x) x (p2 - x)) = (p0 - x) . (edge1 x edge2) leaves no nearly
     /// parallel vectors to cancel (the first form loses the digits of a distant triangle), and
     /// dividing before the dot product keeps every intermediate below f32's range at the
     /// scene's largest coordinates (1e15: a product of three lengths would overflow).
-    volume: f32,
+    volume: R,
     /// The solid angle divided by 2 pi (an angle in turns, as `atan2_turns` gives), by Van
     /// Oosterom and Strackee's formula (1983, "The Solid Angle of a Plane Triangle", IEEE Trans.
     /// Biomed. Eng. 30(2)): with a, b, c the vectors to the vertices,
     /// tan(omega / 2) = |a . (b x c)| / (|a||b||c| + (a . b)|c| + (a . c)|b| + (b . c)|a|), here
     /// divided through by |a||b||c|. It keeps its relative precision for small and distant
     /// triangles, where Girard's alpha + beta + gamma - pi cancels.
-    omega_turns: f32,
+    omega_turns: R,
+}
+
+impl<R: Real> SphericalTriangle<R> {
+    /// The triangle p0, p0 + `edge1`, p0 + `edge2` seen from `x`, in any [`Real`].
+    #[inline]
+    pub fn view(x: V3<R>, p0: V3<R>, edge1: V3<R>, edge2: V3<R>) -> Self {
+        let a = p0 - x;
+        let b = a + edge1;
+        let c = a + edge2;
+        let len = [length(a), length(b), length(c)];
+        let dir = [a / len[0], b / len[1], c / len[2]];
+        let volume = dir[0].dot(edge1.cross(edge2) / (len[1] * len[2]));
+        let [a, b, c] = dir;
+        let one = R::splat(1.0);
+        Self {
+            dir,
+            volume,
+            omega_turns: R::splat(2.0)
+                * atan2_turns(abs(volume), one + a.dot(b) + b.dot(c) + c.dot(a)),
+        }
+    }
+
+    /// [`Self::solid_angle`] in any [`Real`].
+    #[inline]
+    pub fn solid_angle_real(&self) -> R {
+        R::splat(2.0 * PI) * self.omega_turns
+    }
+}
+
+/// |v|, as glam's `Vec3::length` computes it.
+#[inline]
+fn length<R: Real>(v: V3<R>) -> R {
+    v.dot(v).sqrt()
+}
+
+/// v / |v|, as glam's `Vec3::normalize` computes it (a product with the reciprocal).
+#[inline]
+fn normalize<R: Real>(v: V3<R>) -> V3<R> {
+    v * (R::splat(1.0) / length(v))
 }
 
 impl SphericalTriangle {
     /// The triangle p0, p0 + `edge1`, p0 + `edge2` seen from `x`.
     #[inline]
     pub fn of(x: Vec3, p0: Vec3, edge1: Vec3, edge2: Vec3) -> Self {
-        let a = p0 - x;
-        let b = a + edge1;
-        let c = a + edge2;
-        let len = [a.length(), b.length(), c.length()];
-        let dir = [a / len[0], b / len[1], c / len[2]];
-        let volume = dir[0].dot(edge1.cross(edge2) / (len[1] * len[2]));
-        let [a, b, c] = dir;
-        Self {
-            dir,
-            volume,
-            omega_turns: 2.0 * atan2_turns(volume.abs(), 1.0 + a.dot(b) + b.dot(c) + c.dot(a)),
-        }
+        Self::view(x.into(), p0.into(), edge1.into(), edge2.into())
     }
 
     /// The solid angle (steradians): 0 if the receiver lies in the triangle's plane or the
     /// triangle is degenerate.
     #[inline]
     pub fn solid_angle(&self) -> f32 {
-        2.0 * PI * self.omega_turns
+        self.solid_angle_real()
     }
 
     /// Whether the triangle is sampled as a spherical triangle ([`Self::sample`], density
@@ -154,35 +184,48 @@ impl SphericalTriangle {
     /// [`sample`] of the triangle this view holds: the unit direction of (u1, u2).
     #[inline]
     pub fn sample(&self, u1: f32, u2: f32) -> Vec3 {
+        self.sample_real(u1, u2).into()
+    }
+}
+
+impl<R: Real> SphericalTriangle<R> {
+    /// [`Self::sample`] in any [`Real`].
+    #[inline]
+    pub fn sample_real(&self, u1: R, u2: R) -> V3<R> {
+        let k = R::splat;
         let omega_turns = self.omega_turns;
         let [a, b, c] = self.dir;
         // The angle at A, between the planes of (A, B) and (A, C): the cross products' dot is
         // cos alpha |A x B| |A x C|, and the length of their cross product, |A . (B x C)|, the
         // sine's (the triple product of the unit directions).
         let cos_part = a.cross(b).dot(a.cross(c));
-        let sin_part = self.volume.abs();
+        let sin_part = abs(self.volume);
         let alpha_turns = atan2_turns(sin_part, cos_part);
         let sin_alpha = sin_part / (cos_part * cos_part + sin_part * sin_part).sqrt();
 
         let sub_area_turns = u1 * omega_turns;
-        let (_, s) = cos_sin_turns(0.5 * sub_area_turns);
+        let (_, s) = cos_sin_turns(k(0.5) * sub_area_turns);
         let (_, sin_phi) = cos_sin_turns(sub_area_turns - alpha_turns);
-        let m = 0.5 * (a - b).length_squared();
-        let two_s2 = 2.0 * s * s;
-        let one_minus_q = two_s2 * (2.0 - m) / (two_s2 - m * sin_alpha * sin_phi);
+        let half_chord = a - b;
+        let m = k(0.5) * half_chord.dot(half_chord);
+        let two_s2 = k(2.0) * s * s;
+        let one_minus_q = two_s2 * (k(2.0) - m) / (two_s2 - m * sin_alpha * sin_phi);
         // q in [-1, 1]; a degenerate 0 / 0 reads as C' = A.
-        let one_minus_q = if one_minus_q > 0.0 {
-            one_minus_q.min(2.0)
-        } else {
-            0.0
-        };
-        let sin_b = (one_minus_q * (2.0 - one_minus_q)).sqrt();
-        let c_prime = (1.0 - one_minus_q) * a + sin_b * (c - c.dot(a) * a).normalize();
+        let one_minus_q = select(
+            one_minus_q.greater_than(k(0.0)),
+            one_minus_q.min(k(2.0)),
+            k(0.0),
+        );
+        let sin_b = (one_minus_q * (k(2.0) - one_minus_q)).sqrt();
+        let c_prime = a * (k(1.0) - one_minus_q) + normalize(c - a * c.dot(a)) * sin_b;
 
-        let one_minus_cos = u2 * (0.5 * (b - c_prime).length_squared());
-        let cos_theta = 1.0 - one_minus_cos;
-        let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
-        (cos_theta * b + sin_theta * (c_prime - c_prime.dot(b) * b).normalize()).normalize()
+        let chord = b - c_prime;
+        let one_minus_cos = u2 * (k(0.5) * chord.dot(chord));
+        let cos_theta = k(1.0) - one_minus_cos;
+        let sin_theta = (one_minus_cos * (k(2.0) - one_minus_cos))
+            .max(k(0.0))
+            .sqrt();
+        normalize(b * cos_theta + normalize(c_prime - b * c_prime.dot(b)) * sin_theta)
     }
 }
 

@@ -7,7 +7,7 @@
 //! driver's sin/cos they differed by up to 1.2e-7). Their cost on the CPU is libm's `sincosf`'s
 //! (docs/gpu.md).
 
-use crate::real::Real;
+use crate::real::{abs, select, Real};
 use crate::word::Word;
 use core::f32::consts::FRAC_PI_2;
 
@@ -61,9 +61,9 @@ pub fn cos_sin_turns<R: Real>(u: R) -> (R, R) {
 }
 
 /// The angle, in turns, of the vector (x, y) with y >= 0: atan2(y, x) / (2 pi), in [0, 1/2]
-/// (0 for x = y = 0). A polynomial for the same reason as [`cos_sin_turns`]: solid angles and
-/// the spherical-triangle sampler's angles feed a pdf, and the driver's `atan2` has no stated
-/// precision.
+/// (0 for x = y = 0); one number, or one per lane ([`Real`]). A polynomial for the same reason
+/// as [`cos_sin_turns`]: solid angles and the spherical-triangle sampler's angles feed a pdf,
+/// and the driver's `atan2` has no stated precision.
 ///
 /// The octant is reduced without rounding: with m = min(|x|, y) and M = max(|x|, y), the angle
 /// of (M, m) is in [0, pi/4]; above pi/8 (m > tan(pi/8) M) it is pi/4 + atan(w) with
@@ -75,34 +75,29 @@ pub fn cos_sin_turns<R: Real>(u: R) -> (R, R) {
 /// 2 ulp of the result (tested against f64 in `tests/tests/sampling.rs`); small angles keep
 /// their relative precision.
 #[inline]
-pub fn atan2_turns(y: f32, x: f32) -> f32 {
-    let ax = x.abs();
-    let (m, big) = if y > ax { (ax, y) } else { (y, ax) };
-    if !(big > 0.0) {
-        return 0.0;
-    }
+pub fn atan2_turns<R: Real>(y: R, x: R) -> R {
+    let c = R::splat;
+    let ax = abs(x);
+    // Without branches, so that it runs on lanes: each choice below is a mask.
+    let steep = y.greater_than(ax);
+    let m = select(steep, ax, y);
+    let big = select(steep, y, ax);
     // tan(pi/8) = sqrt(2) - 1.
-    let above_eighth = m > 0.414_213_57 * big;
-    let w = if above_eighth {
-        (m - big) / (m + big)
-    } else {
-        m / big
-    };
+    let above_eighth = m.greater_than(c(0.414_213_57) * big);
+    let w = select(above_eighth, m - big, m) / select(above_eighth, m + big, big);
     let z = w * w;
     let atan_w = w + w
         * z
-        * (-1.0 / 3.0
-            + z * (1.0 / 5.0
-                + z * (-1.0 / 7.0
-                    + z * (1.0 / 9.0
-                        + z * (-1.0 / 11.0
-                            + z * (1.0 / 13.0 + z * (-1.0 / 15.0 + z * (1.0 / 17.0))))))));
-    let turns = atan_w * (0.5 * core::f32::consts::FRAC_1_PI);
-    let octant = if above_eighth { 0.125 + turns } else { turns };
-    let quadrant = if y > ax { 0.25 - octant } else { octant };
-    if x < 0.0 {
-        0.5 - quadrant
-    } else {
-        quadrant
-    }
+        * (c(-1.0 / 3.0)
+            + z * (c(1.0 / 5.0)
+                + z * (c(-1.0 / 7.0)
+                    + z * (c(1.0 / 9.0)
+                        + z * (c(-1.0 / 11.0)
+                            + z * (c(1.0 / 13.0) + z * (c(-1.0 / 15.0) + z * c(1.0 / 17.0))))))));
+    let turns = atan_w * c(0.5 * core::f32::consts::FRAC_1_PI);
+    let octant = select(above_eighth, c(0.125) + turns, turns);
+    let quadrant = select(steep, c(0.25) - octant, octant);
+    let angle = select(x.less_than(c(0.0)), c(0.5) - quadrant, quadrant);
+    // (0, 0) and NaN give 0 (their quotient, NaN, is not chosen).
+    select(big.greater_than(c(0.0)), angle, c(0.0))
 }
