@@ -156,8 +156,10 @@ pub mod gpu;
 pub mod placements;
 pub mod reference_bsdf;
 pub mod sheen_fit;
+pub mod spherical_triangle_error;
 pub mod spirv;
 pub mod stats;
+pub mod triangle_bins;
 pub mod vulkan_arithmetic;
 
 /// Renders `scene` at `spp` on `backend` (the GPU with validation layers on).

@@ -27,6 +27,9 @@ use twinpath_tests::device_class::{
 use twinpath_tests::vulkan_arithmetic::{lean, seed, set_model, ulp, Model, Vk32};
 use twinpath_tests::SplitMix;
 
+#[path = "vulkan_precision/spherical_triangles.rs"]
+mod spherical_triangles;
+
 type V = V3<Vk32>;
 
 fn v(x: Vec3) -> V {

@@ -1,0 +1,151 @@
+//! The spherical-triangle sampler of triangle lights (`kernel::spherical_triangle`, written over
+//! `Real`) under Vulkan's arithmetic: its solid angle, the density every light sample divides
+//! by, within the first-order bound derived for the arithmetic (`twinpath_tests::
+//! spherical_triangle_error`), which IEEE's bound does not cover.
+
+use super::{back, cases, f, use_model, v};
+use glam::Vec3;
+use kernel::spherical_triangle::SphericalTriangle;
+use twinpath_tests::device_class::IEEE_ROUNDOFF;
+use twinpath_tests::spherical_triangle_error::{solid_angle_error, solid_angle_exact};
+use twinpath_tests::vulkan_arithmetic::{set_model, Model};
+use twinpath_tests::SplitMix;
+
+/// A triangle (p0, e1, e2) and a receiver: vertices in a box of size 2 at the origin, receivers
+/// from 10^-3 to 10^3 sizes away from its centroid (as `triangle_lights.rs` draws them), every
+/// other one moved to just above or below its plane (elevations down to 10^-4 of the distance),
+/// where the triple product cancels.
+fn triangle_and_receiver(g: &mut SplitMix, k: usize) -> (Vec3, Vec3, Vec3, Vec3) {
+    let mut v = |s: f32| Vec3::new(g.unit() - 0.5, g.unit() - 0.5, g.unit() - 0.5) * s;
+    let p = [v(2.0), v(2.0), v(2.0)];
+    let centroid = (p[0] + p[1] + p[2]) / 3.0;
+    let distance = 10f32.powf((k % 7) as f32 - 3.0);
+    let mut x = centroid + v(2.0 * distance);
+    if k % 2 == 1 {
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+        let along = x - centroid;
+        x = centroid + along - n * along.dot(n) + n * along.length() * 10f32.powf(-4.0 * g.unit());
+    }
+    (x, p[0], p[1] - p[0], p[2] - p[0])
+}
+
+/// The solid angle under IEEE arithmetic and every Vulkan model is within its first-order
+/// relative error of the exact one (`solid_angle_error` for the model's (u, q, w)); the Vulkan
+/// models exceed the bound derived for IEEE arithmetic, so the wider one is needed. Cases whose
+/// solid angle is 0 to the kernel or exactly (the receiver in the plane) are skipped.
+#[test]
+fn solid_angles_are_within_their_error_under_every_arithmetic() {
+    let mut g = SplitMix(31);
+    twinpath_tests::vulkan_arithmetic::seed(31);
+    // Per model (IEEE, Vulkan, worst up, worst down): of the model's bound, of IEEE's bound.
+    let (mut worst, mut of_ieee) = ([0f64; 4], [0f64; 4]);
+    let mut tested = 0;
+    for k in 0..cases() {
+        let (x, p0, e1, e2) = triangle_and_receiver(&mut g, k);
+        let arrays = (x.to_array(), p0.to_array(), e1.to_array(), e2.to_array());
+        let exact = solid_angle_exact(arrays.0, arrays.1, arrays.2, arrays.3);
+        if !(exact > 0.0) {
+            continue;
+        }
+        tested += 1;
+        for model in 0..4 {
+            let roundoff = use_model(model);
+            let got = SphericalTriangle::view(v(x), v(p0), v(e1), v(e2))
+                .solid_angle_real()
+                .value as f64;
+            let error = (got / exact - 1.0).abs();
+            let bound = |r| solid_angle_error(arrays.0, arrays.1, arrays.2, arrays.3, r);
+            worst[model] = worst[model].max(error / bound(roundoff));
+            of_ieee[model] = of_ieee[model].max(error / bound(IEEE_ROUNDOFF));
+        }
+    }
+    set_model(Model::VULKAN);
+    println!("solid angles against the exact ones ({tested} cases), of their bound: IEEE, Vulkan, worst up, worst down {worst:.3?}; of IEEE's bound {of_ieee:.3?}");
+    assert!(tested > cases() / 2, "{tested} cases");
+    assert!(worst.iter().all(|&w| w <= 1.0), "{worst:?}");
+    // The models' liberties move the solid angle further than IEEE arithmetic ever does.
+    assert!(
+        of_ieee[1..].iter().all(|&w| w > of_ieee[0]),
+        "the Vulkan models err no more than IEEE arithmetic: {of_ieee:?}"
+    );
+}
+
+/// Samples per case of the chi-square test below (`Vk32` draws a coin per operation).
+const SAMPLES: usize = 200_000;
+
+/// The sampler's directions under two Vulkan models (liberties at random, all at their largest)
+/// follow its density, uniform in solid angle:
+/// a chi-square test of the sub-triangle each direction meets (`triangle_bins`, the point
+/// found in `f64`) against each sub-triangle's exact share of the solid angle, on triangles the
+/// light samples this way: moderate, close and large (5.6 sr), thin, near the smallest solid
+/// angle sampled (3e-4 sr), and seen at 2 degrees above the plane. Every direction is a finite
+/// unit vector that meets the triangle's plane within its barycentric bounds (to 1e-4: the
+/// light moves such points onto the triangle, `barycentrics_along`). A distribution-level
+/// check: 64 bins and 2 x 10^5 samples see distortions of a few percent of a bin, not rounding;
+/// the directions' first-order bound is not yet derived (`docs/robustness.md`).
+#[test]
+fn sampled_directions_follow_the_solid_angle_under_vulkan_arithmetic() {
+    use twinpath_tests::triangle_bins::{barycentrics, bin_of, bins, solid_angle_f64, N};
+    use twinpath_tests::{chi_square, SplitMix};
+    let right = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let cases = [
+        ("moderate", right, Vec3::new(0.2, 0.3, 1.0)),
+        ("close, 5.6 sr", right, Vec3::new(0.3, 0.3, 0.01)),
+        (
+            "thin",
+            [Vec3::ZERO, Vec3::X, Vec3::new(0.5, 0.06, 0.0)],
+            Vec3::new(0.4, 0.02, 0.3),
+        ),
+        ("near 3e-4 sr", right, Vec3::new(0.3, 0.3, 28.0)),
+        (
+            "2 degrees above the plane",
+            right,
+            Vec3::new(-1.0, 0.3, 0.035),
+        ),
+    ];
+    let tests = 2 * cases.len();
+    let threshold = 1.0 - (1.0 - 0.01f64).powf(1.0 / tests as f64);
+    let mut g = SplitMix(37);
+    twinpath_tests::vulkan_arithmetic::seed(37);
+    for (name, p, x) in cases {
+        let (p0, e1, e2) = (p[0], p[1] - p[0], p[2] - p[0]);
+        assert!(
+            SphericalTriangle::of(x, p0, e1, e2).sampled(),
+            "{name}: not sampled as a spherical triangle"
+        );
+        let (x64, p64) = (x.as_dvec3(), p.map(|q| q.as_dvec3()));
+        let omega = solid_angle_f64(x64, p64);
+        let at = |(u, v): (f64, f64)| p64[0] + u * (p64[1] - p64[0]) + v * (p64[2] - p64[0]);
+        let expected: Vec<f64> = bins()
+            .iter()
+            .map(|b| {
+                b.map_or(0.0, |t| {
+                    SAMPLES as f64 * solid_angle_f64(x64, t.map(at)) / omega
+                })
+            })
+            .collect();
+        for model in 1..3 {
+            use_model(model);
+            let view = SphericalTriangle::view(v(x), v(p0), v(e1), v(e2));
+            let mut observed = vec![0.0; 2 * N * N];
+            for _ in 0..SAMPLES {
+                let d = back(view.sample_real(f(g.unit()), f(g.unit())));
+                let length = d.as_dvec3().length();
+                assert!((length - 1.0).abs() < 1e-5, "{name}: |direction| {length}");
+                let (u, w) = barycentrics(x64, d.as_dvec3(), p64);
+                assert!(
+                    u > -1e-4 && w > -1e-4 && u + w < 1.0 + 1e-4,
+                    "{name}: direction {d} meets the plane at ({u}, {w})"
+                );
+                observed[bin_of(u, w)] += 1.0;
+            }
+            let (stat, dof, p_value) = chi_square(&observed, &expected);
+            println!("{name}, model {model}: chi2 {stat:.1}, dof {dof}, p {p_value:.3}");
+            assert!(
+                p_value > threshold,
+                "{name}: directions under Vulkan arithmetic do not follow the solid angle (chi2 {stat:.1}, dof {dof}, p {p_value:.2e})"
+            );
+        }
+    }
+    set_model(Model::VULKAN);
+}
