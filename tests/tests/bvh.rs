@@ -398,8 +398,8 @@ fn parallel_build_gives_the_one_thread_tree() {
                 .fold(Aabb::EMPTY.grow(p0), Aabb::grow)
         })
         .collect();
-    let parallel = BinaryBvh::build(&bounds);
-    let serial = BinaryBvh::build_one_thread(&bounds);
+    let parallel = BinaryBvh::build(&bounds, bounds.len());
+    let serial = BinaryBvh::build_one_thread(&bounds, bounds.len());
     assert_eq!(parallel.prims, serial.prims, "different primitive order");
     assert_eq!(parallel.nodes.len(), serial.nodes.len());
     // The same tree node for node, walked from both roots (the node order differs).

@@ -1,6 +1,11 @@
 //! The binary bounding volume hierarchy, built top-down with the binned surface-area heuristic
 //! (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies", 2007; pbrt-v4 7.3).
 //! [`super::bvh::Bvh`] collapses it into the 8-wide tree that is traversed.
+//!
+//! The heuristic counts a leaf's cost in the tests traversal makes: its triangles and spheres
+//! are tested four to a SIMD block, so g of them cost ceil(g / 4) tests, and each instance one
+//! (at least: its own tree's traversal), as Embree's builders count blocks. Counting primitives
+//! instead made leaves whose last block was mostly empty (a leaf of five costs two blocks).
 
 use glam::Vec3;
 
@@ -63,25 +68,53 @@ pub const SAH_MAX_DEPTH: usize = 96;
 /// smaller ones by one thread into one vector.
 const PARALLEL_MIN: usize = 4096;
 
+/// What the build reads of the primitives: their boxes, the boxes' centres, and the index from
+/// which on they are instances (the ones before it are triangles and spheres).
+struct Primitives<'a> {
+    bounds: &'a [Aabb],
+    centroids: Vec<Vec3>,
+    first_instance: usize,
+}
+
+impl Primitives<'_> {
+    /// Whether primitive `p` is an instance.
+    fn is_instance(&self, p: u32) -> bool {
+        p as usize >= self.first_instance
+    }
+}
+
+/// The tests a leaf of `geometry` triangles and spheres and `instances` instances costs.
+fn leaf_tests(geometry: usize, instances: usize) -> f32 {
+    (geometry.div_ceil(4) + instances) as f32
+}
+
 impl BinaryBvh {
-    /// Builds the tree over primitives with these bounds. O(n log n): each level partitions
-    /// with a linear binning pass. The two halves of large ranges are built in parallel; the
-    /// tree is the same on any number of threads (every split depends on its range only).
-    pub fn build(bounds: &[Aabb]) -> BinaryBvh {
-        let centroids: Vec<Vec3> = bounds.iter().map(Aabb::centroid).collect();
-        let mut prims: Vec<u32> = (0..bounds.len() as u32).collect();
-        let nodes = build_subtree(bounds, &centroids, &mut prims, 0, 0);
+    /// Builds the tree over primitives with these bounds, of which those from `first_instance`
+    /// on are instances. O(n log n): each level partitions with a linear binning pass. The two
+    /// halves of large ranges are built in parallel; the tree is the same on any number of
+    /// threads (every split depends on its range only).
+    pub fn build(bounds: &[Aabb], first_instance: usize) -> BinaryBvh {
+        let (primitives, mut prims) = Self::inputs(bounds, first_instance);
+        let nodes = build_subtree(&primitives, &mut prims, 0, 0);
         BinaryBvh { nodes, prims }
     }
 
     /// The same tree built on the calling thread alone, in depth-first node order: the
     /// reference the parallel build is tested against.
     #[cfg(feature = "test-support")]
-    pub fn build_one_thread(bounds: &[Aabb]) -> BinaryBvh {
-        let centroids: Vec<Vec3> = bounds.iter().map(Aabb::centroid).collect();
-        let mut prims: Vec<u32> = (0..bounds.len() as u32).collect();
-        let nodes = build_serial(bounds, &centroids, &mut prims, 0, 0);
+    pub fn build_one_thread(bounds: &[Aabb], first_instance: usize) -> BinaryBvh {
+        let (primitives, mut prims) = Self::inputs(bounds, first_instance);
+        let nodes = build_serial(&primitives, &mut prims, 0, 0);
         BinaryBvh { nodes, prims }
+    }
+
+    fn inputs(bounds: &[Aabb], first_instance: usize) -> (Primitives<'_>, Vec<u32>) {
+        let primitives = Primitives {
+            bounds,
+            centroids: bounds.iter().map(Aabb::centroid).collect(),
+            first_instance,
+        };
+        (primitives, (0..bounds.len() as u32).collect())
     }
 }
 
@@ -94,13 +127,8 @@ enum Division {
 }
 
 /// Decides the node over `prims` with bounds `b` at `depth` (reordering `prims` for a split).
-fn divide(
-    prims: &mut [u32],
-    bounds: &[Aabb],
-    centroids: &[Vec3],
-    b: &Aabb,
-    depth: usize,
-) -> Division {
+fn divide(prims: &mut [u32], primitives: &Primitives, b: &Aabb, depth: usize) -> Division {
+    let centroids = &primitives.centroids;
     let count = prims.len();
     if count <= MAX_LEAF {
         return Division::Leaf;
@@ -110,7 +138,7 @@ fn divide(
         .fold(Aabb::EMPTY, |a, &p| a.grow(centroids[p as usize]));
     // Past SAH_MAX_DEPTH only median splits, which bound the depth by log2(n).
     let split = if depth < SAH_MAX_DEPTH {
-        best_split(prims, bounds, centroids, &cb, b.half_area())
+        best_split(prims, primitives, &cb, b.half_area())
     } else {
         None
     };
@@ -149,23 +177,22 @@ fn bounds_of(prims: &[u32], bounds: &[Aabb]) -> Aabb {
 /// first; an interior node's children are adjacent. Large ranges build their halves in
 /// parallel and concatenate them as [root, left root, right root, left rest, right rest].
 fn build_subtree(
-    bounds: &[Aabb],
-    centroids: &[Vec3],
+    primitives: &Primitives,
     prims: &mut [u32],
     offset: usize,
     depth: usize,
 ) -> Vec<Node> {
     if prims.len() < PARALLEL_MIN {
-        return build_serial(bounds, centroids, prims, offset, depth);
+        return build_serial(primitives, prims, offset, depth);
     }
-    let b = bounds_of(prims, bounds);
-    let Division::At(mid) = divide(prims, bounds, centroids, &b, depth) else {
+    let b = bounds_of(prims, primitives.bounds);
+    let Division::At(mid) = divide(prims, primitives, &b, depth) else {
         unreachable!("ranges this large always split");
     };
     let (lp, rp) = prims.split_at_mut(mid);
     let (left, right) = rayon::join(
-        || build_subtree(bounds, centroids, lp, offset, depth + 1),
-        || build_subtree(bounds, centroids, rp, offset + mid, depth + 1),
+        || build_subtree(primitives, lp, offset, depth + 1),
+        || build_subtree(primitives, rp, offset + mid, depth + 1),
     );
     // Node i >= 1 of a part moves to base + i - 1; its root to slot 1 or 2.
     let (base_left, base_right) = (3, 3 + left.len() - 1);
@@ -194,8 +221,7 @@ fn build_subtree(
 
 /// [`build_subtree`] on one thread: an explicit stack, nodes appended in pairs.
 fn build_serial(
-    bounds: &[Aabb],
-    centroids: &[Vec3],
+    primitives: &Primitives,
     prims: &mut [u32],
     offset: usize,
     depth: usize,
@@ -211,9 +237,9 @@ fn build_serial(
     let mut work = vec![(0usize, 0usize, prims.len(), depth)];
     while let Some((node, start, end, depth)) = work.pop() {
         let range = &mut prims[start..end];
-        let b = bounds_of(range, bounds);
+        let b = bounds_of(range, primitives.bounds);
         nodes[node].bounds = b;
-        match divide(range, bounds, centroids, &b, depth) {
+        match divide(range, primitives, &b, depth) {
             Division::Leaf => {
                 nodes[node].first = (offset + start) as u32;
                 nodes[node].count = (end - start) as u32;
@@ -236,11 +262,11 @@ fn build_serial(
 /// The best binned-SAH split of `prims` as (axis, centroid plane), or None when a leaf is cheaper.
 fn best_split(
     prims: &[u32],
-    bounds: &[Aabb],
-    centroids: &[Vec3],
+    primitives: &Primitives,
     cb: &Aabb,
     parent_half_area: f32,
 ) -> Option<(usize, f32)> {
+    let (bounds, centroids) = (primitives.bounds, &primitives.centroids);
     let mut best: Option<(f32, usize, f32)> = None;
     for axis in 0..3 {
         let lo = cb.min[axis];
@@ -249,42 +275,50 @@ fn best_split(
             continue;
         }
         let mut bin_bounds = [Aabb::EMPTY; BINS];
-        let mut bin_count = [0usize; BINS];
+        // (triangles and spheres, instances) per bin.
+        let mut bin_count = [(0usize, 0usize); BINS];
         let scale = BINS as f32 / extent;
         for &p in prims {
             let b = (((centroids[p as usize][axis] - lo) * scale) as usize).min(BINS - 1);
-            bin_count[b] += 1;
+            if primitives.is_instance(p) {
+                bin_count[b].1 += 1;
+            } else {
+                bin_count[b].0 += 1;
+            }
             bin_bounds[b] = bin_bounds[b].union(bounds[p as usize]);
         }
+        let add = |(g, i): (usize, usize), (h, j): (usize, usize)| (g + h, i + j);
         // Sweep: cost of splitting after bin i.
         let mut right_area = [0.0f32; BINS];
-        let mut right_count = [0usize; BINS];
+        let mut right_count = [(0usize, 0usize); BINS];
         let mut acc = Aabb::EMPTY;
-        let mut cnt = 0;
+        let mut cnt = (0, 0);
         for i in (1..BINS).rev() {
             acc = acc.union(bin_bounds[i]);
-            cnt += bin_count[i];
+            cnt = add(cnt, bin_count[i]);
             right_area[i] = acc.half_area();
             right_count[i] = cnt;
         }
         let mut left = Aabb::EMPTY;
-        let mut left_count = 0;
+        let mut left_count = (0, 0);
         for i in 0..BINS - 1 {
             left = left.union(bin_bounds[i]);
-            left_count += bin_count[i];
-            if left_count == 0 || right_count[i + 1] == 0 {
+            left_count = add(left_count, bin_count[i]);
+            if left_count == (0, 0) || right_count[i + 1] == (0, 0) {
                 continue;
             }
-            let cost = left.half_area() * left_count as f32
-                + right_area[i + 1] * right_count[i + 1] as f32;
+            let tests = |(g, i): (usize, usize)| leaf_tests(g, i);
+            let cost = left.half_area() * tests(left_count)
+                + right_area[i + 1] * tests(right_count[i + 1]);
             if best.is_none_or(|(c, _, _)| cost < c) {
                 best = Some((cost, axis, lo + (i + 1) as f32 / scale));
             }
         }
     }
     let (cost, axis, plane) = best?;
-    // Leaf cost: intersect all; split cost: traversal (~1) + expected intersections.
-    let leaf_cost = prims.len() as f32;
+    // Leaf cost: test all; split cost: traversal (~1/2 of a test) + expected tests.
+    let instances = prims.iter().filter(|&&p| primitives.is_instance(p)).count();
+    let leaf_cost = leaf_tests(prims.len() - instances, instances);
     let split_cost = 0.5 + cost / parent_half_area.max(f32::MIN_POSITIVE);
     if split_cost < leaf_cost || prims.len() > SAH_LEAF_MAX {
         Some((axis, plane))

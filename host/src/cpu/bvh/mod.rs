@@ -199,7 +199,7 @@ impl Bvh {
         let bounds: Vec<Aabb> = (0..n as u32)
             .map(|i| prim_bounds(&spheres, &triangles, &instance_boxes, i))
             .collect();
-        let binary = BinaryBvh::build(&bounds);
+        let binary = BinaryBvh::build(&bounds, spheres.len() + triangles.len());
         let mut bvh = Bvh {
             nodes: huge_pages::vec_with_capacity(binary.nodes.len() / 2 + 1),
             leaves: Vec::new(),
