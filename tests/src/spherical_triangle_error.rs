@@ -150,3 +150,235 @@ pub fn solid_angle_error(
     let turns_error = moved / std::f64::consts::TAU + atan2_turns_error(y, d, u, q);
     turns_error / half_turns + u + 0.5 * f32::EPSILON as f64
 }
+
+/// The exact inputs of the sampler (`SphericalTriangle::sample_real`) for the triangle
+/// p0, p0 + e1, p0 + e2 seen from x, and how far one computation of each may be off: the unit
+/// directions per component (absolute), the triple product (absolute) and the solid angle in
+/// turns (relative).
+struct SamplerInputs {
+    dir: [DVec3; 3],
+    dir_error: [DVec3; 3],
+    volume: f64,
+    volume_error: f64,
+    omega_turns: f64,
+    omega_error: f64,
+}
+
+/// [`SamplerInputs`] in the arithmetic (u, q, w). A unit direction's component is the rounded
+/// vector's (u |a_j| for a, u (|a_j| + |b_j|) for b and c) over the computed length, which is
+/// off by the rounded vector's own relative error (r_v, [`view`]) and 1.5 u + w, then the
+/// quotient's q.
+fn sampler_inputs(
+    x: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
+    roundoff: (f64, f64, f64),
+) -> SamplerInputs {
+    let (u, q, w) = roundoff;
+    let a = d3(p0) - d3(x);
+    let v = [a, a + d3(e1), a + d3(e2)];
+    let rounded = [
+        a.abs() * u,
+        (a.abs() + v[1].abs()) * u,
+        (a.abs() + v[2].abs()) * u,
+    ];
+    let dir = v.map(|v| v.normalize());
+    let dir_error = [0, 1, 2].map(|i| {
+        let length = v[i].length();
+        let relative = rounded[i].length() / length + 1.5 * u + w + q;
+        rounded[i] / length + dir[i].abs() * relative
+    });
+    let view = view(x, p0, e1, e2, u, q, w);
+    let omega = solid_angle_exact(x, p0, e1, e2);
+    SamplerInputs {
+        dir,
+        dir_error,
+        volume: view.volume,
+        volume_error: view.volume_error,
+        omega_turns: omega / std::f64::consts::TAU,
+        omega_error: solid_angle_error(x, p0, e1, e2, roundoff),
+    }
+}
+
+/// The roundings of one computation of the sampler, one quantity (a slot) at a time: an exact
+/// pass records each slot's allowance (how far that operation may move its result); a later
+/// pass moves one slot by its whole allowance, up or down, and leaves the rest exact.
+struct Roundings {
+    roundoff: (f64, f64, f64),
+    allowances: Vec<f64>,
+    recording: bool,
+    next: usize,
+    moved: Option<(usize, f64)>,
+}
+
+impl Roundings {
+    /// `x`, moved in this pass if its slot is the one moved; `allowance` is recorded on the
+    /// exact pass.
+    fn abs(&mut self, x: f64, allowance: f64) -> f64 {
+        let k = self.next;
+        self.next += 1;
+        if self.recording {
+            self.allowances.push(allowance);
+        }
+        match self.moved {
+            Some((slot, sign)) if slot == k => x + sign * self.allowances[k],
+            _ => x,
+        }
+    }
+
+    fn rel(&mut self, x: f64, relative: f64) -> f64 {
+        self.abs(x, relative * x.abs())
+    }
+
+    fn abs3(&mut self, v: DVec3, allowance: DVec3) -> DVec3 {
+        DVec3::new(
+            self.abs(v.x, allowance.x),
+            self.abs(v.y, allowance.y),
+            self.abs(v.z, allowance.z),
+        )
+    }
+
+    /// A vector sum or difference: u of each component.
+    fn sum3(&mut self, v: DVec3) -> DVec3 {
+        let u = self.roundoff.0;
+        self.abs3(v, v.abs() * u)
+    }
+
+    /// Componentwise products: u of each component.
+    fn product3(&mut self, v: DVec3) -> DVec3 {
+        self.sum3(v)
+    }
+
+    /// A dot product x . y: three products and two sums, 3 u of the sum of |x_j y_j|.
+    fn dot(&mut self, x: DVec3, y: DVec3) -> f64 {
+        let u = self.roundoff.0;
+        self.abs(x.dot(y), 3.0 * u * (x.abs().dot(y.abs())))
+    }
+
+    /// `v * (1 / |v|)`, as `normalize` computes it: the length (1.5 u + w), the reciprocal (q)
+    /// and the products (u each).
+    fn normalize(&mut self, v: DVec3) -> DVec3 {
+        let (u, q, w) = self.roundoff;
+        let length = self.rel(v.length(), 1.5 * u + w);
+        let reciprocal = self.rel(1.0 / length, q);
+        self.product3(v * reciprocal)
+    }
+}
+
+/// `SphericalTriangle::sample_real`'s operations in `f64`, each result passed through
+/// `r` (its slot), so that one rounding at a time can be put back.
+fn sample_with(r: &mut Roundings, inputs: &SamplerInputs, u1: f64, u2: f64) -> DVec3 {
+    use std::f64::consts::{PI, SQRT_2, TAU};
+    let (u, q, w) = r.roundoff;
+    let a = r.abs3(inputs.dir[0], inputs.dir_error[0]);
+    let b = r.abs3(inputs.dir[1], inputs.dir_error[1]);
+    let c = r.abs3(inputs.dir[2], inputs.dir_error[2]);
+    let volume = r.abs(inputs.volume, inputs.volume_error);
+    let omega_turns = r.rel(inputs.omega_turns, inputs.omega_error);
+    // The angle at A: two cross products (each component u (|xy| + |zw|) + u |result|, a
+    // vector at most u (sqrt 2 + |x cross y|) long) and their dot.
+    let (ab, ac) = (a.cross(b), a.cross(c));
+    let (sc, sb) = (ab.length(), ac.length());
+    let cos_part = r.abs(
+        ab.dot(ac),
+        u * (sb * (SQRT_2 + sc) + sc * (SQRT_2 + sb) + 3.0 * sb * sc),
+    );
+    let sin_part = volume.abs();
+    let alpha_turns = r.abs(
+        sin_part.atan2(cos_part) / TAU,
+        atan2_turns_error(sin_part, cos_part, u, q),
+    );
+    let sin_alpha = r.rel(
+        sin_part / (cos_part * cos_part + sin_part * sin_part).sqrt(),
+        u + w + q,
+    );
+    let sub_area_turns = r.rel(u1 * omega_turns, u);
+    // `cos_sin_turns` is within 4 u of the exact sine (tested under every model).
+    let s = r.abs((PI * sub_area_turns).sin(), 4.0 * u);
+    let phi_turns = sub_area_turns - alpha_turns;
+    let phi_turns = r.abs(phi_turns, u * phi_turns.abs());
+    let sin_phi = r.abs((TAU * phi_turns).sin(), 4.0 * u);
+    let half_chord = r.sum3(a - b);
+    let m = r.rel(0.5 * half_chord.dot(half_chord), 3.0 * u);
+    let two_s2 = r.rel(2.0 * s * s, u);
+    let two_minus_m = r.abs(2.0 - m, u * (2.0 - m).abs());
+    let numerator = r.rel(two_s2 * two_minus_m, u);
+    let p = r.rel(m * sin_alpha * sin_phi, 2.0 * u);
+    let denominator = r.abs(two_s2 - p, u * (two_s2 - p).abs());
+    let one_minus_q = r.rel(numerator / denominator, q);
+    let one_minus_q = if one_minus_q > 0.0 {
+        one_minus_q.min(2.0)
+    } else {
+        0.0
+    };
+    let two_minus = r.abs(2.0 - one_minus_q, u * (2.0 - one_minus_q).abs());
+    let product = r.rel(one_minus_q * two_minus, u);
+    let sin_b = r.rel(product.max(0.0).sqrt(), w);
+    let c_dot_a = r.dot(c, a);
+    let along = r.product3(a * c_dot_a);
+    let perpendicular = r.sum3(c - along);
+    let toward_c = r.normalize(perpendicular);
+    let cos_b = r.abs(1.0 - one_minus_q, u * (1.0 - one_minus_q).abs());
+    let first = r.product3(a * cos_b);
+    let second = r.product3(toward_c * sin_b);
+    let c_prime = r.sum3(first + second);
+
+    let chord = r.sum3(b - c_prime);
+    let half = r.rel(0.5 * chord.dot(chord), 3.0 * u);
+    let one_minus_cos = r.rel(u2 * half, u);
+    let cos_theta = r.abs(1.0 - one_minus_cos, u * (1.0 - one_minus_cos).abs());
+    let two_minus = r.abs(2.0 - one_minus_cos, u * (2.0 - one_minus_cos).abs());
+    let product = r.rel(one_minus_cos * two_minus, u);
+    let sin_theta = r.rel(product.max(0.0).sqrt(), w);
+    let c_dot_b = r.dot(c_prime, b);
+    let along = r.product3(b * c_dot_b);
+    let perpendicular = r.sum3(c_prime - along);
+    let toward_c_prime = r.normalize(perpendicular);
+    let first = r.product3(b * cos_theta);
+    let second = r.product3(toward_c_prime * sin_theta);
+    let direction = r.sum3(first + second);
+    r.normalize(direction)
+}
+
+/// The sampled direction for (u1, u2) computed exactly from the `f32` inputs, and its
+/// first-order error per component for one computation in the arithmetic `roundoff`: the sum,
+/// over every operation of the sampler and every input it takes from the view, of how far that
+/// one rounding at its allowance moves the direction (evaluated in `f64`, each rounding put back
+/// alone, up and down, the larger kept). The allowances are those of the operations: u for a
+/// sum, a product or a component of either, 3 u of the terms' magnitudes for a dot product,
+/// q for a quotient, w for a root, 4 u for `cos_sin_turns`, [`atan2_turns_error`] for the
+/// angle at A, the view's own bounds for its directions, triple product and solid angle. Where
+/// the sampler's map is steep (u1 near 0, a thin spherical triangle) one rounding's effect
+/// is taken as it is, not its derivative.
+pub fn sample_direction_error(
+    x: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
+    (u1, u2): (f32, f32),
+    roundoff: (f64, f64, f64),
+) -> (DVec3, DVec3) {
+    let inputs = sampler_inputs(x, p0, e1, e2, roundoff);
+    let mut r = Roundings {
+        roundoff,
+        allowances: Vec::new(),
+        recording: true,
+        next: 0,
+        moved: None,
+    };
+    let (u1, u2) = (u1 as f64, u2 as f64);
+    let exact = sample_with(&mut r, &inputs, u1, u2);
+    r.recording = false;
+    let mut bound = DVec3::ZERO;
+    for slot in 0..r.allowances.len() {
+        let mut moved = DVec3::ZERO;
+        for sign in [1.0, -1.0] {
+            r.next = 0;
+            r.moved = Some((slot, sign));
+            moved = moved.max((sample_with(&mut r, &inputs, u1, u2) - exact).abs());
+        }
+        bound += moved;
+    }
+    (exact, bound)
+}

@@ -1,7 +1,7 @@
 //! The spherical-triangle sampler of triangle lights (`kernel::spherical_triangle`, written over
-//! `Real`) under Vulkan's arithmetic: its solid angle, the density every light sample divides
-//! by, within the first-order bound derived for the arithmetic (`twinpath_tests::
-//! spherical_triangle_error`), which IEEE's bound does not cover.
+//! `Real`) under Vulkan's arithmetic: its solid angle (the density every light sample divides
+//! by) and its sampled directions within the first-order bounds derived for the arithmetic
+//! (`twinpath_tests::spherical_triangle_error`), and the directions' distribution.
 
 use super::{back, cases, f, use_model, v};
 use glam::Vec3;
@@ -81,8 +81,8 @@ const SAMPLES: usize = 200_000;
 /// angle sampled (3e-4 sr), and seen at 2 degrees above the plane. Every direction is a finite
 /// unit vector that meets the triangle's plane within its barycentric bounds (to 1e-4: the
 /// light moves such points onto the triangle, `barycentrics_along`). A distribution-level
-/// check: 64 bins and 2 x 10^5 samples see distortions of a few percent of a bin, not rounding;
-/// the directions' first-order bound is not yet derived (`docs/robustness.md`).
+/// check beside the pointwise bound below: 64 bins and 2 x 10^5 samples see distortions of a
+/// few percent of a bin, not rounding.
 #[test]
 fn sampled_directions_follow_the_solid_angle_under_vulkan_arithmetic() {
     use twinpath_tests::triangle_bins::{barycentrics, bin_of, bins, solid_angle_f64, N};
@@ -148,4 +148,62 @@ fn sampled_directions_follow_the_solid_angle_under_vulkan_arithmetic() {
         }
     }
     set_model(Model::VULKAN);
+}
+
+/// The sampled direction under IEEE arithmetic and every Vulkan model is within its
+/// first-order error of the exact direction (`sample_direction_error` for the model's
+/// (u, q, w): every rounding of the sampler and of the view it reads, one at a time at its
+/// allowance), on the triangles and receivers above that the kernel samples as spherical
+/// triangles, with u1 and u2 at their extremes every fifth case; and the Vulkan models go
+/// beyond the bound derived for IEEE arithmetic (so the wider one is needed). The bound is per
+/// record and carries the record's conditioning: near u1 = 1 for a receiver close to a large
+/// light's plane the map from u1 to the arc is steep, and there the bound (and the CPU's own
+/// error) is large.
+#[test]
+fn sampled_directions_are_within_their_error_under_every_arithmetic() {
+    use twinpath_tests::spherical_triangle_error::sample_direction_error;
+    let mut g = SplitMix(41);
+    twinpath_tests::vulkan_arithmetic::seed(41);
+    let (mut worst, mut of_ieee) = ([0f64; 4], [0f64; 4]);
+    let mut tested = 0;
+    let extremes = [2f32.powi(-24), 1e-4, 0.5, 1.0 - 1e-4, 1.0 - 2f32.powi(-24)];
+    let mut bounds = Vec::new();
+    for k in 0..cases() {
+        let (x, p0, e1, e2) = triangle_and_receiver(&mut g, k);
+        if !SphericalTriangle::of(x, p0, e1, e2).sampled() {
+            continue;
+        }
+        let (u1, u2) = if k % 5 == 0 {
+            (extremes[k / 5 % 5], extremes[k / 25 % 5])
+        } else {
+            (g.unit(), g.unit())
+        };
+        let arrays = (x.to_array(), p0.to_array(), e1.to_array(), e2.to_array());
+        let error = |r| sample_direction_error(arrays.0, arrays.1, arrays.2, arrays.3, (u1, u2), r);
+        let (exact, ieee_bound) = error(IEEE_ROUNDOFF);
+        let (_, vulkan_bound) = error(twinpath_tests::device_class::VULKAN_ROUNDOFF);
+        bounds.push(vulkan_bound.max_element() / f32::EPSILON as f64);
+        tested += 1;
+        for model in 0..4 {
+            use_model(model);
+            let view = SphericalTriangle::view(v(x), v(p0), v(e1), v(e2));
+            let got = back(view.sample_real(f(u1), f(u2))).as_dvec3();
+            let bound = if model == 0 { ieee_bound } else { vulkan_bound };
+            let off = (got - exact).abs();
+            let ratio = |b: glam::DVec3| (off / b.max(glam::DVec3::splat(1e-300))).max_element();
+            worst[model] = worst[model].max(ratio(bound));
+            of_ieee[model] = of_ieee[model].max(ratio(ieee_bound));
+        }
+    }
+    set_model(Model::VULKAN);
+    bounds.sort_by(f64::total_cmp);
+    let at = |f: f64| bounds[((bounds.len() - 1) as f64 * f) as usize];
+    println!("sampled directions against the exact ones ({tested} cases), of their bound: IEEE, Vulkan, worst up, worst down {worst:.3?}; of IEEE's bound {of_ieee:.3?}; Vulkan bounds, median {:.0} eps, 99th percentile {:.0}, largest {:.0}", at(0.5), at(0.99), at(1.0));
+    assert!(tested > cases() / 10, "{tested} cases");
+    assert!(worst.iter().all(|&w| w <= 1.0), "{worst:?}");
+    // The wider bound is needed: the Vulkan models exceed the one derived for IEEE arithmetic.
+    assert!(
+        of_ieee[1..].iter().all(|&w| w > 1.0),
+        "the Vulkan models stay within IEEE's bound: {of_ieee:?}"
+    );
 }
