@@ -206,8 +206,8 @@ impl<R: Real> SphericalTriangle<R> {
         let sub_area_turns = u1 * omega_turns;
         let (_, s) = cos_sin_turns(k(0.5) * sub_area_turns);
         let (_, sin_phi) = cos_sin_turns(sub_area_turns - alpha_turns);
-        let half_chord = a - b;
-        let m = k(0.5) * half_chord.dot(half_chord);
+        let chord_ab = a - b;
+        let m = k(0.5) * chord_ab.dot(chord_ab);
         let two_s2 = k(2.0) * s * s;
         let one_minus_q = two_s2 * (k(2.0) - m) / (two_s2 - m * sin_alpha * sin_phi);
         // q in [-1, 1]; a degenerate 0 / 0 reads as C' = A.

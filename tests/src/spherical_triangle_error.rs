@@ -299,8 +299,8 @@ fn sample_with(r: &mut Roundings, inputs: &SamplerInputs, u1: f64, u2: f64) -> D
     let phi_turns = sub_area_turns - alpha_turns;
     let phi_turns = r.abs(phi_turns, u * phi_turns.abs());
     let sin_phi = r.abs((TAU * phi_turns).sin(), 4.0 * u);
-    let half_chord = r.sum3(a - b);
-    let m = r.rel(0.5 * half_chord.dot(half_chord), 3.0 * u);
+    let chord_ab = r.sum3(a - b);
+    let m = r.rel(0.5 * chord_ab.dot(chord_ab), 3.0 * u);
     let two_s2 = r.rel(2.0 * s * s, u);
     let two_minus_m = r.abs(2.0 - m, u * (2.0 - m).abs());
     let numerator = r.rel(two_s2 * two_minus_m, u);
