@@ -216,17 +216,24 @@ impl<R: Real> SphericalTriangle<R> {
             one_minus_q.min(k(2.0)),
             k(0.0),
         );
-        let sin_b = (one_minus_q * (k(2.0) - one_minus_q)).sqrt();
-        let c_prime = a * (k(1.0) - one_minus_q) + normalize(c - a * c.dot(a)) * sin_b;
+        let c_prime = arc_toward(a, c, one_minus_q);
 
         let chord = b - c_prime;
         let one_minus_cos = u2 * (k(0.5) * chord.dot(chord));
-        let cos_theta = k(1.0) - one_minus_cos;
-        let sin_theta = (one_minus_cos * (k(2.0) - one_minus_cos))
-            .max(k(0.0))
-            .sqrt();
-        normalize(b * cos_theta + normalize(c_prime - b * c_prime.dot(b)) * sin_theta)
+        normalize(arc_toward(b, c_prime, one_minus_cos))
     }
+}
+
+/// The unit vector at angle theta from unit `from` toward `toward`, in their plane, for
+/// `one_minus_cos` = 1 - cos(theta) in [0, 2]: the sine as sqrt((1 - cos)(1 + cos)), which
+/// keeps its digits for small angles where sqrt(1 - cos^2) would cancel.
+#[inline]
+fn arc_toward<R: Real>(from: V3<R>, toward: V3<R>, one_minus_cos: R) -> V3<R> {
+    let k = R::splat;
+    let sin = (one_minus_cos * (k(2.0) - one_minus_cos))
+        .max(k(0.0))
+        .sqrt();
+    from * (k(1.0) - one_minus_cos) + normalize(toward - from * toward.dot(from)) * sin
 }
 
 /// The barycentric coordinates (u, v) of the point where the ray `x + t dir` meets the plane of

@@ -256,6 +256,25 @@ impl Roundings {
         self.abs(x.dot(y), 3.0 * u * (x.abs().dot(y.abs())))
     }
 
+    /// `arc_toward(from, toward, x)`: the sine sqrt(x (2 - x)) (the difference u, the product
+    /// u, the root w), the cosine 1 - x (u), the perpendicular toward - from (toward . from)
+    /// (the dot, the products, the differences), its normalisation, and the two products and
+    /// the sum.
+    fn arc_toward(&mut self, from: DVec3, toward: DVec3, one_minus_cos: f64) -> DVec3 {
+        let (u, _, w) = self.roundoff;
+        let two_minus = self.abs(2.0 - one_minus_cos, u * (2.0 - one_minus_cos).abs());
+        let product = self.rel(one_minus_cos * two_minus, u);
+        let sin = self.rel(product.max(0.0).sqrt(), w);
+        let cos = self.abs(1.0 - one_minus_cos, u * (1.0 - one_minus_cos).abs());
+        let along = self.dot(toward, from);
+        let along = self.product3(from * along);
+        let perpendicular = self.sum3(toward - along);
+        let unit = self.normalize(perpendicular);
+        let first = self.product3(from * cos);
+        let second = self.product3(unit * sin);
+        self.sum3(first + second)
+    }
+
     /// `v * (1 / |v|)`, as `normalize` computes it: the length (1.5 u + w), the reciprocal (q)
     /// and the products (u each).
     fn normalize(&mut self, v: DVec3) -> DVec3 {
@@ -312,32 +331,11 @@ fn sample_with(r: &mut Roundings, inputs: &SamplerInputs, u1: f64, u2: f64) -> D
     } else {
         0.0
     };
-    let two_minus = r.abs(2.0 - one_minus_q, u * (2.0 - one_minus_q).abs());
-    let product = r.rel(one_minus_q * two_minus, u);
-    let sin_b = r.rel(product.max(0.0).sqrt(), w);
-    let c_dot_a = r.dot(c, a);
-    let along = r.product3(a * c_dot_a);
-    let perpendicular = r.sum3(c - along);
-    let toward_c = r.normalize(perpendicular);
-    let cos_b = r.abs(1.0 - one_minus_q, u * (1.0 - one_minus_q).abs());
-    let first = r.product3(a * cos_b);
-    let second = r.product3(toward_c * sin_b);
-    let c_prime = r.sum3(first + second);
-
+    let c_prime = r.arc_toward(a, c, one_minus_q);
     let chord = r.sum3(b - c_prime);
     let half = r.rel(0.5 * chord.dot(chord), 3.0 * u);
     let one_minus_cos = r.rel(u2 * half, u);
-    let cos_theta = r.abs(1.0 - one_minus_cos, u * (1.0 - one_minus_cos).abs());
-    let two_minus = r.abs(2.0 - one_minus_cos, u * (2.0 - one_minus_cos).abs());
-    let product = r.rel(one_minus_cos * two_minus, u);
-    let sin_theta = r.rel(product.max(0.0).sqrt(), w);
-    let c_dot_b = r.dot(c_prime, b);
-    let along = r.product3(b * c_dot_b);
-    let perpendicular = r.sum3(c_prime - along);
-    let toward_c_prime = r.normalize(perpendicular);
-    let first = r.product3(b * cos_theta);
-    let second = r.product3(toward_c_prime * sin_theta);
-    let direction = r.sum3(first + second);
+    let direction = r.arc_toward(b, c_prime, one_minus_cos);
     r.normalize(direction)
 }
 
