@@ -84,7 +84,7 @@ impl Primitives<'_> {
 }
 
 /// The tests a leaf of `geometry` triangles and spheres and `instances` instances costs.
-fn leaf_tests(geometry: usize, instances: usize) -> f32 {
+fn leaf_tests((geometry, instances): (usize, usize)) -> f32 {
     (geometry.div_ceil(4) + instances) as f32
 }
 
@@ -268,6 +268,8 @@ fn best_split(
 ) -> Option<(usize, f32)> {
     let (bounds, centroids) = (primitives.bounds, &primitives.centroids);
     let mut best: Option<(f32, usize, f32)> = None;
+    // (triangles and spheres, instances) in `prims`, as the binning counts them.
+    let mut total = (0, 0);
     for axis in 0..3 {
         let lo = cb.min[axis];
         let extent = cb.max[axis] - lo;
@@ -299,6 +301,7 @@ fn best_split(
             right_area[i] = acc.half_area();
             right_count[i] = cnt;
         }
+        total = add(bin_count[0], right_count[1]);
         let mut left = Aabb::EMPTY;
         let mut left_count = (0, 0);
         for i in 0..BINS - 1 {
@@ -307,9 +310,8 @@ fn best_split(
             if left_count == (0, 0) || right_count[i + 1] == (0, 0) {
                 continue;
             }
-            let tests = |(g, i): (usize, usize)| leaf_tests(g, i);
-            let cost = left.half_area() * tests(left_count)
-                + right_area[i + 1] * tests(right_count[i + 1]);
+            let cost = left.half_area() * leaf_tests(left_count)
+                + right_area[i + 1] * leaf_tests(right_count[i + 1]);
             if best.is_none_or(|(c, _, _)| cost < c) {
                 best = Some((cost, axis, lo + (i + 1) as f32 / scale));
             }
@@ -317,8 +319,7 @@ fn best_split(
     }
     let (cost, axis, plane) = best?;
     // Leaf cost: test all; split cost: traversal (~1/2 of a test) + expected tests.
-    let instances = prims.iter().filter(|&&p| primitives.is_instance(p)).count();
-    let leaf_cost = leaf_tests(prims.len() - instances, instances);
+    let leaf_cost = leaf_tests(total);
     let split_cost = 0.5 + cost / parent_half_area.max(f32::MIN_POSITIVE);
     if split_cost < leaf_cost || prims.len() > SAH_LEAF_MAX {
         Some((axis, plane))
