@@ -28,7 +28,7 @@ pub fn camera_ray_direction(
 /// The unit direction through position `offset` inside pixel `pixel` (column and row from the
 /// top left, as floats) of an image of `size` pixels, for a camera of axes `forward`, `right`,
 /// `up`: the arithmetic of [`camera_ray_direction`], over any [`Real`] (the kernel's `f32`, or a
-/// test's model of a device's arithmetic). Normalised as glam normalises (times 1 / length).
+/// test's model of a device's arithmetic), normalised as glam normalises ([`V3::normalize`]).
 #[inline]
 pub fn image_plane_direction<R: Real>(
     forward: V3<R>,
@@ -42,7 +42,7 @@ pub fn image_plane_direction<R: Real>(
     let x = two * ((R::splat(pixel.0) + offset.0) / R::splat(size.0)) - one;
     let y = one - two * ((R::splat(pixel.1) + offset.1) / R::splat(size.1));
     let d = forward + right * x + up * y;
-    d * (one / d.dot(d).sqrt())
+    d.normalize()
 }
 
 /// The camera's position.

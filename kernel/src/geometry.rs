@@ -227,12 +227,11 @@ pub fn triangle_normal(edge1: Vec3, edge2: Vec3) -> Vec3 {
     triangle_normal_v3(V3::from(edge1), V3::from(edge2)).into()
 }
 
-/// [`triangle_normal`] over any [`real::Real`]: the cross product times the reciprocal of its
-/// length, as glam normalises (so the `f32` instance is glam's `normalize` bit for bit).
+/// [`triangle_normal`] over any [`real::Real`]: the cross product normalised as glam normalises
+/// ([`V3::normalize`], so the `f32` instance is glam's bit for bit).
 #[inline]
 pub fn triangle_normal_v3<R: real::Real>(edge1: V3<R>, edge2: V3<R>) -> V3<R> {
-    let c = edge1.cross(edge2);
-    c * (R::splat(1.0) / c.dot(c).sqrt())
+    edge1.cross(edge2).normalize()
 }
 
 /// Bound on the rounding error of [`triangle_point`], in units of eps times the magnitudes of
@@ -289,7 +288,7 @@ pub fn triangle_error_condition(edge1: Vec3, edge2: Vec3) -> f32 {
 pub fn triangle_error_condition_v3<R: real::Real>(edge1: V3<R>, edge2: V3<R>) -> R {
     let one = R::splat(1.0);
     let c = edge1.cross(edge2);
-    let sin_theta = c.dot(c).sqrt() / (edge1.dot(edge1).sqrt() * edge2.dot(edge2).sqrt());
+    let sin_theta = c.length() / (edge1.length() * edge2.length());
     let condition = real::select(
         sin_theta.greater_than(R::splat(0.0)),
         (one / sin_theta).min(R::splat(f32::MAX)),

@@ -93,6 +93,5 @@ pub fn sample_v3<R: real::Real>(g: R, wo: V3<R>, u1: R, u2: R) -> V3<R> {
     let travel = -wo;
     let (t, b) = orthonormal_basis_v3(travel);
     let v = travel * mu + (t * cos_phi + b * sin_phi) * sin;
-    // As glam normalises: times the reciprocal of the length.
-    v * (one / v.dot(v).sqrt())
+    v.normalize()
 }

@@ -292,6 +292,30 @@ impl<R: Real> V3<R> {
     pub fn splat(v: Vec3) -> Self {
         Self::new(R::splat(v.x), R::splat(v.y), R::splat(v.z))
     }
+
+    /// |v|, as glam's `Vec3::length` computes it: the root of [`Self::dot`] with itself.
+    #[inline]
+    pub fn length(self) -> R {
+        self.dot(self).sqrt()
+    }
+
+    /// v / |v|, as glam's `Vec3::normalize` computes it: times the reciprocal of
+    /// [`Self::length`], so that a `V3<f32>` gives glam's result bit for bit.
+    #[inline]
+    pub fn normalize(self) -> Self {
+        self * (R::splat(1.0) / self.length())
+    }
+
+    /// `yes` in the lanes where `mask` is all ones, `no` where it is zero, component by
+    /// component ([`select`]).
+    #[inline]
+    pub fn select(mask: R::Bits, yes: Self, no: Self) -> Self {
+        Self::new(
+            select(mask, yes.x, no.x),
+            select(mask, yes.y, no.y),
+            select(mask, yes.z, no.z),
+        )
+    }
 }
 
 impl<R: Real> Add for V3<R> {

@@ -51,7 +51,7 @@ impl<R: Real> SphericalTriangle<R> {
         let a = p0 - x;
         let b = a + edge1;
         let c = a + edge2;
-        let len = [length(a), length(b), length(c)];
+        let len = [a.length(), b.length(), c.length()];
         let dir = [a / len[0], b / len[1], c / len[2]];
         let volume = dir[0].dot(edge1.cross(edge2) / (len[1] * len[2]));
         let [a, b, c] = dir;
@@ -71,16 +71,30 @@ impl<R: Real> SphericalTriangle<R> {
     }
 }
 
-/// |v|, as glam's `Vec3::length` computes it.
-#[inline]
-fn length<R: Real>(v: V3<R>) -> R {
-    v.dot(v).sqrt()
-}
-
-/// v / |v|, as glam's `Vec3::normalize` computes it (a product with the reciprocal).
-#[inline]
-fn normalize<R: Real>(v: V3<R>) -> V3<R> {
-    v * (R::splat(1.0) / length(v))
+impl<R: Real> SphericalTriangle<R> {
+    /// The unit directions to the vertices in the order the sampler names them A, B, C: the
+    /// view's p0, p1, p2 rotated cyclically (which keeps the triple product) so that A is at
+    /// the spherical triangle's largest angle. That angle lies opposite the longest arc (in a
+    /// spherical triangle the larger side faces the larger angle), so A is the vertex whose two
+    /// neighbours have the smallest dot product; ties keep the earlier order.
+    ///
+    /// Why: Arvo's construction keeps the angle at A and sweeps C' along the arc AC, so a
+    /// rounding of the solid angle moves C' by that rounding over the rate at which the
+    /// sub-triangle's area grows along the arc. Seen from near its plane a triangle has one
+    /// angle near pi and two thin ones; with A at a thin corner that rate is small near u1 = 0
+    /// or 1 and C' moves far, with A at the wide corner it is not (docs/robustness.md gives
+    /// the measured errors of each choice).
+    #[inline]
+    pub fn sampling_order(&self) -> [V3<R>; 3] {
+        let [a, b, c] = self.dir;
+        let (ab, bc, ca) = (a.dot(b), b.dot(c), c.dot(a));
+        let a_first = bc.at_most(ca) & bc.at_most(ab);
+        let b_first = ca.at_most(ab);
+        let rotated = |yes_a: V3<R>, yes_b: V3<R>, otherwise: V3<R>| {
+            V3::select(a_first, yes_a, V3::select(b_first, yes_b, otherwise))
+        };
+        [rotated(a, b, c), rotated(b, c, a), rotated(c, a, b)]
+    }
 }
 
 impl SphericalTriangle {
@@ -152,8 +166,9 @@ pub fn uses_solid_angle(omega: f32) -> bool {
 /// meaningless, but finite or caught by [`barycentrics_along`].
 ///
 /// # Derivation
-/// Let A, B, C be the unit directions to the vertices, alpha the spherical triangle's angle at
-/// A and c the arc AB (cos c = A . B). u1 chooses the area A' = u1 omega of a sub-triangle
+/// Let A, B, C be the unit directions to the vertices, A at the largest angle
+/// ([`SphericalTriangle::sampling_order`]), alpha the spherical triangle's angle at A and c
+/// the arc AB (cos c = A . B). u1 chooses the area A' = u1 omega of a sub-triangle
 /// A B C' with C' on the arc AC: uniform in area, as the whole is. Sharing A, the
 /// sub-triangle keeps the angle alpha there, and Girard's theorem gives its other two angles
 /// beta' + gamma' = pi + phi with phi = A' - alpha. Writing gamma' = pi + phi - beta' into the
@@ -192,9 +207,24 @@ impl<R: Real> SphericalTriangle<R> {
     /// [`Self::sample`] in any [`Real`].
     #[inline]
     pub fn sample_real(&self, u1: R, u2: R) -> V3<R> {
+        self.sample_in_order(self.sampling_order(), u1, u2)
+    }
+
+    /// The unit directions from the receiver to p0, p1, p2.
+    #[inline]
+    pub fn directions(&self) -> [V3<R>; 3] {
+        self.dir
+    }
+
+    /// [`Self::sample_real`] with the vertices taken as A, B, C in `order`, a cyclic rotation
+    /// of [`Self::directions`]: every rotation samples the same distribution with different
+    /// roundings (the sampler takes [`Self::sampling_order`]; `vulkan_precision.rs` compares
+    /// them).
+    #[inline]
+    pub fn sample_in_order(&self, order: [V3<R>; 3], u1: R, u2: R) -> V3<R> {
         let k = R::splat;
         let omega_turns = self.omega_turns;
-        let [a, b, c] = self.dir;
+        let [a, b, c] = order;
         // The angle at A, between the planes of (A, B) and (A, C): the cross products' dot is
         // cos alpha |A x B| |A x C|, and the length of their cross product, |A . (B x C)|, the
         // sine's (the triple product of the unit directions).
@@ -220,7 +250,7 @@ impl<R: Real> SphericalTriangle<R> {
 
         let chord = b - c_prime;
         let one_minus_cos = u2 * (k(0.5) * chord.dot(chord));
-        normalize(arc_toward(b, c_prime, one_minus_cos))
+        arc_toward(b, c_prime, one_minus_cos).normalize()
     }
 }
 
@@ -233,7 +263,7 @@ fn arc_toward<R: Real>(from: V3<R>, toward: V3<R>, one_minus_cos: R) -> V3<R> {
     let sin = (one_minus_cos * (k(2.0) - one_minus_cos))
         .max(k(0.0))
         .sqrt();
-    from * (k(1.0) - one_minus_cos) + normalize(toward - from * toward.dot(from)) * sin
+    from * (k(1.0) - one_minus_cos) + (toward - from * toward.dot(from)).normalize() * sin
 }
 
 /// The barycentric coordinates (u, v) of the point where the ray `x + t dir` meets the plane of

@@ -339,6 +339,30 @@ fn sample_with(r: &mut Roundings, inputs: &SamplerInputs, u1: f64, u2: f64) -> D
     r.normalize(direction)
 }
 
+/// The sampled direction for (u1, u2) computed exactly from the `f32` inputs with the vertex
+/// `first` (0, 1 or 2 for p0, p1, p2) taken as A, the vertices after it in cyclic order.
+pub fn sample_direction_exact(
+    x: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
+    first: usize,
+    (u1, u2): (f32, f32),
+) -> DVec3 {
+    let roundoff = crate::device_class::IEEE_ROUNDOFF;
+    let mut inputs = sampler_inputs(x, p0, e1, e2, roundoff);
+    inputs.dir.rotate_left(first);
+    inputs.dir_error.rotate_left(first);
+    let mut r = Roundings {
+        roundoff,
+        allowances: Vec::new(),
+        recording: true,
+        next: 0,
+        moved: None,
+    };
+    sample_with(&mut r, &inputs, u1 as f64, u2 as f64)
+}
+
 /// The sampled direction for (u1, u2) computed exactly from the `f32` inputs, and its
 /// first-order error per component for one computation in the arithmetic `roundoff`: the sum,
 /// over every operation of the sampler and every input it takes from the view, of how far that
@@ -348,16 +372,21 @@ fn sample_with(r: &mut Roundings, inputs: &SamplerInputs, u1: f64, u2: f64) -> D
 /// q for a quotient, w for a root, 4 u for `cos_sin_turns`, [`atan2_turns_error`] for the
 /// angle at A, the view's own bounds for its directions, triple product and solid angle. Where
 /// the sampler's map is steep (u1 near 0, a thin spherical triangle) one rounding's effect
-/// is taken as it is, not its derivative.
+/// is taken as it is, not its derivative. `first` is the vertex (0, 1 or 2 for p0, p1, p2) the
+/// computation took as A (`SphericalTriangle::sampling_order`, whose comparisons a device's
+/// roundings may decide otherwise than exact arithmetic would near a tie, so the caller says).
 pub fn sample_direction_error(
     x: [f32; 3],
     p0: [f32; 3],
     e1: [f32; 3],
     e2: [f32; 3],
+    first: usize,
     (u1, u2): (f32, f32),
     roundoff: (f64, f64, f64),
 ) -> (DVec3, DVec3) {
-    let inputs = sampler_inputs(x, p0, e1, e2, roundoff);
+    let mut inputs = sampler_inputs(x, p0, e1, e2, roundoff);
+    inputs.dir.rotate_left(first);
+    inputs.dir_error.rotate_left(first);
     let mut r = Roundings {
         roundoff,
         allowances: Vec::new(),
