@@ -346,8 +346,9 @@ fn blended_instanced_layers_transmit_one_minus_alpha_each_on_both_backends() {
     assert_validation_clean();
 }
 
-/// A white Lambertian floor (2 x 10^4 wide, z = 0) under a square emitting downward from its
-/// front face alone at z = 1 (black, emissive strength `strength`, `half` its half-width in x,
+/// A white Lambertian floor (8 wide, z = 0: the camera sees a 0.6-wide part of it, and nothing
+/// else in the scene reflects) under a square emitting downward from its front face alone at
+/// z = 1 (black, emissive strength `strength`, `half` its half-width in x,
 /// its centre at x = `centre`; `extra` adds to its material, given the writer to add a texture
 /// to), the camera at z = 0.5 looking down; as a TOML scene including the file (black
 /// background), 24 x 18 pixels.
@@ -369,7 +370,11 @@ fn emitter_scene(
     lamp["extensions"]["KHR_materials_emissive_strength"] = json!({ "emissiveStrength": strength });
     lamp["doubleSided"] = json!(false);
     let lamp_m = g.push("materials", lamp);
-    let floor = square(&mut g, 1e4, 1, floor_m);
+    // Not 10^4 wide: a hit point's error bound is isotropic and grows with the triangle's
+    // coordinates, so on such a floor paths leave 0.02 above it and the lamp's BSDF-sampled
+    // light is 2% too bright (docs/robustness.md, "Known limits"), which the MIS weights of the
+    // two lamps compared here would weigh differently.
+    let floor = square(&mut g, 4.0, 1, floor_m);
     let lamp_mesh = square(&mut g, 1.0, 1, lamp_m);
     let nodes = vec![
         g.push("nodes", json!({ "mesh": floor })),
