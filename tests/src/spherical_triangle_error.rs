@@ -409,3 +409,85 @@ pub fn sample_direction_error(
     }
     (exact, bound)
 }
+
+/// How far apart one IEEE and one Vulkan computation of a triangle light's spherical sample
+/// (`light::triangle::sample` where `spherical_triangle_used` says so) may be, for the triangle
+/// p0, p0 + e1, p0 + e2, the receiver x and (u1, u2).
+#[derive(Clone, Copy, Debug)]
+pub struct SphericalSampleApart {
+    /// The point's distance, from the directions' bounds ([`sample_direction_error`] under
+    /// both arithmetics) carried to where the direction meets the plane: a direction off by
+    /// delta (radians) moves that point by t delta / |cos|, t the distance along the exact
+    /// direction and cos its cosine with the plane's normal, and the clamp onto the triangle
+    /// moves it by at most 2 / sin(theta_min) of that (barycentric coordinates clamped against
+    /// world distances, theta_min the triangle's smallest angle). The plane step's own
+    /// rounding is the caller's (the IEEE-class term).
+    pub point: f64,
+    /// The solid angle's (and so the density's, 1 / omega) relative distance: the two
+    /// computations' [`solid_angle_error`]s.
+    pub solid_angle_relative: f64,
+    /// Whether either computation may take another vertex as A (the two smallest of the dot
+    /// products opposite the vertices within their roundings of each other): its sample is then
+    /// another point of the same distribution, anywhere on the triangle.
+    pub order_may_differ: bool,
+}
+
+/// [`SphericalSampleApart`] of the record: meaningful where the exact view samples the triangle
+/// as a spherical triangle (the caller's decision).
+pub fn spherical_sample_apart(
+    x: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
+    (u1, u2): (f32, f32),
+) -> SphericalSampleApart {
+    use crate::device_class::{IEEE_ROUNDOFF, VULKAN_ROUNDOFF};
+    let roundoffs = [IEEE_ROUNDOFF, VULKAN_ROUNDOFF];
+    // The dot product opposite vertex i and how far each computation may put it: the two
+    // directions' component errors and the dot's own 3 u.
+    let inputs = roundoffs.map(|r| sampler_inputs(x, p0, e1, e2, r));
+    let dir = inputs[0].dir;
+    let opposite = |i: usize| dir[(i + 1) % 3].dot(dir[(i + 2) % 3]);
+    let opposite_error = |i: usize| {
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        inputs
+            .iter()
+            .zip(roundoffs)
+            .map(|(s, r)| {
+                s.dir_error[j].dot(dir[k].abs()) + s.dir_error[k].dot(dir[j].abs()) + 3.0 * r.0
+            })
+            .sum::<f64>()
+    };
+    let mut by_dot = [0, 1, 2];
+    by_dot.sort_by(|&i, &j| opposite(i).total_cmp(&opposite(j)));
+    let first = by_dot[0];
+    let order_may_differ = opposite(by_dot[1]) - opposite(by_dot[0])
+        <= opposite_error(by_dot[0]) + opposite_error(by_dot[1]);
+    let direction_apart: f64 = roundoffs
+        .iter()
+        .map(|&r| {
+            sample_direction_error(x, p0, e1, e2, first, (u1, u2), r)
+                .1
+                .length()
+        })
+        .sum();
+    let solid_angle_relative = roundoffs
+        .iter()
+        .map(|&r| solid_angle_error(x, p0, e1, e2, r))
+        .sum();
+    let exact = sample_direction_exact(x, p0, e1, e2, first, (u1, u2));
+    let (e1, e2) = (d3(e1), d3(e2));
+    let n = e1.cross(e2).normalize();
+    let to_plane = (d3(p0) - d3(x)).dot(n);
+    let cos = exact.dot(n).abs();
+    let t = to_plane.abs() / cos;
+    let sin_angle = |a: DVec3, b: DVec3| a.cross(b).length() / (a.length() * b.length());
+    let sin_min = sin_angle(e1, e2)
+        .min(sin_angle(-e1, e2 - e1))
+        .min(sin_angle(-e2, e1 - e2));
+    SphericalSampleApart {
+        point: t * direction_apart / cos * 2.0 / sin_min,
+        solid_angle_relative,
+        order_may_differ,
+    }
+}

@@ -460,21 +460,8 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
         // b.abs / h (points relative to the size of the geometry, |x| + |p0| + |e1| + |e2|). In
         // the plane (h within rounding) they are 0 / 0, and a two-sided light's normal may face
         // either way.
-        function::TRIANGLE_LIGHT => {
-            let v = |i: usize| glam::Vec3::new(f(i, 0), f(i, 1), f(i, 2));
-            let to_x = v(0) - v(1);
-            let h = to_x.dot(v(2).cross(v(3)).normalize()).abs() / to_x.length();
-            if j == 3 {
-                b.abs * value / h
-            } else if k == 0 {
-                // Points, where the sampled direction meets the plane at the angle h.
-                b.abs * (v(0).length() + v(1).length() + v(2).length() + v(3).length()) / h
-            } else if h > b.abs {
-                b.abs
-            } else {
-                2.0
-            }
-        }
+        function::TRIANGLE_LIGHT if b.vulkan => triangle_light_apart(b, r, k, j, value),
+        function::TRIANGLE_LIGHT => triangle_light_ieee_class(b, r, k, j, value),
         // Triangle points (out1.xyz): relative to |p0| + |e1| + |e2|.
         function::INTERSECT_TRIANGLE if k == 1 && j < 3 => {
             let p0 = glam::Vec3::new(f(2, 0), f(2, 1), f(2, 2));
@@ -582,6 +569,62 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
     }
 }
 
+/// A triangle light record's allowance on an IEEE device (`allowed_abs`'s comment): b.abs / h
+/// relative for the solid angle and the density, of the geometry's size for points; normals
+/// b.abs (either way in the plane).
+fn triangle_light_ieee_class(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> f32 {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
+    let v = |i: usize| glam::Vec3::new(f(i, 0), f(i, 1), f(i, 2));
+    let to_x = v(0) - v(1);
+    let h = to_x.dot(v(2).cross(v(3)).normalize()).abs() / to_x.length();
+    if j == 3 {
+        b.abs * value / h
+    } else if k == 0 {
+        // Points, where the sampled direction meets the plane at the angle h.
+        b.abs * (v(0).length() + v(1).length() + v(2).length() + v(3).length()) / h
+    } else if h > b.abs {
+        b.abs
+    } else {
+        2.0
+    }
+}
+
+/// A triangle light record's allowance on a device that is not IEEE: the IEEE-class terms
+/// (the plane step, the normal) plus, per record, the spherical sampler's direction bounds
+/// carried to the point and the solid angle's bounds under both arithmetics
+/// (`spherical_sample_apart`, checked against the models in `vulkan_precision.rs`). Where the
+/// two computations may take different vertices as A (a tie of two arcs within rounding) the
+/// sample is another point of the same distribution: any point of the light is allowed.
+fn triangle_light_apart(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> f32 {
+    use twinpath_tests::device_class::{IEEE_ROUNDOFF, VULKAN_ROUNDOFF};
+    use twinpath_tests::spherical_triangle_error::{solid_angle_error, spherical_sample_apart};
+    let ieee_class = triangle_light_ieee_class(b, r, k, j, value);
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
+    let v = |i: usize| glam::Vec3::new(f(i, 0), f(i, 1), f(i, 2));
+    let (x, p0, e1, e2) = (v(0), v(1), v(2), v(3));
+    let a = |v: glam::Vec3| v.to_array();
+    if k == 1 && j == 3 {
+        let relative = [IEEE_ROUNDOFF, VULKAN_ROUNDOFF]
+            .map(|ro| solid_angle_error(a(x), a(p0), a(e1), a(e2), ro))
+            .iter()
+            .sum::<f64>();
+        return ieee_class + (value as f64 * relative) as f32;
+    }
+    let light = kernel::probe::probe_triangle_light(p0, e1, e2, r[3][3]);
+    let spherical = kernel::light::triangle::spherical_triangle_used(&light, r[0][3], x);
+    if spherical.is_none() || (k == 1 && j < 3) {
+        return ieee_class;
+    }
+    let apart = spherical_sample_apart(a(x), a(p0), a(e1), a(e2), (f(1, 3), f(2, 3)));
+    if apart.order_may_differ {
+        f32::INFINITY
+    } else if j == 3 {
+        ieee_class + (value as f64 * apart.solid_angle_relative) as f32
+    } else {
+        ieee_class + apart.point as f32
+    }
+}
+
 /// Whether probe record `r` of an intersection function is a ray within the rounding of both
 /// computations of a triangle's edge or a sphere's tangent or a t limit (the probe's layout:
 /// `kernel::probe`).
@@ -648,6 +691,11 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
         function::BRDF => Some(Bound {
             vulkan: true,
             why: "Vulkan class: eval_scattering and pdf_brdf a dot product, a product and the albedo: 8 eps; the cosine sample from the frame (9 eps), sqrt(u1), sqrt(1 - u1), the azimuth's polynomials and four roundings: eps (33 s + 11.1 c) per component, its density 21 eps (`allowed_abs`)",
+            ..*b
+        }),
+        function::TRIANGLE_LIGHT => Some(Bound {
+            vulkan: true,
+            why: "Vulkan class: the IEEE-class terms (the plane step, 64 eps over h; normals 64 eps) plus, where the light is sampled as a spherical triangle, the sampled direction's bounds under both arithmetics carried to the point (t delta / |cos|, times 2 / sin(theta_min) for the clamp onto the triangle) and the solid angle's for the density and the solid angle, per record (`allowed_abs`); any point where the two may take another vertex as A",
             ..*b
         }),
         function::CAMERA_RAY => Some(Bound {

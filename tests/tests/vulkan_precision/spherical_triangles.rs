@@ -294,3 +294,62 @@ fn the_largest_angle_first_keeps_the_most_digits() {
         "another order keeps more digits: {worst:?}"
     );
 }
+
+/// The bound `gpu_functions.rs` holds a non-IEEE device's triangle-light samples to
+/// (`spherical_sample_apart`: the directions' bounds carried to the light's point, the solid
+/// angle's), checked against the models: the point a model's sampled direction meets on the
+/// triangle (`barycentrics_along`, then `triangle_point`, in `f32`) is within it of the
+/// CPU's point, and the model's solid angle within it of the CPU's, wherever both take the
+/// same vertex as A (records where a tie may let them differ are counted, and rare).
+#[test]
+fn light_points_are_within_the_carried_bound_under_every_model() {
+    use kernel::geometry::triangle_point;
+    use kernel::spherical_triangle::barycentrics_along;
+    use twinpath_tests::spherical_triangle_error::spherical_sample_apart;
+    let mut g = SplitMix(47);
+    twinpath_tests::vulkan_arithmetic::seed(47);
+    let extremes = [2f32.powi(-24), 1e-4, 0.5, 1.0 - 1e-4, 1.0 - 2f32.powi(-24)];
+    let (mut worst_point, mut worst_omega) = ([0f64; 3], [0f64; 3]);
+    let (mut tested, mut ties) = (0, 0);
+    for k in 0..cases() / 4 {
+        let (x, p0, e1, e2) = triangle_and_receiver(&mut g, k);
+        let cpu_view = SphericalTriangle::of(x, p0, e1, e2);
+        if !cpu_view.sampled() {
+            continue;
+        }
+        let (u1, u2) = if k % 3 == 0 {
+            (g.unit(), g.unit())
+        } else {
+            (extremes[k / 3 % 5], extremes[k / 15 % 5])
+        };
+        let arrays = (x.to_array(), p0.to_array(), e1.to_array(), e2.to_array());
+        let apart = spherical_sample_apart(arrays.0, arrays.1, arrays.2, arrays.3, (u1, u2));
+        if apart.order_may_differ {
+            ties += 1;
+            continue;
+        }
+        tested += 1;
+        let point = |d: Vec3| {
+            let (u, v) = barycentrics_along(x, d, p0, e1, e2);
+            triangle_point(p0, e1, e2, u, v).as_dvec3()
+        };
+        let cpu_point = point(cpu_view.sample(u1, u2));
+        let cpu_omega = cpu_view.solid_angle() as f64;
+        for model in 1..4 {
+            use_model(model);
+            let view = SphericalTriangle::view(v(x), v(p0), v(e1), v(e2));
+            let off = (point(back(view.sample_real(f(u1), f(u2)))) - cpu_point).length();
+            worst_point[model - 1] = worst_point[model - 1].max(off / apart.point);
+            let omega = view.solid_angle_real().value as f64;
+            let relative = (omega / cpu_omega - 1.0).abs();
+            worst_omega[model - 1] =
+                worst_omega[model - 1].max(relative / apart.solid_angle_relative);
+        }
+    }
+    set_model(Model::VULKAN);
+    println!("light points from a model's direction against the CPU's ({tested} cases, {ties} ties of A skipped), of the carried bound: Vulkan, worst up, worst down {worst_point:.3?}; solid angles {worst_omega:.3?}");
+    assert!(tested > cases() / 40, "{tested} cases");
+    assert!(ties * 1000 <= tested, "{ties} ties in {tested} cases");
+    assert!(worst_point.iter().all(|&w| w <= 1.0), "{worst_point:?}");
+    assert!(worst_omega.iter().all(|&w| w <= 1.0), "{worst_omega:?}");
+}
