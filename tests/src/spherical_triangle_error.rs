@@ -491,3 +491,32 @@ pub fn spherical_sample_apart(
         order_may_differ,
     }
 }
+
+/// Whether one IEEE and one Vulkan computation may decide otherwise whether the triangle
+/// p0, p0 + e1, p0 + e2 seen from x is sampled as a spherical triangle
+/// (`SphericalTriangle::sampled`): the solid angle within the two computations' bounds
+/// ([`solid_angle_error`]) of `MIN_SOLID_ANGLE` or `MAX_SOLID_ANGLE`, or the triple product
+/// within its two bounds plus the solid angle's of `MIN_VOLUME_PER_SOLID_ANGLE` omega.
+pub fn sampled_decision_may_differ(x: [f32; 3], p0: [f32; 3], e1: [f32; 3], e2: [f32; 3]) -> bool {
+    use crate::device_class::{IEEE_ROUNDOFF, VULKAN_ROUNDOFF};
+    use kernel::spherical_triangle::{
+        MAX_SOLID_ANGLE, MIN_SOLID_ANGLE, MIN_VOLUME_PER_SOLID_ANGLE,
+    };
+    let roundoffs = [IEEE_ROUNDOFF, VULKAN_ROUNDOFF];
+    let omega = solid_angle_exact(x, p0, e1, e2);
+    let omega_relative: f64 = roundoffs
+        .iter()
+        .map(|&r| solid_angle_error(x, p0, e1, e2, r))
+        .sum();
+    let near = |value: f64, threshold: f64, apart: f64| (value - threshold).abs() <= apart;
+    let views = roundoffs.map(|(u, q, w)| view(x, p0, e1, e2, u, q, w));
+    let volume_apart: f64 = views.iter().map(|v| v.volume_error).sum();
+    let min_volume = MIN_VOLUME_PER_SOLID_ANGLE as f64 * omega;
+    near(omega, MIN_SOLID_ANGLE as f64, omega * omega_relative)
+        || near(omega, MAX_SOLID_ANGLE as f64, omega * omega_relative)
+        || near(
+            views[0].volume.abs(),
+            min_volume,
+            volume_apart + min_volume * omega_relative,
+        )
+}
