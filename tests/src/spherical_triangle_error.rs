@@ -349,18 +349,31 @@ pub fn sample_direction_exact(
     first: usize,
     (u1, u2): (f32, f32),
 ) -> DVec3 {
-    let roundoff = crate::device_class::IEEE_ROUNDOFF;
+    let (inputs, mut r) = exact_pass(x, p0, e1, e2, first, crate::device_class::IEEE_ROUNDOFF);
+    sample_with(&mut r, &inputs, u1 as f64, u2 as f64)
+}
+
+/// The sampler's inputs in the arithmetic `roundoff` with `first` taken as A, and the
+/// [`Roundings`] of an exact pass that records the allowances.
+fn exact_pass(
+    x: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
+    first: usize,
+    roundoff: (f64, f64, f64),
+) -> (SamplerInputs, Roundings) {
     let mut inputs = sampler_inputs(x, p0, e1, e2, roundoff);
     inputs.dir.rotate_left(first);
     inputs.dir_error.rotate_left(first);
-    let mut r = Roundings {
+    let r = Roundings {
         roundoff,
         allowances: Vec::new(),
         recording: true,
         next: 0,
         moved: None,
     };
-    sample_with(&mut r, &inputs, u1 as f64, u2 as f64)
+    (inputs, r)
 }
 
 /// The sampled direction for (u1, u2) computed exactly from the `f32` inputs, and its
@@ -384,16 +397,7 @@ pub fn sample_direction_error(
     (u1, u2): (f32, f32),
     roundoff: (f64, f64, f64),
 ) -> (DVec3, DVec3) {
-    let mut inputs = sampler_inputs(x, p0, e1, e2, roundoff);
-    inputs.dir.rotate_left(first);
-    inputs.dir_error.rotate_left(first);
-    let mut r = Roundings {
-        roundoff,
-        allowances: Vec::new(),
-        recording: true,
-        next: 0,
-        moved: None,
-    };
+    let (inputs, mut r) = exact_pass(x, p0, e1, e2, first, roundoff);
     let (u1, u2) = (u1 as f64, u2 as f64);
     let exact = sample_with(&mut r, &inputs, u1, u2);
     r.recording = false;
