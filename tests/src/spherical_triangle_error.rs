@@ -496,12 +496,14 @@ pub fn spherical_sample_apart(
     }
 }
 
-/// Whether one IEEE and one Vulkan computation may decide otherwise whether the triangle
-/// p0, p0 + e1, p0 + e2 seen from x is sampled as a spherical triangle
-/// (`SphericalTriangle::sampled`): the solid angle within the two computations' bounds
-/// ([`solid_angle_error`]) of `MIN_SOLID_ANGLE` or `MAX_SOLID_ANGLE`, or the triple product
-/// within its two bounds plus the solid angle's of `MIN_VOLUME_PER_SOLID_ANGLE` omega.
-pub fn sampled_decision_may_differ(x: [f32; 3], p0: [f32; 3], e1: [f32; 3], e2: [f32; 3]) -> bool {
+/// Whether the triangle p0, p0 + e1, p0 + e2 seen from x is sampled as a spherical triangle
+/// (`SphericalTriangle::sampled`) in one IEEE and one Vulkan computation alike: `Some` of that
+/// decision, or `None` where they may decide otherwise. The decision is a conjunction (the
+/// solid angle within [`MIN_SOLID_ANGLE`, `MAX_SOLID_ANGLE`], the triple product at least
+/// `MIN_VOLUME_PER_SOLID_ANGLE` omega), so it is certainly false where one condition is false
+/// beyond the two computations' bounds ([`solid_angle_error`], the view's triple-product
+/// bound), certainly true where both hold beyond them, and open otherwise.
+pub fn sampled_decision(x: [f32; 3], p0: [f32; 3], e1: [f32; 3], e2: [f32; 3]) -> Option<bool> {
     use crate::device_class::{IEEE_ROUNDOFF, VULKAN_ROUNDOFF};
     use kernel::spherical_triangle::{
         MAX_SOLID_ANGLE, MIN_SOLID_ANGLE, MIN_VOLUME_PER_SOLID_ANGLE,
@@ -512,15 +514,35 @@ pub fn sampled_decision_may_differ(x: [f32; 3], p0: [f32; 3], e1: [f32; 3], e2: 
         .iter()
         .map(|&r| solid_angle_error(x, p0, e1, e2, r))
         .sum();
-    let near = |value: f64, threshold: f64, apart: f64| (value - threshold).abs() <= apart;
+    // Whether `value >= threshold` in both computations (`Some`), or may differ (`None`).
+    let at_least = |value: f64, threshold: f64, apart: f64| {
+        if !((value - threshold).abs() <= apart) && value.is_finite() {
+            Some(value >= threshold)
+        } else if value.is_finite() && apart.is_finite() {
+            None
+        } else {
+            // A 0 solid angle (its relative bound infinite) is 0 in both: below every threshold.
+            Some(false)
+        }
+    };
     let views = roundoffs.map(|(u, q, w)| view(x, p0, e1, e2, u, q, w));
     let volume_apart: f64 = views.iter().map(|v| v.volume_error).sum();
     let min_volume = MIN_VOLUME_PER_SOLID_ANGLE as f64 * omega;
-    near(omega, MIN_SOLID_ANGLE as f64, omega * omega_relative)
-        || near(omega, MAX_SOLID_ANGLE as f64, omega * omega_relative)
-        || near(
+    let omega_apart = omega * omega_relative;
+    let conditions = [
+        at_least(omega, MIN_SOLID_ANGLE as f64, omega_apart),
+        at_least(MAX_SOLID_ANGLE as f64, omega, omega_apart),
+        at_least(
             views[0].volume.abs(),
             min_volume,
             volume_apart + min_volume * omega_relative,
-        )
+        ),
+    ];
+    if conditions.contains(&Some(false)) {
+        Some(false)
+    } else if conditions.contains(&None) {
+        None
+    } else {
+        Some(true)
+    }
 }
