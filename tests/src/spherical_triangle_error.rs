@@ -414,6 +414,16 @@ pub fn sample_direction_error(
     (exact, bound)
 }
 
+/// How far apart one IEEE and one Vulkan computation of the solid angle may be, relative to
+/// it: the two computations' [`solid_angle_error`]s (infinite where the solid angle is 0).
+pub fn solid_angle_apart(x: [f32; 3], p0: [f32; 3], e1: [f32; 3], e2: [f32; 3]) -> f64 {
+    use crate::device_class::{IEEE_ROUNDOFF, VULKAN_ROUNDOFF};
+    [IEEE_ROUNDOFF, VULKAN_ROUNDOFF]
+        .iter()
+        .map(|&r| solid_angle_error(x, p0, e1, e2, r))
+        .sum()
+}
+
 /// How far apart one IEEE and one Vulkan computation of a triangle light's spherical sample
 /// (`light::triangle::sample` where `spherical_triangle_used` says so) may be, for the triangle
 /// p0, p0 + e1, p0 + e2, the receiver x and (u1, u2).
@@ -427,8 +437,8 @@ pub struct SphericalSampleApart {
     /// world distances, theta_min the triangle's smallest angle). The plane step's own
     /// rounding is the caller's (the IEEE-class term).
     pub point: f64,
-    /// The solid angle's (and so the density's, 1 / omega) relative distance: the two
-    /// computations' [`solid_angle_error`]s.
+    /// The solid angle's (and so the density's, 1 / omega) relative distance
+    /// ([`solid_angle_apart`]).
     pub solid_angle_relative: f64,
     /// Whether either computation may take another vertex as A (the two smallest of the dot
     /// products opposite the vertices within their roundings of each other): its sample is then
@@ -467,19 +477,11 @@ pub fn spherical_sample_apart(
     let first = by_dot[0];
     let order_may_differ = opposite(by_dot[1]) - opposite(by_dot[0])
         <= opposite_error(by_dot[0]) + opposite_error(by_dot[1]);
-    let direction_apart: f64 = roundoffs
-        .iter()
-        .map(|&r| {
-            sample_direction_error(x, p0, e1, e2, first, (u1, u2), r)
-                .1
-                .length()
-        })
-        .sum();
-    let solid_angle_relative = roundoffs
-        .iter()
-        .map(|&r| solid_angle_error(x, p0, e1, e2, r))
-        .sum();
-    let exact = sample_direction_exact(x, p0, e1, e2, first, (u1, u2));
+    // The exact direction (the same from either arithmetic's pass) and the two bounds.
+    let [(exact, ieee_bound), (_, vulkan_bound)] =
+        roundoffs.map(|r| sample_direction_error(x, p0, e1, e2, first, (u1, u2), r));
+    let direction_apart = ieee_bound.length() + vulkan_bound.length();
+    let solid_angle_relative = solid_angle_apart(x, p0, e1, e2);
     let (e1, e2) = (d3(e1), d3(e2));
     let n = e1.cross(e2).normalize();
     let to_plane = (d3(p0) - d3(x)).dot(n);
@@ -510,10 +512,7 @@ pub fn sampled_decision(x: [f32; 3], p0: [f32; 3], e1: [f32; 3], e2: [f32; 3]) -
     };
     let roundoffs = [IEEE_ROUNDOFF, VULKAN_ROUNDOFF];
     let omega = solid_angle_exact(x, p0, e1, e2);
-    let omega_relative: f64 = roundoffs
-        .iter()
-        .map(|&r| solid_angle_error(x, p0, e1, e2, r))
-        .sum();
+    let omega_relative = solid_angle_apart(x, p0, e1, e2);
     // Whether `value >= threshold` in both computations (`Some`), or may differ (`None`).
     let at_least = |value: f64, threshold: f64, apart: f64| {
         if !((value - threshold).abs() <= apart) && value.is_finite() {

@@ -596,9 +596,8 @@ fn triangle_light_ieee_class(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, v
 /// two computations may take different vertices as A (a tie of two arcs within rounding) the
 /// sample is another point of the same distribution: any point of the light is allowed.
 fn triangle_light_apart(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> f32 {
-    use twinpath_tests::device_class::{IEEE_ROUNDOFF, VULKAN_ROUNDOFF};
     use twinpath_tests::spherical_triangle_error::{
-        sampled_decision, solid_angle_error, spherical_sample_apart,
+        sampled_decision, solid_angle_apart, spherical_sample_apart,
     };
     let ieee_class = triangle_light_ieee_class(b, r, k, j, value);
     let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
@@ -606,10 +605,7 @@ fn triangle_light_apart(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value:
     let (x, p0, e1, e2) = (v(0), v(1), v(2), v(3));
     let a = |v: glam::Vec3| v.to_array();
     if k == 1 && j == 3 {
-        let relative = [IEEE_ROUNDOFF, VULKAN_ROUNDOFF]
-            .map(|ro| solid_angle_error(a(x), a(p0), a(e1), a(e2), ro))
-            .iter()
-            .sum::<f64>();
+        let relative = solid_angle_apart(a(x), a(p0), a(e1), a(e2));
         return ieee_class + (value as f64 * relative) as f32;
     }
     if k == 1 && j < 3 {
@@ -645,10 +641,11 @@ fn triangle_light_apart(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value:
 
 /// Whether `light::triangle::spherical_triangle_used`'s cheap estimate of the solid angle,
 /// |n . (x - c)| / (2 d^3) with c the centroid and d = |x - c|, reaches its threshold in two
-/// computations alike (`Some`), or lies within their rounding of it (`None`): x - c is off by about 2 eps (|x| + |c|) in any direction, which
-/// moves n . (x - c) by that over h (the sine of x's elevation above the plane) relative to
-/// it; the cross product, the length, its cube and the quotients add a few eps each. 16 eps
-/// (1 + (|x| + |c|) / d) / h per computation, two computations.
+/// computations alike (`Some`), or lies within their rounding of it (`None`): x - c is off by
+/// about 2 eps (|x| + |c|) in any direction, which moves n . (x - c) by that over h (the sine
+/// of x's elevation above the plane) relative to it; the cross product, the length, its cube
+/// and the quotients add a few eps each. 16 eps (1 + (|x| + |c|) / d) / h per computation, two
+/// computations.
 fn estimate_decision(
     x: glam::Vec3,
     p0: glam::Vec3,

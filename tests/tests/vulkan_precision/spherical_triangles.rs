@@ -193,19 +193,12 @@ fn sampled_directions_are_within_their_error_under_every_arithmetic() {
                 (exact, ieee_bound, vulkan_bound)
             })
         };
-        let vertices = [p0, p0 + e1, p0 + e2].map(|p| (p - x).as_dvec3().normalize());
         tested += 1;
         for model in 0..4 {
             use_model(model);
             let view = SphericalTriangle::view(v(x), v(p0), v(e1), v(e2));
-            let a = back(view.sampling_order()[0]).as_dvec3();
-            let first = (0..3)
-                .min_by(|&i, &j| {
-                    (vertices[i] - a)
-                        .length()
-                        .total_cmp(&(vertices[j] - a).length())
-                })
-                .unwrap();
+            let first =
+                vertex_taken_as_a(view.directions().map(back), back(view.sampling_order()[0]));
             let (exact, ieee_bound, vulkan_bound) = bounds_for(first);
             if model == 1 {
                 bounds.push(vulkan_bound.max_element() / f32::EPSILON as f64);
@@ -229,6 +222,12 @@ fn sampled_directions_are_within_their_error_under_every_arithmetic() {
         of_ieee[1..].iter().all(|&w| w > 1.0),
         "the Vulkan models stay within IEEE's bound: {of_ieee:?}"
     );
+}
+
+/// Which of a view's `directions` (0, 1 or 2 for p0, p1, p2) its `sampling_order` took as A,
+/// `a`: one of them bit for bit (the order selects, it computes nothing).
+fn vertex_taken_as_a(directions: [Vec3; 3], a: Vec3) -> usize {
+    (0..3).find(|&i| directions[i] == a).unwrap()
 }
 
 /// Which vertex the sampler takes as A changes its roundings, not its distribution, and A at
@@ -269,8 +268,7 @@ fn the_largest_angle_first_keeps_the_most_digits() {
         // From the smallest angle to the largest: the opposite arc's dot from largest down.
         let mut by_angle = [0, 1, 2];
         by_angle.sort_by(|&i, &j| opposite(j).total_cmp(&opposite(i)));
-        let a = Vec3::from(view.sampling_order()[0]);
-        let chosen = (0..3).find(|&i| Vec3::from(dirs[i]) == a).unwrap();
+        let chosen = vertex_taken_as_a(dirs.map(Vec3::from), view.sampling_order()[0].into());
         let arrays = (x.to_array(), p0.to_array(), e1.to_array(), e2.to_array());
         let error = |first: usize| {
             let order: [V3<f32>; 3] = [0, 1, 2].map(|i| dirs[(first + i) % 3]);
