@@ -28,6 +28,8 @@ pub trait Real:
     fn min(self, other: Self) -> Self;
     /// `f32::max` of each lane.
     fn max(self, other: Self) -> Self;
+    /// `f32::clamp` of each lane to [`lo`, `hi`] (lo <= hi; NaN stays NaN).
+    fn clamp(self, lo: Self, hi: Self) -> Self;
     fn to_bits(self) -> Self::Bits;
     fn from_bits(bits: Self::Bits) -> Self;
     /// All ones where `self > other`, zero elsewhere.
@@ -89,6 +91,11 @@ impl Real for f32 {
     #[inline]
     fn max(self, other: Self) -> Self {
         f32::max(self, other)
+    }
+
+    #[inline]
+    fn clamp(self, lo: Self, hi: Self) -> Self {
+        f32::clamp(self, lo, hi)
     }
 
     #[inline]
@@ -189,6 +196,11 @@ impl<const N: usize> Real for core::simd::Simd<f32, N> {
     #[inline]
     fn max(self, other: Self) -> Self {
         core::simd::num::SimdFloat::simd_max(self, other)
+    }
+
+    #[inline]
+    fn clamp(self, lo: Self, hi: Self) -> Self {
+        core::simd::num::SimdFloat::simd_clamp(self, lo, hi)
     }
 
     #[inline]

@@ -22,6 +22,7 @@ use crate::features::FeatureSet;
 use crate::geometry::{blend2, blend3};
 use crate::hit::SurfaceHit;
 use crate::instance::{normal_to_world, vector_to_world};
+use crate::real::{self, V3};
 use crate::scene::{material_kind, shading_flags, texture_slot, Material, ShadingTriangle, NONE};
 use crate::scene_view::SceneView;
 use crate::texture::{self, lookup_at, textured_material, TexCoords};
@@ -111,19 +112,66 @@ pub fn mapped_normal(
     texel: Vec3,
     scale: f32,
 ) -> Vec3 {
-    let t = blend3(
-        Vec3::from(frame.normal0),
-        Vec3::from(frame.normal1),
-        Vec3::from(frame.normal2),
-        bary,
-    );
-    let t = unit_or(t - base * base.dot(t), Vec3::ZERO);
-    if t == Vec3::ZERO {
+    let tangent = |t: [f32; 3]| V3::from(Vec3::from(t));
+    let tangents = [
+        tangent(frame.normal0),
+        tangent(frame.normal1),
+        tangent(frame.normal2),
+    ];
+    mapped_normal_v3(
+        V3::from(base),
+        tangents,
+        frame.uv0[0],
+        (bary.x, bary.y),
+        V3::from(texel),
+        scale,
+    )
+    .into()
+}
+
+/// [`mapped_normal`] over any scalar [`real::Real`], the frame given as its three vertex
+/// tangents and its handedness `sign`, in the same operations (so that a `V3<f32>` gives its
+/// result bit for bit, and its error under a Vulkan device's arithmetic can be bounded by
+/// running it on one: `tests/src/device_class.rs`).
+#[inline]
+pub fn mapped_normal_v3<R: real::Real<Bits = u32>>(
+    base: V3<R>,
+    tangents: [V3<R>; 3],
+    sign: R,
+    bary: (R, R),
+    texel: V3<R>,
+    scale: R,
+) -> V3<R> {
+    let (one, two) = (R::splat(1.0), R::splat(2.0));
+    let t = tangents[0] * (one - bary.0 - bary.1) + tangents[1] * bary.0 + tangents[2] * bary.1;
+    let (t, has_direction) = unit_v3(t - base * base.dot(t));
+    if !has_direction {
         return base;
     }
-    let b = base.cross(t) * frame.uv0[0];
-    let m = (texel * 2.0 - Vec3::ONE) * Vec3::new(scale, scale, 1.0);
-    unit_or(t * m.x + b * m.y + base * m.z, base)
+    let b = base.cross(t) * sign;
+    let m = V3::new(
+        (texel.x * two - one) * scale,
+        (texel.y * two - one) * scale,
+        (texel.z * two - one) * one,
+    );
+    let (n, has_direction) = unit_v3(t * m.x + b * m.y + base * m.z);
+    if has_direction {
+        n
+    } else {
+        base
+    }
+}
+
+/// [`unit_or`] over any scalar [`real::Real`]: `v` scaled to unit length and whether it has a
+/// direction (else `v` as it is).
+#[inline]
+fn unit_v3<R: real::Real<Bits = u32>>(v: V3<R>) -> (V3<R>, bool) {
+    let len2 = v.dot(v);
+    if len2.greater_than(R::splat(0.0)) != 0 && len2.finite() != 0 {
+        (v / len2.sqrt(), true)
+    } else {
+        (v, false)
+    }
 }
 
 /// The material at the vertex of `hit` (its `SurfaceHit::material`, shading record

@@ -255,3 +255,66 @@ pub fn cosine_sample_apart(u1: f32) -> (f64, f64) {
         21.0 * eps,
     )
 }
+
+/// How far apart the CPU's and a conformant device's Fresnel reflectances may be, for the
+/// probe's record (cosine `cos`, index `eta`, extinction `k`, Schlick's `f0`): [conductor,
+/// dielectric F, its cos_t, Schlick's three channels], each the largest distance between the
+/// kernel's own functions run on [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan
+/// arithmetic (every way their comparisons may go: the clamp of the cosine, total internal
+/// reflection). The balls carry each input's conditioning: the conductor's a^2 + b^2 and a are
+/// roots of differences, the dielectric's cos_t a root that vanishes at the critical angle.
+pub fn fresnel_apart(cos: f32, eta: f32, k: f32, f0: [f32; 3]) -> [f64; 6] {
+    use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
+    use kernel::bsdf::fresnel;
+    let b = Ball::exact;
+    ieee_and_vulkan_apart(&|| {
+        let (f, cos_t) = fresnel::dielectric(b(cos), b(eta));
+        let s = f0.map(|f0| fresnel::schlick_f90_channel(b(f0), b(1.0), b(cos)));
+        [
+            fresnel::conductor(b(cos), b(eta), b(k)),
+            f,
+            cos_t,
+            s[0],
+            s[1],
+            s[2],
+        ]
+    })
+}
+
+/// How far apart the CPU's and a conformant device's normal-mapped normals may be, per
+/// component, for the probe's record (unit `base` normal, one `tangent` at all three vertices,
+/// handedness `sign`, barycentrics `bary`, `texel`, `scale`): the largest distance between
+/// `kernel::surface::mapped_normal_v3` run on [`crate::ball_arithmetic::Ball`]s in IEEE and in
+/// Vulkan arithmetic, every way its two tests (the tangent's and the result's direction) may
+/// go. The tangent's component across the normal, t - n (n . t), cancels where they are nearly
+/// parallel; the balls carry it, and where it may vanish the result is any unit vector (or the
+/// base normal): apart by at most 2 per component, which caps the bound.
+pub fn mapped_normal_apart(
+    base: [f32; 3],
+    tangent: [f32; 3],
+    sign: f32,
+    bary: (f32, f32),
+    texel: [f32; 3],
+    scale: f32,
+) -> [f64; 3] {
+    use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
+    use kernel::real::V3;
+    let b = Ball::exact;
+    let v = |x: [f32; 3]| V3::new(b(x[0]), b(x[1]), b(x[2]));
+    ieee_and_vulkan_apart(&|| {
+        let n = kernel::surface::mapped_normal_v3(
+            v(base),
+            [v(tangent); 3],
+            b(sign),
+            (b(bary.0), b(bary.1)),
+            v(texel),
+            b(scale),
+        );
+        [n.x, n.y, n.z]
+    })
+    .map(|apart| apart.min(UNIT_APART))
+}
+
+/// The most two unit vectors' components may differ by, with each vector's normalisation
+/// rounded (a component of a computed unit vector is within a few eps of [-1, 1]).
+const UNIT_APART: f64 = 2.0 + 64.0 * f32::EPSILON as f64;

@@ -146,6 +146,7 @@ pub fn shade_at(
     kernel::surface::shade(kernel::features::Dynamic(0), &scene, &hit)
 }
 
+pub mod ball_arithmetic;
 pub mod cubature;
 pub mod device_class;
 pub mod exact;

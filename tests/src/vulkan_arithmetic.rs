@@ -315,6 +315,10 @@ impl Real for Vk32 {
         Self::exact(self.get().max(other.get()))
     }
 
+    fn clamp(self, lo: Self, hi: Self) -> Self {
+        Self::exact(self.get().clamp(lo.get(), hi.get()))
+    }
+
     fn to_bits(self) -> u32 {
         self.value.to_bits()
     }

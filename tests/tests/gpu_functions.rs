@@ -469,6 +469,24 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let e2 = glam::Vec3::new(f(1, 3), f(2, 3), f(3, 3));
             b.abs * (p0.length() + e1.length() + e2.length())
         }
+        // The Vulkan class's mapped normal, per record (`mapped_normal_apart`).
+        function::MAPPED_NORMAL if b.vulkan => {
+            let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
+            let apart = twinpath_tests::device_class::mapped_normal_apart(
+                v(0),
+                v(1),
+                f(1, 3),
+                (f(2, 3), f(3, 0)),
+                v(2),
+                f(0, 3),
+            );
+            // Rounded up to an f32 (a millionth: more than an f32's rounding).
+            if j < 3 {
+                (apart[j] * (1.0 + 1e-6)) as f32
+            } else {
+                0.0
+            }
+        }
         // The mapped normal: Gram-Schmidt leaves t's component across n, whose rounding is
         // eps |t| absolute, so relative to it b.abs |t| / |t - n (n . t)|.
         function::MAPPED_NORMAL => {
@@ -525,6 +543,19 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
                 pixel,
                 offset,
             ) as f32
+        }
+        // The Vulkan class's Fresnel reflectances, per record: the balls of the kernel's own
+        // functions in IEEE and Vulkan arithmetic (`fresnel_apart`), out0 = (conductor,
+        // dielectric F, cos_t, Schlick r), out1 = (Schlick g, b, 0, 0).
+        function::FRESNEL if b.vulkan => {
+            let (input, f0) = ([f(0, 0), f(0, 1), f(0, 2)], [f(1, 0), f(1, 1), f(1, 2)]);
+            let apart =
+                twinpath_tests::device_class::fresnel_apart(input[0], input[1], input[2], f0);
+            match 4 * k + j {
+                // Rounded up to an f32 (a millionth: more than an f32's rounding).
+                i @ 0..=5 => (apart[i] * (1.0 + 1e-6)) as f32,
+                _ => 0.0,
+            }
         }
         // The Vulkan class's cosine sample (out1.xyz) and its density (out1.w), per record
         // (`cosine_sample_apart` of u1 = in3.x); eval_scattering and pdf_brdf keep 8 eps.
@@ -729,6 +760,20 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
             abs: 0.0,
             vulkan: true,
             why: "Vulkan class: cosines off by 4 u |d|, (d . d)^2 by 11 u, a quotient within 2.5 ULP: 12 eps / |d|^2 + 21 eps G apart from the CPU, per record (`allowed_abs`)",
+            ..*b
+        }),
+        function::MAPPED_NORMAL => Some(Bound {
+            max_ulps: 0,
+            abs: 0.0,
+            vulkan: true,
+            why: "Vulkan class: the kernel's mapped normal (a blend, one Gram-Schmidt step, a cross product, two normalisations and their tests) run on balls in IEEE and in Vulkan arithmetic, every way its tests may go; the largest distance between the two, per record (`mapped_normal_apart`)",
+            ..*b
+        }),
+        function::FRESNEL => Some(Bound {
+            max_ulps: 0,
+            abs: 0.0,
+            vulkan: true,
+            why: "Vulkan class: the kernel's conductor, dielectric and Schlick functions run on balls (midpoint-radius intervals) in IEEE and in Vulkan arithmetic, every way their comparisons may go; the largest distance between the two, per record (`fresnel_apart`)",
             ..*b
         }),
         function::BRDF => Some(Bound {

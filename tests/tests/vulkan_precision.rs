@@ -9,6 +9,7 @@
 //! the light they sample, the orthonormal frame is orthonormal and the samplers stay in their
 //! domains, all within the bounds derived for Vulkan; and [`Vk32`] itself returns only what a
 //! conformant device may, and does take its liberties (else the rest would prove nothing).
+//! `vulkan_precision/ball_bounds.rs` checks the bounds derived by ball arithmetic against it.
 
 use glam::Vec3;
 use kernel::frame::orthonormal_basis_v3;
@@ -27,6 +28,8 @@ use twinpath_tests::device_class::{
 use twinpath_tests::vulkan_arithmetic::{lean, seed, set_model, ulp, Model, Vk32};
 use twinpath_tests::SplitMix;
 
+#[path = "vulkan_precision/ball_bounds.rs"]
+mod ball_bounds;
 #[path = "vulkan_precision/spherical_triangles.rs"]
 mod spherical_triangles;
 

@@ -1,8 +1,7 @@
 //! Fresnel reflectance: the fraction of light a smooth interface reflects, by the angle of
 //! incidence. Derivations and sources: `docs/materials.md` ("Fresnel").
 
-#[cfg(target_arch = "spirv")]
-use crate::Float;
+use crate::real::Real;
 use spirv_std::glam::Vec3;
 
 /// Schlick's approximation F0 + (1 - F0) (1 - cos)^5 (Schlick, "An Inexpensive BRDF Model for
@@ -19,9 +18,28 @@ pub fn schlick(f0: Vec3, cos: f32) -> Vec3 {
 /// [`schlick`] bit for bit.
 #[inline]
 pub fn schlick_f90(f0: Vec3, f90: f32, cos: f32) -> Vec3 {
-    let m = 1.0 - cos.clamp(0.0, 1.0);
+    f0 + (Vec3::splat(f90) - f0) * schlick_weight(cos)
+}
+
+/// [`schlick_f90`] of one channel, over any scalar [`Real`] (so that its error under a Vulkan
+/// device's arithmetic can be bounded by running it on one: `tests/src/device_class.rs`).
+#[inline]
+pub fn schlick_f90_channel<R: Real<Bits = u32>>(f0: R, f90: R, cos: R) -> R {
+    f0 + (f90 - f0) * schlick_weight(cos)
+}
+
+/// Schlick's weight (1 - cos)^5, `cos` clamped to [0, 1].
+#[inline]
+fn schlick_weight<R: Real<Bits = u32>>(cos: R) -> R {
+    let m = R::splat(1.0) - unit_clamp(cos);
     let m2 = m * m;
-    f0 + (Vec3::splat(f90) - f0) * (m2 * m2 * m)
+    m2 * m2 * m
+}
+
+/// `x` clamped to [0, 1] (NaN stays NaN).
+#[inline]
+fn unit_clamp<R: Real>(x: R) -> R {
+    x.clamp(R::splat(0.0), R::splat(1.0))
 }
 
 /// Unpolarised reflectance of a conductor of complex index of refraction eta + i k (relative to
@@ -33,22 +51,25 @@ pub fn schlick_f90(f0: Vec3, f90: f32, cos: f32) -> Vec3 {
 /// Rp = Rs (cos^2 (a^2 + b^2) - 2 a cos sin^2 + sin^4) / (cos^2 (a^2 + b^2) + 2 a cos sin^2 + sin^4)
 /// (Born and Wolf, Principles of Optics, 14.2; the tan-free form multiplies the usual
 /// a sin tan terms by cos^2). Equal to the complex-arithmetic Fresnel equations (tested in f64).
+/// Generic over the scalar [`Real`] so that its error under a Vulkan device's arithmetic can be
+/// bounded by running it on one (`tests/src/device_class.rs`).
 #[inline]
-pub fn conductor(cos: f32, eta: f32, k: f32) -> f32 {
-    let c = cos.clamp(0.0, 1.0);
+pub fn conductor<R: Real<Bits = u32>>(cos: R, eta: R, k: R) -> R {
+    let (half, two, four) = (R::splat(0.5), R::splat(2.0), R::splat(4.0));
+    let c = unit_clamp(cos);
     let c2 = c * c;
-    let s2 = 1.0 - c2;
+    let s2 = R::splat(1.0) - c2;
     let (e2, k2) = (eta * eta, k * k);
     let t0 = e2 - k2 - s2;
-    let a2b2 = (t0 * t0 + 4.0 * e2 * k2).sqrt();
-    let a = (0.5 * (a2b2 + t0)).max(0.0).sqrt();
+    let a2b2 = (t0 * t0 + four * e2 * k2).sqrt();
+    let a = (half * (a2b2 + t0)).max(R::splat(0.0)).sqrt();
     let t1 = a2b2 + c2;
-    let t2 = 2.0 * a * c;
+    let t2 = two * a * c;
     let rs = (t1 - t2) / (t1 + t2);
     let t3 = c2 * a2b2 + s2 * s2;
     let t4 = t2 * s2;
     let rp = rs * (t3 - t4) / (t3 + t4);
-    0.5 * (rs + rp)
+    half * (rs + rp)
 }
 
 /// [`conductor`] per RGB channel.
@@ -67,33 +88,36 @@ pub fn conductor_rgb(cos: f32, eta: Vec3, k: Vec3) -> Vec3 {
 /// the reflectance is 1). Snell: sin_t^2 = (1 - cos^2) / eta^2;
 /// rs = (cos - eta cos_t) / (cos + eta cos_t), rp = (eta cos - cos_t) / (eta cos + cos_t),
 /// F = (rs^2 + rp^2) / 2 (Born and Wolf 1.5.2; pbrt-v4 9.3.1 `FrDielectric`).
+/// Generic over the scalar [`Real`] as [`conductor`] is.
 #[inline]
-pub fn dielectric(cos: f32, eta: f32) -> (f32, f32) {
-    let c = cos.clamp(0.0, 1.0);
-    let sin2_t = (1.0 - c * c) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return (1.0, 0.0);
+pub fn dielectric<R: Real<Bits = u32>>(cos: R, eta: R) -> (R, R) {
+    let one = R::splat(1.0);
+    let c = unit_clamp(cos);
+    let sin2_t = (one - c * c) / (eta * eta);
+    if sin2_t.at_least(one) != 0 {
+        return (one, R::splat(0.0));
     }
-    let cos_t = (1.0 - sin2_t).sqrt();
+    let cos_t = (one - sin2_t).sqrt();
     let rs = (c - eta * cos_t) / (c + eta * cos_t);
     let rp = (eta * c - cos_t) / (eta * c + cos_t);
-    (0.5 * (rs * rs + rp * rp), cos_t)
+    (R::splat(0.5) * (rs * rs + rp * rp), cos_t)
 }
 
 /// 1 - [`dielectric`]'s reflectance, the transmitted fraction, computed without that
 /// cancellation (it loses every digit near total internal reflection, where F -> 1):
 /// 1 - rs^2 = 4 eta cos cos_t / (cos + eta cos_t)^2, 1 - rp^2 = 4 eta cos cos_t / (eta cos + cos_t)^2.
 /// `cos_t` is [`dielectric`]'s; 0 under total internal reflection.
+/// Generic over the scalar [`Real`] as [`conductor`] is.
 #[inline]
-pub fn dielectric_transmittance(cos: f32, eta: f32, cos_t: f32) -> f32 {
-    let c = cos.clamp(0.0, 1.0);
-    let num = 4.0 * eta * c * cos_t;
+pub fn dielectric_transmittance<R: Real<Bits = u32>>(cos: R, eta: R, cos_t: R) -> R {
+    let c = unit_clamp(cos);
+    let num = R::splat(4.0) * eta * c * cos_t;
     let s = c + eta * cos_t;
     let p = eta * c + cos_t;
-    if !(num > 0.0) {
-        return 0.0;
+    if num.greater_than(R::splat(0.0)) == 0 {
+        return R::splat(0.0);
     }
-    0.5 * (num / (s * s) + num / (p * p))
+    R::splat(0.5) * (num / (s * s) + num / (p * p))
 }
 
 /// The direction refracted from `wo` through an interface of unit normal `h` on `wo`'s side
