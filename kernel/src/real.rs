@@ -48,19 +48,41 @@ pub trait Real:
     fn to_i32_bits(self) -> Self::Bits;
     /// The `i32` whose bits are `bits`, `as f32` (rounded to nearest).
     fn from_i32_bits(bits: Self::Bits) -> Self;
+
+    // Operations written on the bits, which a type that has none (a test's interval type)
+    // provides otherwise.
+
+    /// |x| of each lane: the sign bit cleared (exact under any arithmetic).
+    #[inline]
+    fn abs(self) -> Self {
+        Self::from_bits(self.to_bits() & Self::Bits::splat(0x7fff_ffff))
+    }
+
+    /// `yes` in the lanes where `mask` is all ones, `no` where it is zero.
+    #[inline]
+    fn select(mask: Self::Bits, yes: Self, no: Self) -> Self {
+        let (yes, no) = (yes.to_bits(), no.to_bits());
+        Self::from_bits(no ^ ((yes ^ no) & mask))
+    }
+
+    /// (cos, sin) of `self` turns: [`crate::turns::cos_sin_turns`]'s polynomials, whose
+    /// quadrant is chosen on the bits.
+    #[inline]
+    fn cos_sin_turns(self) -> (Self, Self) {
+        crate::turns::polynomial_cos_sin_turns(self)
+    }
 }
 
-/// |x| of each lane: the sign bit cleared (exact under any arithmetic).
+/// |x| of each lane ([`Real::abs`]).
 #[inline]
 pub fn abs<R: Real>(x: R) -> R {
-    R::from_bits(x.to_bits() & R::Bits::splat(0x7fff_ffff))
+    Real::abs(x)
 }
 
-/// `yes` in the lanes where `mask` is all ones, `no` where it is zero.
+/// `yes` in the lanes where `mask` is all ones, `no` where it is zero ([`Real::select`]).
 #[inline]
 pub fn select<R: Real>(mask: R::Bits, yes: R, no: R) -> R {
-    let (yes, no) = (yes.to_bits(), no.to_bits());
-    R::from_bits(no ^ ((yes ^ no) & mask))
+    R::select(mask, yes, no)
 }
 
 impl Real for f32 {

@@ -24,6 +24,12 @@ use core::f32::consts::FRAC_PI_2;
 /// see its fraction.
 #[inline]
 pub fn cos_sin_turns<R: Real>(u: R) -> (R, R) {
+    u.cos_sin_turns()
+}
+
+/// [`cos_sin_turns`]' polynomials ([`Real::cos_sin_turns`] of every type with bits).
+#[inline]
+pub fn polynomial_cos_sin_turns<R: Real>(u: R) -> (R, R) {
     let c = R::splat;
     let quarters = c(4.0) * u;
     // floor(quarters + 1/2) by conversions (truncation, less one below zero: the mask is -1

@@ -285,6 +285,41 @@ impl Real for Ball {
     fn from_i32_bits(_: u32) -> Self {
         unimplemented!("a Ball has no bits: functions that work on them cannot be bounded so")
     }
+
+    // The operations the kernel writes on the bits, on the numbers instead.
+
+    fn abs(self) -> Self {
+        Self {
+            mid: self.mid.abs(),
+            radius: self.radius,
+        }
+    }
+
+    fn select(mask: u32, yes: Self, no: Self) -> Self {
+        if mask != 0 {
+            yes
+        } else {
+            no
+        }
+    }
+
+    /// The exact cosine and sine of 2 pi `self`'s midpoint, within 4 units of roundoff (what
+    /// `kernel::turns::cos_sin_turns`' polynomials keep to under IEEE and every Vulkan model:
+    /// `cos_sin_turns_is_within_four_roundings_under_every_arithmetic`) and 2 pi times the
+    /// argument's radius (both have slope at most 2 pi per turn).
+    fn cos_sin_turns(self) -> (Self, Self) {
+        let roundoff = ROUNDOFF.with(|r| r.get());
+        let angle = std::f64::consts::TAU * self.mid;
+        let radius = 4.0 * roundoff.unit
+            + std::f64::consts::TAU * self.radius
+            + if roundoff.flush {
+                f32::MIN_POSITIVE as f64
+            } else {
+                0.0
+            };
+        let ball = |mid: f64| Self { mid, radius };
+        (ball(angle.cos()), ball(angle.sin()))
+    }
 }
 
 /// The most ways [`computations`] follows before it gives up (and returns unbounded balls).

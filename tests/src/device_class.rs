@@ -4,7 +4,9 @@
 //! eps / 2, quotients and roots correctly rounded) and one under Vulkan's precision rules
 //! (eps, quotients within 2.5 ULP, roots as 1 / inversesqrt), in the comment of the test that
 //! checks it against the model of such a device (`tests/tests/vulkan_precision.rs`, on
-//! [`crate::vulkan_arithmetic::Vk32`]), and collected in `docs/robustness.md`.
+//! [`crate::vulkan_arithmetic::Vk32`]), and collected in `docs/robustness.md`; or, for the
+//! Fresnel, microfacet and mapped-normal functions, by running the kernel's own code on
+//! [`crate::ball_arithmetic::Ball`]s in both arithmetics.
 
 /// How far apart the CPU's and a conformant Vulkan device's `orthonormal_basis` may be, per
 /// component, in eps (derived in `tests/tests/vulkan_precision.rs`; used by `gpu_functions.rs`
@@ -318,3 +320,41 @@ pub fn mapped_normal_apart(
 /// The most two unit vectors' components may differ by, with each vector's normalisation
 /// rounded (a component of a computed unit vector is within a few eps of [-1, 1]).
 const UNIT_APART: f64 = 2.0 + 64.0 * f32::EPSILON as f64;
+
+/// How far apart the CPU's and a conformant device's microfacet functions may be, for the
+/// probe's record (unit mean normal `n`, roughness `alpha`, unit `wo`, a normal's cosine `cos`
+/// and sine squared `sin2`, numbers `u1`, `u2`): [the visible normal's three components, D,
+/// G1, the reflected density], the largest distance between `kernel::bsdf::microfacet`'s
+/// functions run on [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic (every
+/// way their tests may go; the azimuth's cosine and sine within the four roundings
+/// `cos_sin_turns` keeps to). The balls carry the lobe's own conditioning: the stretch by
+/// alpha, D's (sin^2 + alpha^2 cos^2)^2 near the peak of a smooth lobe. The visible normal is a
+/// unit vector: apart by at most 2 per component, which caps its bound.
+pub fn microfacet_apart(
+    n: [f32; 3],
+    alpha: f32,
+    wo: [f32; 3],
+    (cos, sin2): (f32, f32),
+    (u1, u2): (f32, f32),
+) -> [f64; 6] {
+    use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
+    use kernel::bsdf::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal_v3};
+    use kernel::real::V3;
+    let b = Ball::exact;
+    let v = |x: [f32; 3]| V3::new(b(x[0]), b(x[1]), b(x[2]));
+    let mut apart = ieee_and_vulkan_apart(&|| {
+        let h = sample_visible_normal_v3(v(n), v(wo), b(alpha), b(u1), b(u2));
+        [
+            h.x,
+            h.y,
+            h.z,
+            ggx_d(b(cos), b(sin2), b(alpha)),
+            ggx_g1(b(cos), b(alpha)),
+            pdf_reflected(v(n).dot(v(wo)), (b(cos), b(sin2)), b(alpha)),
+        ]
+    });
+    for a in &mut apart[..3] {
+        *a = a.min(UNIT_APART);
+    }
+    apart
+}

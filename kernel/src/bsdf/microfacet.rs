@@ -3,7 +3,8 @@
 //! `alpha` as given (no remapping), as Mitsuba 3's `roughconductor` and pbrt-v4's
 //! `TrowbridgeReitzDistribution`. Derivations and sources: `docs/materials.md` ("Microfacets").
 
-use crate::frame::orthonormal_basis;
+use crate::frame::orthonormal_basis_v3;
+use crate::real::{self, V3};
 use crate::turns::cos_sin_turns;
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -16,15 +17,17 @@ use spirv_std::glam::Vec3;
 /// eq. 33, with 1 + cos^2 (alpha^2 - 1) written as sin^2 + alpha^2 cos^2); 0 for cos_h <= 0.
 /// Normalised: the integral of D(h) cos_h over the hemisphere is 1. Takes sin^2 theta_h
 /// itself ([`normal_angle`]): from 1 - cos^2 it would lose all its digits near the peak of a
-/// smooth lobe, where sin^2 ~ alpha^2 ~ 1e-6.
+/// smooth lobe, where sin^2 ~ alpha^2 ~ 1e-6. Over any scalar [`real::Real`], as the other
+/// functions here, so that its error under a Vulkan device's arithmetic can be bounded by
+/// running it on one (`tests/src/device_class.rs`).
 #[inline]
-pub fn ggx_d(cos_h: f32, sin2_h: f32, alpha: f32) -> f32 {
-    if !(cos_h > 0.0) {
-        return 0.0;
+pub fn ggx_d<R: real::Real<Bits = u32>>(cos_h: R, sin2_h: R, alpha: R) -> R {
+    if cos_h.greater_than(R::splat(0.0)) == 0 {
+        return R::splat(0.0);
     }
     let a2 = alpha * alpha;
     let t = sin2_h + a2 * cos_h * cos_h;
-    a2 / (PI * t * t)
+    a2 / (R::splat(PI) * t * t)
 }
 
 /// (cos, sin^2) of the angle between unit vectors `n` and `h`: the sine from the cross
@@ -40,10 +43,11 @@ pub fn normal_angle(n: Vec3, h: Vec3) -> (f32, f32) {
 /// Heitz, "Understanding the Masking-Shadowing Function", JCGT 3(2), 2014, eq. 86), written as
 /// 2 |cos| / (|cos| + sqrt(alpha^2 + (1 - alpha^2) cos^2)), which needs no tangent.
 #[inline]
-pub fn ggx_g1(cos: f32, alpha: f32) -> f32 {
+pub fn ggx_g1<R: real::Real>(cos: R, alpha: R) -> R {
+    let one = R::splat(1.0);
     let c = cos.abs();
     let a2 = alpha * alpha;
-    2.0 * c / (c + (a2 + (1.0 - a2) * c * c).max(0.0).sqrt())
+    R::splat(2.0) * c / (c + (a2 + (one - a2) * c * c).max(R::splat(0.0)).sqrt())
 }
 
 /// A microfacet normal drawn from the visible normals seen from `wo` (unit, `n . wo` > 0),
@@ -55,15 +59,28 @@ pub fn ggx_g1(cos: f32, alpha: f32) -> f32 {
 /// both backends. `n` is the mean normal, `u1` the azimuth in turns, `u2` the cap's height.
 #[inline]
 pub fn sample_visible_normal(n: Vec3, wo: Vec3, alpha: f32, u1: f32, u2: f32) -> Vec3 {
-    let (t, b) = orthonormal_basis(n);
-    let ws = Vec3::new(alpha * wo.dot(t), alpha * wo.dot(b), wo.dot(n)).normalize();
+    sample_visible_normal_v3(V3::from(n), V3::from(wo), alpha, u1, u2).into()
+}
+
+/// [`sample_visible_normal`] over any scalar [`real::Real`], in the same operations.
+#[inline]
+pub fn sample_visible_normal_v3<R: real::Real<Bits = u32>>(
+    n: V3<R>,
+    wo: V3<R>,
+    alpha: R,
+    u1: R,
+    u2: R,
+) -> V3<R> {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let (t, b) = orthonormal_basis_v3(n);
+    let ws = V3::new(alpha * wo.dot(t), alpha * wo.dot(b), wo.dot(n)).normalize();
     let (cos_phi, sin_phi) = cos_sin_turns(u1);
-    let z = (1.0 - u2) * (1.0 + ws.z) - ws.z;
-    let sin_theta = (1.0 - z * z).clamp(0.0, 1.0).sqrt();
-    let hs = Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, z) + ws;
-    let local = Vec3::new(alpha * hs.x, alpha * hs.y, hs.z.max(0.0));
+    let z = (one - u2) * (one + ws.z) - ws.z;
+    let sin_theta = (one - z * z).clamp(zero, one).sqrt();
+    let hs = V3::new(sin_theta * cos_phi, sin_theta * sin_phi, z) + ws;
+    let local = V3::new(alpha * hs.x, alpha * hs.y, hs.z.max(zero));
     let len2 = local.dot(local);
-    if !(len2 > 0.0) {
+    if len2.greater_than(zero) == 0 {
         // c = -w_s exactly (the cap's rim opposite w_s: measure zero).
         return n;
     }
@@ -76,8 +93,8 @@ pub fn sample_visible_normal(n: Vec3, wo: Vec3, alpha: f32, u1: f32, u2: f32) ->
 /// reflection being 1 / (4 wo . h) (Walter et al. 2007, eq. 14). `cos_o` = n . wo > 0;
 /// (`cos_h`, `sin2_h`) the half vector's angle ([`normal_angle`]).
 #[inline]
-pub fn pdf_reflected(cos_o: f32, (cos_h, sin2_h): (f32, f32), alpha: f32) -> f32 {
-    ggx_g1(cos_o, alpha) * ggx_d(cos_h, sin2_h, alpha) / (4.0 * cos_o)
+pub fn pdf_reflected<R: real::Real<Bits = u32>>(cos_o: R, (cos_h, sin2_h): (R, R), alpha: R) -> R {
+    ggx_g1(cos_o, alpha) * ggx_d(cos_h, sin2_h, alpha) / (R::splat(4.0) * cos_o)
 }
 
 /// A microfacet reflection from `wo` to `wi` (unit, both above `n`, cosines `cos_o`, `cos_i`):
