@@ -140,15 +140,27 @@ pub fn solid_angle_error(
     p0: [f32; 3],
     e1: [f32; 3],
     e2: [f32; 3],
+    roundoff: (f64, f64, f64),
+) -> f64 {
+    solid_angle_error_absolute(x, p0, e1, e2, roundoff) / solid_angle_exact(x, p0, e1, e2)
+}
+
+/// [`solid_angle_error`] in steradians instead of relative: 4 pi times the error of half the
+/// solid angle in turns, plus u and eps / 2 of the solid angle. Finite where the solid angle is
+/// 0 (a receiver in the triangle's plane, whose triple product is all rounding) unless D is too.
+pub fn solid_angle_error_absolute(
+    x: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
     (u, q, w): (f64, f64, f64),
 ) -> f64 {
     let v = view(x, p0, e1, e2, u, q, w);
     let (y, d) = (v.volume.abs(), v.denominator);
-    let half = y.atan2(d);
     let moved = (d.abs() * v.volume_error + y * v.denominator_error) / (y * y + d * d);
-    let half_turns = half / std::f64::consts::TAU;
     let turns_error = moved / std::f64::consts::TAU + atan2_turns_error(y, d, u, q);
-    turns_error / half_turns + u + 0.5 * f32::EPSILON as f64
+    let omega = 2.0 * y.atan2(d);
+    2.0 * std::f64::consts::TAU * turns_error + (u + 0.5 * f32::EPSILON as f64) * omega
 }
 
 /// The exact inputs of the sampler (`SphericalTriangle::sample_real`) for the triangle
@@ -422,6 +434,21 @@ pub fn solid_angle_apart(x: [f32; 3], p0: [f32; 3], e1: [f32; 3], e2: [f32; 3]) 
         .iter()
         .map(|&r| solid_angle_error(x, p0, e1, e2, r))
         .sum()
+}
+
+/// How far apart two computations of the solid angle may be, in steradians: the
+/// [`solid_angle_error_absolute`]s of an IEEE one and of one in `other` (IEEE for lavapipe's
+/// class, Vulkan for any device's).
+pub fn solid_angle_apart_absolute(
+    x: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
+    other: (f64, f64, f64),
+) -> f64 {
+    use crate::device_class::IEEE_ROUNDOFF;
+    solid_angle_error_absolute(x, p0, e1, e2, IEEE_ROUNDOFF)
+        + solid_angle_error_absolute(x, p0, e1, e2, other)
 }
 
 /// How far apart one IEEE and one Vulkan computation of a triangle light's spherical sample

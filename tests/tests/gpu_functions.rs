@@ -623,8 +623,10 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
 fn triangle_light_ieee_class(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> f32 {
     let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
     let v = |i: usize| glam::Vec3::new(f(i, 0), f(i, 1), f(i, 2));
-    let to_x = v(0) - v(1);
-    let h = to_x.dot(v(2).cross(v(3)).normalize()).abs() / to_x.length();
+    let h = triangle_light_elevation(r);
+    if h == 0.0 {
+        return triangle_light_in_plane(b, r, k, j, twinpath_tests::device_class::IEEE_ROUNDOFF);
+    }
     if j == 3 {
         b.abs * value / h
     } else if k == 0 {
@@ -634,6 +636,52 @@ fn triangle_light_ieee_class(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, v
         b.abs
     } else {
         2.0
+    }
+}
+
+/// h, the sine of a triangle light record's receiver's elevation above the light's plane
+/// (computed in `f32`: 0 where the receiver was placed in the plane).
+fn triangle_light_elevation(r: &[[u32; 4]; 4]) -> f32 {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
+    let v = |i: usize| glam::Vec3::new(f(i, 0), f(i, 1), f(i, 2));
+    let to_x = v(0) - v(1);
+    to_x.dot(v(2).cross(v(3)).normalize()).abs() / to_x.length()
+}
+
+/// A triangle light record's allowance where the receiver lies in the light's plane (h = 0),
+/// for an IEEE computation and one in the arithmetic `other` (its (u, q, w)): there the
+/// light's small-triangle estimate is 0 in exact arithmetic and certainly below its threshold
+/// in both (`estimate_decision`, else any value), so both sample by area, whose points do not
+/// depend on h (b.abs of the geometry's size, as `triangle_point`'s); the density is 0 on both,
+/// the height above the plane at the point being rounding far inside `within_plane_rounding`'s
+/// fourfold bound; the solid angle is all rounding of the triple product, apart by the two
+/// computations' absolute errors (`solid_angle_apart_absolute`); a two-sided light's normal may
+/// face either way.
+fn triangle_light_in_plane(
+    b: &Bound,
+    r: &[[u32; 4]; 4],
+    k: usize,
+    j: usize,
+    other: (f64, f64, f64),
+) -> f32 {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
+    let v = |i: usize| glam::Vec3::new(f(i, 0), f(i, 1), f(i, 2));
+    let (x, p0, e1, e2) = (v(0), v(1), v(2), v(3));
+    match (k, j) {
+        (1, 3) => {
+            let a = |v: glam::Vec3| v.to_array();
+            twinpath_tests::spherical_triangle_error::solid_angle_apart_absolute(
+                a(x),
+                a(p0),
+                a(e1),
+                a(e2),
+                other,
+            ) as f32
+        }
+        (1, _) => 2.0,
+        _ if estimate_decision(x, p0, e1, e2) != Some(false) => f32::INFINITY,
+        (0, 3) => 0.0,
+        _ => b.abs * (x.length() + p0.length() + e1.length() + e2.length()),
     }
 }
 
@@ -652,6 +700,9 @@ fn triangle_light_apart(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value:
     let v = |i: usize| glam::Vec3::new(f(i, 0), f(i, 1), f(i, 2));
     let (x, p0, e1, e2) = (v(0), v(1), v(2), v(3));
     let a = |v: glam::Vec3| v.to_array();
+    if triangle_light_elevation(r) == 0.0 {
+        return triangle_light_in_plane(b, r, k, j, twinpath_tests::device_class::VULKAN_ROUNDOFF);
+    }
     if k == 1 && j == 3 {
         let relative = solid_angle_apart(a(x), a(p0), a(e1), a(e2));
         return ieee_class + (value as f64 * relative) as f32;
@@ -705,11 +756,11 @@ fn estimate_decision(
     let to_x = x - c;
     let d = to_x.length();
     let n = e1.cross(e2);
-    let h = n.normalize().dot(to_x).abs() / d;
     let estimate = 0.5 * n.dot(to_x).abs() / (d * d * d);
     let threshold = kernel::light::triangle::SPHERICAL_SAMPLING_MIN_ESTIMATE as f64;
-    let relative = 2.0 * 16.0 * f32::EPSILON as f64 * (1.0 + (x.length() + c.length()) / d) / h;
-    if (estimate - threshold).abs() <= estimate * relative {
+    // The relative error over h times the estimate, 0.5 |n| h / d^2: finite in the plane.
+    let relative_times_h = 2.0 * 16.0 * f32::EPSILON as f64 * (1.0 + (x.length() + c.length()) / d);
+    if (estimate - threshold).abs() <= 0.5 * n.length() / (d * d) * relative_times_h {
         None
     } else {
         Some(estimate >= threshold)

@@ -70,6 +70,57 @@ fn solid_angles_are_within_their_error_under_every_arithmetic() {
     );
 }
 
+/// Receivers exactly in the plane of a triangle (one whose vertices share a coordinate, which
+/// the receiver shares too: the triple product is all rounding, the solid angle 0 outside the
+/// triangle and 2 pi inside it): under IEEE arithmetic and every Vulkan model the kernel's
+/// solid angle stays within its absolute error of the exact one (`solid_angle_error_absolute`),
+/// which `gpu_functions.rs` holds such records to; and rounding does move it there, so the
+/// bound is not vacuous.
+#[test]
+fn solid_angles_in_the_plane_are_within_their_absolute_error_under_every_arithmetic() {
+    use twinpath_tests::spherical_triangle_error::solid_angle_error_absolute;
+    let mut g = SplitMix(59);
+    twinpath_tests::vulkan_arithmetic::seed(59);
+    let (mut worst, mut nonzero) = ([0f64; 4], [0usize; 4]);
+    for k in 0..cases() {
+        let scale = 10f32.powf(4.0 * g.unit() - 2.0);
+        let level = (g.unit() - 0.5) * 4.0 * scale;
+        let axis = k % 3;
+        let spread = 10f32.powf(3.0 * g.unit() - 1.0);
+        let mut point = |spread: f32| {
+            let mut c = [0f32; 3];
+            for (i, c) in c.iter_mut().enumerate() {
+                *c = if i == axis {
+                    level
+                } else {
+                    (g.unit() - 0.5) * 2.0 * spread * scale
+                };
+            }
+            Vec3::from_array(c)
+        };
+        let p = [point(1.0), point(1.0), point(1.0)];
+        let x = point(spread);
+        let (p0, e1, e2) = (p[0], p[1] - p[0], p[2] - p[0]);
+        let arrays = (x.to_array(), p0.to_array(), e1.to_array(), e2.to_array());
+        // 0 outside the triangle, 2 pi inside it (atan2(0, D) of a negative D).
+        let exact = solid_angle_exact(arrays.0, arrays.1, arrays.2, arrays.3);
+        for model in 0..4 {
+            let roundoff = use_model(model);
+            let got = SphericalTriangle::view(v(x), v(p0), v(e1), v(e2))
+                .solid_angle_real()
+                .value as f64;
+            let bound =
+                solid_angle_error_absolute(arrays.0, arrays.1, arrays.2, arrays.3, roundoff);
+            worst[model] = worst[model].max((got - exact).abs() / bound);
+            nonzero[model] += (got != exact) as usize;
+        }
+    }
+    set_model(Model::VULKAN);
+    println!("solid angles in the plane, of their absolute error (IEEE, Vulkan, worst up, worst down): {worst:.3?}; nonzero in {nonzero:?} of {} cases", cases());
+    assert!(worst.iter().all(|&w| w <= 1.0), "{worst:?}");
+    assert!(nonzero.iter().all(|&n| n > 0), "{nonzero:?}");
+}
+
 /// Samples per case of the chi-square test below (`Vk32` draws a coin per operation).
 const SAMPLES: usize = 200_000;
 
