@@ -8,7 +8,8 @@ use kernel::light::choose_light;
 use kernel::scene::{light_selection, Light};
 use twinpath::render::Backend;
 use twinpath::scene::light_table::{
-    alias_table, assign_light_selection, light_power, sphere_light,
+    alias_table, assign_light_selection, directional_light, light_power, punctual_light,
+    sphere_light, triangle_light,
 };
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
@@ -116,6 +117,49 @@ fn power_selection_is_proportional_to_power_and_uniform_is_uniform() {
     assert!((powers[0] / powers[1] - 100.0).abs() < 1e-4);
     assign_light_selection(&mut lights, light_selection::UNIFORM);
     assert!(lights.iter().all(|l| l.select_pmf == 1.0 / 3.0));
+}
+
+/// Power selection weighs every kind of light on one scale: a sphere light (pi L 4 pi r^2), a
+/// point light (4 pi I), a two-sided triangle (pi L 2 A) and a directional light over the
+/// scene's disc (E pi R^2) of the same power are chosen equally often. (Area lights were
+/// weighed without their pi until 2026-12-04, so a point light beside an emitter took pi times
+/// its share.)
+#[test]
+fn power_selection_weighs_every_kind_of_light_alike() {
+    use std::f32::consts::PI;
+    // Power 2 pi^2 each: a sphere of radius 1/2 and radiance 2, a point light of intensity
+    // pi / 2, a two-sided right triangle of legs pi and 1 (area pi / 2) and radiance 2, and a
+    // directional light of irradiance 2 pi over the unit disc its placeholder bounds give.
+    let tri = kernel::scene::Triangle {
+        p0: [0.0; 3],
+        material: 0,
+        edge1: [PI, 0.0, 0.0],
+        light: 0,
+        edge2: [0.0, 1.0, 0.0],
+        shading: kernel::scene::NONE,
+    };
+    let mut lights = vec![
+        sphere_light(Vec3::ZERO, 0.5, [2.0; 3]),
+        punctual_light(Vec3::ZERO, [PI / 2.0; 3], None),
+        triangle_light(&tri, [2.0; 3], true),
+        directional_light(-Vec3::Y, [2.0 * PI; 3]),
+    ];
+    assign_light_selection(&mut lights, light_selection::POWER);
+    let want = 2.0 * (PI as f64).powi(2);
+    for l in &lights {
+        assert!(
+            (light_power(l) / want - 1.0).abs() < 1e-6,
+            "kind {}: power {} against {want}",
+            l.kind,
+            light_power(l)
+        );
+        assert!(
+            (l.select_pmf - 0.25).abs() < 1e-6,
+            "kind {}: pmf {}",
+            l.kind,
+            l.select_pmf
+        );
+    }
 }
 
 /// Three lamps whose powers differ by up to 10^3 (power selection picks the dim one with

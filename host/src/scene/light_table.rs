@@ -145,9 +145,11 @@ pub fn triangle_light(tri: &Triangle, radiance: [f32; 3], two_sided: bool) -> Li
     }
 }
 
-/// Emitted power of a light up to a constant: luminance of its radiance times its emitting
-/// area (power = pi x area x radiance for a uniform Lambertian emitter; a two-sided triangle
-/// emits from twice its area).
+/// Emitted power of a light (luminance-weighted watts), one scale for every kind, since power
+/// selection compares them: pi x area x radiance for a uniform Lambertian emitter (a sphere, a
+/// triangle; a two-sided triangle emits from twice its area), intensity x the solid angle its
+/// falloff lets through for a point or spot light, irradiance x the disc the scene presents for
+/// a directional one.
 pub fn light_power(l: &Light) -> f64 {
     let [r, g, b] = l.radiance.map(f64::from);
     let luminance = 0.2126 * r + 0.7152 * g + 0.0722 * b;
@@ -170,7 +172,7 @@ pub fn light_power(l: &Light) -> f64 {
     } else {
         4.0 * std::f64::consts::PI * (l.radius as f64).powi(2)
     };
-    luminance.max(0.0) * area
+    luminance.max(0.0) * std::f64::consts::PI * area
 }
 
 /// Fills `select_pmf`, `alias_threshold` and `alias` of every light for `mode` (one of
