@@ -22,11 +22,14 @@ less that set-up), relMSE and RMSE against the reference with the definitions of
 `twinpath diff`: relMSE = mean over pixels and channels of (a - b)^2 / (b^2 + 0.01).
 
 Usage: peer_cycles.py REFERENCE.exr OUT.csv [--max-spp 1024] [--max-seconds 60]
-       [--pattern AUTOMATIC] [--scene cornell|materials] [--mesh KNOT.ply] [--once SPP]
-       [--validate SPP]
+       [--pattern AUTOMATIC] [--scene cornell|materials|textured] [--mesh KNOT.ply]
+       [--once SPP] [--validate SPP] [--export-gltf PATH [--size W H]]
 --scene materials: scenes/cornell_materials.toml, the left sphere rough gold (GGX alpha 0.2,
 Au's RGB eta and k, Cycles' Metallic BSDF as a physical conductor) and the right smooth glass
 of index 1.5 (Glass BSDF, roughness 0).
+--scene textured: scripts/textured_room.py's Blender scene, whose glTF export twinpath renders;
+with --export-gltf PATH (and --size W H, default 256 256) it only writes that file (REFERENCE
+and OUT are then not read or written).
 --pattern picks Cycles' sampling pattern (its name is added to the variant column unless
 AUTOMATIC, the default). --mesh replaces the two spheres by a PLY mesh in white, flat-shaded
 (scripts/knot_scenes.py's and scripts/bunny_scene.py's scenes). --once SPP renders once (seed
@@ -49,6 +52,7 @@ import bpy
 import numpy as np
 
 import cycles_fixtures
+import textured_room
 from cornell_scene import (BLUE, EYE, GOLD_ALPHA, GOLD_ETA, GOLD_K, GREEN, LIGHT_CENTER,
                            LIGHT_RADIANCE, LIGHT_RADIUS, LOOK_AT, RED, SPHERES, UP, VFOV, WALLS,
                            WHITE)
@@ -310,14 +314,24 @@ def main():
     ap.add_argument("--max-seconds", type=float, default=60.0)
     ap.add_argument("--pattern", default="AUTOMATIC")
     ap.add_argument("--mesh", help="a PLY mesh in place of the spheres")
-    ap.add_argument("--scene", default="cornell", choices=["cornell", "materials"])
+    ap.add_argument("--scene", default="cornell", choices=["cornell", "materials", "textured"])
+    ap.add_argument("--size", type=int, nargs=2, default=(256, 256), metavar=("W", "H"))
+    ap.add_argument("--export-gltf", metavar="PATH")
     ap.add_argument("--once", type=int, metavar="SPP")
     ap.add_argument("--validate", type=int, metavar="SPP")
     args = ap.parse_args(argv)
 
+    if args.export_gltf:
+        # The textured scene as a glTF file (the reference is rendered from it afterwards).
+        textured_room.build(settings(*args.size))
+        textured_room.export(args.export_gltf)
+        return
     ref = read_exr(args.reference)
     height, width = ref.shape[:2]
-    scene = build(width, height, args.mesh, args.scene == "materials")
+    if args.scene == "textured":
+        scene = textured_room.build(settings(width, height))
+    else:
+        scene = build(width, height, args.mesh, args.scene == "materials")
     scene.cycles.sampling_pattern = args.pattern
     if args.validate:
         validate(scene, args.validate, ref, args.out)

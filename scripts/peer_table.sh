@@ -6,9 +6,11 @@
 # one run. Scenes: `cornell` (scenes/cornell.toml) and `materials` (scenes/cornell_materials.toml)
 # against their Mitsuba references in tests/reference/, the Cornell room with a torus knot of N
 # triangles (scripts/knot_scenes.py) or the Stanford bunny Loop-subdivided L times (`bunnyL`, 3:
-# 235k triangles; scripts/bunny_scene.py, npm) against twinpath's own reference.
-#   scripts/peer_table.sh OUTDIR [cornell | materials | N | bunnyL ...]
-#   (default: cornell materials 10000 100000 1000000 bunny3)
+# 235k triangles; scripts/bunny_scene.py, npm) against twinpath's own reference, and `textured`,
+# a textured scene built in Blender and exported by its glTF exporter (scripts/textured_room.py;
+# twinpath and Cycles only: Mitsuba reads no glTF), against twinpath's own reference.
+#   scripts/peer_table.sh OUTDIR [cornell | materials | textured | N | bunnyL ...]
+#   (default: cornell materials 10000 100000 1000000 bunny3 textured)
 # Per scene: the reference if it has none (`twinpath reference`, $REFERENCE_SPP spp, default
 # 4096, CPU); Cycles' validation (two halves of $VALIDATE_SPP spp, default 64, against the
 # reference: channel means and block z-scores; scripts/peer_cycles.py); `twinpath bench`,
@@ -20,10 +22,12 @@
 # repository root on an otherwise idle machine; about 40 minutes for the default scenes. The
 # binary is $TWINPATH, default target/release/twinpath (`cargo build --release -p twinpath`).
 set -euo pipefail
+# A scene without Mitsuba's CSVs (textured) lists none.
+shopt -s nullglob
 out=${1:?usage: scripts/peer_table.sh OUTDIR [cornell | materials | N | bunnyL ...]}
 shift
 scenes=("$@")
-[ ${#scenes[@]} -gt 0 ] || scenes=(cornell materials 10000 100000 1000000 bunny3)
+[ ${#scenes[@]} -gt 0 ] || scenes=(cornell materials 10000 100000 1000000 bunny3 textured)
 bin=${TWINPATH:-target/release/twinpath}
 ref_spp=${REFERENCE_SPP:-4096}
 max_spp=${MAX_SPP:-256}
@@ -64,6 +68,21 @@ for key in "${scenes[@]}"; do
             scene=scenes/cornell_materials.toml
             ref=tests/reference/cornell_materials/mitsuba_ref.exr
             peer=(--scene materials) ;;
+        textured)
+            # Built in Blender and exported by its glTF exporter (scripts/textured_room.py):
+            # twinpath renders the file, Cycles the scene it came from; Mitsuba has no glTF
+            # loader and sits this one out.
+            peer=(--scene textured)
+            bash scripts/peer_cycles.sh - "${peer[@]}" --export-gltf "$dir/scene.glb" \
+                --size 256 256 > /dev/null
+            scene=$dir/textured.toml
+            printf '[camera]\ngltf = "camera"\nwidth = 256\nheight = 256\n[[gltf]]\nfile = "scene.glb"\n' \
+                > "$scene"
+            ref=$dir/reference.exr
+            [ -f "$ref" ] || "$bin" reference "$scene" --backend cpu --spp "$ref_spp" -o "$ref" 2>&1 \
+                | tail -1
+            triangles=$("$bin" render "$scene" --backend cpu --spp 1 -o "$dir/count.exr" 2>&1 \
+                | sed -n 's/.* \([0-9]*\) triangles.*/\1/p' | head -1) ;;
         bunny*)
             name=$(python3 scripts/bunny_scene.py "$dir" "${key#bunny}")
             scene=$dir/$name.toml ;;
@@ -71,7 +90,7 @@ for key in "${scenes[@]}"; do
             python3 scripts/knot_scenes.py "$dir" "$key" > /dev/null
             scene=$dir/knot_$key.toml ;;
     esac
-    if [ "$key" != cornell ] && [ "$key" != materials ]; then
+    if [ "$key" != cornell ] && [ "$key" != materials ] && [ "$key" != textured ]; then
         ply=${scene%.toml}.ply
         peer=(--mesh "$ply")
         triangles=$(sed -n 's/.*element face \([0-9]*\).*/\1/p' \
@@ -88,7 +107,9 @@ for key in "${scenes[@]}"; do
     } | tee -a "$out/details.txt"
     "$bin" bench "$scene" --reference "$ref" --backend cpu --max-spp "$max_spp" \
         --variant "twinpath:sampler=sobol" --out-dir "$dir/bench" 2>&1 | tail -1
-    for sampler in "${mitsuba_samplers[@]}"; do
+    samplers=("${mitsuba_samplers[@]}")
+    [ "$key" != textured ] || samplers=()
+    for sampler in "${samplers[@]}"; do
         TWINPATH_PEER_REFERENCE=$ref bash scripts/peer_mitsuba.sh "$dir/mitsuba_$sampler.csv" \
             --max-spp "$max_spp" --sampler "$sampler" "${peer[@]}" > /dev/null 2>&1
     done
@@ -103,7 +124,7 @@ for key in "${scenes[@]}"; do
         # reads 12% low at 256 of 4096 spp).
         whole "$dir" twinpath "$whole_spp" "$bin" render "$scene" --backend cpu --seed 2 \
             --spp "$whole_spp" --quiet -o "$dir/whole.exr"
-        for sampler in "${mitsuba_samplers[@]}"; do
+        for sampler in "${samplers[@]}"; do
             whole "$dir" "mitsuba-$sampler" "$whole_spp" env TWINPATH_PEER_REFERENCE="$ref" \
                 bash scripts/peer_mitsuba.sh "$dir/whole.exr" --once "$whole_spp" \
                 --sampler "$sampler" "${peer[@]}"
