@@ -167,21 +167,27 @@ def scene_emission():
     return scene
 
 
-def checker_image(path):
-    """An 8 x 8 image of saturated colours (bytes 0 and 255: sRGB-decoded exactly to 0 and 1 in
-    both renderers), neighbours all different, written as PNG and loaded back."""
-    palette = [(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 1), (1, 1, 0), (0, 1, 1), (1, 0, 1), (0, 0, 0)]
-    image = bpy.data.images.new("checker", 8, 8, alpha=False)
+def png_image(name, size, colour, path):
+    """A `size` x `size` RGB image whose texel (i, j) is `colour(i, j)`, written as PNG to
+    `path` and loaded back (as an exported file reads it)."""
+    image = bpy.data.images.new(name, size, size, alpha=False)
     pixels = []
-    for j in range(8):
-        for i in range(8):
-            pixels += [*palette[(3 * i + 5 * j) % 8], 1.0]
+    for j in range(size):
+        for i in range(size):
+            pixels += [*colour(i, j), 1.0]
     image.pixels = pixels
     image.filepath_raw = path
     image.file_format = "PNG"
     image.save()
     bpy.data.images.remove(image)
     return bpy.data.images.load(path)
+
+
+def checker_image(path):
+    """An 8 x 8 image of saturated colours (bytes 0 and 255: sRGB-decoded exactly to 0 and 1 in
+    both renderers), neighbours all different, written as PNG and loaded back."""
+    palette = [(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 1), (1, 1, 0), (0, 1, 1), (1, 0, 1), (0, 0, 0)]
+    return png_image("checker", 8, lambda i, j: palette[(3 * i + 5 * j) % 8], path)
 
 
 def scene_mapping():

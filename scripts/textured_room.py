@@ -20,7 +20,7 @@ import os
 
 import bpy
 
-from cycles_fixtures import camera, checker_image, light, principled
+from cycles_fixtures import camera, checker_image, light, png_image, principled
 
 # Saturated colours only (see above).
 PALETTE = [(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 1), (1, 1, 0), (0, 1, 1), (1, 0, 1)]
@@ -30,17 +30,7 @@ def stripes_image(path, size=16):
     """A `size` x `size` image of diagonal stripes three texels wide in four palette colours,
     written as PNG and loaded back."""
     colours = [PALETTE[3], PALETTE[0], PALETTE[3], PALETTE[2]]
-    image = bpy.data.images.new("stripes", size, size, alpha=False)
-    pixels = []
-    for j in range(size):
-        for i in range(size):
-            pixels += [*colours[((i + j) // 3) % 4], 1.0]
-    image.pixels = pixels
-    image.filepath_raw = path
-    image.file_format = "PNG"
-    image.save()
-    bpy.data.images.remove(image)
-    return bpy.data.images.load(path)
+    return png_image("stripes", size, lambda i, j: colours[((i + j) // 3) % 4], path)
 
 
 def textured(name, image):
