@@ -39,18 +39,26 @@ fn effective<R: real::Real>(g: R) -> R {
 }
 
 /// The phase function of asymmetry `g` at `cos_theta` (the cosine of the scattering angle),
-/// per steradian.
+/// per steradian. Over any [`real::Real`] (the tests bound its error under a Vulkan device's
+/// arithmetic by running it on intervals).
 #[inline]
-pub fn of_angle(g: f32, cos_theta: f32) -> f32 {
+pub fn of_angle<R: real::Real>(g: R, cos_theta: R) -> R {
+    let one = R::splat(1.0);
     let g = effective(g);
-    let denom = 1.0 + g * g - 2.0 * g * cos_theta;
-    (1.0 - g * g) / (4.0 * PI * denom * denom.max(0.0).sqrt())
+    let denom = one + g * g - R::splat(2.0) * g * cos_theta;
+    (one - g * g) / (R::splat(4.0 * PI) * denom * denom.max(R::splat(0.0)).sqrt())
 }
 
 /// The phase function for light arriving from `wi` and leaving toward `wo` (unit, both
 /// pointing away from the scattering point); also the density of [`sample`]'s direction.
 #[inline]
 pub fn eval(g: f32, wo: Vec3, wi: Vec3) -> f32 {
+    eval_v3(g, V3::from(wo), V3::from(wi))
+}
+
+/// [`eval`] over any [`real::Real`].
+#[inline]
+pub fn eval_v3<R: real::Real>(g: R, wo: V3<R>, wi: V3<R>) -> R {
     of_angle(g, -wi.dot(wo))
 }
 

@@ -358,3 +358,16 @@ pub fn microfacet_apart(
     }
     apart
 }
+
+/// How far apart the CPU's and a conformant device's phase function `kernel::phase::eval_v3`
+/// may be, for asymmetry `g` and unit `wo`, `wi`: the largest distance between it run on
+/// [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic (both ways of the
+/// isotropic test of |g|). Near the peak of a strongly forward phase function 1 + g^2 - 2 g cos
+/// cancels, and the density is its -3/2 power: the balls carry that.
+pub fn phase_density_apart(g: f32, wo: [f32; 3], wi: [f32; 3]) -> f64 {
+    use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
+    use kernel::real::V3;
+    let b = Ball::exact;
+    let v = |x: [f32; 3]| V3::new(b(x[0]), b(x[1]), b(x[2]));
+    ieee_and_vulkan_apart(&|| [kernel::phase::eval_v3(b(g), v(wo), v(wi))])[0]
+}

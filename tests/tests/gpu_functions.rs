@@ -537,6 +537,13 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
                 ((value as f64 * rel) as f32).max(3e-25)
             }
         }
+        // The Vulkan class's phase function (out0.w), per record (`phase_density_apart`).
+        function::MEDIUM if b.vulkan && k == 0 && j == 3 => {
+            let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
+            let apart = twinpath_tests::device_class::phase_density_apart(f(0, 3), v(0), v(1));
+            // Rounded up to an f32 (a millionth: more than an f32's rounding).
+            (apart * (1.0 + 1e-6)) as f32
+        }
         // The phase function's density near its peak: 1 + g^2 - 2 g cos cancels, and the cosine
         // (a dot product, 2 eps absolute) moves it by 4 g eps: relative error 1.5 x 4 g eps /
         // (1 + g^2 - 2 g cos), beside 8 eps of the rest.
@@ -820,7 +827,7 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
         }),
         function::MEDIUM => Some(Bound {
             vulkan: true,
-            why: "Vulkan class: the phase direction's factored sine and mu (quotients within 2.5 ULP, a root), the frame, the azimuth's polynomials and the normalisation, for one IEEE and one Vulkan computation: 92.5 eps per component (`phase_directions_apart`); its density and the flights as derived per record for any device (`allowed_abs`)",
+            why: "Vulkan class: the phase direction's factored sine and mu (quotients within 2.5 ULP, a root), the frame, the azimuth's polynomials and the normalisation, for one IEEE and one Vulkan computation: 92.5 eps per component (`phase_directions_apart`); its density by balls in both arithmetics (`phase_density_apart`) and the flights as derived per record for any device (`allowed_abs`)",
             ..*b
         }),
         function::GEOMETRY_FACTOR => Some(Bound {

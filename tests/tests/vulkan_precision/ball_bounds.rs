@@ -333,3 +333,61 @@ fn microfacet_functions_differ_from_the_cpu_within_their_balls() {
         "the IEEE class's bound holds for devices"
     );
 }
+
+/// The phase function (`kernel::phase::eval_v3`, the density of every phase-sampled direction)
+/// under the models of a device differs from the CPU's by at most
+/// [`phase_density_apart`](twinpath_tests::device_class::phase_density_apart), the balls' bound
+/// for one IEEE and one Vulkan computation; the models leave the IEEE class's (8 + 6 g /
+/// (1 + g^2 - 2 g cos)) eps relative. Inputs: g over (-1, 1) with its ends and the isotropic
+/// range, unit directions, a third of them within 10^-4 of the peak (wi = -wo).
+#[test]
+fn phase_densities_differ_from_the_cpu_within_their_balls() {
+    use glam::Vec3;
+    use kernel::real::V3;
+    use twinpath_tests::device_class::phase_density_apart;
+    let mut g_ = twinpath_tests::placements::Placements(SplitMix(61));
+    seed(61);
+    let (mut worst, mut beyond_ieee_class) = (0f64, 0usize);
+    for k in 0..cases() {
+        let g = match k % 5 {
+            0 => 0.0,
+            1 => 5e-4,
+            2 => 0.99,
+            3 => -0.99,
+            _ => 0.999 * (2.0 * g_.unit() - 1.0),
+        };
+        let wo = g_.dir();
+        let wi = if k % 3 == 0 {
+            (-wo + g_.dir() * 10f32.powf(-4.0 * g_.unit())).normalize()
+        } else {
+            g_.dir()
+        };
+        let density = |model: Option<usize>| {
+            match model {
+                None => set_model(Model::IEEE),
+                Some(k) => any_device(k),
+            }
+            let w = |a: Vec3| V3::new(Vk32::new(a.x), Vk32::new(a.y), Vk32::new(a.z));
+            kernel::phase::eval_v3(Vk32::new(g), w(wo), w(wi)).value
+        };
+        let (cpu, device) = (density(None), density(Some(k)));
+        let apart = phase_density_apart(g, wo.to_array(), wi.to_array());
+        let d = (cpu as f64 - device as f64).abs();
+        assert!(
+            d <= apart,
+            "(g {g}, wo {wo}, wi {wi}): CPU {cpu:e}, device {device:e}, {d:e} apart against {apart:e}"
+        );
+        worst = worst.max(d / apart.max(f64::MIN_POSITIVE));
+        let cos = -(wi.as_dvec3().dot(wo.as_dvec3()));
+        let gg = g as f64;
+        let relative =
+            (8.0 + 6.0 * gg.abs() / (1.0 + gg * gg - 2.0 * gg * cos)) * f32::EPSILON as f64;
+        beyond_ieee_class += (d > relative * cpu.abs().max(device.abs()) as f64) as usize;
+    }
+    set_model(Model::VULKAN);
+    println!("phase densities, a device against the CPU: at most {worst:.3} of the balls' bound; {beyond_ieee_class} beyond the IEEE class's");
+    assert!(
+        beyond_ieee_class > 0,
+        "the IEEE class's bound holds for devices"
+    );
+}
