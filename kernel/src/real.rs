@@ -3,9 +3,13 @@
 //! once and run on an `f32` (the GPU and the one-path loop) or on a SIMD vector of `f32` (the
 //! CPU's packets, one lane per path). Every operation is IEEE-754 arithmetic on each lane alone
 //! (no fused multiply-add, no approximate reciprocal), so a lane's result is exactly the `f32`
-//! one, bit for bit.
+//! one, bit for bit. The operations the kernel writes on the bits (`abs`, `select`, and the
+//! quadrant of `turns::cos_sin_turns`' polynomials, which live here for that reason) are `Real`
+//! methods with those bit operations as defaults, so that a test's interval type, which has no
+//! bits, can provide them otherwise.
 
 use crate::word::Word;
+use core::f32::consts::FRAC_PI_2;
 use core::ops::{Add, Div, Mul, Neg, Sub};
 use spirv_std::glam::Vec3;
 
@@ -65,12 +69,52 @@ pub trait Real:
         Self::from_bits(no ^ ((yes ^ no) & mask))
     }
 
-    /// (cos, sin) of `self` turns: [`crate::turns::cos_sin_turns`]'s polynomials, whose
-    /// quadrant is chosen on the bits.
+    /// (cos, sin) of `self` turns: `crate::turns::cos_sin_turns`' polynomials, whose quadrant
+    /// is chosen on the bits.
     #[inline]
     fn cos_sin_turns(self) -> (Self, Self) {
-        crate::turns::polynomial_cos_sin_turns(self)
+        polynomial_cos_sin_turns(self)
     }
+}
+
+/// `crate::turns::cos_sin_turns`' polynomials and quadrant rotation on the bits (its doc
+/// comment derives them): [`Real::cos_sin_turns`] of every type with bits.
+#[inline]
+fn polynomial_cos_sin_turns<R: Real>(u: R) -> (R, R) {
+    let c = R::splat;
+    let quarters = c(4.0) * u;
+    // floor(quarters + 1/2) by conversions (truncation, less one below zero: the mask is -1
+    // there): `floor` is a libm call on baseline x86-64.
+    let half_up = quarters + c(0.5);
+    let truncated = half_up.to_i32_bits();
+    let nearest = truncated.wrapping_add(R::from_i32_bits(truncated).greater_than(half_up));
+    let q = R::from_i32_bits(nearest);
+    let theta = (quarters - q) * c(FRAC_PI_2);
+    let z = theta * theta;
+    let sin = theta
+        + theta
+            * z
+            * (c(-1.0 / 6.0)
+                + z * (c(1.0 / 120.0) + z * (c(-1.0 / 5040.0) + z * c(1.0 / 362_880.0))));
+    let cos = c(1.0)
+        + z * (c(-0.5)
+            + z * (c(1.0 / 24.0)
+                + z * (c(-1.0 / 720.0) + z * (c(1.0 / 40_320.0) + z * c(-1.0 / 3_628_800.0)))));
+    // Rotate by q quarter turns, (c, s) -> (-s, c) per quarter: odd quadrants swap the two,
+    // quadrants 1 and 2 negate the cosine, 2 and 3 the sine. Done on the bits, without a branch,
+    // because the quadrant of a random azimuth is unpredictable.
+    let bits = R::Bits::splat;
+    let quadrant = nearest & bits(3);
+    let swap = bits(0).wrapping_sub(quadrant & bits(1));
+    let (cos_bits, sin_bits) = (cos.to_bits(), sin.to_bits());
+    // Where `swap` is all ones the two exchange: x ^ ((x ^ y) & swap).
+    let exchanged = (cos_bits ^ sin_bits) & swap;
+    let cos_sign = (quadrant.wrapping_add(bits(1)) & bits(2)) << 30;
+    let sin_sign = (quadrant & bits(2)) << 30;
+    (
+        R::from_bits(cos_bits ^ exchanged ^ cos_sign),
+        R::from_bits(sin_bits ^ exchanged ^ sin_sign),
+    )
 }
 
 /// |x| of each lane ([`Real::abs`]).
