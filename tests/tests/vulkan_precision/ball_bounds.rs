@@ -12,6 +12,15 @@ use twinpath_tests::device_class::fresnel_apart;
 use twinpath_tests::vulkan_arithmetic::{seed, set_model, Model, Vk32};
 use twinpath_tests::SplitMix;
 
+/// Sets the arithmetic of the next computations: the CPU's (IEEE) for `None`, else
+/// [`any_device`]`(k)` for `Some(k)`.
+fn arithmetic(model: Option<usize>) {
+    match model {
+        None => set_model(Model::IEEE),
+        Some(k) => any_device(k),
+    }
+}
+
 /// Every result the models of a device (and IEEE arithmetic) return for sums, products,
 /// quotients, roots and their chains lies in the ball computed for that arithmetic; and the
 /// Vulkan models leave IEEE's balls (so the Vulkan roundoff is needed). Operands span 2^-130
@@ -41,10 +50,7 @@ fn balls_hold_every_result_a_device_may_return() {
             [s, q, r, cancel, (r - cancel) * d]
         }
         for (model, roundoff) in [(None, Roundoff::IEEE), (Some(k), Roundoff::VULKAN)] {
-            match model {
-                None => set_model(Model::IEEE),
-                Some(k) => any_device(k),
-            }
+            arithmetic(model);
             let got = chain(Vk32::new(a), Vk32::new(b), Vk32::new(c), Vk32::new(d));
             let b_ = Ball::exact;
             let balls = computations(roundoff, &|| chain(b_(a), b_(b), b_(c), b_(d)));
@@ -96,10 +102,7 @@ fn fresnel_reflectances_differ_from_the_cpu_within_their_balls() {
         let k_ext = pick(&mut g, &[0.0, 10.0 * u3]);
         let f0 = [g.unit(), g.unit(), g.unit()];
         let reflectances = |model: Option<usize>| {
-            match model {
-                None => set_model(Model::IEEE),
-                Some(k) => any_device(k),
-            }
+            arithmetic(model);
             let x = Vk32::new;
             let (f, cos_t) = fresnel::dielectric(x(cos), x(eta));
             let s = f0.map(|f0| fresnel::schlick_f90_channel(x(f0), x(1.0), x(cos)).value);
@@ -190,10 +193,7 @@ fn mapped_normals_differ_from_the_cpu_within_their_balls() {
         let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
         let (u, v) = (0.5 * g.unit(), 0.5 * g.unit());
         let normal = |model: Option<usize>| {
-            match model {
-                None => set_model(Model::IEEE),
-                Some(k) => any_device(k),
-            }
+            arithmetic(model);
             let x = Vk32::new;
             let w = |a: Vec3| V3::new(x(a.x), x(a.y), x(a.z));
             let m = mapped_normal_v3(
@@ -277,10 +277,7 @@ fn microfacet_functions_differ_from_the_cpu_within_their_balls() {
         let sin2 = (1.0 - cos * cos).max(0.0);
         let (u1, u2) = (g.unit(), g.unit());
         let outputs = |model: Option<usize>| {
-            match model {
-                None => set_model(Model::IEEE),
-                Some(k) => any_device(k),
-            }
+            arithmetic(model);
             let x = Vk32::new;
             let w = |a: Vec3| V3::new(x(a.x), x(a.y), x(a.z));
             let h = sample_visible_normal_v3(w(n), w(wo), x(alpha), x(u1), x(u2));
@@ -363,10 +360,7 @@ fn phase_densities_differ_from_the_cpu_within_their_balls() {
             g_.dir()
         };
         let density = |model: Option<usize>| {
-            match model {
-                None => set_model(Model::IEEE),
-                Some(k) => any_device(k),
-            }
+            arithmetic(model);
             let w = |a: Vec3| V3::new(Vk32::new(a.x), Vk32::new(a.y), Vk32::new(a.z));
             kernel::phase::eval_v3(Vk32::new(g), w(wo), w(wi)).value
         };
