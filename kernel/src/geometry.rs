@@ -212,7 +212,13 @@ pub fn triangle_barycentrics(p0: Vec3, edge1: Vec3, edge2: Vec3, p: Vec3) -> Vec
 /// and p2.
 #[inline]
 pub fn blend3(a: Vec3, b: Vec3, c: Vec3, bary: Vec2) -> Vec3 {
-    a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y
+    blend3_v3(V3::from(a), V3::from(b), V3::from(c), (bary.x, bary.y)).into()
+}
+
+/// [`blend3`] over any [`real::Real`], in the same operations.
+#[inline]
+pub fn blend3_v3<R: real::Real>(a: V3<R>, b: V3<R>, c: V3<R>, (u, v): (R, R)) -> V3<R> {
+    a * (R::splat(1.0) - u - v) + b * u + c * v
 }
 
 /// [`blend3`] of two-component values (texture coordinates).

@@ -19,7 +19,7 @@
 use crate::bsdf;
 use crate::bsdf::multiple_scattering::GlossyAlbedo;
 use crate::features::FeatureSet;
-use crate::geometry::{blend2, blend3};
+use crate::geometry::{blend2, blend3, blend3_v3};
 use crate::hit::SurfaceHit;
 use crate::instance::{normal_to_world, vector_to_world};
 use crate::real::{self, V3};
@@ -47,11 +47,9 @@ pub fn interpolated_normal(tri: &ShadingTriangle, bary: Vec2) -> Vec3 {
 /// that overflows or is not a number).
 #[inline]
 fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
-    let len2 = v.dot(v);
-    if len2 > 0.0 && len2.is_finite() {
-        v / len2.sqrt()
-    } else {
-        fallback
+    match unit_v3(V3::from(v)) {
+        (unit, true) => unit.into(),
+        _ => fallback,
     }
 }
 
@@ -143,7 +141,7 @@ pub fn mapped_normal_v3<R: real::Real<Bits = u32>>(
     scale: R,
 ) -> V3<R> {
     let (one, two) = (R::splat(1.0), R::splat(2.0));
-    let t = tangents[0] * (one - bary.0 - bary.1) + tangents[1] * bary.0 + tangents[2] * bary.1;
+    let t = blend3_v3(tangents[0], tangents[1], tangents[2], bary);
     let (t, has_direction) = unit_v3(t - base * base.dot(t));
     if !has_direction {
         return base;
