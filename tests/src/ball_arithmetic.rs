@@ -20,7 +20,7 @@
 //! function with a branch is bounded along each way it may go ([`computations`] explores them);
 //! a fused multiply-add rounds once where the ball rounds twice, which the ball holds.
 
-use kernel::real::Real;
+use kernel::real::{Real, V3};
 use std::cell::{Cell, RefCell};
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -111,6 +111,11 @@ impl Ball {
             mid,
             radius: f64::INFINITY,
         }
+    }
+
+    /// An input vector: three `f32`s known exactly (each [`Ball::exact`]).
+    pub fn exact_v3(x: [f32; 3]) -> V3<Ball> {
+        V3::new(Ball::exact(x[0]), Ball::exact(x[1]), Ball::exact(x[2]))
     }
 
     /// Whether `x` is in the ball.

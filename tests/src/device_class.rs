@@ -5,8 +5,10 @@
 //! (eps, quotients within 2.5 ULP, roots as 1 / inversesqrt), in the comment of the test that
 //! checks it against the model of such a device (`tests/tests/vulkan_precision.rs`, on
 //! [`crate::vulkan_arithmetic::Vk32`]), and collected in `docs/robustness.md`; or, for the
-//! Fresnel, microfacet and mapped-normal functions, by running the kernel's own code on
+//! Fresnel, microfacet, phase and mapped-normal functions, by running the kernel's own code on
 //! [`crate::ball_arithmetic::Ball`]s in both arithmetics.
+
+use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
 
 /// How far apart the CPU's and a conformant Vulkan device's `orthonormal_basis` may be, per
 /// component, in eps (derived in `tests/tests/vulkan_precision.rs`; used by `gpu_functions.rs`
@@ -266,7 +268,6 @@ pub fn cosine_sample_apart(u1: f32) -> (f64, f64) {
 /// reflection). The balls carry each input's conditioning: the conductor's a^2 + b^2 and a are
 /// roots of differences, the dielectric's cos_t a root that vanishes at the critical angle.
 pub fn fresnel_apart(cos: f32, eta: f32, k: f32, f0: [f32; 3]) -> [f64; 6] {
-    use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
     use kernel::bsdf::fresnel;
     let b = Ball::exact;
     ieee_and_vulkan_apart(&|| {
@@ -299,10 +300,8 @@ pub fn mapped_normal_apart(
     texel: [f32; 3],
     scale: f32,
 ) -> [f64; 3] {
-    use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
-    use kernel::real::V3;
     let b = Ball::exact;
-    let v = |x: [f32; 3]| V3::new(b(x[0]), b(x[1]), b(x[2]));
+    let v = Ball::exact_v3;
     ieee_and_vulkan_apart(&|| {
         let n = kernel::surface::mapped_normal_v3(
             v(base),
@@ -337,11 +336,9 @@ pub fn microfacet_apart(
     (cos, sin2): (f32, f32),
     (u1, u2): (f32, f32),
 ) -> [f64; 6] {
-    use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
     use kernel::bsdf::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal_v3};
-    use kernel::real::V3;
     let b = Ball::exact;
-    let v = |x: [f32; 3]| V3::new(b(x[0]), b(x[1]), b(x[2]));
+    let v = Ball::exact_v3;
     let mut apart = ieee_and_vulkan_apart(&|| {
         let h = sample_visible_normal_v3(v(n), v(wo), b(alpha), b(u1), b(u2));
         [
@@ -365,9 +362,7 @@ pub fn microfacet_apart(
 /// isotropic test of |g|). Near the peak of a strongly forward phase function 1 + g^2 - 2 g cos
 /// cancels, and the density is its -3/2 power: the balls carry that.
 pub fn phase_density_apart(g: f32, wo: [f32; 3], wi: [f32; 3]) -> f64 {
-    use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
-    use kernel::real::V3;
     let b = Ball::exact;
-    let v = |x: [f32; 3]| V3::new(b(x[0]), b(x[1]), b(x[2]));
+    let v = Ball::exact_v3;
     ieee_and_vulkan_apart(&|| [kernel::phase::eval_v3(b(g), v(wo), v(wi))])[0]
 }

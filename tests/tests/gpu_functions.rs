@@ -480,11 +480,7 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
                 (f(1, 3), f(2, 2)),
                 (f(2, 0), f(2, 1)),
             );
-            match 4 * k + j {
-                // Rounded up to an f32 (a millionth: more than an f32's rounding).
-                i @ 0..=5 => (apart[i] * (1.0 + 1e-6)) as f32,
-                _ => 0.0,
-            }
+            output_allowance(&apart, k, j)
         }
         // The Vulkan class's mapped normal, per record (`mapped_normal_apart`).
         function::MAPPED_NORMAL if b.vulkan => {
@@ -497,12 +493,7 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
                 v(2),
                 f(0, 3),
             );
-            // Rounded up to an f32 (a millionth: more than an f32's rounding).
-            if j < 3 {
-                (apart[j] * (1.0 + 1e-6)) as f32
-            } else {
-                0.0
-            }
+            output_allowance(&apart, k, j)
         }
         // The mapped normal: Gram-Schmidt leaves t's component across n, whose rounding is
         // eps |t| absolute, so relative to it b.abs |t| / |t - n (n . t)|.
@@ -541,8 +532,7 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
         function::MEDIUM if b.vulkan && k == 0 && j == 3 => {
             let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
             let apart = twinpath_tests::device_class::phase_density_apart(f(0, 3), v(0), v(1));
-            // Rounded up to an f32 (a millionth: more than an f32's rounding).
-            (apart * (1.0 + 1e-6)) as f32
+            rounded_up(apart)
         }
         // The phase function's density near its peak: 1 + g^2 - 2 g cos cancels, and the cosine
         // (a dot product, 2 eps absolute) moves it by 4 g eps: relative error 1.5 x 4 g eps /
@@ -575,11 +565,7 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             let (input, f0) = ([f(0, 0), f(0, 1), f(0, 2)], [f(1, 0), f(1, 1), f(1, 2)]);
             let apart =
                 twinpath_tests::device_class::fresnel_apart(input[0], input[1], input[2], f0);
-            match 4 * k + j {
-                // Rounded up to an f32 (a millionth: more than an f32's rounding).
-                i @ 0..=5 => (apart[i] * (1.0 + 1e-6)) as f32,
-                _ => 0.0,
-            }
+            output_allowance(&apart, k, j)
         }
         // The Vulkan class's cosine sample (out1.xyz) and its density (out1.w), per record
         // (`cosine_sample_apart` of u1 = in3.x); eval_scattering and pdf_brdf keep 8 eps.
@@ -622,6 +608,18 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
         }
         _ => b.abs,
     }
+}
+
+/// A per-output bound of `device_class` as the allowance of output component (k, j): the
+/// outputs numbered through out0 then out1 (4 k + j), those beyond `apart` 0 (both sides write
+/// 0 there).
+fn output_allowance(apart: &[f64], k: usize, j: usize) -> f32 {
+    apart.get(4 * k + j).map_or(0.0, |&a| rounded_up(a))
+}
+
+/// `x` rounded up to an `f32` (by a millionth: more than an `f32`'s rounding).
+fn rounded_up(x: f64) -> f32 {
+    (x * (1.0 + 1e-6)) as f32
 }
 
 /// A triangle light record's allowance on an IEEE device (`allowed_abs`'s comment): b.abs / h
