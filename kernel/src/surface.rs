@@ -101,7 +101,8 @@ fn after_frame(record: u32, material: &Material) -> u32 {
 /// (T, B, N) at the point: N = `base` (unit: the vertex-normal blend, or the geometric normal),
 /// T = the blend of the tangent record `frame`'s vertex tangents made orthogonal to N
 /// (Gram-Schmidt), B = sign x N x T with the record's sign. Unit; `base` itself where the
-/// tangent or the result has no direction (a degenerate frame leaves the point unmapped).
+/// tangent is within [`MIN_TANGENT_SINE`] of N or the result has no direction (a degenerate
+/// frame leaves the point unmapped).
 #[inline]
 pub fn mapped_normal(
     base: Vec3,
@@ -142,7 +143,12 @@ pub fn mapped_normal_v3<R: real::Real<Bits = u32>>(
 ) -> V3<R> {
     let (one, two) = (R::splat(1.0), R::splat(2.0));
     let t = blend3_v3(tangents[0], tangents[1], tangents[2], bary);
-    let (t, has_direction) = unit_v3(t - base * base.dot(t));
+    let across = t - base * base.dot(t);
+    let min_across = R::splat(MIN_TANGENT_SINE * MIN_TANGENT_SINE) * t.dot(t);
+    if across.dot(across).greater_than(min_across) == 0 {
+        return base;
+    }
+    let (t, has_direction) = unit_v3(across);
     if !has_direction {
         return base;
     }
@@ -159,6 +165,15 @@ pub fn mapped_normal_v3<R: real::Real<Bits = u32>>(
         base
     }
 }
+
+/// The least sine between a normal map's tangent and the normal it stands on for the tangent
+/// to give the frame its direction (2^-10, 0.056 degrees); below it the point is left unmapped.
+/// The direction across the normal is t - n (n . t) over |t|, whose rounding is a few eps on
+/// any device: with the test relative to |t| and far above that rounding, the CPU and a
+/// device decide alike (except within rounding of the threshold), and a frame that passes
+/// carries at most a few eps / 2^-10 of rounding in its direction. Testing against zero
+/// instead let a tangent parallel to the normal take either branch on a real GPU.
+const MIN_TANGENT_SINE: f32 = 1.0 / 1024.0;
 
 /// [`unit_or`] over any scalar [`real::Real`]: `v` scaled to unit length and whether it has a
 /// direction (else `v` as it is).

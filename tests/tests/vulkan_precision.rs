@@ -30,6 +30,8 @@ use twinpath_tests::SplitMix;
 
 #[path = "vulkan_precision/ball_bounds.rs"]
 mod ball_bounds;
+#[path = "vulkan_precision/normal_map_frames.rs"]
+mod normal_map_frames;
 #[path = "vulkan_precision/spherical_triangles.rs"]
 mod spherical_triangles;
 
