@@ -5,7 +5,7 @@
 //! (eps, quotients within 2.5 ULP, roots as 1 / inversesqrt), in the comment of the test that
 //! checks it against the model of such a device (`tests/tests/vulkan_precision.rs`, on
 //! [`crate::vulkan_arithmetic::Vk32`]), and collected in `docs/robustness.md`; or, for the
-//! Fresnel, microfacet, phase and mapped-normal functions, by running the kernel's own code on
+//! Fresnel, microfacet, phase and mapped-normal functions and the cone's density, by running the kernel's own code on
 //! [`crate::ball_arithmetic::Ball`]s in both arithmetics.
 
 use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
@@ -69,6 +69,22 @@ pub fn cone_points_apart(center: [f32; 3], radius: f32, p: [f32; 3]) -> (f64, f6
     let normal = apart(|(u, q, w)| cone_normal_error(u, q, w, tan_max));
     let position = normal * r + APART_U * (c.abs().max_element() + 2.0 * r);
     (normal, position)
+}
+
+/// How far apart the CPU's and a conformant device's `sample_sphere_cone` densities may be for
+/// the sphere (`center`, `radius`) seen from `p` (numbers `u1`, `u2`): the kernel's sampler run
+/// on [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic. The density 1 / (2 pi
+/// (1 - cos theta_max)) carries the receiver's conditioning near the sphere: sin^2(theta_max) =
+/// r^2 / d^2 is off by a few eps relative, and cos(theta_max) = sqrt(1 - sin^2) moves by that
+/// over 2 cos, so the density's relative error grows as 1 / (2 cos theta_max) there (to sqrt of
+/// the rounding where the receiver is within rounding of the surface); the balls carry it.
+pub fn cone_density_apart(center: [f32; 3], radius: f32, p: [f32; 3], u1: f32, u2: f32) -> f64 {
+    let b = Ball::exact;
+    let v = Ball::exact_v3;
+    ieee_and_vulkan_apart(&|| {
+        let s = kernel::sampling::sample_sphere_cone_v3(v(center), b(radius), v(p), b(u1), b(u2));
+        [s.pdf_solid_angle]
+    })[0]
 }
 
 /// First-order error of one computation of `kernel::phase::sample_v3`'s unit direction, per
