@@ -3,7 +3,7 @@
 # and no network (docs/gpu.md, "An NVIDIA H200"): builds here, then puts into .gpu/ (ignored
 # by git) what that machine lacks: the Debian packages of the
 # Vulkan loader, libglvnd (NVIDIA's Vulkan driver is libGLX_nvidia.so.0, which needs it) and
-# the validation layers, the stripped twinpath binary and the GPU test binaries, and
+# the validation layers, spirv-val (spirv_module.rs runs it), the stripped twinpath binary and the GPU test binaries (one xz archive), and
 # scripts/torus_scenes.py's generator. Run there: `bash scripts/gpu_machine_check.sh`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,11 +12,17 @@ rm -rf .gpu && mkdir -p .gpu/bin .gpu/debs /tmp/twinpath-apt/partial
 apt_opts=(-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 -oDir::State::Lists=/tmp/twinpath-apt)
 apt-get "${apt_opts[@]}" update -qq
 (cd .gpu/debs && apt-get "${apt_opts[@]}" download libvulkan1 libglvnd0 libglx0 libegl1 libgl1 \
-  libopengl0 libgles2 vulkan-validationlayers)
+  libopengl0 libgles2 vulkan-validationlayers spirv-tools)
 strip -o .gpu/bin/twinpath target/debug/twinpath
 for t in gpu_functions gpu_render spirv_module furnace scene_scale specialize_adaptive \
-  hard_lighting light_selection sobol closed_form_materials opacity texture_sets; do
+  hard_lighting light_selection sobol closed_form_materials opacity texture_sets media media_grids \
+  triangle_lights environment textures normal_maps gltf instances punctual_lights \
+  reflecting_lights vertex_colours shading_normals camera; do
   f=$(cargo test -p twinpath-tests --test "$t" --no-run 2>&1 | sed -n 's/.*Executable .*(\(.*\))/\1/p')
   strip -o ".gpu/bin/$t" "$f"
 done
+# The binaries share most of their code: one xz stream over all of them is 14 MB instead of
+# 225 MB, which keeps .gpu within what a lent machine's working tree may carry (64 MiB).
+tar -C .gpu -cf - bin | xz -9 > .gpu/bin.tar.xz
+rm -rf .gpu/bin
 du -sh .gpu
