@@ -382,3 +382,57 @@ pub fn phase_density_apart(g: f32, wo: [f32; 3], wi: [f32; 3]) -> f64 {
     let v = Ball::exact_v3;
     ieee_and_vulkan_apart(&|| [kernel::phase::eval_v3(b(g), v(wo), v(wi))])[0]
 }
+
+/// How far apart the CPU's and a conformant device's texture footprint and bilinear blend may
+/// be (`kernel::texture::footprint` and `bilerp`, the probe's layout: coordinates `uv`, a
+/// `width` x `height` image, wrap modes, texel values in [0, 1]): per output, (x0, x1, y0, y1,
+/// the blend's three channels, fx), infinite for an axis's indices and fx where the texel
+/// coordinate lies within both computations' rounding of a texel centre boundary (there the
+/// floor may differ, and fx with it by 1: the same blend, by another pair of texels).
+///
+/// Along an axis of n texels: the wrapped coordinate (a difference and a fold) is off by at
+/// most two roundings, 2 u; x = u' n - 1/2 (or (1 - v') n - 1/2) adds n times that, the product's
+/// rounding u n and the difference's u (n + 1/2): x, and fx = x - floor(x) (exact), are off by
+/// u (4 n + 1/2) per computation. The blend is Lipschitz in x and y with constant 2 max|c| (1
+/// here; continuous across texel boundaries, the wrap included), and its roundings (the two
+/// weights 1 - f, four products and two sums per level, two levels) are at most 9 u max|c|. A
+/// fused multiply-add only removes roundings.
+pub fn texture_apart(uv: [f32; 2], width: u32, height: u32, wrap_u: u32, wrap_v: u32) -> [f64; 8] {
+    let axis = |t: f32, n: u32, mode: u32, flipped: bool| {
+        let t = t as f64;
+        let unit = if !t.is_finite() {
+            0.0
+        } else if mode == kernel::texture::wrap::REPEAT {
+            t - t.floor()
+        } else if mode == kernel::texture::wrap::CLAMP {
+            t.clamp(0.0, 1.0)
+        } else {
+            let r = t - 2.0 * (0.5 * t).floor();
+            if r > 1.0 {
+                2.0 - r
+            } else {
+                r
+            }
+        };
+        let n = n as f64;
+        let x = if flipped { 1.0 - unit } else { unit } * n - 0.5;
+        let dx = APART_U * (4.0 * n + 0.5);
+        let f = x - x.floor();
+        let at_boundary = f.min(1.0 - f) <= dx;
+        (dx, at_boundary)
+    };
+    let (dx, x_boundary) = axis(uv[0], width, wrap_u, false);
+    let (dy, y_boundary) = axis(uv[1], height, wrap_v, true);
+    let index = |boundary: bool| if boundary { f64::INFINITY } else { 0.0 };
+    let blend = 9.0 * APART_U + 2.0 * (dx + dy);
+    [
+        index(x_boundary),
+        index(x_boundary),
+        index(y_boundary),
+        index(y_boundary),
+        blend,
+        blend,
+        blend,
+        if x_boundary { f64::INFINITY } else { dx },
+    ]
+}

@@ -482,6 +482,17 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             );
             output_allowance(&apart, k, j)
         }
+        // The Vulkan class's texture footprint and blend, per record (`texture_apart`).
+        function::TEXTURE if b.vulkan => {
+            let apart = twinpath_tests::device_class::texture_apart(
+                [f(0, 0), f(0, 1)],
+                r[0][2],
+                r[0][3],
+                r[1][0],
+                r[1][1],
+            );
+            output_allowance(&apart, k, j)
+        }
         // The Vulkan class's mapped normal, per record (`mapped_normal_apart`).
         function::MAPPED_NORMAL if b.vulkan => {
             let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
@@ -812,6 +823,11 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
             abs: twinpath_tests::device_class::BASIS_APART_EPS * eps,
             vulkan: true,
             why: "Vulkan class: a sum, a quotient within 2.5 ULP and products, rounded either way: 6.5 eps per component on a device, 2.5 on the CPU: 9 eps absolute",
+            ..*b
+        }),
+        function::TEXTURE => Some(Bound {
+            vulkan: true,
+            why: "Vulkan class: the wrapped coordinate (two roundings), x = u n - 1/2 and fx = x - floor(x): u (4 n + 1/2) per computation; the blend Lipschitz in x and y (2 max|c|) with 9 u max|c| of its own roundings; an axis's indices and fx unchecked where x is within that of a texel boundary (the same blend by the next pair), per record (`texture_apart`)",
             ..*b
         }),
         function::SAMPLE_SPHERE_CONE => Some(Bound {
