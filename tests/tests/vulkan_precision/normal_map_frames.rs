@@ -31,14 +31,7 @@ fn tangents_within_rounding_of_the_normal_leave_the_point_unmapped_under_every_a
             } else {
                 any_device(model - 1);
             }
-            let m = mapped_normal_v3(
-                v(n),
-                [v(t); 3],
-                f(sign),
-                (f(u), f(w)),
-                v(texel),
-                f(scale),
-            );
+            let m = mapped_normal_v3(v(n), [v(t); 3], f(sign), (f(u), f(w)), v(texel), f(scale));
             assert_eq!(back(m), n, "model {model}: n {n}, t {t}");
         }
     }
