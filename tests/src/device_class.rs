@@ -9,6 +9,7 @@
 //! [`crate::ball_arithmetic::Ball`]s in both arithmetics.
 
 use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
+use kernel::real::Real;
 
 /// How far apart the CPU's and a conformant Vulkan device's `orthonormal_basis` may be, per
 /// component, in eps (derived in `tests/tests/vulkan_precision.rs`; used by `gpu_functions.rs`
@@ -435,4 +436,63 @@ pub fn texture_apart(uv: [f32; 2], width: u32, height: u32, wrap_u: u32, wrap_v:
         blend,
         if x_boundary { f64::INFINITY } else { dx },
     ]
+}
+
+/// How far apart the CPU's and a conformant device's probe of `kernel::intersect::sphere` may
+/// be for the ray (`origin`, `dir`) and the sphere (`center`, `radius`) within (`t_min`,
+/// `t_max`): (t, the hit re-projected onto the sphere), the kernel's functions run on
+/// [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic, every way their tests
+/// may go. The balls carry the discriminant's conditioning near a tangent; where a root lies
+/// within rounding of a limit (an origin on the sphere) the ways include the other root and a
+/// miss, so the two may rightly be a root apart there.
+pub fn sphere_hit_apart(
+    origin: [f32; 3],
+    dir: [f32; 3],
+    center: [f32; 3],
+    radius: f32,
+    t_min: f32,
+    t_max: f32,
+) -> [f64; 4] {
+    let b = Ball::exact;
+    let v = Ball::exact_v3;
+    ieee_and_vulkan_apart(&|| {
+        let (o, d, c, r) = (v(origin), v(dir), v(center), b(radius));
+        let t = kernel::intersect::sphere(o, d, c, r, b(t_min), b(t_max));
+        if t.at_least(b(0.0)) != 0 {
+            let p = kernel::geometry::reproject_to_sphere_v3(o + d * t, c, r);
+            [t, p.x, p.y, p.z]
+        } else {
+            [t, b(0.0), b(0.0), b(0.0)]
+        }
+    })
+}
+
+/// How far apart the CPU's and a conformant device's probe of `kernel::intersect::triangle`
+/// may be for the ray (`origin`, `dir`) and the triangle (`p0`, `e1`, `e2`) within (0,
+/// `t_max`): (t, u, v, the hit point's error bound, the hit point p0 + u e1 + v e2), the
+/// kernel's functions run on [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan
+/// arithmetic, every way their tests may go (a ray within rounding of an edge or a limit may
+/// hit on one and miss on the other: the miss's outputs are among the ways).
+pub fn triangle_hit_apart(
+    origin: [f32; 3],
+    dir: [f32; 3],
+    p0: [f32; 3],
+    e1: [f32; 3],
+    e2: [f32; 3],
+    t_max: f32,
+) -> [f64; 7] {
+    let b = Ball::exact;
+    let v = Ball::exact_v3;
+    ieee_and_vulkan_apart(&|| {
+        let (o, d, p0, e1, e2) = (v(origin), v(dir), v(p0), v(e1), v(e2));
+        let (t, u, w) = kernel::intersect::triangle(o, d, p0, e1, e2, b(0.0), b(t_max));
+        if t.at_least(b(0.0)) != 0 {
+            let condition = kernel::geometry::triangle_error_condition_v3(e1, e2);
+            let error = kernel::geometry::triangle_point_error_v3(p0, e1, e2, u, w, condition);
+            let p = kernel::geometry::triangle_point_v3(p0, e1, e2, u, w);
+            [t, u, w, error, p.x, p.y, p.z]
+        } else {
+            [t, b(0.0), b(0.0), b(0.0), b(0.0), b(0.0), b(0.0)]
+        }
+    })
 }

@@ -482,6 +482,33 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
             );
             output_allowance(&apart, k, j)
         }
+        // The Vulkan class's intersections, per record (`sphere_hit_apart`,
+        // `triangle_hit_apart`; the probe's layout: `kernel::probe`).
+        function::INTERSECT_SPHERE if b.vulkan => {
+            let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
+            let apart = twinpath_tests::device_class::sphere_hit_apart(
+                v(0),
+                v(1),
+                v(2),
+                f(2, 3),
+                f(3, 0),
+                f(3, 1),
+            );
+            output_allowance(&apart, k, j)
+        }
+        function::INTERSECT_TRIANGLE if b.vulkan => {
+            let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
+            let e2 = [f(1, 3), f(2, 3), f(3, 3)];
+            let apart = twinpath_tests::device_class::triangle_hit_apart(
+                v(0),
+                v(1),
+                v(2),
+                v(3),
+                e2,
+                f(0, 3),
+            );
+            output_allowance(&apart, k, j)
+        }
         // The Vulkan class's texture footprint and blend, per record (`texture_apart`).
         function::TEXTURE if b.vulkan => {
             let apart = twinpath_tests::device_class::texture_apart(
@@ -823,6 +850,18 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
             abs: twinpath_tests::device_class::BASIS_APART_EPS * eps,
             vulkan: true,
             why: "Vulkan class: a sum, a quotient within 2.5 ULP and products, rounded either way: 6.5 eps per component on a device, 2.5 on the CPU: 9 eps absolute",
+            ..*b
+        }),
+        function::INTERSECT_SPHERE => Some(Bound {
+            max_ulps: 0,
+            vulkan: true,
+            why: "Vulkan class: the kernel's sphere test and re-projection run on balls in IEEE and in Vulkan arithmetic, every way their tests may go (near a tangent the discriminant's conditioning; a root within rounding of a limit, as from an origin on the sphere, may be taken or not: the other root is among the ways), per record (`sphere_hit_apart`); hit/miss may flip only within rounding of a tangent or a limit (`hit_may_flip`)",
+            ..*b
+        }),
+        function::INTERSECT_TRIANGLE => Some(Bound {
+            max_ulps: 0,
+            vulkan: true,
+            why: "Vulkan class: Moller-Trumbore, the hit point and its error bound run on balls in IEEE and in Vulkan arithmetic, every way their tests may go, per record (`triangle_hit_apart`); hit/miss may flip only within rounding of an edge or a limit (`hit_may_flip`)",
             ..*b
         }),
         function::TEXTURE => Some(Bound {
