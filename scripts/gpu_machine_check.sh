@@ -28,18 +28,20 @@ timeout 120 $B/gpu_functions --test-threads=1 --nocapture 2>&1 | grep -vE "^test
 echo "== tests"
 for t in spirv_module gpu_render; do echo "-- $t"; timeout ${TT:-120} $B/$t --test-threads=1 2>&1 | grep -vE "^test .* ok$|^$"; done
 echo "-- furnace gpu, 10^8 samples"; TWINPATH_FURNACE_GPU_SPP=24576 timeout 90 $B/furnace gpu --nocapture 2>&1 | tail -15
-# Every other test with a GPU part, whole binaries (their CPU parts too), in three queues run
-# side by side (one Vulkan context each), --test-threads=1 within each because of the two-thread
-# hang; each binary under its own limit and none started after the step's 4 minutes, so that
+# Every other test with a GPU part, whole binaries (their CPU parts too), in four queues run
+# side by side (one Vulkan context each; specialize_adaptive alone in one, it compiles two
+# pipelines per scene), --test-threads=1 within each because of the two-thread
+# hang; each binary under its own limit and none started after the step's 200 s, so that
 # nothing outlives the step; the slowest first (the H200 compiled a pipeline in 2 to 10 s on
 # 2026-12-04). Each log ends with its exit status and time.
 echo "== the other GPU tests"
 mkdir -p /tmp/tl
-end=$(( $(date +%s) + ${QEND:-240} ))
-queue() { for t in "$@"; do s=$(date +%s); [ $s -ge $end ] && { echo "not run: the step's time is up" > /tmp/tl/$t.log; continue; }; timeout ${QT:-100} $B/$t --test-threads=1 > /tmp/tl/$t.log 2>&1; echo "rc $? in $(( $(date +%s) - s )) s" >> /tmp/tl/$t.log; done; }
-queue specialize_adaptive camera reflecting_lights vertex_colours shading_normals texture_sets & 
-queue gltf instances normal_maps textures environment triangle_lights scene_scale &
-queue opacity sobol media closed_form_materials punctual_lights light_selection media_grids hard_lighting &
+end=$(( $(date +%s) + ${QEND:-200} ))
+queue() { for t in "$@"; do s=$(date +%s); [ $s -ge $end ] && { echo "not run: the step's time is up" > /tmp/tl/$t.log; continue; }; timeout ${QT:-150} $B/$t --test-threads=1 > /tmp/tl/$t.log 2>&1; echo "rc $? in $(( $(date +%s) - s )) s" >> /tmp/tl/$t.log; done; }
+QT=235 queue specialize_adaptive &
+queue gltf sobol media_grids normal_maps camera vertex_colours &
+queue instances opacity light_selection textures reflecting_lights &
+queue media punctual_lights closed_form_materials hard_lighting scene_scale triangle_lights environment texture_sets shading_normals &
 wait
 for f in /tmp/tl/*.log; do echo "-- $(basename $f .log)"; grep -vE "^test .* ok$|^$" $f | tail -25; done
 echo "== speed"
