@@ -977,7 +977,7 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
         let mut max_loose = 0f32;
         // The largest difference as a fraction of the bound it is held to, so that a run on a
         // new device says how close it came.
-        let mut max_fraction = 0f32;
+        let (mut max_fraction, mut max_fraction_at) = (0f32, (0, 0));
         for (r, g_out) in input.iter().zip(&gpu) {
             let c_out = evaluate(b.func, r.map(glam::UVec4::from_array)).map(|v| v.to_array());
             let is_t = matches!(
@@ -1010,8 +1010,13 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
                     if allowed == f32::INFINITY {
                         unchecked_records.insert(*r);
                     }
-                    if allowed.is_finite() && allowed > 0.0 && d.is_finite() && u > b.max_ulps {
-                        max_fraction = max_fraction.max(d / allowed);
+                    if allowed.is_finite()
+                        && allowed > 0.0
+                        && d.is_finite()
+                        && u > b.max_ulps
+                        && d / allowed > max_fraction
+                    {
+                        (max_fraction, max_fraction_at) = (d / allowed, (k, j));
                     }
                     if allowed > b.abs && d.is_finite() && j < 3 {
                         max_rel_scale = max_rel_scale.max(d / (allowed / b.abs));
@@ -1043,7 +1048,7 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
         }
         let flip_frac = flips as f64 / N as f64;
         println!(
-            "{:<42} max {:>10} ulp, max abs {:.3e}{}, {:.2} of the bound, hit/miss flips {flips} / {N}, {} records out of bound, {} ill-conditioned beyond it (max relative difference {:.1e}){}; bound: {}",
+            "{:<42} max {:>10} ulp, max abs {:.3e}{}, {:.2} of the bound (out{}.{}), hit/miss flips {flips} / {N}, {} records out of bound, {} ill-conditioned beyond it (max relative difference {:.1e}){}; bound: {}",
             b.name,
             max_ulps,
             max_abs,
@@ -1053,6 +1058,8 @@ fn kernel_functions_agree_between_cpu_and_gpu() {
                 String::new()
             },
             max_fraction,
+            max_fraction_at.0,
+            ["x", "y", "z", "w"][max_fraction_at.1],
             bad_records.len(),
             loose_records.len(),
             max_loose,
