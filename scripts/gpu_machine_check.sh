@@ -20,7 +20,7 @@ rm -rf /tmp/gpubin && mkdir -p /tmp/gpubin && tar -C /tmp/gpubin -xJf .gpu/bin.t
 B=/tmp/gpubin/bin
 mkdir -p target/debug && cp $B/twinpath target/debug/twinpath
 set +x
-echo "== machine"; nvidia-smi -L; nproc; date -u
+echo "== machine"; nvidia-smi -L; nproc; date -u; python3 --version; ldconfig -p | grep -E "libcuda.so|libnvrtc" | head -3  # for a later Mitsuba cuda_ad_rgb peer (issue 36): its wheel is per Python version
 echo "== twinpath info"; timeout 60 $B/twinpath info; j=$(python3 -c "import json;print(json.load(open('$VK_DRIVER_FILES'))['ICD']['library_path'])" 2>/dev/null); echo "icd lib $j"; ldd $(ls /usr/local/nvidia/lib64/$j /usr/local/nvidia/lib/$j $j 2>/dev/null | head -1) 2>&1 | grep -i "not found"; VK_LOADER_DEBUG=error,driver timeout 30 $B/twinpath info 2>&1 | grep -iE "error|fail|driver" | head -20
 if timeout 60 $B/twinpath info | grep -q "gpu backend: unavailable"; then echo "NO VULKAN DEVICE"; exit 3; fi
 echo "== function bounds (issue 35)"
@@ -54,6 +54,16 @@ for s in cornell_fog cornell_smoke coloured_glass gltf_showcase sky_meshes many_
 timeout 30 $B/twinpath render scenes/cornell.toml --backend gpu --spp 1024 -o ${OUT:-/tmp}/cornell_gpu.png 2>&1 | grep -E "backend|rror"
 timeout 30 $B/twinpath render scenes/cornell.toml --backend gpu --spp 1024 --validation -o /tmp/v.exr 2>&1 | tail -5
 for n in 4000 1000000; do sp /tmp/gs/mesh_$n.toml; done
+# A baseline binary (gpu_machine_prepare.sh's BASELINE), on its own scenes, alternating with the
+# current one: the same machine, minutes apart.
+if [ -e $B/twinpath_baseline ]; then
+  echo "== baseline $(cat .gpu/baseline_commit) against the current binary"
+  for s in cornell meshes; do for bin in twinpath_baseline twinpath twinpath_baseline twinpath; do
+    sc=.gpu/baseline_scenes/$s.toml; [ $bin = twinpath ] && sc=scenes/$s.toml
+    echo "-- $bin $s"; timeout 25 $B/$bin render $sc --backend gpu --spp 4096 -o /tmp/x.exr 2>&1 | grep -E "backend|rror"
+  done; done
+  for bin in twinpath_baseline twinpath; do echo "-- $bin torus 4k"; timeout 25 $B/$bin render /tmp/gs/mesh_4000.toml --backend gpu --spp 4096 -o /tmp/x.exr 2>&1 | grep -E "backend|rror"; done
+fi
 # The two-thread hang (docs/gpu.md): sobol's two GPU tests in two threads of one process,
 # with a short limit; a stuck fence says so every minute with the process's context count.
 echo "-- sobol gpu, two threads (the hang)"; timeout 75 $B/sobol gpu both_backends --test-threads=2 2>&1 | grep -vE "^test .* ok$|^$"; echo "rc ${PIPESTATUS[0]} (124: timed out)"

@@ -21,6 +21,18 @@ for t in gpu_functions gpu_render spirv_module furnace scene_scale specialize_ad
   f=$(cargo test -p twinpath-tests --test "$t" --no-run 2>&1 | sed -n 's/.*Executable .*(\(.*\))/\1/p')
   strip -o ".gpu/bin/$t" "$f"
 done
+# With BASELINE=<commit>: that commit's twinpath and scenes as well (built in a worktree), which
+# the check times beside the current binary, so that a change in speed between two runs on a
+# lent machine can be told from the machine's (docs/gpu.md, "The H200 again").
+if [ -n "${BASELINE:-}" ]; then
+  w=/tmp/twinpath-baseline
+  git worktree remove --force "$w" 2>/dev/null || rm -rf "$w"
+  git worktree add --detach "$w" "$BASELINE"
+  (cd "$w" && CARGO_TARGET_DIR="$w/target" cargo build -p twinpath)
+  strip -o .gpu/bin/twinpath_baseline "$w/target/debug/twinpath"
+  cp -r "$w/scenes" .gpu/baseline_scenes
+  git -C "$w" rev-parse HEAD > .gpu/baseline_commit
+fi
 # The binaries share most of their code: one xz stream over all of them is 14 MB instead of
 # 225 MB, which keeps .gpu within what a lent machine's working tree may carry (64 MiB).
 tar -C .gpu -cf - bin | xz -9 > .gpu/bin.tar.xz
