@@ -221,11 +221,14 @@ impl Real for Ball {
             return Ball::unbounded(f64::NAN);
         }
         let lo = (self.mid - self.radius).max(0.0);
-        let mid = self.mid.max(0.0).sqrt();
-        // The root is monotone: every root of the ball lies between those of its ends.
-        let spread = (hi.sqrt() - mid).max(mid - lo.sqrt());
+        // The root is monotone: every root of the ball lies between those of its ends, and the
+        // ball of them is centred between the two (not at the root of the midpoint, whose ball
+        // would reach below 0 where the operand's ball straddles it: a root is never negative,
+        // and a difference with it, as the sphere test's q = -(b - sqrt(disc)), must not
+        // seem able to vanish where it cannot).
+        let (root_lo, root_hi) = (lo.sqrt(), hi.sqrt());
         let w = ROUNDOFF.with(|r| r.get().root);
-        Ball::rounded(mid, spread, w)
+        Ball::rounded(0.5 * (root_lo + root_hi), 0.5 * (root_hi - root_lo), w)
     }
 
     // min, max and clamp are exact and move their result by no more than their operands move.
