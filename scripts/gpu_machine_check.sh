@@ -60,9 +60,9 @@ if [ -e $B/twinpath_baseline ]; then
   echo "== baseline $(cat .gpu/baseline_commit) against the current binary"
   for s in cornell meshes; do for bin in twinpath_baseline twinpath twinpath_baseline twinpath; do
     sc=.gpu/baseline_scenes/$s.toml; [ $bin = twinpath ] && sc=scenes/$s.toml
-    echo "-- $bin $s"; timeout 25 $B/$bin render $sc --backend gpu --spp 4096 -o /tmp/x.exr 2>&1 | grep -E "backend|rror"
+    echo "-- $bin $s"; timeout 25 $B/$bin render $sc --backend gpu --spp ${GPU_SPP:-4096} -o /tmp/x.exr 2>&1 | grep -E "backend|rror"
   done; done
-  for bin in twinpath_baseline twinpath; do echo "-- $bin torus 4k"; timeout 25 $B/$bin render /tmp/gs/mesh_4000.toml --backend gpu --spp 4096 -o /tmp/x.exr 2>&1 | grep -E "backend|rror"; done
+  for bin in twinpath_baseline twinpath; do echo "-- $bin torus 4k"; timeout 25 $B/$bin render /tmp/gs/mesh_4000.toml --backend gpu --spp ${GPU_SPP:-4096} -o /tmp/x.exr 2>&1 | grep -E "backend|rror"; done
 fi
 # The two-thread hang (docs/gpu.md): sobol's two GPU tests in two threads of one process,
 # with a short limit; a stuck fence says so every minute with the process's context count.

@@ -24,10 +24,14 @@ done
 # With BASELINE=<commit>: that commit's twinpath and scenes as well (built in a worktree), which
 # the check times beside the current binary, so that a change in speed between two runs on a
 # lent machine can be told from the machine's (docs/gpu.md, "The H200 again").
+# A worktree already at that commit (BASELINE_DIR) is reused with its build.
 if [ -n "${BASELINE:-}" ]; then
-  w=/tmp/twinpath-baseline
-  git worktree remove --force "$w" 2>/dev/null || rm -rf "$w"
-  git worktree add --detach "$w" "$BASELINE"
+  w=${BASELINE_DIR:-/tmp/twinpath-baseline}
+  if [ "$(git -C "$w" rev-parse HEAD 2>/dev/null)" != "$(git rev-parse "$BASELINE^{commit}")" ]; then
+    git worktree remove --force "$w" 2>/dev/null || rm -rf "$w"
+    git worktree prune
+    git worktree add --detach "$w" "$BASELINE"
+  fi
   (cd "$w" && CARGO_TARGET_DIR="$w/target" cargo build -p twinpath)
   strip -o .gpu/bin/twinpath_baseline "$w/target/debug/twinpath"
   cp -r "$w/scenes" .gpu/baseline_scenes
