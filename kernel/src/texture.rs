@@ -139,7 +139,7 @@ pub fn footprint(uv: Vec2, width: u32, height: u32, wrap_u: u32, wrap_v: u32) ->
 /// 1), or its fractional part (which rounding may leave at 1, handled by [`axis`]); 0 for a
 /// non-finite `t`.
 #[inline]
-fn unit_coordinate(t: f32, mode: u32) -> f32 {
+pub fn unit_coordinate(t: f32, mode: u32) -> f32 {
     if !t.is_finite() {
         return 0.0;
     }

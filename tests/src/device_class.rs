@@ -399,27 +399,15 @@ pub fn phase_density_apart(g: f32, wo: [f32; 3], wi: [f32; 3]) -> f64 {
 /// weights 1 - f, four products and two sums per level, two levels) are at most 9 u max|c|. A
 /// fused multiply-add only removes roundings.
 pub fn texture_apart(uv: [f32; 2], width: u32, height: u32, wrap_u: u32, wrap_v: u32) -> [f64; 8] {
+    // x from the CPU's wrapped coordinate, which is within 2 u of the exact one: a boundary
+    // nearer than both computations' error plus that may be crossed by either.
     let axis = |t: f32, n: u32, mode: u32, flipped: bool| {
-        let t = t as f64;
-        let unit = if !t.is_finite() {
-            0.0
-        } else if mode == kernel::texture::wrap::REPEAT {
-            t - t.floor()
-        } else if mode == kernel::texture::wrap::CLAMP {
-            t.clamp(0.0, 1.0)
-        } else {
-            let r = t - 2.0 * (0.5 * t).floor();
-            if r > 1.0 {
-                2.0 - r
-            } else {
-                r
-            }
-        };
+        let unit = kernel::texture::unit_coordinate(t, mode) as f64;
         let n = n as f64;
         let x = if flipped { 1.0 - unit } else { unit } * n - 0.5;
         let dx = APART_U * (4.0 * n + 0.5);
         let f = x - x.floor();
-        let at_boundary = f.min(1.0 - f) <= dx;
+        let at_boundary = f.min(1.0 - f) <= dx + 2.0 * IEEE_ROUNDOFF.0 * n;
         (dx, at_boundary)
     };
     let (dx, x_boundary) = axis(uv[0], width, wrap_u, false);
