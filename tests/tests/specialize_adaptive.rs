@@ -9,8 +9,9 @@ use twinpath::scene::SceneFile;
 use twinpath::settings::{LightSampling, Mis, Roulette};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches_with_variance, assert_films_identical, plane_exact, plane_under_lamps,
-    render_film, repo_root, variance_of_mean_from, z_critical, Lamp,
+    assert_film_matches_with_variance, assert_films_identical, image_mean_z, plane_exact,
+    plane_under_lamps, render_film, repo_root, variance_of_mean_from, with_independent_samples,
+    z_critical, Lamp,
 };
 
 fn small(mut s: SceneFile) -> SceneFile {
@@ -144,17 +145,41 @@ fn scene_analysis_finds_the_features_present() {
     assert_eq!(generic.features(), 0);
 }
 
-/// Every test scene rendered specialized and generic on `backend` at `spp`: identical films.
+/// Every test scene rendered specialized and generic on `backend` at `spp`: identical films
+/// on the CPU and on a device of the CPU's arithmetic. A Vulkan-class device compiles the two
+/// pipelines separately and may round them differently (a multiply fused in one, not in the
+/// other: `docs/robustness.md`), so there a ray within rounding of an edge may take another
+/// path: equal pixels are reported, and the two image means, from independent seeds, are held
+/// to agree within their noise.
 fn assert_specialized_matches_generic(backend: Backend, spp: u32) {
-    for (name, scene) in scenes() {
+    let list = scenes();
+    let identical = backend == Backend::Cpu || twinpath_tests::gpu::device_is_ieee();
+    for (name, scene) in &list {
         let mut generic = scene.clone();
         generic.settings.specialize = false;
-        let a = render_film(&scene, backend, spp);
+        let a = render_film(scene, backend, spp);
         let b = render_film(&generic, backend, spp);
-        assert_films_identical(&a, &b, name);
+        if identical {
+            assert_films_identical(&a, &b, name);
+            println!(
+                "{backend:?} {name}: features {:#x}: identical to the generic path",
+                scene.features()
+            );
+            continue;
+        }
+        let same = a.sum.iter().zip(&b.sum).filter(|(x, y)| x == y).count();
+        let mut other = with_independent_samples(generic);
+        other.settings.seed = scene.settings.seed.wrapping_add(1000);
+        let b = render_film(&other, backend, spp);
+        let a = render_film(&with_independent_samples(scene.clone()), backend, spp);
+        let z = image_mean_z(&a, &b);
         println!(
-            "{backend:?} {name}: features {:#x}: identical to the generic path",
-            scene.features()
+            "{backend:?} {name}: a Vulkan-class device: {same} of {} pixel sums equal to the generic path's (same seed); image means z = {z:+.2} (independent seeds)",
+            a.sum.len()
+        );
+        assert!(
+            z.abs() < z_critical(1e-3, list.len()),
+            "{name}: specialized and generic image means differ: z = {z:.2}"
         );
     }
 }
