@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Prepares a run of scripts/gpu_machine_check.sh on a borrowed Linux x86-64 machine with a GPU
 # and no network (docs/gpu.md, "An NVIDIA H200"): builds here, then puts into .gpu/ (ignored
-# by git) what that machine lacks: the Debian packages of the
-# Vulkan loader, libglvnd (NVIDIA's Vulkan driver is libGLX_nvidia.so.0, which needs it) and
-# the validation layers, spirv-val (spirv_module.rs runs it), the stripped twinpath binary and the GPU test binaries (one xz archive), and
-# scripts/torus_scenes.py's generator. Run there: `bash scripts/gpu_machine_check.sh`.
+# by git) what that machine lacks: the Debian packages of the Vulkan loader, libglvnd
+# (NVIDIA's Vulkan driver is libGLX_nvidia.so.0, which needs it), the validation layers and
+# spirv-val (spirv_module.rs runs it); the stripped twinpath binary and the GPU test binaries
+# (one xz archive); and scripts/torus_scenes.py's generator. Run there: `bash scripts/gpu_machine_check.sh`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --workspace --all-targets

@@ -5,11 +5,12 @@
 //! (eps, quotients within 2.5 ULP, roots as 1 / inversesqrt), in the comment of the test that
 //! checks it against the model of such a device (`tests/tests/vulkan_precision.rs`, on
 //! [`crate::vulkan_arithmetic::Vk32`]), and collected in `docs/robustness.md`; or, for the
-//! Fresnel, microfacet, phase and mapped-normal functions and the cone's density, by running the kernel's own code on
-//! [`crate::ball_arithmetic::Ball`]s in both arithmetics.
+//! Fresnel, microfacet, phase and mapped-normal functions, the cone's density and the
+//! intersection probes, by running the kernel's own code on [`crate::ball_arithmetic::Ball`]s
+//! in both arithmetics.
 
 use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
-use kernel::real::Real;
+use kernel::real::{Real, V3};
 
 /// How far apart the CPU's and a conformant Vulkan device's `orthonormal_basis` may be, per
 /// component, in eps (derived in `tests/tests/vulkan_precision.rs`; used by `gpu_functions.rs`
@@ -426,13 +427,55 @@ pub fn texture_apart(uv: [f32; 2], width: u32, height: u32, wrap_u: u32, wrap_v:
     ]
 }
 
-/// How far apart the CPU's and a conformant device's probe of `kernel::intersect::sphere` may
-/// be for the ray (`origin`, `dir`) and the sphere (`center`, `radius`) within (`t_min`,
-/// `t_max`): (t, the hit re-projected onto the sphere), the kernel's functions run on
-/// [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic, every way their tests
-/// may go. The balls carry the discriminant's conditioning near a tangent; where a root lies
-/// within rounding of a limit (an origin on the sphere) the ways include the other root and a
-/// miss, so the two may rightly be a root apart there.
+/// What `kernel::probe` computes for a ray against a sphere, over any [`Real`]: (t, the hit
+/// re-projected onto the sphere), the point 0 on a miss (t < 0). On `f32` it is the probe's
+/// result; on balls or on a model of a device, theirs.
+pub fn sphere_probe<R: Real<Bits = u32>>(
+    origin: V3<R>,
+    dir: V3<R>,
+    center: V3<R>,
+    radius: R,
+    t_min: R,
+    t_max: R,
+) -> [R; 4] {
+    let t = kernel::intersect::sphere(origin, dir, center, radius, t_min, t_max);
+    if t.at_least(R::splat(0.0)) != 0 {
+        let p = kernel::geometry::reproject_to_sphere_v3(origin + dir * t, center, radius);
+        [t, p.x, p.y, p.z]
+    } else {
+        [t, R::splat(0.0), R::splat(0.0), R::splat(0.0)]
+    }
+}
+
+/// What `kernel::probe` computes for a ray against a triangle within (0, `t_max`), over any
+/// [`Real`]: (t, u, v, the hit point's error bound, the hit point p0 + u e1 + v e2), all but t
+/// 0 on a miss.
+pub fn triangle_probe<R: Real<Bits = u32>>(
+    origin: V3<R>,
+    dir: V3<R>,
+    p0: V3<R>,
+    e1: V3<R>,
+    e2: V3<R>,
+    t_max: R,
+) -> [R; 7] {
+    let zero = R::splat(0.0);
+    let (t, u, v) = kernel::intersect::triangle(origin, dir, p0, e1, e2, zero, t_max);
+    if t.at_least(zero) != 0 {
+        let condition = kernel::geometry::triangle_error_condition_v3(e1, e2);
+        let error = kernel::geometry::triangle_point_error_v3(p0, e1, e2, u, v, condition);
+        let p = kernel::geometry::triangle_point_v3(p0, e1, e2, u, v);
+        [t, u, v, error, p.x, p.y, p.z]
+    } else {
+        [t, zero, zero, zero, zero, zero, zero]
+    }
+}
+
+/// How far apart the CPU's and a conformant device's [`sphere_probe`] may be for the ray
+/// (`origin`, `dir`) and the sphere (`center`, `radius`) within (`t_min`, `t_max`): the probe
+/// run on [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic, every way its
+/// tests may go. The balls carry the discriminant's conditioning near a tangent; where a root
+/// lies within rounding of a limit (an origin on the sphere) the ways include the other root
+/// and a miss, so the two may rightly be a root apart there.
 pub fn sphere_hit_apart(
     origin: [f32; 3],
     dir: [f32; 3],
@@ -441,26 +484,17 @@ pub fn sphere_hit_apart(
     t_min: f32,
     t_max: f32,
 ) -> [f64; 4] {
-    let b = Ball::exact;
-    let v = Ball::exact_v3;
+    let (b, v) = (Ball::exact, Ball::exact_v3);
     ieee_and_vulkan_apart(&|| {
-        let (o, d, c, r) = (v(origin), v(dir), v(center), b(radius));
-        let t = kernel::intersect::sphere(o, d, c, r, b(t_min), b(t_max));
-        if t.at_least(b(0.0)) != 0 {
-            let p = kernel::geometry::reproject_to_sphere_v3(o + d * t, c, r);
-            [t, p.x, p.y, p.z]
-        } else {
-            [t, b(0.0), b(0.0), b(0.0)]
-        }
+        sphere_probe(v(origin), v(dir), v(center), b(radius), b(t_min), b(t_max))
     })
 }
 
-/// How far apart the CPU's and a conformant device's probe of `kernel::intersect::triangle`
-/// may be for the ray (`origin`, `dir`) and the triangle (`p0`, `e1`, `e2`) within (0,
-/// `t_max`): (t, u, v, the hit point's error bound, the hit point p0 + u e1 + v e2), the
-/// kernel's functions run on [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan
-/// arithmetic, every way their tests may go (a ray within rounding of an edge or a limit may
-/// hit on one and miss on the other: the miss's outputs are among the ways).
+/// How far apart the CPU's and a conformant device's [`triangle_probe`] may be for the ray
+/// (`origin`, `dir`) and the triangle (`p0`, `e1`, `e2`) within (0, `t_max`): the probe run on
+/// [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic, every way its tests may
+/// go (a ray within rounding of an edge or a limit may hit on one and miss on the other: the
+/// miss's outputs are among the ways).
 pub fn triangle_hit_apart(
     origin: [f32; 3],
     dir: [f32; 3],
@@ -469,18 +503,6 @@ pub fn triangle_hit_apart(
     e2: [f32; 3],
     t_max: f32,
 ) -> [f64; 7] {
-    let b = Ball::exact;
-    let v = Ball::exact_v3;
-    ieee_and_vulkan_apart(&|| {
-        let (o, d, p0, e1, e2) = (v(origin), v(dir), v(p0), v(e1), v(e2));
-        let (t, u, w) = kernel::intersect::triangle(o, d, p0, e1, e2, b(0.0), b(t_max));
-        if t.at_least(b(0.0)) != 0 {
-            let condition = kernel::geometry::triangle_error_condition_v3(e1, e2);
-            let error = kernel::geometry::triangle_point_error_v3(p0, e1, e2, u, w, condition);
-            let p = kernel::geometry::triangle_point_v3(p0, e1, e2, u, w);
-            [t, u, w, error, p.x, p.y, p.z]
-        } else {
-            [t, b(0.0), b(0.0), b(0.0), b(0.0), b(0.0), b(0.0)]
-        }
-    })
+    let (b, v) = (Ball::exact, Ball::exact_v3);
+    ieee_and_vulkan_apart(&|| triangle_probe(v(origin), v(dir), v(p0), v(e1), v(e2), b(t_max)))
 }

@@ -249,14 +249,12 @@ pub fn render_output(
     out
 }
 
-/// z of the difference between two images' overall means, each with the variance of its mean
-/// (the sum of the per-pixel variances of the means over n^2): for independent renders.
 /// Asserts two films hold the same samples bit for bit: sample and pilot counts, and every
 /// pixel's sums.
 pub fn assert_films_identical(a: &twinpath::film::Film, b: &twinpath::film::Film, label: &str) {
     assert_eq!(a.count, b.count, "{label}: sample counts differ");
     assert_eq!(a.pilot_count, b.pilot_count, "{label}: pilot counts differ");
-    let same = a.sum.iter().zip(&b.sum).filter(|(x, y)| x == y).count();
+    let same = equal_pixel_sums(a, b);
     assert_eq!(
         same,
         a.sum.len(),
@@ -266,6 +264,13 @@ pub fn assert_films_identical(a: &twinpath::film::Film, b: &twinpath::film::Film
     );
 }
 
+/// How many of two films' pixel sums (per channel) are equal, bit for bit.
+pub fn equal_pixel_sums(a: &twinpath::film::Film, b: &twinpath::film::Film) -> usize {
+    a.sum.iter().zip(&b.sum).filter(|(x, y)| x == y).count()
+}
+
+/// z of the difference between two images' overall means, each with the variance of its mean
+/// (the sum of the per-pixel variances of the means over n^2): for independent renders.
 pub fn image_mean_z(a: &twinpath::film::Film, b: &twinpath::film::Film) -> f64 {
     let stats = |f: &twinpath::film::Film| {
         let n = (3 * f.count.len()) as f64;

@@ -9,9 +9,9 @@ use twinpath::scene::SceneFile;
 use twinpath::settings::{LightSampling, Mis, Roulette};
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
-    assert_film_matches_with_variance, assert_films_identical, image_mean_z, plane_exact,
-    plane_under_lamps, render_film, repo_root, variance_of_mean_from, with_independent_samples,
-    z_critical, Lamp,
+    assert_film_matches_with_variance, assert_films_identical, equal_pixel_sums, image_mean_z,
+    plane_exact, plane_under_lamps, render_film, repo_root, variance_of_mean_from,
+    with_independent_samples, z_critical, Lamp,
 };
 
 fn small(mut s: SceneFile) -> SceneFile {
@@ -167,7 +167,7 @@ fn assert_specialized_matches_generic(backend: Backend, spp: u32) {
             );
             continue;
         }
-        let same = a.sum.iter().zip(&b.sum).filter(|(x, y)| x == y).count();
+        let same = equal_pixel_sums(&a, &b);
         let mut other = with_independent_samples(generic);
         other.settings.seed = scene.settings.seed.wrapping_add(1000);
         let b = render_film(&other, backend, spp);

@@ -8,7 +8,9 @@ use super::{any_device, cases};
 use kernel::bsdf::fresnel;
 use kernel::real::Real;
 use twinpath_tests::ball_arithmetic::{computations, Ball, Roundoff};
-use twinpath_tests::device_class::{fresnel_apart, sphere_hit_apart, triangle_hit_apart};
+use twinpath_tests::device_class::{
+    fresnel_apart, sphere_hit_apart, sphere_probe, triangle_hit_apart, triangle_probe,
+};
 use twinpath_tests::vulkan_arithmetic::{seed, set_model, Model, Vk32};
 use twinpath_tests::SplitMix;
 
@@ -395,11 +397,6 @@ fn phase_densities_differ_from_the_cpu_within_their_balls() {
 /// tangent plane); triangles hit anywhere, from grazing directions, and near their edges.
 #[test]
 fn intersections_differ_from_the_cpu_within_their_balls() {
-    use kernel::geometry::{
-        reproject_to_sphere_v3, triangle_error_condition_v3, triangle_point_error_v3,
-        triangle_point_v3,
-    };
-    use kernel::intersect;
     let mut g = SplitMix(47);
     seed(47);
     let (mut worst, mut beyond_64_ulp, mut both_hit) = (0f64, 0usize, 0usize);
@@ -450,10 +447,8 @@ fn intersections_differ_from_the_cpu_within_their_balls() {
         };
         let sphere = |model: Option<usize>| {
             arithmetic(model);
-            let (o_, d_, c_) = (xv(o), xv(d), xv(c));
-            let t = intersect::sphere(o_, d_, c_, x(r), x(0.0), x(f32::INFINITY));
-            let p = reproject_to_sphere_v3(o_ + d_ * t, c_, x(r));
-            [t.value, p.x.value, p.y.value, p.z.value]
+            let (o, d, c) = (xv(o), xv(d), xv(c));
+            sphere_probe(o, d, c, x(r), x(0.0), x(f32::INFINITY)).map(|y| y.value)
         };
         let (cpu, device) = (sphere(None), sphere(Some(k)));
         if cpu[0] >= 0.0 && device[0] >= 0.0 {
@@ -482,12 +477,7 @@ fn intersections_differ_from_the_cpu_within_their_balls() {
         let t_max = if k % 5 == 0 { 1e30 } else { f32::INFINITY };
         let triangle = |model: Option<usize>| {
             arithmetic(model);
-            let (p0_, e1_, e2_) = (xv(p0), xv(e1), xv(e2));
-            let (t, u, v) = intersect::triangle(xv(o), xv(d), p0_, e1_, e2_, x(0.0), x(t_max));
-            let condition = triangle_error_condition_v3(e1_, e2_);
-            let error = triangle_point_error_v3(p0_, e1_, e2_, u, v, condition);
-            let p = triangle_point_v3(p0_, e1_, e2_, u, v);
-            [t, u, v, error, p.x, p.y, p.z].map(|y| y.value)
+            triangle_probe(xv(o), xv(d), xv(p0), xv(e1), xv(e2), x(t_max)).map(|y| y.value)
         };
         let (cpu, device) = (triangle(None), triangle(Some(k)));
         if cpu[0] >= 0.0 && device[0] >= 0.0 {
