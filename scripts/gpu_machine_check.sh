@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # The device check of a borrowed GPU machine, from what scripts/gpu_machine_prepare.sh put into
-# .gpu/: is there a Vulkan ray-tracing device, how fast is a render against the CPU backend
-# (Cornell, meshes.toml, materials.toml, tori of 4k to 1M triangles), do the GPU tests pass. Writes
-# $OUT/log.txt. Ordered by what matters most, each step under its own limit; at most about 9 minutes.
+# .gpu/: is there a Vulkan ray-tracing device; do the GPU tests pass, and the function bounds
+# (issue 35); how fast is a render, against the baseline binary if one was prepared, and against
+# Mitsuba 3 cuda_ad_rgb at equal error (issue 36, scripts/gpu_peer_table.py reads the images back
+# here). Writes $OUT/log.txt, $OUT/test_logs.tar.gz and $OUT/peer.tar.gz (the
+# peer images). Each step under its own limit;
+# at most about 9 minutes.
 exec > >(tee "${OUT:-/tmp}/log.txt") 2>&1
 set -x
 R=$PWD
@@ -20,51 +23,64 @@ rm -rf /tmp/gpubin && mkdir -p /tmp/gpubin && tar -C /tmp/gpubin -xJf .gpu/bin.t
 B=/tmp/gpubin/bin
 mkdir -p target/debug && cp $B/twinpath target/debug/twinpath
 set +x
-echo "== machine"; nvidia-smi -L; nproc; date -u; python3 --version; ldconfig -p | grep -E "libcuda.so|libnvrtc" | head -3  # for a later Mitsuba cuda_ad_rgb peer (issue 36): its wheel is per Python version
+echo "== machine"; nvidia-smi -L; nproc; date -u; python3 --version
 echo "== twinpath info"; timeout 60 $B/twinpath info; j=$(python3 -c "import json;print(json.load(open('$VK_DRIVER_FILES'))['ICD']['library_path'])" 2>/dev/null); echo "icd lib $j"; ldd $(ls /usr/local/nvidia/lib64/$j /usr/local/nvidia/lib/$j $j 2>/dev/null | head -1) 2>&1 | grep -i "not found"; VK_LOADER_DEBUG=error,driver timeout 30 $B/twinpath info 2>&1 | grep -iE "error|fail|driver" | head -20
 if timeout 60 $B/twinpath info | grep -q "gpu backend: unavailable"; then echo "NO VULKAN DEVICE"; exit 3; fi
-echo "== function bounds (issue 35)"
-timeout 120 $B/gpu_functions --test-threads=1 --nocapture 2>&1 | grep -vE "^test .* ok$|^$"
-echo "== tests"
-for t in spirv_module gpu_render; do echo "-- $t"; timeout ${TT:-120} $B/$t --test-threads=1 2>&1 | grep -vE "^test .* ok$|^$"; done
-echo "-- furnace gpu, 10^8 samples"; TWINPATH_FURNACE_GPU_SPP=24576 timeout 90 $B/furnace gpu --nocapture 2>&1 | tail -15
-# Every other test with a GPU part, whole binaries (their CPU parts too), in four queues run
-# side by side (one Vulkan context each; specialize_adaptive alone in one, it compiles two
-# pipelines per scene), --test-threads=1 within each because of the two-thread
-# hang; each binary under its own limit and none started after the step's 200 s, so that
-# nothing outlives the step; the slowest first (the H200 compiled a pipeline in 2 to 10 s on
-# 2026-12-04). Each log ends with its exit status and time.
-echo "== the other GPU tests"
-mkdir -p /tmp/tl
+# Correctness first, every part at once (16 cores; the speed step runs alone afterwards): the
+# function bounds; the module, the backends' equivalence and the furnace; every other test with
+# a GPU part, whole binaries (their CPU parts too) in four queues, one Vulkan context each
+# (specialize_adaptive alone in one: it compiles two pipelines per scene, 2 to 10 s each on
+# the H200), --test-threads=1 within each because of the two-thread hang, each binary under its
+# own limit and none started after the step's QEND s, so that nothing outlives the step; and the
+# two-thread hang itself, sobol's two GPU tests in two threads of one process, with the
+# validation layers and without (TWINPATH_TESTS_NO_VALIDATION), a stuck fence saying so every
+# minute. Each log ends with its exit status and time.
+echo "== tests (issue 35)"
+rm -rf /tmp/tl && mkdir -p /tmp/tl
 end=$(( $(date +%s) + ${QEND:-200} ))
 queue() { for t in "$@"; do s=$(date +%s); [ $s -ge $end ] && { echo "not run: the step's time is up" > /tmp/tl/$t.log; continue; }; timeout ${QT:-150} $B/$t --test-threads=1 > /tmp/tl/$t.log 2>&1; echo "rc $? in $(( $(date +%s) - s )) s" >> /tmp/tl/$t.log; done; }
+(s=$(date +%s); timeout 150 $B/gpu_functions --test-threads=1 --nocapture > /tmp/tl/0_gpu_functions.log 2>&1; echo "rc $? in $(( $(date +%s) - s )) s" >> /tmp/tl/0_gpu_functions.log) &
+(queue spirv_module gpu_render; s=$(date +%s); TWINPATH_FURNACE_GPU_SPP=24576 timeout 90 $B/furnace gpu --nocapture > /tmp/tl/furnace.log 2>&1; echo "rc $? in $(( $(date +%s) - s )) s" >> /tmp/tl/furnace.log) &
 QT=235 queue specialize_adaptive &
 queue gltf sobol media_grids normal_maps camera vertex_colours &
 queue instances opacity light_selection textures reflecting_lights &
 queue media punctual_lights closed_form_materials hard_lighting scene_scale triangle_lights environment texture_sets shading_normals &
+(s=$(date +%s); timeout 75 $B/sobol gpu both_backends --test-threads=2 > /tmp/tl/hang_validation.log 2>&1; echo "rc $? in $(( $(date +%s) - s )) s (124: timed out)" >> /tmp/tl/hang_validation.log
+ s=$(date +%s); TWINPATH_TESTS_NO_VALIDATION=1 timeout 75 $B/sobol gpu both_backends --test-threads=2 > /tmp/tl/hang_no_validation.log 2>&1; echo "rc $? in $(( $(date +%s) - s )) s (124: timed out)" >> /tmp/tl/hang_no_validation.log) &
 wait
-for f in /tmp/tl/*.log; do echo "-- $(basename $f .log)"; grep -vE "^test .* ok$|^$" $f | tail -25; done
-echo "== speed"
-python3 scripts/torus_scenes.py /tmp/gs 4000 16000 65000 262000 1000000
-sp() { echo "-- $1"; for b in gpu gpu cpu; do n=${GPU_SPP:-4096}; [ $b = cpu ] && n=${CPU_SPP:-256}; timeout 25 $B/twinpath render $1 --backend $b --spp $n -o /tmp/x.exr 2>&1 | grep -E "backend|rror"; done; }
-sp scenes/cornell.toml; sp scenes/meshes.toml; sp scenes/materials.toml
-# The scenes with media, coloured glass, textures and many lights: one GPU run and one CPU run each.
-sq() { echo "-- $1"; for b in gpu cpu; do n=1024; [ $b = cpu ] && n=64; timeout 20 $B/twinpath render $1 --backend $b --spp $n -o /tmp/x.exr 2>&1 | grep -E "backend|rror"; done; }
-for s in cornell_fog cornell_smoke coloured_glass gltf_showcase sky_meshes many_lights; do sq scenes/$s.toml; done
-timeout 30 $B/twinpath render scenes/cornell.toml --backend gpu --spp 1024 -o ${OUT:-/tmp}/cornell_gpu.png 2>&1 | grep -E "backend|rror"
-timeout 30 $B/twinpath render scenes/cornell.toml --backend gpu --spp 1024 --validation -o /tmp/v.exr 2>&1 | tail -5
-for n in 4000 1000000; do sp /tmp/gs/mesh_$n.toml; done
-# A baseline binary (gpu_machine_prepare.sh's BASELINE), on its own scenes, alternating with the
-# current one: the same machine, minutes apart.
+for f in /tmp/tl/*.log; do echo "-- $(basename $f .log)"; grep -vE "^test .* ok$|^$" $f | tail -${TAIL:-25}; done
+grep -vE "^test .* ok$|^$" /tmp/tl/0_gpu_functions.log | tail -80 | head -55
+tar -C /tmp -czf ${OUT:-/tmp}/test_logs.tar.gz tl
+echo "== speed (issue 36)"
+python3 scripts/torus_scenes.py /tmp/gs 4000 1000000
+G=${GPU_SPP:-2048}
+gpu() { echo "-- $1 $2"; timeout 30 $B/$1 render $2 --backend gpu --spp $G -o /tmp/x.exr 2>&1 | grep -E "backend|rror"; }
+# The 2026-11-30 binary (gpu_machine_prepare.sh's BASELINE) on its own scenes, alternating with
+# the current one: the same machine, minutes apart (docs/gpu.md: half the speed on 2026-12-04).
 if [ -e $B/twinpath_baseline ]; then
-  echo "== baseline $(cat .gpu/baseline_commit) against the current binary"
+  echo "baseline $(cat .gpu/baseline_commit)"
   for s in cornell meshes; do for bin in twinpath_baseline twinpath twinpath_baseline twinpath; do
-    sc=.gpu/baseline_scenes/$s.toml; [ $bin = twinpath ] && sc=scenes/$s.toml
-    echo "-- $bin $s"; timeout 25 $B/$bin render $sc --backend gpu --spp ${GPU_SPP:-4096} -o /tmp/x.exr 2>&1 | grep -E "backend|rror"
-  done; done
-  for bin in twinpath_baseline twinpath; do echo "-- $bin torus 4k"; timeout 25 $B/$bin render /tmp/gs/mesh_4000.toml --backend gpu --spp ${GPU_SPP:-4096} -o /tmp/x.exr 2>&1 | grep -E "backend|rror"; done
+    sc=.gpu/baseline_scenes/$s.toml; [ $bin = twinpath ] && sc=scenes/$s.toml; gpu $bin $sc; done; done
+  for bin in twinpath_baseline twinpath; do gpu $bin /tmp/gs/mesh_4000.toml; done
 fi
-# The two-thread hang (docs/gpu.md): sobol's two GPU tests in two threads of one process,
-# with a short limit; a stuck fence says so every minute with the process's context count.
-echo "-- sobol gpu, two threads (the hang)"; timeout 75 $B/sobol gpu both_backends --test-threads=2 2>&1 | grep -vE "^test .* ok$|^$"; echo "rc ${PIPESTATUS[0]} (124: timed out)"
+for sc in scenes/materials.toml /tmp/gs/mesh_1000000.toml scenes/gltf_showcase.toml; do gpu twinpath $sc; done
+# Against Mitsuba 3 cuda_ad_rgb (gpu_machine_prepare.sh's bundle): both render the four Cornell
+# scenes at the same sample count; scripts/gpu_peer_table.py measures the images' error here
+# (from $OUT/peer.tar.gz: a run returns at most 8 files).
+rm -rf /tmp/peer && mkdir -p /tmp/peer
+for s in cornell cornell_materials cornell_fog cornell_smoke; do
+  timeout 40 $B/twinpath render scenes/$s.toml --backend gpu --spp ${PEER_SPP:-1024} -o /tmp/peer/twinpath_$s.exr > /tmp/peer/twinpath_$s.txt 2>&1; grep -E "backend|rror" /tmp/peer/twinpath_$s.txt
+done
+if [ -e .gpu/mitsuba.tar.xz ]; then
+  echo "== Mitsuba cuda_ad_rgb"
+  rm -rf /tmp/mb && mkdir -p /tmp/mb && { tar -C /tmp/mb -xJf .gpu/mitsuba.tar.xz ||
+    python3 -c "import tarfile; tarfile.open('.gpu/mitsuba.tar.xz').extractall('/tmp/mb')"; }
+  py=$(python3 -c 'import sys; print(f"{sys.version_info[0]}{sys.version_info[1]}")')
+  lib() { for d in /usr/local/nvidia/lib64 /usr/local/nvidia/lib /usr/lib/x86_64-linux-gnu /usr/lib64; do ls $d/$1* 2>/dev/null; done | head -1; }
+  export DRJIT_LIBCUDA_PATH=$(lib libcuda.so) DRJIT_LIBOPTIX_PATH=$(lib libnvoptix.so)
+  echo "python $py, libcuda $DRJIT_LIBCUDA_PATH, optix $DRJIT_LIBOPTIX_PATH"
+  (cd scripts && PYTHONPATH=/tmp/mb/py$py timeout 150 python3 peer_mitsuba_gpu.py /tmp/peer --spp ${PEER_SPP:-1024} 2>&1 | tail -20)
+fi
+tar -C /tmp -czf ${OUT:-/tmp}/peer.tar.gz peer
+timeout 30 $B/twinpath render scenes/cornell.toml --backend gpu --spp 1024 --validation -o /tmp/v.exr 2>&1 | tail -3
 echo "== done"; date -u

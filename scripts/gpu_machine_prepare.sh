@@ -4,7 +4,7 @@
 # by git) what that machine lacks: the Debian packages of the Vulkan loader, libglvnd
 # (NVIDIA's Vulkan driver is libGLX_nvidia.so.0, which needs it), the validation layers and
 # spirv-val (spirv_module.rs runs it); the stripped twinpath binary and the GPU test binaries
-# (one xz archive); and scripts/torus_scenes.py's generator. Run there: `bash scripts/gpu_machine_check.sh`.
+# (one xz archive); Mitsuba 3's files for its GPU variant (another). Run there: `bash scripts/gpu_machine_check.sh`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --workspace --all-targets
@@ -36,6 +36,20 @@ if [ -n "${BASELINE:-}" ]; then
   strip -o .gpu/bin/twinpath_baseline "$w/target/debug/twinpath"
   cp -r "$w/scenes" .gpu/baseline_scenes
   git -C "$w" rev-parse HEAD > .gpu/baseline_commit
+fi
+# Mitsuba 3 cuda_ad_rgb, the GPU peer (issue 36; MITSUBA=0 leaves it out): its files for the lent
+# machine's CPython (3.12 on the H200 image; MITSUBA_PYTHON="3.12 3.13" for several), cut to
+# what scripts/peer_mitsuba_gpu.py renders (scripts/mitsuba_gpu_bundle.py): 17 MB.
+if [ "${MITSUBA:-1}" != 0 ]; then
+  wheels=target/mitsuba-wheels versions=()
+  for v in ${MITSUBA_PYTHON:-3.12}; do
+    pip download -q --no-deps --only-binary=:all: --python-version $v \
+      --platform manylinux_2_28_x86_64 -d $wheels mitsuba==3.9.1 drjit==1.5.0
+    versions+=("${v/./}")
+  done
+  pip download -q --no-deps -d $wheels typing_extensions
+  python3 scripts/mitsuba_gpu_bundle.py $wheels /tmp/twinpath-mitsuba "${versions[@]}"
+  tar -C /tmp/twinpath-mitsuba -cf - . | xz -9 -T0 > .gpu/mitsuba.tar.xz
 fi
 # The binaries share most of their code: one xz stream over all of them is 14 MB instead of
 # 225 MB, which keeps .gpu within what a lent machine's working tree may carry (64 MiB).

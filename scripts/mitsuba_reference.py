@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A converged Mitsuba 3 reference of a scene of scripts/peer_mitsuba.py, as the mean of two
+"""A converged Mitsuba 3 reference of a scene of scripts/mitsuba_scenes.py, as the mean of two
 independent halves (each rendered in chunks of samples with their own seeds), written as
 OUT/mitsuba_ref.exr, OUT/mitsuba_ref_half_a.exr, OUT/mitsuba_ref_half_b.exr and
 OUT/mitsuba_ref_meta.json: what tests/tests/mitsuba.rs compares twinpath with.
@@ -17,7 +17,7 @@ import time
 import mitsuba as mi
 import numpy as np
 
-import peer_mitsuba
+import mitsuba_scenes
 
 
 def main():
@@ -29,9 +29,9 @@ def main():
     ap.add_argument("--variant", default="llvm_ad_rgb")
     args = ap.parse_args()
     mi.set_variant(args.variant)
-    build = {"cornell_materials": peer_mitsuba.cornell_materials_dict,
-             "cornell_fog": peer_mitsuba.cornell_fog_dict,
-             "cornell_smoke": peer_mitsuba.cornell_smoke_dict}[args.scene]
+    build = {"cornell_materials": mitsuba_scenes.cornell_materials_dict,
+             "cornell_fog": mitsuba_scenes.cornell_fog_dict,
+             "cornell_smoke": mitsuba_scenes.cornell_smoke_dict}[args.scene]
     os.makedirs(args.out, exist_ok=True)
     chunks = max(2, args.spp // args.chunk)
     chunks += chunks % 2

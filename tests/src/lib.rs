@@ -163,7 +163,8 @@ pub mod stats;
 pub mod triangle_bins;
 pub mod vulkan_arithmetic;
 
-/// Renders `scene` at `spp` on `backend` (the GPU with validation layers on).
+/// Renders `scene` at `spp` on `backend` (the GPU with validation layers on, see
+/// [`gpu::validation_wanted`]).
 pub fn render_film(
     scene: &SceneFile,
     backend: twinpath::render::Backend,
@@ -239,7 +240,7 @@ pub fn render_output(
     let opts = twinpath::render::RenderOptions {
         backend,
         device: None,
-        validation: backend == twinpath::render::Backend::Gpu,
+        validation: backend == twinpath::render::Backend::Gpu && gpu::validation_wanted(),
         progress: false,
         samples: None,
     };
