@@ -8,8 +8,9 @@ twinpath_SCENE.exr with twinpath_SCENE.txt (its report, whose
 scripts/peer_mitsuba_gpu.py in DIR/log.txt. Measures each image's relMSE against
 tests/reference/<scene>/mitsuba_ref.exr with `twinpath diff`, and, since past the first samples
 relMSE falls as 1 / samples (unbiased estimators, variance only), the time to relMSE 0.002 as
-seconds x relMSE / 0.002. Prints a Markdown table; the ratio is twinpath's time to that of the
-fastest Mitsuba configuration of the scene.
+seconds x relMSE / 0.002. Prints a Markdown table; the ratio is each time to that of the fastest
+Mitsuba configuration of the scene whose image agrees with the reference (`twinpath diff`'s z of
+the mean difference within 4: a peer that renders another image is not a peer).
 
 Usage: gpu_peer_table.py DIR [--twinpath target/debug/twinpath]
 """
@@ -22,15 +23,16 @@ import subprocess
 REFERENCE = {"cornell": "cornell_spheres", "cornell_materials": "cornell_materials",
              "cornell_fog": "cornell_fog", "cornell_smoke": "cornell_smoke"}
 TARGET = 0.002
+Z_AGREE = 4.0
 
 
 def diff(twinpath, image, scene):
-    """(relMSE, mean signed difference) of `image` against the scene's converged reference."""
+    """(relMSE, z of the mean difference) of `image` against the scene's converged reference."""
     ref = os.path.join("tests", "reference", REFERENCE[scene], "mitsuba_ref.exr")
     out = subprocess.run([twinpath, "diff", image, ref], capture_output=True, text=True,
                          check=True).stdout
     values = dict(line.split() for line in out.splitlines() if line.strip())
-    return float(values["relmse"]), float(values["mean_signed_diff"])
+    return float(values["relmse"]), float(values["mean_diff_z"])
 
 
 def main():
@@ -53,19 +55,21 @@ def main():
             name, sampler, _, seconds = m.groups()
             rows.setdefault(name, []).append((f"mitsuba cuda_ad_rgb {sampler}",
                                               f"mitsuba_{name}_{sampler}.exr", float(seconds)))
-    print("| scene | renderer | render s | relMSE | mean diff | time to relMSE 0.002, s "
-          "| / best Mitsuba |")
+    print("| scene | renderer | render s | relMSE | z of the mean difference "
+          "| time to relMSE 0.002, s | / best Mitsuba |")
     print("|---|---|---|---|---|---|---|")
     for name, entries in rows.items():
         measured = []
         for label, image, seconds in entries:
-            rel, mean = diff(args.twinpath, os.path.join(args.dir, image), name)
-            measured.append((label, seconds, rel, mean, seconds * rel / TARGET))
-        peers = [m[4] for m in measured if m[0].startswith("mitsuba")]
+            rel, z = diff(args.twinpath, os.path.join(args.dir, image), name)
+            measured.append((label, seconds, rel, z, seconds * rel / TARGET))
+        peers = [m[4] for m in measured if m[0].startswith("mitsuba") and abs(m[3]) < Z_AGREE]
         best = min(peers) if peers else None
-        for label, seconds, rel, mean, to_target in measured:
+        for label, seconds, rel, z, to_target in measured:
             ratio = f"{to_target / best:.2f}x" if best else ""
-            print(f"| {name} | {label} | {seconds:.3f} | {rel:.3e} | {mean:+.2e} "
+            if abs(z) >= Z_AGREE:
+                ratio += " (another image)"
+            print(f"| {name} | {label} | {seconds:.3f} | {rel:.3e} | {z:+.1f} "
                   f"| {to_target:.3f} | {ratio} |")
 
 

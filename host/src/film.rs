@@ -286,6 +286,12 @@ pub struct ImageDiff {
     pub relmse: f64,
     /// Mean over pixels and channels of a - b.
     pub mean_signed: f64,
+    /// `mean_signed` over its standard error, the pixels taken as independent samples of the
+    /// difference (each pixel's channels averaged first, since a path's channels are
+    /// correlated): whether two renders of one image differ by more than their noise, e.g. a
+    /// peer's image against a converged reference (|z| of a few at most). 0 where every pixel
+    /// differs alike (no spread), as for identical images.
+    pub mean_z: f64,
     pub max_abs: f64,
 }
 
@@ -301,7 +307,10 @@ pub fn diff_images(a: &RgbImage, b: &RgbImage) -> Result<ImageDiff> {
         );
     }
     let (mut se, mut rel, mut signed, mut max_abs) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut pixel_squares = 0.0f64;
     for (pa, pb) in a.pixels.iter().zip(&b.pixels) {
+        let pixel: f64 = (0..3).map(|c| pa[c] as f64 - pb[c] as f64).sum::<f64>() / 3.0;
+        pixel_squares += pixel * pixel;
         for c in 0..3 {
             let (x, y) = (pa[c] as f64, pb[c] as f64);
             let d = x - y;
@@ -312,10 +321,21 @@ pub fn diff_images(a: &RgbImage, b: &RgbImage) -> Result<ImageDiff> {
         }
     }
     let n = (a.pixels.len() * 3).max(1) as f64;
+    let pixels = a.pixels.len().max(1) as f64;
+    // The mean of the pixels' means is `signed / n`; their sample variance over `pixels`.
+    let mean = signed / n;
+    let variance =
+        (pixel_squares / pixels - mean * mean).max(0.0) * pixels / (pixels - 1.0).max(1.0);
+    let standard_error = (variance / pixels).sqrt();
     Ok(ImageDiff {
         rmse: (se / n).sqrt(),
         relmse: rel / n,
-        mean_signed: signed / n,
+        mean_signed: mean,
+        mean_z: if standard_error > 0.0 {
+            mean / standard_error
+        } else {
+            0.0
+        },
         max_abs,
     })
 }

@@ -90,3 +90,42 @@ fn bench_sweeps_writes_csv_and_plot() {
     let png = image::open(dir.join("bench.png")).unwrap();
     assert_eq!((png.width(), png.height()), (900, 600));
 }
+
+/// `twinpath diff`'s z of the mean difference: the mean of the pixels' channel means over its
+/// standard error (sample variance over the pixels); small for noise alone, large for a bias.
+#[test]
+fn diff_z_tells_a_bias_from_noise() {
+    let image = |pixels: Vec<[f32; 3]>, width: u32| RgbImage {
+        width,
+        height: pixels.len() as u32 / width,
+        pixels,
+    };
+    // Pixel differences 1 and 3: mean 2, sample variance 2, standard error 1, z = 2.
+    let d = diff_images(
+        &image(vec![[1.0; 3], [3.0, 2.0, 4.0]], 2),
+        &image(vec![[0.0; 3]; 2], 2),
+    )
+    .unwrap();
+    assert_eq!((d.mean_signed, d.mean_z), (2.0, 2.0));
+    // Identical images: no spread, z 0.
+    let same = image(vec![[0.25, 0.5, 0.75]; 16], 4);
+    assert_eq!(diff_images(&same, &same).unwrap().mean_z, 0.0);
+    // Uniform noise of +-0.1 per channel on 64 x 64 pixels, then the same plus a bias of 0.01:
+    // the standard error is 0.1 / sqrt(3) / sqrt(3) / 64 = 5.2e-4, so the bias reads z ~ 19.
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut noise = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32 * 0.2 - 0.1
+    };
+    let noisy: Vec<[f32; 3]> = (0..64 * 64)
+        .map(|_| [0.5 + noise(), 0.5 + noise(), 0.5 + noise()])
+        .collect();
+    let reference = image(vec![[0.5; 3]; 64 * 64], 64);
+    let unbiased = diff_images(&image(noisy.clone(), 64), &reference).unwrap();
+    assert!(unbiased.mean_z.abs() < 4.0, "z = {}", unbiased.mean_z);
+    let biased: Vec<[f32; 3]> = noisy.iter().map(|p| p.map(|v| v + 0.01)).collect();
+    let biased = diff_images(&image(biased, 64), &reference).unwrap();
+    assert!(biased.mean_z > 12.0, "z = {}", biased.mean_z);
+}

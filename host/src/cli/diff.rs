@@ -5,7 +5,8 @@ use clap::Args;
 use std::path::PathBuf;
 use twinpath::film::{diff_images, RgbImage};
 
-/// Compare two images: RMSE, relMSE, mean signed difference, max abs difference.
+/// Compare two images: RMSE, relMSE, mean signed difference and its z (pixels as independent
+/// samples), max abs difference.
 #[derive(Args)]
 pub struct DiffArgs {
     /// The image to judge.
@@ -21,6 +22,7 @@ pub fn run(a: DiffArgs) -> Result<()> {
     println!("rmse {:.6e}", d.rmse);
     println!("relmse {:.6e}", d.relmse);
     println!("mean_signed_diff {:+.6e}", d.mean_signed);
+    println!("mean_diff_z {:+.2}", d.mean_z);
     println!("max_abs_diff {:.6e}", d.max_abs);
     Ok(())
 }
