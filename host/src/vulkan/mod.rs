@@ -21,7 +21,7 @@ use ash::vk;
 use device::Context;
 use gpu_allocator::MemoryLocation;
 use indicatif::ProgressBar;
-use kernel::scene::{Material, RenderParams};
+use kernel::scene::RenderParams;
 use memory::{Buffer, Image};
 use pipeline::{binding, HitGroups, RtPipeline};
 use std::time::{Duration, Instant};
@@ -72,16 +72,7 @@ impl GpuRenderer {
         limits::check_scene_fits(scene, &ctx.limits)?;
         let (w, h) = (scene.camera.width, scene.camera.height);
         let features = scene.features(settings);
-        let hit_groups = if settings.specialize {
-            HitGroups {
-                triangles: scene.world_triangle_count() > 0,
-                spheres: !scene.spheres.is_empty(),
-                instances: !scene.instances.is_empty(),
-                holes: scene.materials.iter().any(Material::has_holes),
-            }
-        } else {
-            HitGroups::ALL
-        };
+        let hit_groups = HitGroups::for_scene(scene, settings);
         let t0 = Instant::now();
         let accel = ctx.build_scene_accel(scene, hit_groups)?;
         let accel_build_time = t0.elapsed();

@@ -3,9 +3,12 @@
 
 use super::device::Context;
 use super::memory::Buffer;
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use anyhow::{anyhow, Context as _, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
+use kernel::scene::Material;
 use std::ffi::CStr;
 
 /// Entry points of the kernel module the pipeline uses (asserted by a test on the module).
@@ -57,6 +60,21 @@ impl HitGroups {
         instances: true,
         holes: true,
     };
+
+    /// The groups a render of `scene` with `settings` uses: only those of the geometry it has
+    /// when specialized, every group otherwise (the generic pipeline).
+    pub fn for_scene(scene: &Scene, settings: &RenderSettings) -> HitGroups {
+        if settings.specialize {
+            HitGroups {
+                triangles: scene.world_triangle_count() > 0,
+                spheres: !scene.spheres.is_empty(),
+                instances: !scene.instances.is_empty(),
+                holes: scene.materials.iter().any(Material::has_holes),
+            }
+        } else {
+            HitGroups::ALL
+        }
+    }
 
     /// SBT record offset of the triangle hit group (instances of triangle BLASes).
     pub fn triangle_offset(self) -> u32 {
