@@ -214,11 +214,6 @@ impl PathState {
         scene: &SceneView,
     ) -> Self {
         loop {
-            let hit = if self.extend {
-                tracer.closest_hit(self.ray_origin, self.ray_dir)
-            } else {
-                SurfaceHit::miss()
-            };
             // A scene with media asks for the surface that blocks the segment (it may be an
             // interface, which the segment passes); any other only whether one does.
             let mut occluded = false;
@@ -232,6 +227,11 @@ impl PathState {
                     occluded = tracer.occluded(self.shadow_from, self.shadow_to);
                 }
             }
+            let hit = if self.extend {
+                tracer.closest_hit(self.ray_origin, self.ray_dir)
+            } else {
+                SurfaceHit::miss()
+            };
             if self.advance(features, scene, &hit, occluded) {
                 let arrival = self.arrival(features, scene, &hit);
                 let samples = VertexSamples::draw(&arrival.query, &mut self.rng);
