@@ -4,20 +4,13 @@
 use std::sync::{Mutex, OnceLock};
 use twinpath::vulkan::device::{Context, VALIDATION_ERRORS, VALIDATION_WARNINGS};
 
-/// Whether the GPU tests turn the validation layers on: always, unless the environment sets
-/// `TWINPATH_TESTS_NO_VALIDATION`, which only the device check uses, to tell whether the layers
-/// take part in the two-thread hang (`docs/gpu.md`).
-pub fn validation_wanted() -> bool {
-    std::env::var_os("TWINPATH_TESTS_NO_VALIDATION").is_none()
-}
-
-/// The test binary's Vulkan context (validation on, see [`validation_wanted`]). Tests take the
-/// lock in turn.
+/// The test binary's Vulkan context (validation on, see [`crate::validation_wanted`]). Tests
+/// take the lock in turn.
 pub fn context() -> &'static Mutex<Context> {
     static CTX: OnceLock<Mutex<Context>> = OnceLock::new();
     CTX.get_or_init(|| {
         Mutex::new(
-            Context::new(None, validation_wanted())
+            Context::new(None, crate::validation_wanted())
                 .expect("a Vulkan ray-tracing device (lavapipe: scripts/setup.sh installs it)"),
         )
     })

@@ -163,8 +163,15 @@ pub mod stats;
 pub mod triangle_bins;
 pub mod vulkan_arithmetic;
 
+/// Whether the GPU tests turn the validation layers on: always, unless the environment sets
+/// `TWINPATH_TESTS_NO_VALIDATION`, which only the device check uses, to tell whether the layers
+/// take part in the two-thread hang (`docs/gpu.md`).
+pub fn validation_wanted() -> bool {
+    std::env::var_os("TWINPATH_TESTS_NO_VALIDATION").is_none()
+}
+
 /// Renders `scene` at `spp` on `backend` (the GPU with validation layers on, see
-/// [`gpu::validation_wanted`]).
+/// [`validation_wanted`]).
 pub fn render_film(
     scene: &SceneFile,
     backend: twinpath::render::Backend,
@@ -240,7 +247,7 @@ pub fn render_output(
     let opts = twinpath::render::RenderOptions {
         backend,
         device: None,
-        validation: backend == twinpath::render::Backend::Gpu && gpu::validation_wanted(),
+        validation: backend == twinpath::render::Backend::Gpu && validation_wanted(),
         progress: false,
         samples: None,
     };
