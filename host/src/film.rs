@@ -309,16 +309,18 @@ pub fn diff_images(a: &RgbImage, b: &RgbImage) -> Result<ImageDiff> {
     let (mut se, mut rel, mut signed, mut max_abs) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut pixel_squares = 0.0f64;
     for (pa, pb) in a.pixels.iter().zip(&b.pixels) {
-        let pixel: f64 = (0..3).map(|c| pa[c] as f64 - pb[c] as f64).sum::<f64>() / 3.0;
-        pixel_squares += pixel * pixel;
+        let mut pixel = 0.0f64;
         for c in 0..3 {
             let (x, y) = (pa[c] as f64, pb[c] as f64);
             let d = x - y;
             se += d * d;
             rel += d * d / (y * y + 0.01);
             signed += d;
+            pixel += d;
             max_abs = max_abs.max(d.abs());
         }
+        pixel /= 3.0;
+        pixel_squares += pixel * pixel;
     }
     let n = (a.pixels.len() * 3).max(1) as f64;
     let pixels = a.pixels.len().max(1) as f64;
