@@ -3,9 +3,9 @@
 # .gpu/: is there a Vulkan ray-tracing device; do the GPU tests pass, and the function bounds
 # (issue 35); how fast is a render, against the baseline binary if one was prepared, and against
 # Mitsuba 3 cuda_ad_rgb at equal error (issue 36, scripts/gpu_peer_table.py reads the images back
-# here). Writes $OUT/log.txt, $OUT/test_logs.tar.gz and $OUT/peer.tar.gz (the
-# peer images). Each step under its own limit;
-# at most about 9 minutes.
+# here). Writes $OUT/log.txt, $OUT/tests.txt (each test binary's log as it ends) and
+# $OUT/peer.tar.gz (the peer images). Each step under its own limit; at most about 9 minutes;
+# SKIP_TESTS=1 runs the speed and peer steps alone.
 exec > >(tee "${OUT:-/tmp}/log.txt") 2>&1
 set -x
 R=$PWD

@@ -4,7 +4,8 @@
 # by git) what that machine lacks: the Debian packages of the Vulkan loader, libglvnd
 # (NVIDIA's Vulkan driver is libGLX_nvidia.so.0, which needs it), the validation layers and
 # spirv-val (spirv_module.rs runs it); the stripped twinpath binary and the GPU test binaries
-# (one xz archive); Mitsuba 3's files for its GPU variant (another). Run there: `bash scripts/gpu_machine_check.sh`.
+# (one xz archive); Mitsuba 3's files for its GPU variant (another). Run there:
+# `bash scripts/gpu_machine_check.sh`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --workspace --all-targets

@@ -37,9 +37,8 @@ whole_spp=${WHOLE_SPP:-256}
 read -r -a mitsuba_samplers <<< "${MITSUBA_SAMPLERS:-ldsampler}"
 
 # whole DIR LABEL SPP COMMAND...: runs COMMAND (which writes DIR/whole.exr) and prints its wall
-# time, the image's relMSE against $ref, the time to 0.002 at that efficiency and the z of its mean
-# difference (flagged beyond 4); appends
-# "LABEL,seconds,relmse" to DIR/whole.csv.
+# time, the image's relMSE against $ref, the time to 0.002 at that efficiency and the z of its
+# mean difference (flagged beyond 4); appends "LABEL,seconds,relmse" to DIR/whole.csv.
 whole() {
     local dir=$1 label=$2 spp=$3 t0 t1 e d z
     shift 3

@@ -19,10 +19,14 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 printf '%-12s %6s %8s %8s %12s %8s\n' revision vgprs instrs waves cycles/wave scratch
 for rev in "${@:-kernel/shipped/kernel.spv}"; do
-  if [ -f "$rev" ]; then spv=$rev; else spv=$tmp/$rev.spv; git show "$rev:kernel/shipped/kernel.spv" > "$spv"; fi
+  if [ -f "$rev" ]; then spv=$rev; else spv=$tmp/module.spv; git show "$rev:kernel/shipped/kernel.spv" > "$spv"; fi
+  # The example ends with an error on null hardware, after the statistics (see its doc); a run
+  # that printed none shows its error instead.
   MESA_SHADER_CACHE_DISABLE=true RADV_DEBUG=shaderstats RADV_FORCE_FAMILY=navi31 VK_DRIVER_FILES=$icd \
-    target/debug/examples/pipeline_stats "$scene" "$spv" > "$tmp/log" 2>&1 || true  # see its doc
+    target/debug/examples/pipeline_stats "$scene" "$spv" > "$tmp/log" 2>&1 || true
   awk -v r="$rev" '/Ray Generation/{g=1} g&&/^VGPRs/{v=$2} g&&/^Instructions/{i=$2}
       g&&/Subgroups per SIMD/{w=$4} g&&/Inverse Throughput/{t=$3} g&&/^Scratch size/{s=$3}
-      END{printf "%-12s %6s %8s %8s %12s %8s\n", r, v, i, w, t, s}' "$tmp/log"
+      /^Error/ && e == "" {e=$0}
+      END{if (v == "") printf "%-12s no statistics: %s\n", r, e
+          else printf "%-12s %6s %8s %8s %12s %8s\n", r, v, i, w, t, s}' "$tmp/log"
 done
