@@ -1,20 +1,23 @@
 //! Compiles the ray-tracing pipeline that a render of SCENE would use, and nothing else: no
-//! acceleration structure, no dispatch. With Mesa's RADV on null hardware
-//! (`RADV_FORCE_FAMILY=navi31`, no GPU needed) and `RADV_DEBUG=shaderstats`, the driver prints
-//! each shader's registers, instructions, occupancy and estimated throughput: an offline proxy
-//! for what a GPU compiler makes of the kernel, which lavapipe's timings cannot show
-//! (`scripts/shader_stats.sh`, docs/gpu.md). MODULE replaces the shipped SPIR-V module, e.g. an
-//! earlier commit's `kernel/shipped/kernel.spv`. On null hardware the shader binding table has
-//! no memory to live in, so the run ends with that error, after the driver has printed the
-//! statistics.
+//! acceleration structure, no shader binding table, no dispatch; then prints the ray-generation
+//! group's stack size (`vkGetRayTracingShaderGroupStackSizeKHR`). With Mesa's RADV on null
+//! hardware (`RADV_FORCE_FAMILY=navi31`, no GPU needed) and `RADV_DEBUG=shaderstats`, the
+//! driver prints each shader's registers, instructions, occupancy and estimated throughput: an
+//! offline proxy for what a GPU compiler makes of the kernel, which lavapipe's timings cannot
+//! show (`scripts/shader_stats.sh`, docs/gpu.md). With `--separate` the pipeline carries an
+//! unused callable shader, which makes RADV compile the stages apart as hardware-traversal GPUs
+//! do; the stack size is then what the ray-generation shader keeps live across its trace calls
+//! (`vulkan::pipeline::Compilation::Separate`). On a real GPU the same run prints its driver's
+//! stack size. MODULE replaces the shipped SPIR-V module, e.g. an earlier commit's
+//! `kernel/shipped/kernel.spv`.
 //!
-//! Usage: `cargo run --example pipeline_stats -- SCENE [MODULE.spv] [--device N]`
+//! Usage: `cargo run --example pipeline_stats -- SCENE [MODULE.spv] [--separate] [--device N]`
 
 use anyhow::{bail, Context as _, Result};
 use std::path::Path;
 use twinpath::scene::SceneFile;
 use twinpath::vulkan::device::Context;
-use twinpath::vulkan::pipeline::{HitGroups, RtPipeline};
+use twinpath::vulkan::pipeline::{Compilation, CompiledPipeline, HitGroups};
 
 fn main() -> Result<()> {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
@@ -29,10 +32,17 @@ fn main() -> Result<()> {
         }
         None => None,
     };
+    let compilation = match args.iter().position(|a| a == "--separate") {
+        Some(i) => {
+            args.remove(i);
+            Compilation::Separate
+        }
+        None => Compilation::Render,
+    };
     let (scene, module) = match args.as_slice() {
         [scene] => (scene, None),
         [scene, module] => (scene, Some(module)),
-        _ => bail!("usage: pipeline_stats SCENE [MODULE.spv] [--device N]"),
+        _ => bail!("usage: pipeline_stats SCENE [MODULE.spv] [--separate] [--device N]"),
     };
     let file = SceneFile::load(Path::new(scene))?;
     let spv = match module {
@@ -42,20 +52,14 @@ fn main() -> Result<()> {
     let ctx = Context::new(device, false)?;
     let features = file.scene.features(&file.settings);
     let hit_groups = HitGroups::for_scene(&file.scene, &file.settings);
+    let pipeline = CompiledPipeline::new(&ctx, &spv, features, hit_groups, compilation)?;
+    println!(
+        "{}: features {features:#x}, {hit_groups:?}, {compilation:?}: raygen stack {} bytes",
+        ctx.device_name,
+        pipeline.raygen_stack_size(&ctx)
+    );
+    pipeline.destroy(&ctx);
     // A null device (RADV_FORCE_FAMILY) cannot wait for idle, which dropping the context does:
     // the process exits without dropping it.
-    match RtPipeline::new(&ctx, &spv, features, hit_groups) {
-        Ok(pipeline) => {
-            println!(
-                "{}: features {features:#x}, {hit_groups:?}: compiled",
-                ctx.device_name
-            );
-            pipeline.destroy(&ctx);
-            std::process::exit(0)
-        }
-        Err(e) => {
-            eprintln!("{}: {e:#}", ctx.device_name);
-            std::process::exit(1)
-        }
-    }
+    std::process::exit(0)
 }

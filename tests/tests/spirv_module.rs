@@ -91,6 +91,69 @@ fn module_needs_ray_tracing_pipelines_and_not_ray_queries() {
         .any(|e| e.to_bytes() == b"VK_KHR_ray_query"));
 }
 
+/// The callable shader `pipeline_stats --separate` adds (`Compilation::Separate`) is the
+/// assembly of its text, valid, and a callable entry point (CallableKHR, 5318).
+#[test]
+fn callable_module_is_its_assembly_text() {
+    use twinpath::vulkan::pipeline::{CALLABLE_SPV, CALLABLE_SPVASM};
+    let dir = std::env::temp_dir();
+    let text = dir.join(format!("twinpath-callable-{}.spvasm", std::process::id()));
+    let binary = text.with_extension("spv");
+    std::fs::write(&text, CALLABLE_SPVASM).unwrap();
+    let out = Command::new("spirv-as")
+        .args(["--target-env", "vulkan1.2"])
+        .arg(&text)
+        .arg("-o")
+        .arg(&binary)
+        .output()
+        .expect("spirv-as (Debian package spirv-tools) must be installed: run scripts/setup.sh");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let words: Vec<u32> = std::fs::read(&binary)
+        .unwrap()
+        .chunks(4)
+        .map(|w| u32::from_le_bytes(w.try_into().unwrap()))
+        .collect();
+    let _ = (std::fs::remove_file(&text), std::fs::remove_file(&binary));
+    assert_eq!(words, CALLABLE_SPV);
+    let bytes: Vec<u8> = CALLABLE_SPV.iter().flat_map(|w| w.to_le_bytes()).collect();
+    spirv_val("callable", &bytes);
+    let entry_points = Module::parse(&bytes).entry_points;
+    assert_eq!(entry_points, BTreeSet::from([(5318, "main".to_string())]));
+}
+
+/// The test device compiles the pipeline with the stages apart too (the callable shader
+/// accepted, the validation layers silent), and answers the ray-generation group's stack size.
+#[test]
+fn pipeline_compiles_with_its_stages_apart() {
+    use twinpath::vulkan::pipeline::{Compilation, CompiledPipeline, HitGroups};
+    let file = twinpath::scene::SceneFile::builtin_default();
+    let features = file.features();
+    let hit_groups = HitGroups::for_scene(&file.scene, &file.settings);
+    let ctx = twinpath_tests::gpu::context().lock().unwrap();
+    for compilation in [Compilation::Render, Compilation::Separate] {
+        let pipeline = CompiledPipeline::new(
+            &ctx,
+            twinpath::KERNEL_SPV,
+            features,
+            hit_groups,
+            compilation,
+        )
+        .unwrap();
+        println!(
+            "{}, {compilation:?}: raygen stack {} bytes",
+            ctx.device_name,
+            pipeline.raygen_stack_size(&ctx)
+        );
+        pipeline.destroy(&ctx);
+    }
+    drop(ctx);
+    twinpath_tests::gpu::assert_validation_clean();
+}
+
 #[test]
 fn modules_pass_spirv_val() {
     for (name, module) in [

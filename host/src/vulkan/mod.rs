@@ -137,7 +137,7 @@ impl GpuRenderer {
                 descriptor_count: 11,
             },
         ];
-        let (pool, set) = ctx.create_descriptor_set(pipeline.set_layout, &sizes)?;
+        let (pool, set) = ctx.create_descriptor_set(pipeline.compiled.set_layout, &sizes)?;
         let tlas = [accel.tlas.handle];
         let mut as_write = vk::WriteDescriptorSetAccelerationStructureKHR::default()
             .acceleration_structures(&tlas);
@@ -269,12 +269,12 @@ impl GpuRenderer {
             ctx.device.cmd_bind_pipeline(
                 cmd,
                 vk::PipelineBindPoint::RAY_TRACING_KHR,
-                res.pipeline.pipeline,
+                res.pipeline.compiled.pipeline,
             );
             ctx.device.cmd_bind_descriptor_sets(
                 cmd,
                 vk::PipelineBindPoint::RAY_TRACING_KHR,
-                res.pipeline.layout,
+                res.pipeline.compiled.layout,
                 0,
                 &[res.set],
                 &[],

@@ -96,12 +96,62 @@ impl HitGroups {
     }
 }
 
-/// The pipeline and the objects it owns.
-pub struct RtPipeline {
+/// The compiled pipeline and the objects it owns, without a shader binding table: what
+/// [`RtPipeline`] renders with, and what `examples/pipeline_stats` compiles for a driver's
+/// statistics (on hardware without memory, where no table can be made).
+pub struct CompiledPipeline {
     pub module: vk::ShaderModule,
     pub set_layout: vk::DescriptorSetLayout,
     pub layout: vk::PipelineLayout,
     pub pipeline: vk::Pipeline,
+    /// The groups in pipeline order: ray generation, miss, the hit groups of [`HitGroups`]
+    /// (then the callable group of [`Compilation::Separate`]).
+    pub group_count: u32,
+    callable_module: Option<vk::ShaderModule>,
+}
+
+/// How [`CompiledPipeline::new`] asks the driver to compile.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compilation {
+    /// As a render does: the driver chooses.
+    Render,
+    /// With an unused callable shader ([`CALLABLE_SPV`]) in the pipeline, which makes Mesa's
+    /// RADV compile every stage separately instead of inlining them into the ray-generation
+    /// shader: each trace call is then a call, across which what the ray-generation shader
+    /// keeps live is saved on the ray-tracing stack, as on GPUs that traverse in hardware
+    /// (NVIDIA's guides: keep the live state across `traceRay` small). The raygen group's
+    /// stack size ([`CompiledPipeline::raygen_stack_size`]) then measures that state. For
+    /// statistics only: the shader binding table has no callable region.
+    Separate,
+}
+
+/// The text of a callable shader that returns at once ([`CALLABLE_SPV`] is its assembly).
+pub const CALLABLE_SPVASM: &str = "\
+OpCapability RayTracingKHR
+OpExtension \"SPV_KHR_ray_tracing\"
+OpMemoryModel Logical GLSL450
+OpEntryPoint CallableKHR %main \"main\"
+%void = OpTypeVoid
+%fn = OpTypeFunction %void
+%main = OpFunction %void None %fn
+%l = OpLabel
+OpReturn
+OpFunctionEnd
+";
+
+/// [`CALLABLE_SPVASM`] assembled by `spirv-as --target-env vulkan1.2` (the test
+/// `callable_module_is_its_assembly_text` assembles it again and compares).
+pub const CALLABLE_SPV: [u32; 35] = [
+    0x07230203, 0x00010500, 0x00070000, 0x00000005, 0x00000000, 0x00020011, 0x0000117f, 0x0006000a,
+    0x5f565053, 0x5f52484b, 0x5f796172, 0x63617274, 0x00676e69, 0x0003000e, 0x00000000, 0x00000001,
+    0x0005000f, 0x000014c6, 0x00000001, 0x6e69616d, 0x00000000, 0x00020013, 0x00000002, 0x00030021,
+    0x00000003, 0x00000002, 0x00050036, 0x00000002, 0x00000001, 0x00000000, 0x00000003, 0x000200f8,
+    0x00000004, 0x000100fd, 0x00010038,
+];
+
+/// The pipeline, the objects it owns and its shader binding table.
+pub struct RtPipeline {
+    pub compiled: CompiledPipeline,
     pub sbt: Buffer,
     pub raygen_region: vk::StridedDeviceAddressRegionKHR,
     pub miss_region: vk::StridedDeviceAddressRegionKHR,
@@ -125,15 +175,17 @@ pub fn shader_module(ctx: &Context, spv: &[u8]) -> Result<vk::ShaderModule> {
     .context("cannot create the shader module")
 }
 
-impl RtPipeline {
+impl CompiledPipeline {
     /// The pipeline with `hit_groups`, the raygen shader specialized to `features`
-    /// (specialization constant 0, `kernel::features`; 0 keeps the generic path).
+    /// (specialization constant 0, `kernel::features`; 0 keeps the generic path), compiled as
+    /// `compilation` says.
     pub fn new(
         ctx: &Context,
         spv: &[u8],
         features: u32,
         hit_groups: HitGroups,
-    ) -> Result<RtPipeline> {
+        compilation: Compilation,
+    ) -> Result<CompiledPipeline> {
         let module = shader_module(ctx, spv)?;
         let all = vk::ShaderStageFlags::RAYGEN_KHR
             | vk::ShaderStageFlags::CLOSEST_HIT_KHR
@@ -264,6 +316,30 @@ impl RtPipeline {
                 ANY_HIT_INSTANCE,
             );
         }
+        let callable_module = if compilation == Compilation::Separate {
+            let callable = unsafe {
+                ctx.device.create_shader_module(
+                    &vk::ShaderModuleCreateInfo::default().code(&CALLABLE_SPV),
+                    None,
+                )
+            }
+            .context("cannot create the callable shader's module")?;
+            stages.push(
+                vk::PipelineShaderStageCreateInfo::default()
+                    .stage(vk::ShaderStageFlags::CALLABLE_KHR)
+                    .module(callable)
+                    .name(c"main"),
+            );
+            groups.push(group(
+                vk::RayTracingShaderGroupTypeKHR::GENERAL,
+                stages.len() as u32 - 1,
+                unused,
+                unused,
+            ));
+            Some(callable)
+        } else {
+            None
+        };
         let info = vk::RayTracingPipelineCreateInfoKHR::default()
             .stages(&stages)
             .groups(&groups)
@@ -278,6 +354,56 @@ impl RtPipeline {
             )
         }
         .map_err(|(_, e)| anyhow!("cannot create the ray-tracing pipeline: {e}"))?[0];
+        Ok(CompiledPipeline {
+            module,
+            set_layout,
+            layout,
+            pipeline,
+            group_count: groups.len() as u32,
+            callable_module,
+        })
+    }
+
+    /// The bytes of ray-tracing stack the ray-generation shader needs
+    /// (`vkGetRayTracingShaderGroupStackSizeKHR` of group 0): with [`Compilation::Separate`] on
+    /// RADV, and on drivers that compile stages apart, what it keeps live across its trace
+    /// calls.
+    pub fn raygen_stack_size(&self, ctx: &Context) -> u64 {
+        unsafe {
+            (ctx.rt.fp().get_ray_tracing_shader_group_stack_size_khr)(
+                ctx.device.handle(),
+                self.pipeline,
+                0,
+                vk::ShaderGroupShaderKHR::GENERAL,
+            )
+        }
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+            ctx.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
+            ctx.device.destroy_shader_module(self.module, None);
+            if let Some(callable) = self.callable_module {
+                ctx.device.destroy_shader_module(callable, None);
+            }
+        }
+    }
+}
+
+impl RtPipeline {
+    /// The pipeline of a render ([`CompiledPipeline::new`] with [`Compilation::Render`]) and
+    /// its shader binding table.
+    pub fn new(
+        ctx: &Context,
+        spv: &[u8],
+        features: u32,
+        hit_groups: HitGroups,
+    ) -> Result<RtPipeline> {
+        let compiled = CompiledPipeline::new(ctx, spv, features, hit_groups, Compilation::Render)?;
+        let pipeline = compiled.pipeline;
 
         // Shader binding table: raygen | miss | hit (triangles, spheres), each region starting
         // at the base alignment, records at the handle alignment.
@@ -293,8 +419,8 @@ impl RtPipeline {
             ctx.rt.get_ray_tracing_shader_group_handles(
                 pipeline,
                 0,
-                groups.len() as u32,
-                groups.len() * handle_size as usize,
+                compiled.group_count,
+                compiled.group_count as usize * handle_size as usize,
             )
         }?;
         let mut table = vec![0u8; (raygen_size + miss_size + hit_size + base) as usize];
@@ -340,10 +466,7 @@ impl RtPipeline {
             }
         };
         Ok(RtPipeline {
-            module,
-            set_layout,
-            layout,
-            pipeline,
+            compiled,
             sbt,
             raygen_region,
             miss_region,
@@ -352,13 +475,7 @@ impl RtPipeline {
     }
 
     pub fn destroy(self, ctx: &Context) {
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device
-                .destroy_descriptor_set_layout(self.set_layout, None);
-            ctx.device.destroy_shader_module(self.module, None);
-        }
+        self.compiled.destroy(ctx);
         ctx.destroy_buffer(self.sbt);
     }
 }
