@@ -7,6 +7,7 @@
 //! Both paths compute the same values: a feature bit may only be cleared when the run-time
 //! answer is the same (`scene_features` derives both from the same parameters).
 
+use crate::adaptive::is_adaptive;
 use crate::scene::{
     light_sampling, mis, roulette, shading_flags, texture_slot, Material, RenderParams,
     ShadingTriangle, NONE,
@@ -79,6 +80,11 @@ pub const SECOND_UVS: u32 = 1 << 23;
 /// it, and pass interfaces. Scenes with it run the CPU's generic path, so that others do not
 /// carry its checks.
 pub const MEDIA: u32 = 1 << 24;
+/// The render samples adaptively (`crate::adaptive`: pilot samples, converged pixels skipped).
+/// Read by the GPU's ray-generation shader only, so that a render without it keeps no pilot
+/// record live across its trace calls (`crate::shaders::raygen`); the CPU counts pilots in its
+/// film and masks the bit before choosing its monomorphised path.
+pub const ADAPTIVE: u32 = 1 << 25;
 
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
 /// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals,
@@ -167,6 +173,9 @@ pub fn scene_features(params: &RenderParams) -> u32 {
     }
     if params.environment.medium != 0 {
         f |= MEDIA;
+    }
+    if is_adaptive(params) {
+        f |= ADAPTIVE;
     }
     f
 }
@@ -324,6 +333,12 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn rr_throughput(self, p: &RenderParams) -> bool {
         self.answer(RR_THROUGHPUT, p.integrator.rr_mode == roulette::THROUGHPUT)
+    }
+    /// Whether the render samples adaptively ([`ADAPTIVE`]: asked by the GPU's ray generation
+    /// only).
+    #[inline]
+    fn adaptive(self, p: &RenderParams) -> bool {
+        self.answer(ADAPTIVE, is_adaptive(p))
     }
 }
 

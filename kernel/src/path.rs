@@ -216,7 +216,6 @@ impl PathState {
         loop {
             // A scene with media asks for the surface that blocks the segment (it may be an
             // interface, which the segment passes); any other only whether one does.
-            let mut occluded = false;
             if self.shadow {
                 if features.media() {
                     let blocker = tracer.first_hit_on(self.shadow_from, self.shadow_to);
@@ -224,7 +223,8 @@ impl PathState {
                         continue;
                     }
                 } else {
-                    occluded = tracer.occluded(self.shadow_from, self.shadow_to);
+                    let occluded = tracer.occluded(self.shadow_from, self.shadow_to);
+                    self.settle_shadow(occluded);
                 }
             }
             let hit = if self.extend {
@@ -232,7 +232,7 @@ impl PathState {
             } else {
                 SurfaceHit::miss()
             };
-            if self.advance(features, scene, &hit, occluded) {
+            if self.advance(features, scene, &hit, false) {
                 let arrival = self.arrival(features, scene, &hit);
                 let samples = VertexSamples::draw(&arrival.query, &mut self.rng);
                 self.vertex(
@@ -288,10 +288,9 @@ impl PathState {
         occluded: bool,
     ) -> bool {
         let (params, lights, environment) = (scene.params, scene.lights, scene.environment);
-        if self.shadow && !occluded {
-            self.radiance += self.shadow_radiance;
+        if self.shadow {
+            self.settle_shadow(occluded);
         }
-        self.shadow = false;
         if !self.extend {
             return false;
         }
@@ -644,6 +643,19 @@ impl PathState {
         }
         let origin = offset_ray_origin(x, side(ng, !s.transmitted), hit.error);
         self.await_extension(origin, s.wi, x, s.pdf);
+    }
+
+    /// The shadow segment's answer: the light sample's radiance is added if the segment is
+    /// not `occluded`, and no segment waits any more. [`PathState::run`] settles it before it
+    /// traces the extension ray, so that `shadow_radiance` is not live across that trace (on a
+    /// GPU, what is live across a trace call is saved and restored around it); the sum is the
+    /// same, since [`PathState::advance`] adds nothing before it.
+    #[inline]
+    fn settle_shadow(&mut self, occluded: bool) {
+        if !occluded {
+            self.radiance += self.shadow_radiance;
+        }
+        self.shadow = false;
     }
 
     /// Step 4 at the vertex of `query`: whether the path survives Russian roulette, dividing

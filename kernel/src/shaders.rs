@@ -18,7 +18,7 @@
 //! too, which run for the triangles of BLASes built without the OPAQUE flag, and rays are
 //! traced without `RayFlags::OPAQUE`. Miss shader 0 serves both kinds of ray.
 
-use crate::adaptive::{is_adaptive, luminance, pixel_converged};
+use crate::adaptive::{luminance, pixel_converged};
 use crate::features::{Dynamic, FeatureSet};
 use crate::film_sample::{classify, sample_use};
 use crate::geometry::{intersect_sphere, TriangleShape};
@@ -193,12 +193,12 @@ pub fn raygen(
     let px = launch_id.x;
     let py = launch_id.y;
     let coord = UVec2::new(px, py);
-    let a: Vec4 = accum_mean.read(coord);
-    let adaptive = is_adaptive(params);
+    let adaptive = Dynamic(features).adaptive(params);
     let mut pilot = Vec4::ZERO;
     if adaptive {
         pilot = pilots.read(coord);
-        if pixel_converged(params, pilot.x, pilot.y, pilot.z, a.w) {
+        let merged: Vec4 = accum_mean.read(coord);
+        if pixel_converged(params, pilot.x, pilot.y, pilot.z, merged.w) {
             return;
         }
     }
@@ -254,6 +254,7 @@ pub fn raygen(
             pilots.write(coord, pilot);
         }
     }
+    let a: Vec4 = accum_mean.read(coord);
     let a_m2: Vec4 = accum_m2.read(coord);
     let n_a = a.w;
     let n = n_a + n_b;

@@ -35,7 +35,8 @@ pub struct CpuRenderer {
     pub media: Vec<Medium>,
     /// The grid table (`kernel::density_grid`).
     pub grids: Vec<u32>,
-    /// The kernel's feature bits (`kernel::features`; 0: generic path).
+    /// The kernel's feature bits (`kernel::features`; 0: generic path), without
+    /// `features::ADAPTIVE` (the GPU's ray generation reads it; this film counts pilots itself).
     pub features: u32,
     /// How a tile's samples are computed, chosen once when the renderer is built.
     pub tiles: TileStrategy,
@@ -156,7 +157,7 @@ impl CpuRenderer {
             textures: scene.textures.words.clone(),
             media: scene.media.clone(),
             grids: scene.grids.words.clone(),
-            features: with_all_extended(scene.features(settings)),
+            features: with_all_extended(scene.features(settings) & !features::ADAPTIVE),
             tiles,
             holes,
         }
