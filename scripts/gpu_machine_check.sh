@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The device check of a borrowed GPU machine, from what scripts/gpu_machine_prepare.sh put into
 # .gpu/: is there a Vulkan ray-tracing device; do the GPU tests pass, and the function bounds
-# (issue 35); how fast is a render, against the baseline binary if one was prepared, and against
+# (issue 35); how much the ray-generation shader keeps live across its trace calls (the driver's
+# stack size); how fast is a render, against the baseline binary if one was prepared, and against
 # Mitsuba 3 cuda_ad_rgb at equal error (issue 36, scripts/gpu_peer_table.py reads the images back
 # here). Writes $OUT/log.txt, $OUT/tests.txt (each test binary's log as it ends) and
 # $OUT/peer.tar.gz (the peer images). Each step under its own limit; at most about 9 minutes;
@@ -61,6 +62,14 @@ while [ -n "$(jobs -rp)" ] && [ $(date +%s) -lt $stop ]; do sleep 5; done
 if [ -n "$(jobs -rp)" ]; then echo "-- still running at the step's end" >> $T; ps -eo pid,etime,stat,wchan:32,args | grep "$B/" | grep -v grep >> $T; kill -9 $(jobs -p); pkill -9 -f "$B/"; fi
 cat $T
 fi
+echo "== live state across trace calls (issue 36)"
+# The ray-generation group's stack size as this device's driver compiles it (what the shader
+# keeps live across traceRayEXT; RADV's numbers in docs/gpu.md), the current module against the
+# earlier ones gpu_machine_prepare.sh put in .gpu/modules.
+for sc in cornell materials gltf_showcase; do for m in current .gpu/modules/*.spv; do
+  [ $m = current ] && m=
+  echo "-- $sc ${m:-current}: $(timeout -k 5 60 $B/pipeline_stats scenes/$sc.toml $m 2>&1 | tail -1)"
+done; done
 echo "== speed (issue 36)"
 python3 scripts/torus_scenes.py /tmp/gs 4000 1000000
 G=${GPU_SPP:-2048}

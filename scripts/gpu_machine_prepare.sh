@@ -15,6 +15,11 @@ apt-get "${apt_opts[@]}" update -qq
 (cd .gpu/debs && apt-get "${apt_opts[@]}" download libvulkan1 libglvnd0 libglx0 libegl1 libgl1 \
   libopengl0 libgles2 vulkan-validationlayers spirv-tools)
 strip -o .gpu/bin/twinpath target/debug/twinpath
+strip -o .gpu/bin/pipeline_stats target/debug/examples/pipeline_stats
+# Earlier shipped modules whose ray-generation stack the check asks the device for beside the
+# current one (STATS_REVS; default 5de8811, the module before the live-state change).
+mkdir -p .gpu/modules
+for rev in ${STATS_REVS:-5de8811}; do git show "$rev:kernel/shipped/kernel.spv" > ".gpu/modules/$rev.spv"; done
 for t in gpu_functions gpu_render spirv_module furnace scene_scale specialize_adaptive \
   hard_lighting light_selection sobol closed_form_materials opacity texture_sets media media_grids \
   triangle_lights environment textures normal_maps gltf instances punctual_lights \
