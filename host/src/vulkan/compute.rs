@@ -156,12 +156,12 @@ impl ProbeRunner {
     }
 
     pub fn destroy(self, ctx: &Context) {
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device
-                .destroy_descriptor_set_layout(self.set_layout, None);
-            ctx.device.destroy_shader_module(self.module, None);
-        }
+        super::pipeline::destroy_pipeline_objects(
+            ctx,
+            self.pipeline,
+            self.layout,
+            self.set_layout,
+            self.module,
+        );
     }
 }

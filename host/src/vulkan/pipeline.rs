@@ -380,16 +380,33 @@ impl CompiledPipeline {
     }
 
     pub fn destroy(self, ctx: &Context) {
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device
-                .destroy_descriptor_set_layout(self.set_layout, None);
-            ctx.device.destroy_shader_module(self.module, None);
-            if let Some(callable) = self.callable_module {
-                ctx.device.destroy_shader_module(callable, None);
-            }
+        destroy_pipeline_objects(
+            ctx,
+            self.pipeline,
+            self.layout,
+            self.set_layout,
+            self.module,
+        );
+        if let Some(callable) = self.callable_module {
+            unsafe { ctx.device.destroy_shader_module(callable, None) };
         }
+    }
+}
+
+/// Destroys a pipeline with its layout, its descriptor set layout and its shader module (the
+/// ray-tracing pipeline's and the compute probe's, `super::compute`).
+pub(super) fn destroy_pipeline_objects(
+    ctx: &Context,
+    pipeline: vk::Pipeline,
+    layout: vk::PipelineLayout,
+    set_layout: vk::DescriptorSetLayout,
+    module: vk::ShaderModule,
+) {
+    unsafe {
+        ctx.device.destroy_pipeline(pipeline, None);
+        ctx.device.destroy_pipeline_layout(layout, None);
+        ctx.device.destroy_descriptor_set_layout(set_layout, None);
+        ctx.device.destroy_shader_module(module, None);
     }
 }
 
