@@ -15,7 +15,10 @@ renderer (the variants of the CSVs):
 - whole process to 0.002: the wall time of one process as a user runs it (load, build,
   kernel compilation included) times its image's relMSE over 0.002.
 The ratios divide twinpath's time by the best peer's (the smaller of the peers' times), render
-and whole process apart. Plain Python, no packages.
+and whole process apart. A peer whose whole-process image is another image (the z of its mean
+difference from the reference beyond 4, the fourth column of whole.csv: Mitsuba's `ldsampler`,
+docs/performance.md) is listed but is no peer: the best is chosen among the others. Plain
+Python, no packages.
 """
 
 import csv
@@ -51,11 +54,14 @@ def main():
         loaded = {short(k): v for k, v in load([f for f in files if os.path.exists(f)]).items()}
         # twinpath first, then the peers by name.
         variants = {k: loaded[k] for k in sorted(loaded, key=lambda k: (k != "twinpath", k))}
-        whole = {}
+        whole, another_image = {}, set()
         if os.path.exists(os.path.join(d, "whole.csv")):
             with open(os.path.join(d, "whole.csv")) as f:
-                for label, seconds, rel in csv.reader(f):
+                # Rows written before the z column have three fields.
+                for label, seconds, rel, *z in csv.reader(f):
                     whole[label] = float(seconds) * float(rel) / TARGET
+                    if z and abs(float(z[0])) >= 4:
+                        another_image.add(label)
         with open(os.path.join(d, "triangles")) as f:
             triangles = int(f.read())
         render = {}
@@ -63,9 +69,10 @@ def main():
             secs, spp, t, e = time_to(points, TARGET)
             render[name] = secs
             w = f"{whole[name]:.2f} s" if name in whole else "-"
-            print(f"| {key} | {triangles} | {name} | {t / spp:.4f} s | {e * spp:.4f} | "
+            label = f"{name} (another image)" if name in another_image else name
+            print(f"| {key} | {triangles} | {label} | {t / spp:.4f} s | {e * spp:.4f} | "
                   f"{secs:.2f} s | {w} |")
-        peers = [n for n in render if n != "twinpath"]
+        peers = [n for n in render if n != "twinpath" and n not in another_image]
         best = min(peers, key=render.get)
         best_whole = min((n for n in peers if n in whole), key=whole.get, default=None)
         ratio_whole = (f"{whole['twinpath'] / whole[best_whole]:.2f} ({best_whole})"

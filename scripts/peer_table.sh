@@ -38,7 +38,7 @@ read -r -a mitsuba_samplers <<< "${MITSUBA_SAMPLERS:-ldsampler}"
 
 # whole DIR LABEL SPP COMMAND...: runs COMMAND (which writes DIR/whole.exr) and prints its wall
 # time, the image's relMSE against $ref, the time to 0.002 at that efficiency and the z of its
-# mean difference (flagged beyond 4); appends "LABEL,seconds,relmse" to DIR/whole.csv.
+# mean difference (flagged beyond 4); appends "LABEL,seconds,relmse,z" to DIR/whole.csv.
 whole() {
     local dir=$1 label=$2 spp=$3 t0 t1 e d z
     shift 3
@@ -49,7 +49,7 @@ whole() {
     d=$("$bin" diff "$dir/whole.exr" "$ref")
     e=$(awk '$1 == "relmse" {print $2}' <<< "$d")
     z=$(awk '$1 == "mean_diff_z" {print $2}' <<< "$d")
-    echo "$label,$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }'),$e" >> "$dir/whole.csv"
+    echo "$label,$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }'),$e,$z" >> "$dir/whole.csv"
     # z: the image's mean difference from the reference over its standard error; a peer beyond
     # 4 renders another image (Mitsuba's ldsampler: docs/performance.md) and is flagged.
     awk -v l="$label" -v a="$t0" -v b="$t1" -v e="$e" -v s="$spp" -v z="$z" 'BEGIN {
