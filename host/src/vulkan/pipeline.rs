@@ -370,8 +370,7 @@ impl CompiledPipeline {
     /// calls.
     pub fn raygen_stack_size(&self, ctx: &Context) -> u64 {
         unsafe {
-            (ctx.rt.fp().get_ray_tracing_shader_group_stack_size_khr)(
-                ctx.device.handle(),
+            ctx.rt.get_ray_tracing_shader_group_stack_size(
                 self.pipeline,
                 0,
                 vk::ShaderGroupShaderKHR::GENERAL,
