@@ -159,6 +159,9 @@ impl Tracer for RayTracer<'_> {
 /// accurate in f32 where a sum of squares minus n mean^2 would cancel. Samples the film does not
 /// sum (`film_sample::classify`: non-finite or huge) are not merged; they are counted in
 /// `accum_m2.a`. With adaptive sampling, a converged pixel takes no samples, and pilot samples go to the pilot image instead (`crate::adaptive`).
+/// The earlier launches' mean and M2 are read after the sample loop, where they are merged: a
+/// value read before it would be live across every trace call, which GPUs that traverse in
+/// hardware save and restore around each ray (`docs/gpu.md`).
 #[spirv(ray_generation)]
 pub fn raygen(
     #[spirv(launch_id)] launch_id: UVec3,
