@@ -24,8 +24,6 @@
 use crate::frame::orthonormal_basis_v3;
 use crate::real::{self, abs, V3};
 use crate::turns::cos_sin_turns;
-#[cfg(target_arch = "spirv")]
-use crate::Float;
 use core::f32::consts::PI;
 use spirv_std::glam::Vec3;
 

@@ -5,6 +5,7 @@
 
 use crate::bsdf;
 use crate::bsdf::fresnel::{conductor, dielectric, schlick};
+use crate::bsdf::inputs::BsdfInputs;
 use crate::bsdf::lambert::{eval_scattering, pdf_brdf, sample_brdf};
 use crate::bsdf::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal};
 use crate::bsdf::multiple_scattering::GlossyAlbedo;
@@ -18,6 +19,7 @@ use crate::geometry::{
 };
 use crate::light::triangle;
 use crate::phase;
+use crate::real::{self, V3};
 use crate::rng::{pcg4d, u32_to_unit_f32};
 use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
 use crate::scene::{light_kind, Camera, Light, Material, ShadingTriangle};
@@ -69,9 +71,10 @@ pub mod function {
     /// out0.xyz = sample_visible_normal(n, wo, alpha, u), out0.w = ggx_d(cos, sin^2, alpha),
     /// out1.x = ggx_g1(cos, alpha), out1.y = pdf_reflected(n . wo, (cos, sin^2), alpha)
     pub const MICROFACET: u32 = 12;
-    /// n = in0.xyz, alpha = in0.w, wo = in1.xyz, eta = in1.w, wi = in2.xyz, material kind and
-    /// complex flag = in3.xy as u32 ([`probe_material`]), GGX albedo (E, E_avg) = in3.zw
-    /// (`bsdf::multiple_scattering::GlossyAlbedo`) -> out0 = (bsdf::eval's f cos, pdf)
+    /// n = in0.xyz, alpha = in0.w, wo = in1.xyz, eta = in1.w, wi = in2.xyz, the packed clear
+    /// coat = in2.w as u32, material kind and complex flag = in3.xy as u32
+    /// ([`probe_bsdf_inputs`]), GGX albedo (E, E_avg) = in3.zw ([`probe_glossy_albedo`]) ->
+    /// out0 = (bsdf::eval's f cos, pdf)
     pub const BSDF_EVAL: u32 = 13;
     /// As [`BSDF_EVAL`] with (u_lobe, u1, u2) = in2.xyz -> bsdf::sample's out0 = (wi, pdf),
     /// out1 = (weight, eta2)
@@ -126,6 +129,61 @@ fn v3(v: Vec3) -> Vec4 {
 /// where bit 1 is set, resolved as `surface::shade` resolves it.
 #[inline]
 pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material {
+    let coat = Material::pack_coat(0.8, alpha.sqrt());
+    let m = unresolved_probe_material(kind, complex, alpha, eta, coat);
+    if kind == crate::scene::material_kind::METALLIC_ROUGHNESS {
+        crate::bsdf::metallic_roughness::resolve(&m)
+    } else {
+        m
+    }
+}
+
+/// [`probe_material`]'s scattering numbers over any scalar [`real::Real`], as the BSDF probes read
+/// them: the clear coat's packed word `coat` given (the records carry it, so that no device
+/// rounding of its roughness can move its 16-bit quantisation), glTF's material resolved over
+/// `R` from the roughness sqrt(alpha) computed over `R` (what a device computes before the
+/// scattering: `tests/src/device_class.rs` bounds it with the rest).
+#[inline]
+pub fn probe_bsdf_inputs<R: real::Real>(
+    kind: u32,
+    complex: u32,
+    alpha: f32,
+    eta: f32,
+    coat: u32,
+) -> BsdfInputs<R> {
+    let m = unresolved_probe_material(kind, complex, alpha, eta, coat);
+    if kind == crate::scene::material_kind::METALLIC_ROUGHNESS {
+        crate::bsdf::metallic_roughness::resolve_v3(&m, R::splat(alpha).sqrt())
+    } else {
+        BsdfInputs::of(&m)
+    }
+}
+
+/// The GGX albedos the BSDF probes pass `bsdf::eval` and `bsdf::sample`, over any scalar
+/// [`real::Real`], from the record's (E, E_avg) = (`e`, `e_avg`): the coat's the material's (the
+/// probe's coat has its roughness), its reflectance 0.05 + 0.5 (1 - E_avg), and a sheen lobe
+/// (A, B, R) = (0.2 + 0.7 E_avg, -0.15 E, 0.05 + 0.6 (1 - E)) in the table's range.
+#[inline]
+pub fn probe_glossy_albedo<R: real::Real>(e: f32, e_avg: f32) -> GlossyAlbedo<R> {
+    let c = R::splat;
+    let (e, e_avg, one) = (c(e), c(e_avg), c(1.0));
+    GlossyAlbedo {
+        directional: e,
+        average: e_avg,
+        coat_directional: e,
+        coat_average: e_avg,
+        coat_reflectance: c(0.05) + c(0.5) * (one - e_avg),
+        sheen: V3::new(
+            c(0.2) + c(0.7) * e_avg,
+            c(-0.15) * e,
+            c(0.05) + c(0.6) * (one - e),
+        ),
+    }
+}
+
+/// [`probe_material`] before glTF's material is resolved, its clear coat the packed `coat`.
+#[inline]
+fn unresolved_probe_material(kind: u32, complex: u32, alpha: f32, eta: f32, coat: u32) -> Material {
     let mut m = Material::diffuse([0.5, 0.4, 0.3]);
     m.kind = kind;
     m.alpha = alpha;
@@ -154,15 +212,14 @@ pub fn probe_material(kind: u32, complex: u32, alpha: f32, eta: f32) -> Material
         if complex & 2 != 0 {
             // A clear coat (KHR_materials_clearcoat) of weight 0.8, rough or smooth with the
             // material.
-            m.coat = Material::pack_coat(0.8, alpha.sqrt());
+            m.coat = coat;
         }
         // Gold's index is a conductor's: no sheen, unless `complex` asks for one
-        // (KHR_materials_sheen), orange, its roughness drawn from the material's.
+        // (KHR_materials_sheen), orange (its roughness is not read: the record gives the lobe).
         m.set_sheen([0.0; 3], 0.0);
         if complex & 4 != 0 {
             m.set_sheen([0.9, 0.6, 0.3], 0.2 + 0.8 * alpha.sqrt());
         }
-        m = crate::bsdf::metallic_roughness::resolve(&m);
     }
     m
 }
@@ -312,25 +369,20 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
             ),
         )
     } else if function == function::BSDF_EVAL || function == function::BSDF_SAMPLE {
-        let m = probe_material(input[3].x, input[3].y, i0.w, i1.w);
-        let (n, wo) = (i0.truncate(), i1.truncate());
-        // The probe's coat has the material's roughness, so its albedos too; its reflectance
-        // a number in the table's range drawn from them.
-        let albedo = GlossyAlbedo {
-            directional: i3.z,
-            average: i3.w,
-            coat_directional: i3.z,
-            coat_average: i3.w,
-            coat_reflectance: 0.05 + 0.5 * (1.0 - i3.w),
-            // A sheen lobe (A, B, R) in the table's range, drawn from the same numbers.
-            sheen: Vec3::new(0.2 + 0.7 * i3.w, -0.15 * i3.z, 0.05 + 0.6 * (1.0 - i3.z)),
-        };
+        let m = probe_bsdf_inputs::<f32>(input[3].x, input[3].y, i0.w, i1.w, input[2].w);
+        let albedo = probe_glossy_albedo::<f32>(i3.z, i3.w);
+        let (n, wo) = (V3::from(i0.truncate()), V3::from(i1.truncate()));
         if function == function::BSDF_EVAL {
-            let (f, pdf) = bsdf::eval(Dynamic(0), &m, n, wo, i2.truncate(), i1.w, albedo);
-            (f.extend(pdf), Vec4::ZERO)
+            let wi = V3::from(i2.truncate());
+            let (f, pdf) = bsdf::eval_v3(Dynamic(0), &m, n, wo, wi, i1.w, albedo);
+            (Vec3::from(f).extend(pdf), Vec4::ZERO)
         } else {
-            let s = bsdf::sample(Dynamic(0), &m, n, wo, i1.w, albedo, i2.x, i2.y, i2.z);
-            (s.wi.extend(s.pdf), s.weight.extend(s.eta2))
+            let u = (i2.x, i2.y, i2.z);
+            let s = bsdf::sample_v3(Dynamic(0), &m, n, wo, i1.w, albedo, u);
+            (
+                Vec3::from(s.wi).extend(s.pdf),
+                Vec3::from(s.weight).extend(s.eta2),
+            )
         }
     } else if function == function::TRIANGLE_LIGHT {
         let (x, p0, e1, e2) = (i0.truncate(), i1.truncate(), i2.truncate(), i3.truncate());

@@ -62,6 +62,13 @@ pub trait Real:
         Self::from_bits(self.to_bits() & Self::Bits::splat(0x7fff_ffff))
     }
 
+    /// `self` where `self > other`, else `other` (so `other` where either is NaN): glam's
+    /// `max_element` comparison, which x86's `maxss` computes in one instruction.
+    #[inline]
+    fn greater_of(self, other: Self) -> Self {
+        Self::select(self.greater_than(other), self, other)
+    }
+
     /// `yes` in the lanes where `mask` is all ones, `no` where it is zero.
     #[inline]
     fn select(mask: Self::Bits, yes: Self, no: Self) -> Self {
@@ -162,6 +169,15 @@ impl Real for f32 {
     #[inline]
     fn clamp(self, lo: Self, hi: Self) -> Self {
         f32::clamp(self, lo, hi)
+    }
+
+    #[inline]
+    fn greater_of(self, other: Self) -> Self {
+        if self > other {
+            self
+        } else {
+            other
+        }
     }
 
     #[inline]
@@ -384,6 +400,26 @@ impl<R: Real> V3<R> {
         self * (R::splat(1.0) / self.length())
     }
 
+    /// v . v, as glam's `Vec3::length_squared`.
+    #[inline]
+    pub fn length_squared(self) -> R {
+        self.dot(self)
+    }
+
+    /// The largest component, as glam's `Vec3::max_element` takes it: max(x, max(y, z)) with
+    /// max(a, b) = a where a > b, else b ([`Real::greater_of`]).
+    #[inline]
+    pub fn max_element(self) -> R {
+        self.x.greater_of(self.y.greater_of(self.z))
+    }
+
+    /// (x + y) + z: the dot product with (1, 1, 1) bit for bit (a product by 1 is exact in
+    /// any arithmetic), without its three products.
+    #[inline]
+    pub fn element_sum(self) -> R {
+        (self.x + self.y) + self.z
+    }
+
     /// `yes` in the lanes where `mask` is all ones, `no` where it is zero, component by
     /// component ([`select`]).
     #[inline]
@@ -426,6 +462,15 @@ impl<R: Real> Mul<R> for V3<R> {
     #[inline]
     fn mul(self, rhs: R) -> Self {
         Self::new(self.x * rhs, self.y * rhs, self.z * rhs)
+    }
+}
+
+/// Component by component, as glam's `Vec3 * Vec3`.
+impl<R: Real> Mul for V3<R> {
+    type Output = Self;
+    #[inline]
+    fn mul(self, rhs: Self) -> Self {
+        Self::new(self.x * rhs.x, self.y * rhs.y, self.z * rhs.z)
     }
 }
 

@@ -26,8 +26,6 @@ use crate::real::{self, V3};
 use crate::scene::{material_kind, shading_flags, texture_slot, Material, ShadingTriangle, NONE};
 use crate::scene_view::SceneView;
 use crate::texture::{self, lookup_at, textured_material, TexCoords};
-#[cfg(target_arch = "spirv")]
-use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
 
 /// The shading normal of `tri` at barycentrics `bary`: unit, or the zero vector where the blend
@@ -315,7 +313,7 @@ pub fn glossy_albedo<F: FeatureSet>(
         albedo.coat_reflectance = e.z;
     }
     if m.has_sheen() {
-        albedo.sheen = texture::sheen_ltc(textures, m.sheen_roughness(), mu);
+        albedo.sheen = texture::sheen_ltc(textures, m.sheen_roughness(), mu).into();
     }
     albedo
 }

@@ -9,6 +9,7 @@ use glam::{DVec3, Vec3};
 use kernel::bsdf::eval;
 use kernel::bsdf::sheen::{self, Sheen};
 use kernel::features::Dynamic;
+use kernel::real::V3;
 use std::f64::consts::PI;
 use twinpath::scene::sheen_ltc::{cosine_of, roughness_of, LTC, ROUGHNESSES};
 use twinpath_tests::cubature::integrate;
@@ -127,7 +128,7 @@ fn the_transformed_cosine_is_normalised() {
         (0.06, -0.1),
     ] {
         let lobe = Sheen {
-            reflectance: Vec3::ONE,
+            reflectance: V3::splat(Vec3::ONE),
             weight: 1.0,
             a,
             b,
@@ -135,7 +136,7 @@ fn the_transformed_cosine_is_normalised() {
         for mu in [0.05f32, 0.5, 1.0] {
             let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
             let total = over_directions(
-                &|w| sheen::pdf(&lobe, Vec3::Z, wo, w.as_vec3()) as f64,
+                &|w| sheen::pdf(&lobe, V3::splat(Vec3::Z), wo.into(), w.as_vec3().into()) as f64,
                 false,
             );
             assert!(

@@ -35,11 +35,11 @@
 //! `DELTA_ALPHA`) is a mirror of weight c / c = 1.
 
 use super::fresnel::dielectric;
+use super::inputs::BsdfNumbers;
 use super::microfacet::{reflection_height_correlated, Reflection};
 use super::multiple_scattering::{coat_factor, GlossyAlbedo};
 use super::DELTA_ALPHA;
-use crate::scene::Material;
-use spirv_std::glam::Vec3;
+use crate::real::{Real, V3};
 
 /// The coat's index of refraction (the extension's; `KHR_materials_clearcoat_ior` is not
 /// read).
@@ -48,17 +48,20 @@ pub const COAT_IOR: f32 = 1.5;
 /// A clear coat at a point seen from `wo`: its weight c, what it reflects of light from
 /// everywhere (the probability with which the mixture samples it, [`at`]), and its GGX alpha.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Coat {
-    pub weight: f32,
-    pub alpha: f32,
+pub struct Coat<R> {
+    pub weight: R,
+    pub alpha: R,
 }
 
-impl Coat {
+impl<R: Real> Coat<R> {
     /// No coat.
-    pub const NONE: Self = Self {
-        weight: 0.0,
-        alpha: 0.0,
-    };
+    #[inline]
+    pub fn none() -> Self {
+        Self {
+            weight: R::splat(0.0),
+            alpha: R::splat(0.0),
+        }
+    }
 }
 
 /// The coat of material `m` seen at cosine `cos_o` > 0 with the point's GGX albedos `albedo`
@@ -66,11 +69,15 @@ impl Coat {
 /// clearcoatFactor x F(cos_o) for a smooth coat and clearcoatFactor x k x the table's coat
 /// albedo for a rough one (k its multiple-scattering factor); weight 0 without a coat.
 #[inline]
-pub fn at(m: &Material, cos_o: f32, albedo: GlossyAlbedo) -> Coat {
+pub fn at<R: Real<Bits = u32>>(
+    m: &impl BsdfNumbers<R>,
+    cos_o: R,
+    albedo: GlossyAlbedo<R>,
+) -> Coat<R> {
     let factor = m.coat_weight();
     let alpha = m.coat_alpha();
-    let weight = if alpha < DELTA_ALPHA {
-        factor * dielectric(cos_o, COAT_IOR).0
+    let weight = if alpha.less_than(R::splat(DELTA_ALPHA)) != 0 {
+        factor * dielectric(cos_o, R::splat(COAT_IOR)).0
     } else {
         factor * coat_factor(albedo) * albedo.coat_reflectance
     };
@@ -81,14 +88,26 @@ pub fn at(m: &Material, cos_o: f32, albedo: GlossyAlbedo) -> Coat {
 /// F(wo . h), the dielectric's reflectance at the microfacet (Cycles' coat), k the
 /// multiple-scattering factor of `albedo`.
 #[inline]
-pub fn lobe_weight(m: &Material, wo: Vec3, h: Vec3, albedo: GlossyAlbedo) -> f32 {
-    m.coat_weight() * coat_factor(albedo) * dielectric(wo.dot(h), COAT_IOR).0
+pub fn lobe_weight<R: Real<Bits = u32>>(
+    m: &impl BsdfNumbers<R>,
+    wo: V3<R>,
+    h: V3<R>,
+    albedo: GlossyAlbedo<R>,
+) -> R {
+    m.coat_weight() * coat_factor(albedo) * dielectric(wo.dot(h), R::splat(COAT_IOR)).0
 }
 
 /// The coat's rough reflection from `wo` to `wi` (cosines `cos_o`, `cos_i` > 0), unweighted:
 /// D G2 / (4 cos_o) (times cos_i, `Reflection::value`) and the density of `wi` from its
 /// visible-normal sampling.
 #[inline]
-pub fn reflection(coat: &Coat, n: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32) -> Reflection {
+pub fn reflection<R: Real<Bits = u32>>(
+    coat: &Coat<R>,
+    n: V3<R>,
+    wo: V3<R>,
+    wi: V3<R>,
+    cos_o: R,
+    cos_i: R,
+) -> Reflection<R> {
     reflection_height_correlated(n, wo, wi, cos_o, cos_i, coat.alpha)
 }

@@ -1,7 +1,7 @@
 //! Fresnel reflectance: the fraction of light a smooth interface reflects, by the angle of
 //! incidence. Derivations and sources: `docs/materials.md` ("Fresnel").
 
-use crate::real::Real;
+use crate::real::{Real, V3};
 use spirv_std::glam::Vec3;
 
 /// Schlick's approximation F0 + (1 - F0) (1 - cos)^5 (Schlick, "An Inexpensive BRDF Model for
@@ -9,16 +9,21 @@ use spirv_std::glam::Vec3;
 /// F0 = Ks. `cos` is clamped to [0, 1].
 #[inline]
 pub fn schlick(f0: Vec3, cos: f32) -> Vec3 {
-    schlick_f90(f0, 1.0, cos)
+    schlick_f90(V3::from(f0), 1.0, cos).into()
 }
 
 /// Schlick's approximation with reflectance `f90` at grazing incidence instead of 1,
 /// f0 + (f90 - f0) (1 - cos)^5 (`cos` clamped to [0, 1]): glTF's `KHR_materials_specular`
 /// scales a dielectric's Fresnel curve by its specularFactor this way. With `f90` = 1 it is
-/// [`schlick`] bit for bit.
+/// [`schlick`] bit for bit. Over any scalar [`Real`], as the functions below.
 #[inline]
-pub fn schlick_f90(f0: Vec3, f90: f32, cos: f32) -> Vec3 {
-    f0 + (Vec3::splat(f90) - f0) * schlick_weight(cos)
+pub fn schlick_f90<R: Real<Bits = u32>>(f0: V3<R>, f90: R, cos: R) -> V3<R> {
+    let w = schlick_weight(cos);
+    V3::new(
+        f0.x + (f90 - f0.x) * w,
+        f0.y + (f90 - f0.y) * w,
+        f0.z + (f90 - f0.z) * w,
+    )
 }
 
 /// [`schlick_f90`] of one channel, over any scalar [`Real`] (so that its error under a Vulkan
@@ -74,8 +79,8 @@ pub fn conductor<R: Real<Bits = u32>>(cos: R, eta: R, k: R) -> R {
 
 /// [`conductor`] per RGB channel.
 #[inline]
-pub fn conductor_rgb(cos: f32, eta: Vec3, k: Vec3) -> Vec3 {
-    Vec3::new(
+pub fn conductor_rgb<R: Real<Bits = u32>>(cos: R, eta: V3<R>, k: V3<R>) -> V3<R> {
+    V3::new(
         conductor(cos, eta.x, k.x),
         conductor(cos, eta.y, k.y),
         conductor(cos, eta.z, k.z),
@@ -108,7 +113,7 @@ pub fn dielectric<R: Real<Bits = u32>>(cos: R, eta: R) -> (R, R) {
 /// 1 - rs^2 = 4 eta cos cos_t / (cos + eta cos_t)^2, 1 - rp^2 = 4 eta cos cos_t / (eta cos + cos_t)^2.
 /// `cos_t` is [`dielectric`]'s; 0 under total internal reflection.
 /// Generic over the scalar [`Real`] as [`conductor`] is.
-#[inline]
+#[inline(always)]
 pub fn dielectric_transmittance<R: Real<Bits = u32>>(cos: R, eta: R, cos_t: R) -> R {
     let c = unit_clamp(cos);
     let num = R::splat(4.0) * eta * c * cos_t;
@@ -125,6 +130,6 @@ pub fn dielectric_transmittance<R: Real<Bits = u32>>(cos: R, eta: R, cos_t: R) -
 /// refracted cosine ([`dielectric`]'s, nonzero): -wo / eta + (cos_o / eta - cos_t) h, a unit
 /// vector on the far side (Snell's law in vector form; pbrt-v4 9.3.2 `Refract`).
 #[inline]
-pub fn refract(wo: Vec3, h: Vec3, cos_o: f32, eta: f32, cos_t: f32) -> Vec3 {
-    -wo / eta + (cos_o / eta - cos_t) * h
+pub fn refract<R: Real>(wo: V3<R>, h: V3<R>, cos_o: R, eta: R, cos_t: R) -> V3<R> {
+    -wo / eta + h * (cos_o / eta - cos_t)
 }

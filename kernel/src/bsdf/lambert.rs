@@ -4,10 +4,10 @@
 //! packets call these functions directly; [`eval`] and [`sample`] are the kind's entries in
 //! `bsdf`'s dispatch.
 
-use super::{BsdfFlags, BsdfSample};
+use super::inputs::BsdfNumbers;
+use super::{BsdfFlags, BsdfSampleV3};
 use crate::real::{self, V3};
 use crate::sampling::{pdf_cosine_hemisphere, sample_cosine_hemisphere_v3};
-use crate::scene::Material;
 use core::f32::consts::PI;
 use spirv_std::glam::Vec3;
 
@@ -53,22 +53,23 @@ pub const FLAGS: BsdfFlags = BsdfFlags {
     chooses_lobe: false,
 };
 
-/// The kind's entry in `bsdf::eval`: (f |n . wi|, the density of [`sample`]).
+/// The kind's entry in `bsdf::eval`: (f |n . wi|, the density of [`sample`]), over any
+/// scalar [`real::Real`] in [`eval_scattering`]'s and [`pdf_brdf`]'s operations.
 #[inline]
-pub fn eval(m: &Material, n: Vec3, wi: Vec3) -> (Vec3, f32) {
-    (
-        eval_scattering(n, wi, Vec3::from(m.albedo)),
-        pdf_brdf(n, wi),
-    )
+pub fn eval<R: real::Real<Bits = u32>>(m: &impl BsdfNumbers<R>, n: V3<R>, wi: V3<R>) -> (V3<R>, R) {
+    let c = n.dot(wi).max(R::splat(0.0)) * R::splat(1.0 / PI);
+    (m.albedo() * c, c)
 }
 
 /// The kind's entry in `bsdf::sample`: a cosine-weighted direction, weight exactly Kd.
 #[inline]
-pub fn sample(m: &Material, n: Vec3, u1: f32, u2: f32) -> BsdfSample {
-    let wi = sample_brdf(n, u1, u2);
-    BsdfSample::reflected(
-        wi,
-        sampled_brdf_weight(Vec3::from(m.albedo)),
-        pdf_brdf(n, wi),
-    )
+pub fn sample<R: real::Real<Bits = u32>>(
+    m: &impl BsdfNumbers<R>,
+    n: V3<R>,
+    u1: R,
+    u2: R,
+) -> BsdfSampleV3<R> {
+    let wi = sample_brdf_v3(n, u1, u2);
+    let pdf = n.dot(wi).max(R::splat(0.0)) * R::splat(1.0 / PI);
+    BsdfSampleV3::reflected(wi, m.albedo(), pdf)
 }

@@ -3,10 +3,12 @@
 //! and resolved at each point ([`resolve`], after its textures) into the `mixture`'s Kd + Ks
 //! form with the dielectric layer, which evaluates and samples it.
 
+use super::inputs::{BsdfInputs, BsdfNumbers};
 use super::mixture;
 use super::multiple_scattering::GlossyAlbedo;
-use super::{BsdfFlags, BsdfSample};
+use super::{BsdfFlags, BsdfSampleV3};
 use crate::features;
+use crate::real::{Real, V3};
 use crate::scene::Material;
 use spirv_std::glam::Vec3;
 
@@ -30,12 +32,25 @@ pub const FLAGS: BsdfFlags = mixture::FLAGS;
 /// alpha = roughness^2. The kind stays METALLIC_ROUGHNESS, which is what selects that weight.
 #[inline]
 pub fn resolve(m: &Material) -> Material {
+    let resolved = resolve_v3::<f32>(m, m.roughness);
     let mut r = *m;
-    let base = Vec3::from(m.albedo);
-    let metallic = m.metallic;
-    r.albedo = (base * (1.0 - metallic)).to_array();
-    r.specular = (Vec3::from(m.layer_f0) * (1.0 - metallic) + base * metallic).to_array();
-    r.alpha = m.roughness * m.roughness;
+    r.albedo = Vec3::from(resolved.albedo).to_array();
+    r.specular = Vec3::from(resolved.specular).to_array();
+    r.alpha = resolved.alpha;
+    r
+}
+
+/// [`resolve`] over any scalar [`Real`], in the same operations: `m`'s scattering numbers with
+/// Kd, Ks and alpha resolved from `roughness` (`m.roughness`, or what computed it over `R`),
+/// the others as they are.
+#[inline]
+pub fn resolve_v3<R: Real>(m: &Material, roughness: R) -> BsdfInputs<R> {
+    let mut r = BsdfInputs::of(m);
+    let base = r.albedo;
+    let one_less = R::splat(1.0) - r.metallic;
+    r.albedo = base * one_less;
+    r.specular = r.layer_f0 * one_less + base * r.metallic;
+    r.alpha = roughness * roughness;
     r
 }
 
@@ -51,12 +66,24 @@ pub fn apply_ks_texture(m: &mut Material, value: Vec3) {
 /// multiple scattering given back (`albedo`: the GGX albedo at the point's roughness and `wo`,
 /// `surface::glossy_albedo`).
 #[inline]
-pub fn eval(m: &Material, n: Vec3, wo: Vec3, wi: Vec3, albedo: GlossyAlbedo) -> (Vec3, f32) {
-    mixture::eval::<true>(m, n, wo, wi, albedo)
+pub fn eval<R: Real<Bits = u32>>(
+    m: &impl BsdfNumbers<R>,
+    n: V3<R>,
+    wo: V3<R>,
+    wi: V3<R>,
+    albedo: GlossyAlbedo<R>,
+) -> (V3<R>, R) {
+    mixture::eval::<true, R>(m, n, wo, wi, albedo)
 }
 
 /// `bsdf::sample` of the resolved material: the mixture's, as [`eval`].
 #[inline]
-pub fn sample(m: &Material, n: Vec3, wo: Vec3, albedo: GlossyAlbedo, u: Vec3) -> BsdfSample {
-    mixture::sample::<true>(m, n, wo, albedo, u)
+pub fn sample<R: Real<Bits = u32>>(
+    m: &impl BsdfNumbers<R>,
+    n: V3<R>,
+    wo: V3<R>,
+    albedo: GlossyAlbedo<R>,
+    u: (R, R, R),
+) -> BsdfSampleV3<R> {
+    mixture::sample::<true, R>(m, n, wo, albedo, u)
 }

@@ -6,8 +6,6 @@
 use crate::frame::orthonormal_basis_v3;
 use crate::real::{self, V3};
 use crate::turns::cos_sin_turns;
-#[cfg(target_arch = "spirv")]
-use crate::Float;
 use core::f32::consts::PI;
 use spirv_std::glam::Vec3;
 
@@ -33,7 +31,7 @@ pub fn ggx_d<R: real::Real<Bits = u32>>(cos_h: R, sin2_h: R, alpha: R) -> R {
 /// (cos, sin^2) of the angle between unit vectors `n` and `h`: the sine from the cross
 /// product, accurate for small angles.
 #[inline]
-pub fn normal_angle(n: Vec3, h: Vec3) -> (f32, f32) {
+pub fn normal_angle<R: real::Real>(n: V3<R>, h: V3<R>) -> (R, R) {
     let c = n.cross(h);
     (n.dot(h), c.dot(c))
 }
@@ -101,22 +99,29 @@ pub fn pdf_reflected<R: real::Real<Bits = u32>>(cos_o: R, (cos_h, sin2_h): (R, R
 /// its half vector, D G / (4 cos_o) (the value times cos_i, without the Fresnel factor), and the
 /// density of `wi` from [`sample_visible_normal`] ([`pdf_reflected`]).
 #[derive(Clone, Copy, Debug)]
-pub struct Reflection {
-    pub h: Vec3,
-    pub value: f32,
-    pub pdf: f32,
+pub struct Reflection<R> {
+    pub h: V3<R>,
+    pub value: R,
+    pub pdf: R,
 }
 
 /// The [`Reflection`] from `wo` to `wi` with separable Smith G = G1(wo) G1(wi).
-#[inline]
-pub fn reflection(n: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32, alpha: f32) -> Reflection {
+#[inline(always)]
+pub fn reflection<R: real::Real<Bits = u32>>(
+    n: V3<R>,
+    wo: V3<R>,
+    wi: V3<R>,
+    cos_o: R,
+    cos_i: R,
+    alpha: R,
+) -> Reflection<R> {
     let h = (wo + wi).normalize();
     let angle = normal_angle(n, h);
     let d = ggx_d(angle.0, angle.1, alpha);
     let g = ggx_g1(cos_o, alpha) * ggx_g1(cos_i, alpha);
     Reflection {
         h,
-        value: d * g / (4.0 * cos_o),
+        value: d * g / (R::splat(4.0) * cos_o),
         pdf: pdf_reflected(cos_o, angle, alpha),
     }
 }
@@ -127,24 +132,25 @@ pub fn reflection(n: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, cos_i: f32, alpha: f3
 /// cos^2) per direction, the sum of one and the two Lambdas is (a_o / cos_o + a_i / cos_i) / 2,
 /// so D G2 / (4 cos_o) = D cos_i / (2 (a_o cos_i + a_i cos_o)): no tangent, no division by a
 /// cosine.
-#[inline]
-pub fn reflection_height_correlated(
-    n: Vec3,
-    wo: Vec3,
-    wi: Vec3,
-    cos_o: f32,
-    cos_i: f32,
-    alpha: f32,
-) -> Reflection {
+#[inline(always)]
+pub fn reflection_height_correlated<R: real::Real<Bits = u32>>(
+    n: V3<R>,
+    wo: V3<R>,
+    wi: V3<R>,
+    cos_o: R,
+    cos_i: R,
+    alpha: R,
+) -> Reflection<R> {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
     let h = (wo + wi).normalize();
     let angle = normal_angle(n, h);
     let d = ggx_d(angle.0, angle.1, alpha);
     let a2 = alpha * alpha;
-    let a_o = (a2 + (1.0 - a2) * cos_o * cos_o).max(0.0).sqrt();
-    let a_i = (a2 + (1.0 - a2) * cos_i * cos_i).max(0.0).sqrt();
+    let a_o = (a2 + (one - a2) * cos_o * cos_o).max(zero).sqrt();
+    let a_i = (a2 + (one - a2) * cos_i * cos_i).max(zero).sqrt();
     Reflection {
         h,
-        value: d * cos_i / (2.0 * (a_o * cos_i + a_i * cos_o)),
+        value: d * cos_i / (R::splat(2.0) * (a_o * cos_i + a_i * cos_o)),
         pdf: pdf_reflected(cos_o, angle, alpha),
     }
 }

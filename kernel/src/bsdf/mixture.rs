@@ -11,13 +11,14 @@
 
 use super::coat::{self, Coat};
 use super::fresnel::schlick_f90;
-use super::lambert::sample_brdf;
-use super::microfacet::{reflection, reflection_height_correlated, sample_visible_normal};
+use super::inputs::BsdfNumbers;
+use super::lambert::sample_brdf_v3;
+use super::microfacet::{reflection, reflection_height_correlated, sample_visible_normal_v3};
 use super::multiple_scattering::{factor, GlossyAlbedo};
 use super::sheen::{self, Sheen};
-use super::{reflect, BsdfFlags, BsdfSample, DELTA_ALPHA};
+use super::{reflect, BsdfFlags, BsdfSampleV3, DELTA_ALPHA};
 use crate::features;
-use crate::scene::Material;
+use crate::real::{Real, V3};
 use core::f32::consts::PI;
 use spirv_std::glam::Vec3;
 
@@ -34,13 +35,14 @@ pub const FLAGS: BsdfFlags = BsdfFlags {
 /// lobe in proportion to an estimate of its albedo, mean(Kd) for the diffuse and
 /// mean(F_Schlick(cos_o)) for the glossy (the masking left out); 0 when both are 0.
 #[inline]
-pub fn glossy_lobe_probability(m: &Material, cos_o: f32) -> f32 {
-    let fd = Vec3::from(m.albedo).dot(Vec3::ONE);
-    let fs = schlick_f90(Vec3::from(m.specular), glossy_f90(m), cos_o).dot(Vec3::ONE);
-    if fd + fs > 0.0 {
-        fs / (fd + fs)
+pub fn glossy_lobe_probability<R: Real<Bits = u32>>(m: &impl BsdfNumbers<R>, cos_o: R) -> R {
+    let fd = m.albedo().element_sum();
+    let fs = schlick_f90(m.specular(), glossy_f90(m), cos_o).element_sum();
+    let sum = fd + fs;
+    if sum.greater_than(R::splat(0.0)) != 0 {
+        fs / sum
     } else {
-        0.0
+        R::splat(0.0)
     }
 }
 
@@ -49,21 +51,25 @@ pub fn glossy_lobe_probability(m: &Material, cos_o: f32) -> f32 {
 /// metal's specular terms sum to one Schlick curve); 1 for GLOSSY (`layer_f90` 1, `metallic`
 /// 0), exactly.
 #[inline]
-pub fn glossy_f90(m: &Material) -> f32 {
-    m.layer_f90 + (1.0 - m.layer_f90) * m.metallic
+pub fn glossy_f90<R: Real<Bits = u32>>(m: &impl BsdfNumbers<R>) -> R {
+    m.layer_f90() + (R::splat(1.0) - m.layer_f90()) * m.metallic()
 }
 
 /// The factor on the Kd lobe for light from `wi` toward `wo`: 1 without the layer, and with it
 /// the share the layer lets through, 1 - max over channels of F_Schlick(`layer_f0`,
 /// `layer_f90`, |wo . h|) at the half vector h of `wo` and `wi` (Appendix B's `fresnel_mix`
 /// as `KHR_materials_specular` extends it: `1 - weight * max_value(fr)`).
-#[inline]
-fn diffuse_share<const LAYERED: bool>(m: &Material, wo: Vec3, wi: Vec3) -> f32 {
+#[inline(always)]
+fn diffuse_share<const LAYERED: bool, R: Real<Bits = u32>>(
+    m: &impl BsdfNumbers<R>,
+    wo: V3<R>,
+    wi: V3<R>,
+) -> R {
     if LAYERED {
         let h = (wo + wi).normalize();
-        1.0 - schlick_f90(Vec3::from(m.layer_f0), m.layer_f90, wo.dot(h).abs()).max_element()
+        R::splat(1.0) - schlick_f90(m.layer_f0(), m.layer_f90(), wo.dot(h).abs()).max_element()
     } else {
-        1.0
+        R::splat(1.0)
     }
 }
 
@@ -73,60 +79,62 @@ fn diffuse_share<const LAYERED: bool>(m: &Material, wo: Vec3, wi: Vec3) -> f32 {
 /// clear coat and the sheen where the material has them. Zero where `wo` is not above `n`
 /// (rounding at grazing hits).
 #[inline]
-pub fn eval<const LAYERED: bool>(
-    m: &Material,
-    n: Vec3,
-    wo: Vec3,
-    wi: Vec3,
-    albedo: GlossyAlbedo,
-) -> (Vec3, f32) {
+pub fn eval<const LAYERED: bool, R: Real<Bits = u32>>(
+    m: &impl BsdfNumbers<R>,
+    n: V3<R>,
+    wo: V3<R>,
+    wi: V3<R>,
+    albedo: GlossyAlbedo<R>,
+) -> (V3<R>, R) {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
     let cos_o = n.dot(wo);
     let cos_i = n.dot(wi);
-    if !(cos_o > 0.0) || !(cos_i > 0.0) {
-        return (Vec3::ZERO, 0.0);
+    if cos_o.greater_than(zero) == 0 || cos_i.greater_than(zero) == 0 {
+        return (V3::splat(Vec3::ZERO), zero);
     }
     let p_glossy = glossy_lobe_probability(m, cos_o);
-    let c = cos_i * (1.0 / PI);
-    let mut f = Vec3::from(m.albedo) * (c * diffuse_share::<LAYERED>(m, wo, wi));
-    let mut pdf = (1.0 - p_glossy) * c;
-    if !(m.alpha < DELTA_ALPHA) {
+    let c = cos_i * R::splat(1.0 / PI);
+    let mut f = m.albedo() * (c * diffuse_share::<LAYERED, R>(m, wo, wi));
+    let mut pdf = (one - p_glossy) * c;
+    if m.alpha().less_than(R::splat(DELTA_ALPHA)) == 0 {
         let r = if LAYERED {
-            reflection_height_correlated(n, wo, wi, cos_o, cos_i, m.alpha)
+            reflection_height_correlated(n, wo, wi, cos_o, cos_i, m.alpha())
         } else {
-            reflection(n, wo, wi, cos_o, cos_i, m.alpha)
+            reflection(n, wo, wi, cos_o, cos_i, m.alpha())
         };
-        let (f0, f90) = (Vec3::from(m.specular), glossy_f90(m));
+        let (f0, f90) = (m.specular(), glossy_f90(m));
         let glossy = schlick_f90(f0, f90, wi.dot(r.h)) * r.value;
-        f += if LAYERED {
+        f = f + if LAYERED {
             glossy * factor(albedo, f0, f90)
         } else {
             glossy
         };
-        pdf += p_glossy * r.pdf;
+        pdf = pdf + p_glossy * r.pdf;
     }
-    if LAYERED && m.coat != 0 {
+    if LAYERED && m.coat() != 0 {
         let coat = coat::at(m, cos_o, albedo);
-        if coat.weight > 0.0 {
+        if coat.weight.greater_than(zero) != 0 {
             // Under glTF's clear coat (`coat`): the material's 1 - c, and the coat's rough
             // lobe (a smooth one is a delta lobe: in neither).
-            f *= 1.0 - coat.weight;
-            pdf *= 1.0 - coat.weight;
-            if !(coat.alpha < DELTA_ALPHA) {
+            f = f * (one - coat.weight);
+            pdf = pdf * (one - coat.weight);
+            if coat.alpha.less_than(R::splat(DELTA_ALPHA)) == 0 {
                 let r = coat::reflection(&coat, n, wo, wi, cos_o, cos_i);
-                f += Vec3::splat(coat::lobe_weight(m, wo, r.h, albedo) * r.value);
-                pdf += coat.weight * r.pdf;
+                let value = coat::lobe_weight(m, wo, r.h, albedo) * r.value;
+                f = f + V3::new(value, value, value);
+                pdf = pdf + coat.weight * r.pdf;
             }
         }
     }
-    if LAYERED && albedo.sheen.z > 0.0 {
+    if LAYERED && albedo.sheen.z.greater_than(zero) != 0 {
         // Over everything, glTF's sheen (`sheen`): the rest's 1 - s, and the sheen's lobe.
         // Its R is 0 where the material has none (`surface::glossy_albedo` looks it up only
         // for a sheen): one test of a number already at hand.
-        let sheen = sheen::at(Vec3::from(m.sheen_colour()), albedo.sheen);
-        if sheen.weight > 0.0 {
+        let sheen = sheen::at(m.sheen_colour(), albedo.sheen);
+        if sheen.weight.greater_than(zero) != 0 {
             let (value, density) = sheen::eval(&sheen, n, wo, wi);
-            f = f * (1.0 - sheen.weight) + value;
-            pdf = pdf * (1.0 - sheen.weight) + sheen.weight * density;
+            f = f * (one - sheen.weight) + value;
+            pdf = pdf * (one - sheen.weight) + sheen.weight * density;
         }
     }
     (f, pdf)
@@ -138,97 +146,102 @@ pub fn eval<const LAYERED: bool>(
 /// (`coat`), and is else mapped again by (u_lobe - c) / (1 - c); then below the glossy lobe's
 /// probability it chooses that lobe; (u1, u2) draw the direction in the chosen lobe.
 #[inline]
-pub fn sample<const LAYERED: bool>(
-    m: &Material,
-    n: Vec3,
-    wo: Vec3,
-    albedo: GlossyAlbedo,
-    u: Vec3,
-) -> BsdfSample {
-    let (mut u_lobe, u1, u2) = (u.x, u.y, u.z);
+pub fn sample<const LAYERED: bool, R: Real<Bits = u32>>(
+    m: &impl BsdfNumbers<R>,
+    n: V3<R>,
+    wo: V3<R>,
+    albedo: GlossyAlbedo<R>,
+    (u_lobe, u1, u2): (R, R, R),
+) -> BsdfSampleV3<R> {
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let mut u_lobe = u_lobe;
     let cos_o = n.dot(wo);
-    if !(cos_o > 0.0) {
-        return BsdfSample::NONE;
+    if cos_o.greater_than(zero) == 0 {
+        return BsdfSampleV3::none();
     }
-    let mut sheen_weight = 0.0;
-    if LAYERED && albedo.sheen.z > 0.0 {
-        let sheen = sheen::at(Vec3::from(m.sheen_colour()), albedo.sheen);
-        if u_lobe < sheen.weight {
-            return sampled_sheen::<LAYERED>(&sheen, m, n, wo, albedo, (u1, u2));
+    let mut sheen_weight = zero;
+    if LAYERED && albedo.sheen.z.greater_than(zero) != 0 {
+        let sheen = sheen::at(m.sheen_colour(), albedo.sheen);
+        if u_lobe.less_than(sheen.weight) != 0 {
+            return sampled_sheen::<LAYERED, R>(&sheen, m, n, wo, albedo, (u1, u2));
         }
         // s < 1 here (u_lobe < 1).
         sheen_weight = sheen.weight;
-        u_lobe = (u_lobe - sheen.weight) / (1.0 - sheen.weight);
+        u_lobe = (u_lobe - sheen.weight) / (one - sheen.weight);
     }
-    let coat = if LAYERED && m.coat != 0 {
+    let coat = if LAYERED && m.coat() != 0 {
         coat::at(m, cos_o, albedo)
     } else {
-        Coat::NONE
+        Coat::none()
     };
-    if coat.weight > 0.0 {
-        if u_lobe < coat.weight {
+    let coated = coat.weight.greater_than(zero) != 0;
+    if coated {
+        if u_lobe.less_than(coat.weight) != 0 {
             // The coat, chosen with probability c: a smooth one's mirror weighs c / c.
-            if coat.alpha < DELTA_ALPHA {
-                return BsdfSample::mirror(n, reflect(wo, n), Vec3::ONE);
+            if coat.alpha.less_than(R::splat(DELTA_ALPHA)) != 0 {
+                return BsdfSampleV3::mirror(n, reflect(wo, n), V3::new(one, one, one));
             }
-            let wi = reflect(wo, sample_visible_normal(n, wo, coat.alpha, u1, u2));
-            return weighed::<LAYERED>(m, n, wo, wi, albedo);
+            let wi = reflect(wo, sample_visible_normal_v3(n, wo, coat.alpha, u1, u2));
+            return weighed::<LAYERED, R>(m, n, wo, wi, albedo);
         }
         // c < 1 here (u_lobe < 1).
-        u_lobe = (u_lobe - coat.weight) / (1.0 - coat.weight);
+        u_lobe = (u_lobe - coat.weight) / (one - coat.weight);
     }
-    let smooth = m.alpha < DELTA_ALPHA;
+    let smooth = m.alpha().less_than(R::splat(DELTA_ALPHA)) != 0;
     let p_glossy = glossy_lobe_probability(m, cos_o);
-    let glossy = u_lobe < p_glossy;
+    let glossy = u_lobe.less_than(p_glossy) != 0;
     if smooth && glossy {
-        return BsdfSample::mirror(
+        return BsdfSampleV3::mirror(
             n,
             reflect(wo, n),
-            schlick_f90(Vec3::from(m.specular), glossy_f90(m), cos_o) / p_glossy,
+            schlick_f90(m.specular(), glossy_f90(m), cos_o) / p_glossy,
         );
     }
     let wi = if glossy {
-        reflect(wo, sample_visible_normal(n, wo, m.alpha, u1, u2))
+        reflect(wo, sample_visible_normal_v3(n, wo, m.alpha(), u1, u2))
     } else {
-        sample_brdf(n, u1, u2)
+        sample_brdf_v3(n, u1, u2)
     };
-    if smooth && coat.weight == 0.0 && sheen_weight == 0.0 {
+    if smooth && coat.weight.not_equal(zero) == 0 && sheen_weight.not_equal(zero) == 0 {
         // The diffuse lobe beside a delta one: (Kd/pi cos) / ((1 - p) cos/pi), exactly.
-        let weight =
-            Vec3::from(m.albedo) * (diffuse_share::<LAYERED>(m, wo, wi) / (1.0 - p_glossy));
-        return BsdfSample::reflected(wi, weight, (1.0 - p_glossy) * n.dot(wi) * (1.0 / PI));
+        let weight = m.albedo() * (diffuse_share::<LAYERED, R>(m, wo, wi) / (one - p_glossy));
+        return BsdfSampleV3::reflected(
+            wi,
+            weight,
+            (one - p_glossy) * n.dot(wi) * R::splat(1.0 / PI),
+        );
     }
-    weighed::<LAYERED>(m, n, wo, wi, albedo)
+    weighed::<LAYERED, R>(m, n, wo, wi, albedo)
 }
 
 /// The sheen's sample (chosen with probability s) from numbers `u`, weighed by the whole
 /// mixture. Kept out of line on the CPU: materials without a sheen never run it.
 #[cfg_attr(not(target_arch = "spirv"), inline(never))]
-fn sampled_sheen<const LAYERED: bool>(
-    sheen: &Sheen,
-    m: &Material,
-    n: Vec3,
-    wo: Vec3,
-    albedo: GlossyAlbedo,
-    u: (f32, f32),
-) -> BsdfSample {
+fn sampled_sheen<const LAYERED: bool, R: Real<Bits = u32>>(
+    sheen: &Sheen<R>,
+    m: &impl BsdfNumbers<R>,
+    n: V3<R>,
+    wo: V3<R>,
+    albedo: GlossyAlbedo<R>,
+    u: (R, R),
+) -> BsdfSampleV3<R> {
     let wi = sheen::sample(sheen, n, wo, u.0, u.1);
-    weighed::<LAYERED>(m, n, wo, wi, albedo)
+    weighed::<LAYERED, R>(m, n, wo, wi, albedo)
 }
 
 /// The sample of direction `wi` weighed f cos / pdf by [`eval`] (the whole mixture's value and
 /// density, the delta lobes in neither), or none where the density is 0.
 #[inline]
-fn weighed<const LAYERED: bool>(
-    m: &Material,
-    n: Vec3,
-    wo: Vec3,
-    wi: Vec3,
-    albedo: GlossyAlbedo,
-) -> BsdfSample {
-    let (f, pdf) = eval::<LAYERED>(m, n, wo, wi, albedo);
-    if !(pdf > 0.0) {
-        return BsdfSample::NONE;
+fn weighed<const LAYERED: bool, R: Real<Bits = u32>>(
+    m: &impl BsdfNumbers<R>,
+    n: V3<R>,
+    wo: V3<R>,
+    wi: V3<R>,
+    albedo: GlossyAlbedo<R>,
+) -> BsdfSampleV3<R> {
+    let (f, pdf) = eval::<LAYERED, R>(m, n, wo, wi, albedo);
+    if pdf.greater_than(R::splat(0.0)) == 0 {
+        return BsdfSampleV3::none();
     }
-    BsdfSample::reflected(wi, f / pdf, pdf)
+    BsdfSampleV3::reflected(wi, f / pdf, pdf)
 }

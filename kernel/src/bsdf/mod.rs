@@ -23,6 +23,7 @@ pub mod coat;
 pub mod conductor;
 pub mod dielectric;
 pub mod fresnel;
+pub mod inputs;
 pub mod lambert;
 pub mod metallic_roughness;
 pub mod microfacet;
@@ -31,7 +32,9 @@ pub mod multiple_scattering;
 pub mod sheen;
 
 use crate::features::FeatureSet;
+use crate::real::{Real, V3};
 use crate::scene::{material_kind, Material};
+use inputs::BsdfNumbers;
 use multiple_scattering::GlossyAlbedo;
 use spirv_std::glam::Vec3;
 
@@ -68,35 +71,74 @@ impl BsdfSample {
         eta2: 1.0,
         transmitted: false,
     };
+}
 
-    /// A reflected sample.
+/// [`BsdfSample`] over any scalar [`Real`]: what [`sample_v3`] returns.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSampleV3<R> {
+    pub wi: V3<R>,
+    pub weight: V3<R>,
+    pub pdf: R,
+    pub eta2: R,
+    pub transmitted: bool,
+}
+
+impl<R: Real> BsdfSampleV3<R> {
+    /// The sample that ends the path ([`BsdfSample::NONE`]).
     #[inline]
-    pub fn reflected(wi: Vec3, weight: Vec3, pdf: f32) -> Self {
+    pub fn none() -> Self {
         Self {
-            wi,
-            weight,
-            pdf,
-            eta2: 1.0,
+            wi: V3::splat(Vec3::Z),
+            weight: V3::splat(Vec3::ZERO),
+            pdf: R::splat(0.0),
+            eta2: R::splat(1.0),
             transmitted: false,
         }
     }
 
+    /// A reflected sample.
+    #[inline]
+    pub fn reflected(wi: V3<R>, weight: V3<R>, pdf: R) -> Self {
+        Self {
+            wi,
+            weight,
+            pdf,
+            eta2: R::splat(1.0),
+            transmitted: false,
+        }
+    }
+}
+
+impl<R: Real<Bits = u32>> BsdfSampleV3<R> {
     /// A delta lobe's reflection `wi` (about `n` or a microfacet), unless rounding put it
     /// below the surface (a grazing `wo` has a grazing mirror image): then the path ends, as
     /// for the rough lobes' directions below the surface.
     #[inline]
-    pub fn mirror(n: Vec3, wi: Vec3, weight: Vec3) -> Self {
-        if !(n.dot(wi) > 0.0) {
-            return Self::NONE;
+    pub fn mirror(n: V3<R>, wi: V3<R>, weight: V3<R>) -> Self {
+        if n.dot(wi).greater_than(R::splat(0.0)) == 0 {
+            return Self::none();
         }
-        Self::reflected(wi, weight, DELTA_PDF)
+        Self::reflected(wi, weight, R::splat(DELTA_PDF))
     }
 }
 
-/// The mirror direction of `wo` about unit `h`.
+impl From<BsdfSampleV3<f32>> for BsdfSample {
+    #[inline]
+    fn from(s: BsdfSampleV3<f32>) -> Self {
+        Self {
+            wi: s.wi.into(),
+            weight: s.weight.into(),
+            pdf: s.pdf,
+            eta2: s.eta2,
+            transmitted: s.transmitted,
+        }
+    }
+}
+
+/// The mirror direction of `wo` about unit `h`: 2 (wo . h) h - wo.
 #[inline]
-pub fn reflect(wo: Vec3, h: Vec3) -> Vec3 {
-    2.0 * wo.dot(h) * h - wo
+pub fn reflect<R: Real>(wo: V3<R>, h: V3<R>) -> V3<R> {
+    h * (R::splat(2.0) * wo.dot(h)) - wo
 }
 
 /// What a path vertex asks of a material before it draws its numbers (pbrt-v4's
@@ -190,10 +232,34 @@ pub fn eval<F: FeatureSet>(
     eta: f32,
     albedo: GlossyAlbedo,
 ) -> (Vec3, f32) {
-    match m.kind {
+    let (f, pdf) = eval_v3(
+        features,
+        m,
+        V3::from(n),
+        V3::from(wo),
+        V3::from(wi),
+        eta,
+        albedo,
+    );
+    (f.into(), pdf)
+}
+
+/// [`eval`] over any scalar [`Real`], in the same operations: the `f32` instance is [`eval`]'s
+/// arithmetic, another type bounds it (`tests/src/device_class.rs`).
+#[inline]
+pub fn eval_v3<F: FeatureSet, R: Real<Bits = u32>>(
+    features: F,
+    m: &impl BsdfNumbers<R>,
+    n: V3<R>,
+    wo: V3<R>,
+    wi: V3<R>,
+    eta: R,
+    albedo: GlossyAlbedo<R>,
+) -> (V3<R>, R) {
+    match m.kind() {
         material_kind::DIFFUSE => lambert::eval(m, n, wi),
         material_kind::GLOSSY if features.has_all(mixture::FEATURES) => {
-            mixture::eval::<false>(m, n, wo, wi, GlossyAlbedo::NONE)
+            mixture::eval::<false, R>(m, n, wo, wi, GlossyAlbedo::none())
         }
         material_kind::METALLIC_ROUGHNESS if features.has_all(metallic_roughness::FEATURES) => {
             metallic_roughness::eval(m, n, wo, wi, albedo)
@@ -204,7 +270,7 @@ pub fn eval<F: FeatureSet>(
         material_kind::DIELECTRIC if features.has_all(dielectric::FEATURES) => {
             dielectric::eval(m, n, wo, wi, eta)
         }
-        _ => (Vec3::ZERO, 0.0),
+        _ => (V3::splat(Vec3::ZERO), R::splat(0.0)),
     }
 }
 
@@ -226,13 +292,36 @@ pub fn sample<F: FeatureSet>(
     u1: f32,
     u2: f32,
 ) -> BsdfSample {
-    match m.kind {
+    sample_v3(
+        features,
+        m,
+        V3::from(n),
+        V3::from(wo),
+        eta,
+        albedo,
+        (u_lobe, u1, u2),
+    )
+    .into()
+}
+
+/// [`sample`] over any scalar [`Real`], in the same operations, with `u` = (u_lobe, u1, u2).
+#[inline]
+pub fn sample_v3<F: FeatureSet, R: Real<Bits = u32>>(
+    features: F,
+    m: &impl BsdfNumbers<R>,
+    n: V3<R>,
+    wo: V3<R>,
+    eta: R,
+    albedo: GlossyAlbedo<R>,
+    (u_lobe, u1, u2): (R, R, R),
+) -> BsdfSampleV3<R> {
+    match m.kind() {
         material_kind::DIFFUSE => lambert::sample(m, n, u1, u2),
         material_kind::GLOSSY if features.has_all(mixture::FEATURES) => {
-            mixture::sample::<false>(m, n, wo, GlossyAlbedo::NONE, Vec3::new(u_lobe, u1, u2))
+            mixture::sample::<false, R>(m, n, wo, GlossyAlbedo::none(), (u_lobe, u1, u2))
         }
         material_kind::METALLIC_ROUGHNESS if features.has_all(metallic_roughness::FEATURES) => {
-            metallic_roughness::sample(m, n, wo, albedo, Vec3::new(u_lobe, u1, u2))
+            metallic_roughness::sample(m, n, wo, albedo, (u_lobe, u1, u2))
         }
         material_kind::CONDUCTOR if features.has_all(conductor::FEATURES) => {
             conductor::sample(m, n, wo, u1, u2)
@@ -240,6 +329,6 @@ pub fn sample<F: FeatureSet>(
         material_kind::DIELECTRIC if features.has_all(dielectric::FEATURES) => {
             dielectric::sample(m, n, wo, eta, u_lobe, u1, u2)
         }
-        _ => BsdfSample::NONE,
+        _ => BsdfSampleV3::none(),
     }
 }

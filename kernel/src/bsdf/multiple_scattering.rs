@@ -31,26 +31,27 @@
 //! (the integral of 2 mu (1 - mu)^5 over [0, 1] is 1/21).
 //! Derivations and bounds: `docs/materials.md` ("Multiple scattering").
 
+use crate::real::{Real, V3};
 use spirv_std::glam::Vec3;
 
 /// The directional albedo E(mu_o) of a point's GGX lobes (Fresnel factor 1) at their
 /// roughness and its view, and their hemispherical averages E_avg: the material's glossy lobe's
 /// (`directional`, `average`) and its clear coat's (`coat_directional`, `coat_average`; `coat`).
 /// What the compensation divides by and weighs with; 1 (as in [`GlossyAlbedo::NONE`]) is no
-/// compensation.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GlossyAlbedo {
-    pub directional: f32,
-    pub average: f32,
-    pub coat_directional: f32,
-    pub coat_average: f32,
+/// compensation. Over any scalar [`Real`] (`f32` unless said), as `bsdf::eval_v3` reads it.
+#[derive(Clone, Copy, Debug)]
+pub struct GlossyAlbedo<R = f32> {
+    pub directional: R,
+    pub average: R,
+    pub coat_directional: R,
+    pub coat_average: R,
     /// The coat lobe's directional albedo with its Fresnel factor F(wo . h) (index 1.5), before
     /// its weight and its compensation: what the coat reflects of light from everywhere, and so
     /// what it takes from the material below (`coat`).
-    pub coat_reflectance: f32,
+    pub coat_reflectance: R,
     /// The sheen's linearly transformed cosine (A, B, R) at its roughness and the view
     /// (`sheen`, `texture::sheen_ltc`); R = 0: no sheen.
-    pub sheen: Vec3,
+    pub sheen: V3<R>,
 }
 
 impl GlossyAlbedo {
@@ -62,8 +63,28 @@ impl GlossyAlbedo {
         coat_directional: 1.0,
         coat_average: 1.0,
         coat_reflectance: 1.0,
-        sheen: Vec3::ZERO,
+        sheen: V3 {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+        },
     };
+}
+
+impl<R: Real> GlossyAlbedo<R> {
+    /// [`GlossyAlbedo::NONE`] over `R`.
+    #[inline]
+    pub fn none() -> Self {
+        let one = R::splat(1.0);
+        Self {
+            directional: one,
+            average: one,
+            coat_directional: one,
+            coat_average: one,
+            coat_reflectance: one,
+            sheen: V3::splat(Vec3::ZERO),
+        }
+    }
 }
 
 /// The cosine-weighted hemispherical average of the exact Fresnel reflectance of a dielectric of
@@ -72,22 +93,28 @@ impl GlossyAlbedo {
 pub const COAT_FRESNEL_AVERAGE: f32 = 0.091_777_96;
 
 /// The factor on the clear coat's lobe (`coat`): 1 + F_ms (1 - E) / E with the coat's albedos
-/// and F_avg = [`COAT_FRESNEL_AVERAGE`], as Cycles gives its coat's energy back.
+/// and F_avg = [`COAT_FRESNEL_AVERAGE`], as Cycles gives its coat's energy back. Over any
+/// scalar [`Real`].
 #[inline]
-pub fn coat_factor(albedo: GlossyAlbedo) -> f32 {
+pub fn coat_factor<R: Real>(albedo: GlossyAlbedo<R>) -> R {
     let (e, e_avg) = (albedo.coat_directional, albedo.coat_average);
-    let f_avg = COAT_FRESNEL_AVERAGE;
-    let f_ms = f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg));
-    1.0 + f_ms * ((1.0 - e) / e)
+    let (one, f_avg) = (R::splat(1.0), R::splat(COAT_FRESNEL_AVERAGE));
+    let f_ms = f_avg * e_avg / (one - f_avg * (one - e_avg));
+    one + f_ms * ((one - e) / e)
 }
 
 /// The factor on a Schlick lobe of reflectances `f0` (normal incidence) and `f90` (grazing):
 /// 1 + F_ms (1 - E) / E, F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)), F_avg = F0 + (F90 -
-/// F0) / 21. Exactly 1 for [`GlossyAlbedo::NONE`].
+/// F0) / 21, per channel. Exactly 1 for [`GlossyAlbedo::NONE`].
 #[inline]
-pub fn factor(albedo: GlossyAlbedo, f0: Vec3, f90: f32) -> Vec3 {
+pub fn factor<R: Real>(albedo: GlossyAlbedo<R>, f0: V3<R>, f90: R) -> V3<R> {
     let (e, e_avg) = (albedo.directional, albedo.average);
-    let f_avg = f0 + (Vec3::splat(f90) - f0) * (1.0 / 21.0);
-    let f_ms = f_avg * e_avg / (Vec3::ONE - f_avg * (1.0 - e_avg));
-    Vec3::ONE + f_ms * ((1.0 - e) / e)
+    let one = R::splat(1.0);
+    let (rest, scale) = (one - e_avg, (one - e) / e);
+    let channel = |f0: R| {
+        let f_avg = f0 + (f90 - f0) * R::splat(1.0 / 21.0);
+        let f_ms = f_avg * e_avg / (one - f_avg * rest);
+        one + f_ms * scale
+    };
+    V3::new(channel(f0.x), channel(f0.y), channel(f0.z))
 }

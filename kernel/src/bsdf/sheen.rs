@@ -27,44 +27,47 @@
 //! Sampling (`mixture`): the sheen is chosen with probability s, so the material's lobes keep
 //! their weights ((1 - s) / (1 - s)).
 
-use crate::frame::orthonormal_basis;
-use crate::sampling::sample_cosine_hemisphere;
-#[cfg(target_arch = "spirv")]
-use crate::Float;
+use crate::frame::orthonormal_basis_v3;
+use crate::real::{Real, V3};
+use crate::sampling::sample_cosine_hemisphere_v3;
 use core::f32::consts::PI;
 use spirv_std::glam::Vec3;
 
 /// A sheen at a point seen from `wo`: its colour times its reflectance R, the weight s with
 /// which it is chosen and takes from the material below, and its transform (A, B).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Sheen {
-    pub reflectance: Vec3,
-    pub weight: f32,
-    pub a: f32,
-    pub b: f32,
+#[derive(Clone, Copy, Debug)]
+pub struct Sheen<R> {
+    pub reflectance: V3<R>,
+    pub weight: R,
+    pub a: R,
+    pub b: R,
 }
 
-impl Sheen {
+impl<R: Real> Sheen<R> {
     /// No sheen.
-    pub const NONE: Self = Self {
-        reflectance: Vec3::ZERO,
-        weight: 0.0,
-        a: 1.0,
-        b: 0.0,
-    };
+    #[inline]
+    pub fn none() -> Self {
+        Self {
+            reflectance: V3::splat(Vec3::ZERO),
+            weight: R::splat(0.0),
+            a: R::splat(1.0),
+            b: R::splat(0.0),
+        }
+    }
 }
 
 /// The sheen of colour `colour` whose lobe at the point and view is `ltc` = (A, B, R)
 /// (`GlossyAlbedo::sheen`); none where R or A is not positive.
 #[inline]
-pub fn at(colour: Vec3, ltc: Vec3) -> Sheen {
-    if !(ltc.z > 0.0 && ltc.x > 0.0) {
-        return Sheen::NONE;
+pub fn at<R: Real<Bits = u32>>(colour: V3<R>, ltc: V3<R>) -> Sheen<R> {
+    let zero = R::splat(0.0);
+    if ltc.z.greater_than(zero) == 0 || ltc.x.greater_than(zero) == 0 {
+        return Sheen::none();
     }
     let reflectance = colour * ltc.z;
     Sheen {
         reflectance,
-        weight: reflectance.max_element().min(1.0),
+        weight: reflectance.max_element().min(R::splat(1.0)),
         a: ltc.x,
         b: ltc.y,
     }
@@ -73,34 +76,35 @@ pub fn at(colour: Vec3, ltc: Vec3) -> Sheen {
 /// The frame (x, y) around `n` with x along `wo`'s projection onto the surface (any, where
 /// `wo` is the normal: the lobe is then symmetric about it, B being 0 at normal view).
 #[inline]
-fn frame(n: Vec3, wo: Vec3) -> (Vec3, Vec3) {
+fn frame<R: Real<Bits = u32>>(n: V3<R>, wo: V3<R>) -> (V3<R>, V3<R>) {
     let tangential = wo - n * n.dot(wo);
     let length2 = tangential.length_squared();
-    if length2 > 1e-12 {
+    if length2.greater_than(R::splat(1e-12)) != 0 {
         let x = tangential / length2.sqrt();
         (x, n.cross(x))
     } else {
-        orthonormal_basis(n)
+        orthonormal_basis_v3(n)
     }
 }
 
 /// The normalised lobe's density at `wi` (per unit solid angle): D(w') A^2 / |M^-1 w|^3.
 #[inline]
-pub fn pdf(sheen: &Sheen, n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
+pub fn pdf<R: Real<Bits = u32>>(sheen: &Sheen<R>, n: V3<R>, wo: V3<R>, wi: V3<R>) -> R {
+    let zero = R::splat(0.0);
     let (x, y) = frame(n, wo);
     let (wx, wy, wz) = (wi.dot(x), wi.dot(y), wi.dot(n));
-    let v = Vec3::new(sheen.a * wx + sheen.b * wz, sheen.a * wy, wz);
+    let v = V3::new(sheen.a * wx + sheen.b * wz, sheen.a * wy, wz);
     let length = v.length();
-    if !(wz > 0.0 && length > 0.0) {
-        return 0.0;
+    if wz.greater_than(zero) == 0 || length.greater_than(zero) == 0 {
+        return zero;
     }
     let cos = v.z / length;
-    cos.max(0.0) * (1.0 / PI) * sheen.a * sheen.a / (length * length * length)
+    cos.max(zero) * R::splat(1.0 / PI) * sheen.a * sheen.a / (length * length * length)
 }
 
 /// The sheen's f cos_i from `wo` to `wi` (before the layering) and its density.
 #[inline]
-pub fn eval(sheen: &Sheen, n: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+pub fn eval<R: Real<Bits = u32>>(sheen: &Sheen<R>, n: V3<R>, wo: V3<R>, wi: V3<R>) -> (V3<R>, R) {
     let p = pdf(sheen, n, wo, wi);
     (sheen.reflectance * p, p)
 }
@@ -108,10 +112,10 @@ pub fn eval(sheen: &Sheen, n: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
 /// A direction drawn from the normalised lobe with (u1, u2): w' cosine-distributed about z,
 /// then w = M w' = (w'_x / A - B w'_z / A, w'_y / A, w'_z) normalised.
 #[inline]
-pub fn sample(sheen: &Sheen, n: Vec3, wo: Vec3, u1: f32, u2: f32) -> Vec3 {
+pub fn sample<R: Real<Bits = u32>>(sheen: &Sheen<R>, n: V3<R>, wo: V3<R>, u1: R, u2: R) -> V3<R> {
     let (x, y) = frame(n, wo);
-    let w = sample_cosine_hemisphere(Vec3::Z, u1, u2);
-    let inverse_a = 1.0 / sheen.a;
-    let local = Vec3::new((w.x - sheen.b * w.z) * inverse_a, w.y * inverse_a, w.z).normalize();
+    let w = sample_cosine_hemisphere_v3(V3::splat(Vec3::Z), u1, u2);
+    let inverse_a = R::splat(1.0) / sheen.a;
+    let local = V3::new((w.x - sheen.b * w.z) * inverse_a, w.y * inverse_a, w.z).normalize();
     x * local.x + y * local.y + n * local.z
 }
