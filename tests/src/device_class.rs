@@ -374,6 +374,75 @@ pub fn microfacet_apart(
     apart
 }
 
+/// A record of the BSDF probes (`kernel::probe::function::BSDF_EVAL`, `BSDF_SAMPLE`): the
+/// material's kind, `complex` bits and packed clear coat (`kernel::probe::probe_bsdf_inputs`),
+/// unit normal `n`, roughness `alpha`, unit `wo`, index ratio `eta`, `third` = wi (eval) or
+/// (u_lobe, u1, u2) (sample), and the GGX albedos (E, E_avg)
+/// (`kernel::probe::probe_glossy_albedo`).
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfRecord {
+    pub sample: bool,
+    pub kind: u32,
+    pub complex: u32,
+    pub coat: u32,
+    pub n: [f32; 3],
+    pub alpha: f32,
+    pub wo: [f32; 3],
+    pub eta: f32,
+    pub third: [f32; 3],
+    pub albedo: (f32, f32),
+}
+
+impl BsdfRecord {
+    /// The probe's outputs for this record, computed over any scalar [`Real`] by the kernel's
+    /// own code (the material's resolution and the albedos included): eval's (f cos, pdf, 0,
+    /// 0, 0, 0), or sample's (wi, pdf, weight, eta2).
+    pub fn outputs<R: Real<Bits = u32>>(&self) -> [R; 8] {
+        use kernel::bsdf::{eval_v3, sample_v3};
+        use kernel::features::Dynamic;
+        use kernel::probe::{probe_bsdf_inputs, probe_glossy_albedo};
+        let m = probe_bsdf_inputs::<R>(self.kind, self.complex, self.alpha, self.eta, self.coat);
+        let albedo = probe_glossy_albedo::<R>(self.albedo.0, self.albedo.1);
+        let v = |x: [f32; 3]| V3::new(R::splat(x[0]), R::splat(x[1]), R::splat(x[2]));
+        let (n, wo, eta) = (v(self.n), v(self.wo), R::splat(self.eta));
+        let zero = R::splat(0.0);
+        if self.sample {
+            let u = (
+                R::splat(self.third[0]),
+                R::splat(self.third[1]),
+                R::splat(self.third[2]),
+            );
+            let s = sample_v3(Dynamic(0), &m, n, wo, eta, albedo, u);
+            [
+                s.wi.x, s.wi.y, s.wi.z, s.pdf, s.weight.x, s.weight.y, s.weight.z, s.eta2,
+            ]
+        } else {
+            let (f, pdf) = eval_v3(Dynamic(0), &m, n, wo, v(self.third), eta, albedo);
+            [f.x, f.y, f.z, pdf, zero, zero, zero, zero]
+        }
+    }
+}
+
+/// How far apart the CPU's and a conformant device's `bsdf::eval` or `bsdf::sample` may be for
+/// the probe's record `r`, per output (out0 then out1): the largest distance between the
+/// kernel's own code run on [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic,
+/// every way its tests may go (a lobe choice within rounding of its threshold takes either
+/// lobe: the other sample is among the ways). The glTF material's resolution (its roughness
+/// sqrt(alpha), Kd, Ks and alpha) and the probe's albedos are computed in the same arithmetic,
+/// as a device computes them. The balls carry each lobe's conditioning (a sharp lobe's density,
+/// the refraction's Jacobian near an index-matched interface); a sampled direction is a unit
+/// vector, apart by at most 2 per component, which caps its bound; a delta lobe's density
+/// (infinite in both) is not apart.
+pub fn bsdf_apart(r: &BsdfRecord) -> [f64; 8] {
+    let mut apart = ieee_and_vulkan_apart(&|| r.outputs::<Ball>());
+    if r.sample {
+        for a in &mut apart[..3] {
+            *a = a.min(UNIT_APART);
+        }
+    }
+    apart
+}
+
 /// How far apart the CPU's and a conformant device's phase function `kernel::phase::eval_v3`
 /// may be, for asymmetry `g` and unit `wo`, `wi`: the largest distance between it run on
 /// [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic (both ways of the

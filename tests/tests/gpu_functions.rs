@@ -6,6 +6,7 @@
 use glam::Vec3;
 use kernel::probe::{evaluate, function};
 use twinpath::vulkan::compute::ProbeRunner;
+use twinpath_tests::device_class::bsdf_apart;
 use twinpath_tests::gpu::{assert_validation_clean, context};
 
 const N: usize = 100_000;
@@ -236,6 +237,8 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                     [g.unit(), g.unit(), g.unit(), 0.0]
                 };
                 let mut x = rec([w(n, alpha), w(wo, eta), third, [0.0; 4]]);
+                // The clear coat (where `complex` asks for one) has the material's roughness.
+                x[2][3] = kernel::scene::Material::pack_coat(0.8, alpha.sqrt());
                 x[3][0] = (g.u64() % 5) as u32;
                 // Bits of `probe_material`'s `complex`: gold's index, a clear coat, a sheen.
                 x[3][1] = (g.u64() % 8) as u32;
@@ -447,6 +450,24 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
 
+/// The BSDF probe's record `r` of function `func` (`kernel::probe`'s layout).
+fn bsdf_record(func: u32, r: &[[u32; 4]; 4]) -> twinpath_tests::device_class::BsdfRecord {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
+    let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
+    twinpath_tests::device_class::BsdfRecord {
+        sample: func == function::BSDF_SAMPLE,
+        kind: r[3][0],
+        complex: r[3][1],
+        coat: r[2][3],
+        n: v(0),
+        alpha: f(0, 3),
+        wo: v(1),
+        eta: f(1, 3),
+        third: v(2),
+        albedo: (f(3, 2), f(3, 3)),
+    }
+}
+
 /// The absolute error allowed for output component (k, j) of record `r` under bound `b`, whose
 /// larger magnitude on the two sides is `value`: unit vectors and pdfs take `b.abs`; positions on a sphere take `b.abs`
 /// times the size of the geometry (|centre| + radius), since a unit-vector error scales with it.
@@ -481,6 +502,11 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
                 (f(2, 0), f(2, 1)),
             );
             output_allowance(&apart, k, j)
+        }
+        // The Vulkan class's BSDFs, per record (`bsdf_apart`): out0 = (f cos, pdf) or (wi,
+        // pdf), out1 = (weight, eta2).
+        function::BSDF_EVAL | function::BSDF_SAMPLE if b.vulkan => {
+            output_allowance(&bsdf_apart(&bsdf_record(b.func, r)), k, j)
         }
         // The Vulkan class's intersections, per record (`sphere_hit_apart`,
         // `triangle_hit_apart`; the probe's layout: `kernel::probe`).
@@ -913,6 +939,14 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
             abs: 0.0,
             vulkan: true,
             why: "Vulkan class: the kernel's mapped normal (a blend, one Gram-Schmidt step, a cross product, two normalisations and their tests) run on balls in IEEE and in Vulkan arithmetic, every way its tests may go; the largest distance between the two, per record (`mapped_normal_apart`)",
+            ..*b
+        }),
+        function::BSDF_EVAL | function::BSDF_SAMPLE => Some(Bound {
+            max_ulps: 0,
+            abs: 0.0,
+            ill_conditioned: None,
+            vulkan: true,
+            why: "Vulkan class: the kernel's bsdf::eval_v3 / sample_v3 (every kind and lobe, the glTF material's resolution and the probe's albedos) run on balls in IEEE and in Vulkan arithmetic, every way their tests may go (a lobe choice within rounding of its threshold takes either lobe); the largest distance between the two, per record (`bsdf_apart`), which carries each lobe's conditioning; unbounded (unchecked) where a ball is",
             ..*b
         }),
         function::FRESNEL => Some(Bound {
