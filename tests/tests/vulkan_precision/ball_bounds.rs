@@ -571,6 +571,18 @@ fn bsdfs_differ_from_the_cpu_within_their_balls() {
         let cpu = run(None);
         assert_eq!(cpu, r.outputs::<f32>(), "Vk32 under IEEE is the f32 kernel");
         let device = run(Some(k));
+        // No NaN, no negative value or weight, a positive eta^2, under any arithmetic: what
+        // the path multiplies its throughput by stays a number (the same checks as
+        // `properties.rs` makes of the CPU's).
+        for (i, x) in device.iter().enumerate() {
+            assert!(!x.is_nan(), "output {i} of {r:?} NaN on a device");
+            let non_negative = if sample { (3..7).contains(&i) } else { i < 4 };
+            assert!(
+                !non_negative || *x >= 0.0,
+                "output {i} of {r:?}: {x} on a device"
+            );
+        }
+        assert!(!sample || device[7] > 0.0, "eta^2 {} of {r:?}", device[7]);
         let apart = bsdf_apart(&r);
         let one_way = [Roundoff::IEEE, Roundoff::VULKAN]
             .into_iter()
