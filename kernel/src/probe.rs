@@ -17,7 +17,7 @@ use crate::geometry::{
     geometry_factor, intersect_sphere, intersect_triangle_uv, offset_ray_origin,
     reproject_to_sphere, shadow_ray_end, triangle_point, triangle_point_error,
 };
-use crate::light::triangle;
+use crate::light::{directional, punctual, triangle};
 use crate::phase;
 use crate::real::{self, V3};
 use crate::rng::{pcg4d, u32_to_unit_f32};
@@ -97,7 +97,13 @@ pub mod function {
     /// phase::eval(g, wo, wi)), out1 = free_flight::sample(sigma_t, sigma_s, d,
     /// hero_channel(u1), u2, (1, 1, 1))'s (t, weight)
     pub const MEDIUM: u32 = 18;
-    pub const COUNT: u32 = 19;
+    /// receiver x = in0.xyz, selection probability = in0.w, position = in1.xyz, spot scale =
+    /// in1.w, axis (and a directional light's direction of travel) = in2.xyz, spot offset =
+    /// in2.w, the scene's bounding sphere (centre, radius) = in3 ([`probe_punctual_light`]) ->
+    /// out0 = light::punctual::sample's (normal, pdf), out1 = (its spot_attenuation,
+    /// light::directional::sample's position)
+    pub const PUNCTUAL_LIGHT: u32 = 19;
+    pub const COUNT: u32 = 20;
 }
 
 #[inline]
@@ -247,6 +253,33 @@ pub fn probe_triangle_light(p0: Vec3, e1: Vec3, e2: Vec3, two_sided: u32) -> Lig
     }
 }
 
+/// The punctual-light probe's spot light: at `position`, chosen with probability
+/// `select_pmf`, its axis `axis` with (scale, offset) `spot` (`light::punctual`).
+#[inline]
+pub fn probe_punctual_light(
+    position: Vec3,
+    select_pmf: f32,
+    axis: Vec3,
+    spot: (f32, f32),
+) -> Light {
+    let mut l = probe_triangle_light(position, axis, Vec3::new(spot.0, spot.1, 0.0), 0);
+    l.kind = light_kind::PUNCTUAL;
+    l.select_pmf = select_pmf;
+    l.area = 0.0;
+    l
+}
+
+/// The punctual-light probe's directional light: travelling along `travel`, placed beyond the
+/// scene's bounding sphere `bounds` (centre, radius) (`light::directional`).
+#[inline]
+pub fn probe_directional_light(travel: Vec3, bounds: Vec4) -> Light {
+    let mut l = probe_triangle_light(bounds.truncate(), travel, Vec3::ZERO, 0);
+    l.kind = light_kind::DIRECTIONAL;
+    l.radius = bounds.w;
+    l.area = 0.0;
+    l
+}
+
 /// An RGBA8 word's red, green and blue as byte / 256 (exact in f32), the texture probe's
 /// stand-in for the decoding tables.
 #[inline]
@@ -317,6 +350,20 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
         (
             phase::sample(g, wo, u1, u2).extend(phase::eval(g, wo, wi)),
             Vec4::new(flight.t, flight.weight.x, flight.weight.y, flight.weight.z),
+        )
+    } else if function == function::PUNCTUAL_LIGHT {
+        let l = probe_punctual_light(i1.truncate(), i0.w, i2.truncate(), (i1.w, i2.w));
+        let s = punctual::sample(&l, 0, i0.truncate());
+        let sun = probe_directional_light(i2.truncate(), i3);
+        let far = directional::sample(&sun, 0, i0.truncate()).point.position;
+        (
+            s.point.normal.extend(s.pdf_solid_angle),
+            Vec4::new(
+                punctual::spot_attenuation(&l, s.point.normal),
+                far.x,
+                far.y,
+                far.z,
+            ),
         )
     } else if function == function::BRDF {
         let (n, w) = (i0.truncate(), i1.truncate());

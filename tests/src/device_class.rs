@@ -443,6 +443,67 @@ pub fn bsdf_apart(r: &BsdfRecord) -> [f64; 8] {
     apart
 }
 
+/// A record of the punctual-light probe (`kernel::probe::function::PUNCTUAL_LIGHT`): receiver
+/// `x`, selection probability `select_pmf`, the spot light's `position`, `axis` and spot
+/// (scale, offset), and the bounding sphere (centre, radius) a directional light along `axis`
+/// is placed beyond.
+#[derive(Clone, Copy, Debug)]
+pub struct PunctualRecord {
+    pub x: [f32; 3],
+    pub select_pmf: f32,
+    pub position: [f32; 3],
+    pub axis: [f32; 3],
+    pub spot: (f32, f32),
+    pub bounds: [f32; 4],
+}
+
+impl PunctualRecord {
+    /// The probe's outputs computed over any scalar [`Real`] by the kernel's own code
+    /// (`light::punctual::direction_and_density`, `spot_attenuation_v3`,
+    /// `light::directional::far_point`): (normal, pdf, attenuation, the directional light's
+    /// point).
+    pub fn outputs<R: Real<Bits = u32>>(&self) -> [R; 8] {
+        use kernel::light::{directional::far_point, punctual};
+        let v = |x: [f32; 3]| V3::new(R::splat(x[0]), R::splat(x[1]), R::splat(x[2]));
+        let axis = v(self.axis);
+        let (normal, pdf) =
+            punctual::direction_and_density(v(self.position), R::splat(self.select_pmf), v(self.x));
+        let attenuation = punctual::spot_attenuation_v3(
+            axis,
+            R::splat(self.spot.0),
+            R::splat(self.spot.1),
+            normal,
+        );
+        let b = self.bounds;
+        let far = far_point(axis, v([b[0], b[1], b[2]]), R::splat(b[3]), v(self.x));
+        [
+            normal.x,
+            normal.y,
+            normal.z,
+            pdf,
+            attenuation,
+            far.x,
+            far.y,
+            far.z,
+        ]
+    }
+}
+
+/// How far apart the CPU's and a conformant device's punctual and directional light samples
+/// may be for the probe's record `r`, per output (out0 then out1): the kernel's code run on
+/// [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic, every way its tests may
+/// go. The balls carry the spot's conditioning (the attenuation's cancellation where the
+/// transition between the cones is narrow: its slope is the spot's scale) and the directional
+/// light's point's magnitude (the receiver's distance plus twice the scene's bounding radius);
+/// the normal is a unit vector, apart by at most 2 per component.
+pub fn punctual_apart(r: &PunctualRecord) -> [f64; 8] {
+    let mut apart = ieee_and_vulkan_apart(&|| r.outputs::<Ball>());
+    for a in &mut apart[..3] {
+        *a = a.min(UNIT_APART);
+    }
+    apart
+}
+
 /// How far apart the CPU's and a conformant device's phase function `kernel::phase::eval_v3`
 /// may be, for asymmetry `g` and unit `wo`, `wi`: the largest distance between it run on
 /// [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic (both ways of the

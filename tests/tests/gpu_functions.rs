@@ -6,7 +6,7 @@
 use glam::Vec3;
 use kernel::probe::{evaluate, function};
 use twinpath::vulkan::compute::ProbeRunner;
-use twinpath_tests::device_class::bsdf_apart;
+use twinpath_tests::device_class::{bsdf_apart, punctual_apart};
 use twinpath_tests::gpu::{assert_validation_clean, context};
 
 const N: usize = 100_000;
@@ -312,6 +312,36 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                     [v * 0.5, 0.0, 0.0, 0.0],
                 ])
             }
+            function::PUNCTUAL_LIGHT => {
+                let x = g.vec() * g.scale();
+                // A receiver at the light (density 0) now and then, else anywhere around it.
+                let position = if g.u64().is_multiple_of(16) {
+                    x
+                } else {
+                    x + g.dir() * g.scale()
+                };
+                let axis = g.dir();
+                // A point light (scale 0, offset 1) or a spot whose cones are wide or narrow
+                // apart (the falloff's slope 1 / (cos inner - cos outer) up to 10^4).
+                let spot = if g.u64().is_multiple_of(4) {
+                    (0.0, 1.0)
+                } else {
+                    let outer = g.range(-0.9, 0.99);
+                    let any = 0.01 + (0.999 - outer) * g.unit();
+                    let width = g.pick(&[1e-4, 1e-2, any]);
+                    let scale = 1.0 / width.min(0.999 - outer);
+                    (scale, -outer * scale)
+                };
+                let centre = g.vec() * g.scale();
+                let any = g.range(1e-3, 1.0);
+                let pmf = g.pick(&[1.0, 0.25, any]);
+                rec([
+                    w(x, pmf),
+                    w(position, spot.0),
+                    w(axis, spot.1),
+                    w(centre, g.scale()),
+                ])
+            }
             function::MEDIUM => {
                 // Phase: any g in (-1, 1) (isotropic below 1e-3 included), unit directions.
                 // Flights: coefficients over four decades, a channel of 0 at times, surfaces
@@ -447,8 +477,23 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "texture footprint and bilerp", func: function::TEXTURE, max_ulps: 0, abs: 0.0, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "the same texels and weights bit for bit: wrapping, clamping and the blend" },
     Bound { name: "phase::sample / eval, free_flight::sample", func: function::MEDIUM, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "the phase sampler's azimuth (cos_sin_turns' polynomials), its factored sine, sqrt and normalisation (FMA contraction): 8 eps on a unit vector; its density a rational function of one dot product, 8 ULP; a flight's t = -ln(1 - u) / sigma under Vulkan's log (2^-21 absolute on [0.5, 2]) and its weights, quotients of exponentials (3 + 2 |x| ULP) whose exponents carry t's error, denormals flushed: derived per record in `allowed_abs`" },
     Bound { name: "surface::mapped_normal", func: function::MAPPED_NORMAL, max_ulps: 8, abs: 16.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "a blend, one Gram-Schmidt step, a cross product and two normalisations of unit-scale vectors (FMA contraction, sqrt): 16 eps on a unit vector" },
+    Bound { name: "punctual and directional light samples", func: function::PUNCTUAL_LIGHT, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "a difference, a dot product, a root and a quotient (FMA contraction): 8 eps on the unit normal, 8 ULP on the density; the spot's falloff a multiply-add clamped and squared, 8 eps times (1 + |scale| + |offset|); the directional light's point 8 eps of |x| + 2 (radius + |x - centre|), per record (`allowed_abs`)" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
+
+/// The punctual-light probe's record `r` (`kernel::probe`'s layout).
+fn punctual_record(r: &[[u32; 4]; 4]) -> twinpath_tests::device_class::PunctualRecord {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
+    let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
+    twinpath_tests::device_class::PunctualRecord {
+        x: v(0),
+        select_pmf: f(0, 3),
+        position: v(1),
+        axis: v(2),
+        spot: (f(1, 3), f(2, 3)),
+        bounds: [f(3, 0), f(3, 1), f(3, 2), f(3, 3)],
+    }
+}
 
 /// The BSDF probe's record `r` of function `func` (`kernel::probe`'s layout).
 fn bsdf_record(func: u32, r: &[[u32; 4]; 4]) -> twinpath_tests::device_class::BsdfRecord {
@@ -502,6 +547,22 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
                 (f(2, 0), f(2, 1)),
             );
             output_allowance(&apart, k, j)
+        }
+        // The Vulkan class's punctual and directional lights, per record (`punctual_apart`).
+        function::PUNCTUAL_LIGHT if b.vulkan => {
+            output_allowance(&punctual_apart(&punctual_record(r)), k, j)
+        }
+        // The IEEE class's: the falloff's magnitudes (out1.x), the far point's (out1.yzw).
+        function::PUNCTUAL_LIGHT if k == 1 => {
+            let r = punctual_record(r);
+            let length = |v: [f32; 3]| Vec3::from_array(v).length();
+            if j == 0 {
+                b.abs * (1.0 + r.spot.0.abs() + r.spot.1.abs())
+            } else {
+                let centre = [r.bounds[0], r.bounds[1], r.bounds[2]];
+                let to_centre = Vec3::from_array(r.x) - Vec3::from_array(centre);
+                b.abs * (length(r.x) + 2.0 * (r.bounds[3] + to_centre.length()))
+            }
         }
         // The Vulkan class's BSDFs, per record (`bsdf_apart`): out0 = (f cos, pdf) or (wi,
         // pdf), out1 = (weight, eta2).
@@ -939,6 +1000,13 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
             abs: 0.0,
             vulkan: true,
             why: "Vulkan class: the kernel's mapped normal (a blend, one Gram-Schmidt step, a cross product, two normalisations and their tests) run on balls in IEEE and in Vulkan arithmetic, every way its tests may go; the largest distance between the two, per record (`mapped_normal_apart`)",
+            ..*b
+        }),
+        function::PUNCTUAL_LIGHT => Some(Bound {
+            max_ulps: 0,
+            abs: 0.0,
+            vulkan: true,
+            why: "Vulkan class: the kernel's point and spot light sample (a difference, a dot product, a root within 4.5 eps, a quotient within 2.5 ULP) and falloff, and the directional light's point, run on balls in IEEE and in Vulkan arithmetic, every way their tests may go, per record (`punctual_apart`), which carries the falloff's slope",
             ..*b
         }),
         function::BSDF_EVAL | function::BSDF_SAMPLE => Some(Bound {

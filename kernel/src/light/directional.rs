@@ -4,6 +4,7 @@
 //! `radius`) that bounds the scene. A delta light: next-event estimation alone finds it.
 
 use super::LightSample;
+use crate::real::{Real, V3};
 use crate::sampling::SurfacePoint;
 use crate::scene::Light;
 use spirv_std::glam::Vec3;
@@ -16,15 +17,29 @@ use spirv_std::glam::Vec3;
 #[inline]
 pub fn sample(l: &Light, light: u32, x: Vec3) -> LightSample {
     let travel = Vec3::from(l.edge1);
-    let far = 2.0 * (l.radius + (x - Vec3::from(l.position)).length());
+    let position = far_point(
+        V3::from(travel),
+        V3::from(Vec3::from(l.position)),
+        l.radius,
+        V3::from(x),
+    );
     LightSample {
         point: SurfacePoint {
-            position: x - travel * far,
+            position: position.into(),
             normal: travel,
         },
         light,
         pdf_solid_angle: l.select_pmf,
     }
+}
+
+/// [`sample`]'s point for direction of travel `travel` and the scene's bounding sphere
+/// (`centre`, `radius`), over any scalar [`Real`] in the same operations:
+/// x - travel 2 (radius + |x - centre|).
+#[inline]
+pub fn far_point<R: Real>(travel: V3<R>, centre: V3<R>, radius: R, x: V3<R>) -> V3<R> {
+    let far = R::splat(2.0) * (radius + (x - centre).length());
+    x - travel * far
 }
 
 /// The irradiance the light sends toward every receiver.

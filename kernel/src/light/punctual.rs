@@ -4,10 +4,9 @@
 //! alone finds it: no ray can hit it, so its samples have MIS weight 1.
 
 use super::LightSample;
+use crate::real::{Real, V3};
 use crate::sampling::SurfacePoint;
 use crate::scene::Light;
-#[cfg(target_arch = "spirv")]
-use crate::Float;
 use spirv_std::glam::Vec3;
 
 /// glTF's spot falloff of `l` toward unit direction `out` (from the light):
@@ -16,7 +15,20 @@ use spirv_std::glam::Vec3;
 /// 1 everywhere for a point light (scale 0, offset 1).
 #[inline]
 pub fn spot_attenuation(l: &Light, out: Vec3) -> f32 {
-    let a = (Vec3::from(l.edge1).dot(out) * l.edge2[0] + l.edge2[1]).clamp(0.0, 1.0);
+    spot_attenuation_v3(
+        V3::from(Vec3::from(l.edge1)),
+        l.edge2[0],
+        l.edge2[1],
+        V3::from(out),
+    )
+}
+
+/// [`spot_attenuation`] of the spot of axis `axis`, `scale` and `offset`, over any scalar
+/// [`Real`] in the same operations (so that a device's arithmetic can be bounded by running it
+/// on one: `tests/src/device_class.rs`, `punctual_apart`).
+#[inline]
+pub fn spot_attenuation_v3<R: Real>(axis: V3<R>, scale: R, offset: R, out: V3<R>) -> R {
+    let a = (axis.dot(out) * scale + offset).clamp(R::splat(0.0), R::splat(1.0));
     a * a
 }
 
@@ -29,17 +41,28 @@ pub fn spot_attenuation(l: &Light, out: Vec3) -> f32 {
 #[inline]
 pub fn sample(l: &Light, light: u32, x: Vec3) -> LightSample {
     let p = Vec3::from(l.position);
-    let d = x - p;
-    let d2 = d.dot(d);
-    let ok = d2 > 0.0 && d2.is_finite();
+    let (normal, pdf) = direction_and_density(V3::from(p), l.select_pmf, V3::from(x));
     LightSample {
         point: SurfacePoint {
             position: p,
-            normal: if ok { d / d2.sqrt() } else { Vec3::Z },
+            normal: normal.into(),
         },
         light,
-        pdf_solid_angle: if ok { l.select_pmf * d2 } else { 0.0 },
+        pdf_solid_angle: pdf,
     }
+}
+
+/// [`sample`]'s normal and density for a light at `p` chosen with probability `select_pmf`,
+/// over any scalar [`Real`] in the same operations: ((x - p) / |x - p|, select_pmf |x - p|^2),
+/// or (+z, 0) where |x - p|^2 is 0 or not finite.
+#[inline]
+pub fn direction_and_density<R: Real<Bits = u32>>(p: V3<R>, select_pmf: R, x: V3<R>) -> (V3<R>, R) {
+    let d = x - p;
+    let d2 = d.dot(d);
+    if d2.greater_than(R::splat(0.0)) == 0 || d2.finite() == 0 {
+        return (V3::splat(Vec3::Z), R::splat(0.0));
+    }
+    (d / d2.sqrt(), select_pmf * d2)
 }
 
 /// The radiance light sample `ls` of `l` sends toward its receiver: the intensity times the

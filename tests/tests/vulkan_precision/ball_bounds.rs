@@ -638,3 +638,84 @@ fn bsdfs_differ_from_the_cpu_within_their_balls() {
         "{unbounded} of {outputs} outputs unbounded: the balls say too little"
     );
 }
+
+/// The point and spot light's sample (its direction, density and falloff) and the directional
+/// light's far point (`kernel::light::punctual`, `directional`) under the models of a device
+/// differ from the CPU's by at most [`punctual_apart`], the balls' bound for one IEEE and one
+/// Vulkan computation. Records as `gpu_functions.rs` draws them: receivers and lights 10^-6 to
+/// 10^6 apart and from the origin, receivers at the light, point lights and spots whose cones
+/// are 10^-4 to 1 apart in cosine. The falloff near a narrow transition moves by its slope
+/// times the cosine's rounding, beyond the IEEE class's 8 eps times its magnitudes.
+#[test]
+fn punctual_lights_differ_from_the_cpu_within_their_balls() {
+    use twinpath_tests::device_class::{punctual_apart, PunctualRecord};
+    let mut g = twinpath_tests::placements::Placements(SplitMix(67));
+    seed(67);
+    let (mut worst, mut beyond_ieee_class, mut outputs) = (0f64, 0, 0);
+    for k in 0..cases() {
+        let scale = |g: &mut twinpath_tests::placements::Placements| g.pow10(-6.0, 6.0);
+        let x = g.dir() * scale(&mut g);
+        let position = if k % 16 == 0 {
+            x
+        } else {
+            x + g.dir() * scale(&mut g)
+        };
+        let axis = g.dir();
+        let spot = if k % 4 == 0 {
+            (0.0, 1.0)
+        } else {
+            let outer = -0.9 + 1.89 * g.unit();
+            let width = [1e-4, 1e-2, 0.01 + (0.999 - outer) * g.unit()][k % 3];
+            let s = 1.0 / width.min(0.999 - outer);
+            (s, -outer * s)
+        };
+        let centre = g.dir() * scale(&mut g);
+        let r = PunctualRecord {
+            x: x.to_array(),
+            select_pmf: [1.0, 0.25, 1e-3 + g.unit()][k % 3].min(1.0),
+            position: position.to_array(),
+            axis: axis.to_array(),
+            spot,
+            bounds: [centre.x, centre.y, centre.z, scale(&mut g)],
+        };
+        let run = |model: Option<usize>| {
+            arithmetic(model);
+            r.outputs::<Vk32>().map(|x| x.value)
+        };
+        let cpu = run(None);
+        assert_eq!(cpu, r.outputs::<f32>(), "Vk32 under IEEE is the f32 kernel");
+        let device = run(Some(k));
+        let apart = punctual_apart(&r);
+        for i in 0..8 {
+            outputs += 1;
+            assert!(apart[i].is_finite(), "output {i} of {r:?} unbounded");
+            let d = (cpu[i] as f64 - device[i] as f64).abs();
+            assert!(
+                d <= apart[i],
+                "output {i} of {r:?}: CPU {:e}, device {:e}, {d:e} apart against {:e}",
+                cpu[i],
+                device[i],
+                apart[i]
+            );
+            worst = worst.max(d / apart[i].max(f64::MIN_POSITIVE));
+            // The bound devices were held to before (`gpu_functions.rs`' IEEE class).
+            let eps = f32::EPSILON as f64;
+            let ieee_class = match i {
+                4 => 8.0 * eps * (1.0 + spot.0.abs() as f64 + spot.1.abs() as f64),
+                5..=7 => {
+                    let to_centre = (x - centre).length() as f64;
+                    8.0 * eps * (x.length() as f64 + 2.0 * (r.bounds[3] as f64 + to_centre))
+                }
+                _ => 8.0 * eps,
+            };
+            let ulps = (cpu[i].to_bits() as i64 - device[i].to_bits() as i64).unsigned_abs();
+            beyond_ieee_class += (ulps > 8 && d > ieee_class) as usize;
+        }
+    }
+    set_model(Model::VULKAN);
+    println!("punctual and directional lights, a device against the CPU: at most {worst:.3} of the balls' bound; {beyond_ieee_class} of {outputs} outputs beyond the IEEE class's bound");
+    assert!(
+        beyond_ieee_class > 0,
+        "the IEEE class's bound holds for devices"
+    );
+}
