@@ -4,9 +4,12 @@
 //! (glTF's), `conductor`, `dielectric`; `fresnel` and `microfacet` are what they share. This
 //! module holds the one dispatch over kinds ([`flags`], [`eval`], [`sample`], [`at_point`],
 //! [`apply_ks_texture`], [`material_features`]), pbrt-v4's tagged `BxDF`
-//! dispatch in one `match`; `multiple_scattering` gives back what a GGX lobe loses between its
-//! microfacets (glTF's material), `coat` its clear coat (`KHR_materials_clearcoat`), `sheen`
-//! its sheen (`KHR_materials_sheen`).
+//! dispatch in one `match`. The scattering is written once over any scalar [`Real`]
+//! ([`eval_v3`], [`sample_v3`], reading the material through `inputs::BsdfNumbers`): [`eval`]
+//! and [`sample`] are its `f32` instances, and a test's interval type bounds what a Vulkan
+//! device's arithmetic may make of it (`docs/robustness.md`). `multiple_scattering` gives back
+//! what a GGX lobe loses between its microfacets (glTF's material), `coat` its clear coat
+//! (`KHR_materials_clearcoat`), `sheen` its sheen (`KHR_materials_sheen`).
 //! Derivations and sources: `docs/materials.md`.
 //!
 //! Conventions: `wo` is the unit direction toward the previous vertex (the camera side), `wi`
