@@ -374,6 +374,13 @@ pub fn microfacet_apart(
     apart
 }
 
+/// A probe record whose eight outputs the kernel's own code computes over any scalar [`Real`]
+/// (the CPU's `f32`, a device model, balls).
+pub trait ProbeOutputs {
+    /// out0 then out1, as the probe writes them.
+    fn outputs<R: Real<Bits = u32>>(&self) -> [R; 8];
+}
+
 /// A record of the BSDF probes (`kernel::probe::function::BSDF_EVAL`, `BSDF_SAMPLE`): the
 /// material's kind, `complex` bits and packed clear coat (`kernel::probe::probe_bsdf_inputs`),
 /// unit normal `n`, roughness `alpha`, unit `wo`, index ratio `eta`, `third` = wi (eval) or
@@ -393,11 +400,11 @@ pub struct BsdfRecord {
     pub albedo: (f32, f32),
 }
 
-impl BsdfRecord {
-    /// The probe's outputs for this record, computed over any scalar [`Real`] by the kernel's
-    /// own code (the material's resolution and the albedos included): eval's (f cos, pdf, 0,
-    /// 0, 0, 0), or sample's (wi, pdf, weight, eta2).
-    pub fn outputs<R: Real<Bits = u32>>(&self) -> [R; 8] {
+/// The probe's outputs for this record, computed over any scalar [`Real`] by the kernel's own
+/// code (the material's resolution and the albedos included): eval's (f cos, pdf, 0, 0, 0, 0),
+/// or sample's (wi, pdf, weight, eta2).
+impl ProbeOutputs for BsdfRecord {
+    fn outputs<R: Real<Bits = u32>>(&self) -> [R; 8] {
         use kernel::bsdf::{eval_v3, sample_v3};
         use kernel::features::Dynamic;
         use kernel::probe::{probe_bsdf_inputs, probe_glossy_albedo};
@@ -457,12 +464,11 @@ pub struct PunctualRecord {
     pub bounds: [f32; 4],
 }
 
-impl PunctualRecord {
-    /// The probe's outputs computed over any scalar [`Real`] by the kernel's own code
-    /// (`light::punctual::direction_and_density`, `spot_attenuation_v3`,
-    /// `light::directional::far_point`): (normal, pdf, attenuation, the directional light's
-    /// point).
-    pub fn outputs<R: Real<Bits = u32>>(&self) -> [R; 8] {
+/// The probe's outputs computed over any scalar [`Real`] by the kernel's own code
+/// (`light::punctual::direction_and_density`, `spot_attenuation_v3`,
+/// `light::directional::far_point`): (normal, pdf, attenuation, the directional light's point).
+impl ProbeOutputs for PunctualRecord {
+    fn outputs<R: Real<Bits = u32>>(&self) -> [R; 8] {
         use kernel::light::{directional::far_point, punctual};
         let v = |x: [f32; 3]| V3::new(R::splat(x[0]), R::splat(x[1]), R::splat(x[2]));
         let axis = v(self.axis);

@@ -9,7 +9,7 @@ use kernel::bsdf::fresnel;
 use kernel::real::Real;
 use twinpath_tests::ball_arithmetic::{computations, Ball, Roundoff};
 use twinpath_tests::device_class::{
-    fresnel_apart, sphere_hit_apart, sphere_probe, triangle_hit_apart, triangle_probe,
+    fresnel_apart, sphere_hit_apart, sphere_probe, triangle_hit_apart, triangle_probe, ProbeOutputs,
 };
 use twinpath_tests::vulkan_arithmetic::{seed, set_model, Model, Vk32};
 use twinpath_tests::SplitMix;
@@ -21,6 +21,35 @@ fn arithmetic(model: Option<usize>) {
         None => set_model(Model::IEEE),
         Some(k) => any_device(k),
     }
+}
+
+/// How far a device's `device` is from the CPU's `cpu` (0 where they are equal, as the same
+/// infinity), asserting that it is within the balls' bound `apart`; `what` names the output
+/// for the message.
+fn apart_within(what: impl FnOnce() -> String, cpu: f32, device: f32, apart: f64) -> f64 {
+    let d = if cpu == device {
+        0.0
+    } else {
+        (cpu as f64 - device as f64).abs()
+    };
+    assert!(
+        d <= apart,
+        "{}: CPU {cpu:e}, device {device:e}, {d:e} apart against {apart:e}",
+        what()
+    );
+    d
+}
+
+/// Probe record `r`'s outputs computed by the CPU (IEEE arithmetic, which `Vk32` reproduces
+/// bit for bit: checked) and by [`any_device`]`(k)`.
+fn cpu_and_device(r: &impl ProbeOutputs, k: usize) -> ([f32; 8], [f32; 8]) {
+    let run = |model: Option<usize>| {
+        arithmetic(model);
+        r.outputs::<Vk32>().map(|x| x.value)
+    };
+    let cpu = run(None);
+    assert_eq!(cpu, r.outputs::<f32>(), "Vk32 under IEEE is the f32 kernel");
+    (cpu, run(Some(k)))
 }
 
 /// Every result the models of a device (and IEEE arithmetic) return for sums, products,
@@ -128,13 +157,11 @@ fn fresnel_reflectances_differ_from_the_cpu_within_their_balls() {
             [fresnel::conductor(b(cos), b(eta), b(k_ext)), f, cos_t]
         });
         for i in 0..6 {
-            let d = (cpu[i] as f64 - device[i] as f64).abs();
-            assert!(
-                d <= apart[i],
-                "output {i} of (cos {cos:e}, eta {eta:e}, k {k_ext:e}, f0 {f0:?}): CPU {:e}, device {:e}, {d:e} apart against {:e}",
+            let d = apart_within(
+                || format!("output {i} of (cos {cos:e}, eta {eta:e}, k {k_ext:e}, f0 {f0:?})"),
                 cpu[i],
                 device[i],
-                apart[i]
+                apart[i],
             );
             if apart[i] > 0.0 {
                 worst = worst.max(d / apart[i]);
@@ -217,13 +244,13 @@ fn mapped_normals_differ_from_the_cpu_within_their_balls() {
         let across = (td - nd * nd.dot(td)).length();
         let ieee_class = 16.0 * f32::EPSILON as f64 * (td.length() / across).max(1.0);
         for i in 0..3 {
-            let d = (cpu[i] as f64 - device[i] as f64).abs();
-            assert!(
-                d <= apart[i],
-                "component {i} of (n {n}, t {t}, sign {sign}, bary ({u}, {v}), texel {texel:?}, scale {scale}): CPU {:e}, device {:e}, {d:e} apart against {:e}",
+            let d = apart_within(
+                || {
+                    format!("component {i} of (n {n}, t {t}, sign {sign}, bary ({u}, {v}), texel {texel:?}, scale {scale})")
+                },
                 cpu[i],
                 device[i],
-                apart[i]
+                apart[i],
             );
             worst = worst.max(d / apart[i].max(f64::MIN_POSITIVE));
             // Only a tangent within 10^-4 of parallel to the normal may lose its direction.
@@ -307,13 +334,15 @@ fn microfacet_functions_differ_from_the_cpu_within_their_balls() {
                 );
                 continue;
             }
-            let d = (cpu[i] as f64 - device[i] as f64).abs();
-            assert!(
-                d <= apart[i],
-                "output {i} of (n {n}, alpha {alpha}, wo {wo}, cos {cos}, u ({u1}, {u2})): CPU {:e}, device {:e}, {d:e} apart against {:e}",
+            let d = apart_within(
+                || {
+                    format!(
+                        "output {i} of (n {n}, alpha {alpha}, wo {wo}, cos {cos}, u ({u1}, {u2}))"
+                    )
+                },
                 cpu[i],
                 device[i],
-                apart[i]
+                apart[i],
             );
             worst = worst.max(d / apart[i].max(f64::MIN_POSITIVE));
             worst_eps = worst_eps.max(d / f32::EPSILON as f64);
@@ -405,13 +434,11 @@ fn intersections_differ_from_the_cpu_within_their_balls() {
     let mut check = |cpu: &[f32], device: &[f32], apart: &[f64], what: &str| {
         both_hit += 1;
         for i in 0..cpu.len() {
-            let d = (cpu[i] as f64 - device[i] as f64).abs();
-            assert!(
-                d <= apart[i],
-                "{what}: output {i}: CPU {:e}, device {:e}, {d:e} apart against {:e}",
+            let d = apart_within(
+                || format!("{what}: output {i}"),
                 cpu[i],
                 device[i],
-                apart[i]
+                apart[i],
             );
             if apart[i] > 0.0 && apart[i].is_finite() {
                 worst = worst.max(d / apart[i]);
@@ -564,13 +591,7 @@ fn bsdfs_differ_from_the_cpu_within_their_balls() {
             third,
             albedo: e,
         };
-        let run = |model: Option<usize>| {
-            arithmetic(model);
-            r.outputs::<Vk32>().map(|x| x.value)
-        };
-        let cpu = run(None);
-        assert_eq!(cpu, r.outputs::<f32>(), "Vk32 under IEEE is the f32 kernel");
-        let device = run(Some(k));
+        let (cpu, device) = cpu_and_device(&r, k);
         // No NaN, no negative value or weight, a positive eta^2, under any arithmetic: what
         // the path multiplies its throughput by stays a number (the same checks as
         // `properties.rs` makes of the CPU's).
@@ -596,17 +617,11 @@ fn bsdfs_differ_from_the_cpu_within_their_balls() {
                 continue;
             }
             // Equal (a delta lobe's infinite density in both) is not apart.
-            let d = if cpu[i] == device[i] {
-                0.0
-            } else {
-                (cpu[i] as f64 - device[i] as f64).abs()
-            };
-            assert!(
-                d <= apart[i],
-                "output {i} of {r:?}: CPU {:e}, device {:e}, {d:e} apart against {:e}",
+            let d = apart_within(
+                || format!("output {i} of {r:?}"),
                 cpu[i],
                 device[i],
-                apart[i]
+                apart[i],
             );
             // Where neither arithmetic has an uncertain test (one way each), how close the
             // models come to the balls says how tight they are; elsewhere the bound is the
@@ -678,24 +693,16 @@ fn punctual_lights_differ_from_the_cpu_within_their_balls() {
             spot,
             bounds: [centre.x, centre.y, centre.z, scale(&mut g)],
         };
-        let run = |model: Option<usize>| {
-            arithmetic(model);
-            r.outputs::<Vk32>().map(|x| x.value)
-        };
-        let cpu = run(None);
-        assert_eq!(cpu, r.outputs::<f32>(), "Vk32 under IEEE is the f32 kernel");
-        let device = run(Some(k));
+        let (cpu, device) = cpu_and_device(&r, k);
         let apart = punctual_apart(&r);
         for i in 0..8 {
             outputs += 1;
             assert!(apart[i].is_finite(), "output {i} of {r:?} unbounded");
-            let d = (cpu[i] as f64 - device[i] as f64).abs();
-            assert!(
-                d <= apart[i],
-                "output {i} of {r:?}: CPU {:e}, device {:e}, {d:e} apart against {:e}",
+            let d = apart_within(
+                || format!("output {i} of {r:?}"),
                 cpu[i],
                 device[i],
-                apart[i]
+                apart[i],
             );
             worst = worst.max(d / apart[i].max(f64::MIN_POSITIVE));
             // The bound devices were held to before (`gpu_functions.rs`' IEEE class).
