@@ -234,23 +234,10 @@ fn unresolved_probe_material(kind: u32, complex: u32, alpha: f32, eta: f32, coat
 /// probability 1, its area in f32, radiance 1.
 #[inline]
 pub fn probe_triangle_light(p0: Vec3, e1: Vec3, e2: Vec3, two_sided: u32) -> Light {
-    Light {
-        position: p0.to_array(),
-        radius: 0.0,
-        edge1: e1.to_array(),
-        kind: light_kind::TRIANGLE,
-        edge2: e2.to_array(),
-        two_sided,
-        radiance: [1.0; 3],
-        select_pmf: 1.0,
-        alias_threshold: 1.0,
-        alias: 0,
-        area: 0.5 * e1.cross(e2).length(),
-        point_error: 0.0,
-        uv: [0.0; 6],
-        emission_texture: crate::scene::NONE,
-        material: crate::scene::NONE,
-    }
+    let mut l = probe_light(light_kind::TRIANGLE, p0, e1, e2);
+    l.two_sided = two_sided;
+    l.area = 0.5 * e1.cross(e2).length();
+    l
 }
 
 /// The punctual-light probe's spot light: at `position`, chosen with probability
@@ -262,10 +249,13 @@ pub fn probe_punctual_light(
     axis: Vec3,
     spot: (f32, f32),
 ) -> Light {
-    let mut l = probe_triangle_light(position, axis, Vec3::new(spot.0, spot.1, 0.0), 0);
-    l.kind = light_kind::PUNCTUAL;
+    let mut l = probe_light(
+        light_kind::PUNCTUAL,
+        position,
+        axis,
+        Vec3::new(spot.0, spot.1, 0.0),
+    );
     l.select_pmf = select_pmf;
-    l.area = 0.0;
     l
 }
 
@@ -273,11 +263,38 @@ pub fn probe_punctual_light(
 /// scene's bounding sphere `bounds` (centre, radius) (`light::directional`).
 #[inline]
 pub fn probe_directional_light(travel: Vec3, bounds: Vec4) -> Light {
-    let mut l = probe_triangle_light(bounds.truncate(), travel, Vec3::ZERO, 0);
-    l.kind = light_kind::DIRECTIONAL;
+    let mut l = probe_light(
+        light_kind::DIRECTIONAL,
+        bounds.truncate(),
+        travel,
+        Vec3::ZERO,
+    );
     l.radius = bounds.w;
-    l.area = 0.0;
     l
+}
+
+/// A probe's light of kind `kind` with `position`, `edge1` and `edge2` (what each kind reads
+/// them as: `scene::Light`), one-sided, radiance 1, chosen with probability 1; no area, radius,
+/// texture or material.
+#[inline]
+fn probe_light(kind: u32, position: Vec3, edge1: Vec3, edge2: Vec3) -> Light {
+    Light {
+        position: position.to_array(),
+        radius: 0.0,
+        edge1: edge1.to_array(),
+        kind,
+        edge2: edge2.to_array(),
+        two_sided: 0,
+        radiance: [1.0; 3],
+        select_pmf: 1.0,
+        alias_threshold: 1.0,
+        alias: 0,
+        area: 0.0,
+        point_error: 0.0,
+        uv: [0.0; 6],
+        emission_texture: crate::scene::NONE,
+        material: crate::scene::NONE,
+    }
 }
 
 /// An RGBA8 word's red, green and blue as byte / 256 (exact in f32), the texture probe's

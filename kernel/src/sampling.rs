@@ -63,7 +63,13 @@ pub fn sample_cosine_hemisphere_v3<R: real::Real>(n: V3<R>, u1: R, u2: R) -> V3<
 /// Solid-angle density of [`sample_cosine_hemisphere`]: max(0, n . w) / pi.
 #[inline]
 pub fn pdf_cosine_hemisphere(n: Vec3, w: Vec3) -> f32 {
-    n.dot(w).max(0.0) * (1.0 / PI)
+    pdf_cosine_hemisphere_v3(V3::from(n), V3::from(w))
+}
+
+/// [`pdf_cosine_hemisphere`] over any scalar [`real::Real`], in the same operations.
+#[inline]
+pub fn pdf_cosine_hemisphere_v3<R: real::Real>(n: V3<R>, w: V3<R>) -> R {
+    n.dot(w).max(R::splat(0.0)) * R::splat(1.0 / PI)
 }
 
 /// A point on a sphere and its outward unit normal.

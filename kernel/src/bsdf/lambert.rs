@@ -7,8 +7,9 @@
 use super::inputs::BsdfNumbers;
 use super::{BsdfFlags, BsdfSampleV3};
 use crate::real::{self, V3};
-use crate::sampling::{pdf_cosine_hemisphere, sample_cosine_hemisphere_v3};
-use core::f32::consts::PI;
+use crate::sampling::{
+    pdf_cosine_hemisphere, pdf_cosine_hemisphere_v3, sample_cosine_hemisphere_v3,
+};
 use spirv_std::glam::Vec3;
 
 /// Seed: `EvalScattering(N, w_i)`. The BRDF times the cosine at the receiver,
@@ -17,7 +18,7 @@ use spirv_std::glam::Vec3;
 /// light arrive through the back of the surface; with `n` on the outgoing side it must be zero.
 #[inline]
 pub fn eval_scattering(n: Vec3, wi: Vec3, albedo: Vec3) -> Vec3 {
-    albedo * (n.dot(wi).max(0.0) * (1.0 / PI))
+    albedo * pdf_cosine_hemisphere(n, wi)
 }
 
 /// Seed: `SampleBrdf(N)`. Direction w_i = SampleLobe(n, sqrt(u1), 2 pi u2): cosine-weighted, the
@@ -57,7 +58,7 @@ pub const FLAGS: BsdfFlags = BsdfFlags {
 /// scalar [`real::Real`] in [`eval_scattering`]'s and [`pdf_brdf`]'s operations.
 #[inline]
 pub fn eval<R: real::Real<Bits = u32>>(m: &impl BsdfNumbers<R>, n: V3<R>, wi: V3<R>) -> (V3<R>, R) {
-    let c = n.dot(wi).max(R::splat(0.0)) * R::splat(1.0 / PI);
+    let c = pdf_cosine_hemisphere_v3(n, wi);
     (m.albedo() * c, c)
 }
 
@@ -70,6 +71,5 @@ pub fn sample<R: real::Real<Bits = u32>>(
     u2: R,
 ) -> BsdfSampleV3<R> {
     let wi = sample_brdf_v3(n, u1, u2);
-    let pdf = n.dot(wi).max(R::splat(0.0)) * R::splat(1.0 / PI);
-    BsdfSampleV3::reflected(wi, m.albedo(), pdf)
+    BsdfSampleV3::reflected(wi, m.albedo(), pdf_cosine_hemisphere_v3(n, wi))
 }

@@ -65,17 +65,6 @@ pub struct BsdfSample {
     pub transmitted: bool,
 }
 
-impl BsdfSample {
-    /// The sample that ends the path.
-    pub const NONE: Self = Self {
-        wi: Vec3::Z,
-        weight: Vec3::ZERO,
-        pdf: 0.0,
-        eta2: 1.0,
-        transmitted: false,
-    };
-}
-
 /// [`BsdfSample`] over any scalar [`Real`]: what [`sample_v3`] returns.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSampleV3<R> {
@@ -87,7 +76,7 @@ pub struct BsdfSampleV3<R> {
 }
 
 impl<R: Real> BsdfSampleV3<R> {
-    /// The sample that ends the path ([`BsdfSample::NONE`]).
+    /// The sample that ends the path: no weight, density 0, `wi` +z.
     #[inline]
     pub fn none() -> Self {
         Self {
