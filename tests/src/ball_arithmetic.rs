@@ -11,13 +11,15 @@
 //! that operation applied to any numbers of its operands' balls and rounded as the arithmetic
 //! allows, so the ball of a function's output holds what any computation in that arithmetic
 //! returns. The bounds are not first-order: a product carries the product of the radii, a
-//! quotient's denominator is bounded away from its midpoint by its radius (a ball holding 0
-//! divides to an unbounded one), a square root of a ball reaching 0 is bounded by the root of
+//! quotient spans the quotients of its operands' ends (a ball holding 0 divides to an
+//! unbounded one), a square root of a ball reaching 0 is bounded by the root of
 //! the radius. Midpoints are computed in `f64` from the `f32` inputs (exact there: the balls
 //! start with radius 0) and carry their own `f64` rounding in the radius.
 //!
-//! A comparison whose operands' balls overlap may come out either way in a computation, so a
-//! function with a branch is bounded along each way it may go ([`computations`] explores them);
+//! A comparison whose operands' balls overlap may come out either way in a computation, and a
+//! conversion to an integer of a ball that spans integers may give any of them, so a function
+//! with a branch or a conversion is bounded along each way it may go ([`computations`]
+//! explores them);
 //! a fused multiply-add rounds once where the ball rounds twice, which the ball holds.
 
 use kernel::real::{Real, V3};
@@ -123,6 +125,15 @@ impl Ball {
         V3::new(Ball::exact(x[0]), Ball::exact(x[1]), Ball::exact(x[2]))
     }
 
+    /// The ball of the numbers from `lo` to `hi` (None unless both are finite: an unbounded
+    /// ball or a NaN has no ends).
+    fn between(lo: f64, hi: f64) -> Option<Self> {
+        (lo.is_finite() && hi.is_finite()).then_some(Self {
+            mid: 0.5 * (lo + hi),
+            radius: 0.5 * (hi - lo),
+        })
+    }
+
     /// Whether `x` is in the ball.
     pub fn holds(self, x: f64) -> bool {
         self.radius == f64::INFINITY || (x - self.mid).abs() <= self.radius
@@ -157,9 +168,27 @@ impl Neg for Ball {
     }
 }
 
+/// Whether `b` is exactly a power of two (a scale that multiplies without rounding): a single
+/// finite, nonzero number whose mantissa bits are all zero.
+fn is_power_of_two(b: Ball) -> bool {
+    const MANTISSA: u64 = (1 << 52) - 1;
+    b.radius == 0.0 && b.mid.is_normal() && b.mid.to_bits() & MANTISSA == 0
+}
+
 impl Mul for Ball {
     type Output = Self;
     fn mul(self, rhs: Self) -> Self {
+        // A product by an exact power of two is exact in every arithmetic while it stays
+        // among the normal floats (4 x, x / 2: a sampler's scales).
+        for (scale, x) in [(self, rhs), (rhs, self)] {
+            if is_power_of_two(scale) {
+                let (mid, radius) = (x.mid * scale.mid, x.radius * scale.mid.abs());
+                let least = mid.abs() - radius;
+                if least >= f32::MIN_POSITIVE as f64 && mid.abs() + radius <= f32::MAX as f64 {
+                    return Ball { mid, radius };
+                }
+            }
+        }
         let spread =
             self.mid.abs() * rhs.radius + rhs.mid.abs() * self.radius + self.radius * rhs.radius;
         Ball::rounded(self.mid * rhs.mid, spread, unit())
@@ -173,10 +202,26 @@ impl Div for Ball {
         if !(b > rb) {
             return Ball::unbounded(self.mid / rhs.mid);
         }
-        // |x / y - a / b| = |x b - a y| / |y b| <= (|b| r_x + |a| r_y) / (|b| (|b| - r_y)).
-        let spread = (b * self.radius + self.mid.abs() * rb) / (b * (b - rb));
+        // The denominator's ball holds no 0, so the quotient is monotone in each operand over
+        // the two balls: its range is spanned by the quotients of their ends (a ball centred
+        // on a / b would reach as far below it as above, though 1 / y grows faster toward 0).
         let q = ROUNDOFF.with(|r| r.get().quotient);
-        Ball::rounded(self.mid / rhs.mid, spread, q)
+        let ends = |b: Ball| [b.mid - b.radius, b.mid + b.radius];
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for x in ends(self) {
+            for y in ends(rhs) {
+                lo = lo.min(x / y);
+                hi = hi.max(x / y);
+            }
+        }
+        if self.radius == 0.0 && rhs.radius == 0.0 {
+            return Ball::rounded(self.mid / rhs.mid, 0.0, q);
+        }
+        // An unbounded operand (or a quotient beyond f64) has no finite range.
+        match Ball::between(lo, hi) {
+            Some(range) => Ball::rounded(range.mid, range.radius, q),
+            None => Ball::unbounded(self.mid / rhs.mid),
+        }
     }
 }
 
@@ -236,19 +281,29 @@ impl Real for Ball {
         Ball::rounded(0.5 * (root_lo + root_hi), 0.5 * (root_hi - root_lo), w)
     }
 
-    // min, max and clamp are exact and move their result by no more than their operands move.
+    // min, max and clamp are exact: the min of numbers of two balls lies between the min of
+    // their lower ends and the min of their upper ends (so a ball clamped below a bound stays
+    // below it), and likewise the max.
     fn min(self, other: Self) -> Self {
-        Self {
+        Ball::between(
+            (self.mid - self.radius).min(other.mid - other.radius),
+            (self.mid + self.radius).min(other.mid + other.radius),
+        )
+        .unwrap_or(Self {
             mid: self.mid.min(other.mid),
             radius: self.radius.max(other.radius),
-        }
+        })
     }
 
     fn max(self, other: Self) -> Self {
-        Self {
+        Ball::between(
+            (self.mid - self.radius).max(other.mid - other.radius),
+            (self.mid + self.radius).max(other.mid + other.radius),
+        )
+        .unwrap_or(Self {
             mid: self.mid.max(other.mid),
             radius: self.radius.max(other.radius),
-        }
+        })
     }
 
     fn clamp(self, lo: Self, hi: Self) -> Self {
@@ -291,12 +346,43 @@ impl Real for Ball {
         )
     }
 
+    /// The conversion truncates toward zero (saturating): every number of the ball truncates
+    /// to an integer between those of its ends, so where they differ each of them is a way the
+    /// computation may go (the first uncertain test asks "the lowest?", the next "the next?",
+    /// and so on). More than [`MOST_WAYS`] of them exhaust [`computations`], which then
+    /// returns unbounded balls.
     fn to_i32_bits(self) -> u32 {
-        unimplemented!("a Ball has no bits: functions that work on them cannot be bounded so")
+        let truncate = |x: f64| x as i32;
+        let (lo, hi) = if self.radius.is_finite() {
+            (
+                truncate(self.mid - self.radius),
+                truncate(self.mid + self.radius),
+            )
+        } else {
+            (i32::MIN, i32::MAX)
+        };
+        let exact = truncate(self.mid);
+        let mut k = lo;
+        while k < hi && k.abs_diff(lo) as usize <= MOST_WAYS {
+            if decide_if(true, exact == k) != 0 {
+                return k as u32;
+            }
+            k += 1;
+        }
+        k as u32
     }
 
-    fn from_i32_bits(_: u32) -> Self {
-        unimplemented!("a Ball has no bits: functions that work on them cannot be bounded so")
+    /// The integer as a float: exact where it fits in 24 bits, else rounded.
+    fn from_i32_bits(bits: u32) -> Self {
+        let i = bits as i32;
+        if (i as f32) as i32 == i {
+            Ball {
+                mid: i as f64,
+                radius: 0.0,
+            }
+        } else {
+            Ball::rounded(i as f64, 0.0, unit())
+        }
     }
 
     // The operations the kernel writes on the bits, on the numbers instead.
@@ -316,21 +402,30 @@ impl Real for Ball {
         }
     }
 
-    /// The exact cosine and sine of 2 pi `self`'s midpoint, within 4 units of roundoff (what
-    /// `kernel::turns::cos_sin_turns`' polynomials keep to under IEEE and every Vulkan model:
-    /// `cos_sin_turns_is_within_four_roundings_under_every_arithmetic`) and 2 pi times the
-    /// argument's radius (both have slope at most 2 pi per turn).
+    /// The exact cosine and sine of 2 pi `self`'s midpoint, within 2 pi times the argument's
+    /// radius (both have slope at most 2 pi per turn) and what `kernel::turns::cos_sin_turns`'
+    /// polynomials keep to under IEEE and every Vulkan model
+    /// (`cos_sin_turns_is_within_four_roundings_under_every_arithmetic`): 4 units of roundoff,
+    /// or 4 of them relative to the value (the smaller, so a sine near its zero stays as
+    /// accurate as its argument) plus the smallest normal float.
     fn cos_sin_turns(self) -> (Self, Self) {
         let roundoff = ROUNDOFF.with(|r| r.get());
         let angle = std::f64::consts::TAU * self.mid;
-        let radius = 4.0 * roundoff.unit
-            + std::f64::consts::TAU * self.radius
-            + if roundoff.flush {
-                f32::MIN_POSITIVE as f64
-            } else {
-                0.0
-            };
-        let ball = |mid: f64| Self { mid, radius };
+        let moved = std::f64::consts::TAU * self.radius;
+        let u = roundoff.unit;
+        let ball = |mid: f64| {
+            let absolute = 4.0 * u
+                + if roundoff.flush {
+                    f32::MIN_POSITIVE as f64
+                } else {
+                    0.0
+                };
+            let relative = 4.0 * u * (mid.abs() + moved) + f32::MIN_POSITIVE as f64;
+            Self {
+                mid,
+                radius: moved + absolute.min(relative),
+            }
+        };
         (ball(angle.cos()), ball(angle.sin()))
     }
 }

@@ -705,38 +705,69 @@ fn sphere_and_lobe_samples_are_within_their_error_under_every_arithmetic() {
 }
 
 /// `cos_sin_turns`, the azimuth of every sampler, is within 4 u of the exact cosine and sine
-/// under IEEE arithmetic (u = eps / 2) and every Vulkan model (u = eps): the assumption of the
-/// samplers' derived bounds (`device_class`). Its range reduction is exact in any rounding
-/// mode (4 u and the nearest integer are exact, the remainder by Sterbenz's lemma), and the
-/// polynomials' roundings stay below a few u of results of magnitude <= 1.
+/// under IEEE arithmetic (u = eps / 2) and every Vulkan model (u = eps), and within 4 u of each
+/// relative to its magnitude (plus the smallest normal float, which a model that flushes
+/// denormals may lose): the assumptions of the samplers' derived bounds (`device_class`) and of
+/// the balls' (`Ball::cos_sin_turns`). Its range reduction is exact in any rounding mode (4 x
+/// and the nearest integer are exact, the remainder by Sterbenz's lemma), so the remainder's
+/// quarter turn carries one product's rounding relative to itself, and the odd sine
+/// polynomial's roundings are relative to its value; the cosine polynomial's lie below a few u
+/// of results between cos(pi / 4) and 1. The reference reduces the same way in f64, so that
+/// it, too, is accurate relative to values near 0 (at half a turn, f64's sin(2 pi x) is
+/// 1.2e-16, the kernel's 0).
 #[test]
 fn cos_sin_turns_is_within_four_roundings_under_every_arithmetic() {
     use kernel::turns::cos_sin_turns;
     let mut g = SplitMix(43);
     seed(43);
-    let mut worst = [0f64; 4];
+    let (mut worst, mut worst_relative) = ([0f64; 4], [0f64; 4]);
     for k in 0..cases() {
         let x = if k < 1 << 12 {
             // Both sides of every eighth of a turn, where the reduction's quadrant changes.
             let edge = (k >> 6) as f32 / 8.0 - 4.0;
             let step = ((k & 63) as i32 - 32) as f32 * f32::EPSILON;
             edge + step * edge.abs().max(1.0)
+        } else if k % 2 == 0 {
+            // Within 10^-8..10^-3 of a quarter turn (the zeros of one of the two).
+            (g.u64() % 8) as f32 / 4.0 - 1.0
+                + 10f32.powf(-8.0 + 5.0 * g.unit()) * if k % 4 == 0 { 1.0 } else { -1.0 }
         } else {
             g.unit()
         };
-        let (sin64, cos64) = (std::f64::consts::TAU * x as f64).sin_cos();
-        for (model, worst) in worst.iter_mut().enumerate() {
+        let (cos64, sin64) = exact_cos_sin_turns(x as f64);
+        for (model, (worst, worst_relative)) in
+            worst.iter_mut().zip(&mut worst_relative).enumerate()
+        {
             let (u, _, _) = use_model(model);
             let (c, s) = cos_sin_turns(f(x));
-            let error = (c.value as f64 - cos64)
-                .abs()
-                .max((s.value as f64 - sin64).abs());
-            *worst = worst.max(error / (4.0 * u));
+            for (computed, exact) in [(c.value as f64, cos64), (s.value as f64, sin64)] {
+                let error = (computed - exact).abs();
+                *worst = worst.max(error / (4.0 * u));
+                let relative = 4.0 * u * exact.abs() + f32::MIN_POSITIVE as f64;
+                *worst_relative = worst_relative.max(error / relative);
+            }
         }
     }
     set_model(Model::VULKAN);
-    println!("cos_sin_turns against f64, of 4 u (IEEE, Vulkan, worst up, worst down): {worst:.3?}");
+    println!("cos_sin_turns against f64, of 4 u (IEEE, Vulkan, worst up, worst down): {worst:.3?}; of 4 u relative: {worst_relative:.3?}");
     assert!(worst.iter().all(|&w| w <= 1.0), "{worst:?}");
+    assert!(
+        worst_relative.iter().all(|&w| w <= 1.0),
+        "{worst_relative:?}"
+    );
+}
+
+/// (cos, sin) of 2 pi `x` turns, accurate relative to each: x less its nearest quarter turn
+/// (exact in f64 for an f32 x), its cosine and sine, rotated by the quarters.
+fn exact_cos_sin_turns(x: f64) -> (f64, f64) {
+    let q = (4.0 * x).round();
+    let (s, c) = (std::f64::consts::TAU * (x - 0.25 * q)).sin_cos();
+    match (q as i64).rem_euclid(4) {
+        0 => (c, s),
+        1 => (-s, c),
+        2 => (-c, -s),
+        _ => (s, -c),
+    }
 }
 
 /// How far the kernel's hit points fall from the exact surface, worst over random triangles and
