@@ -10,6 +10,7 @@ use crate::bsdf::lambert::{eval_scattering, pdf_brdf, sample_brdf};
 use crate::bsdf::microfacet::{ggx_d, ggx_g1, pdf_reflected, sample_visible_normal};
 use crate::bsdf::multiple_scattering::GlossyAlbedo;
 use crate::camera::camera_ray_direction;
+use crate::environment::{direction_in_texel, map_coordinates, texel_of, DrawnTexel, MapShape};
 use crate::features::Dynamic;
 use crate::frame::orthonormal_basis;
 use crate::free_flight;
@@ -103,7 +104,14 @@ pub mod function {
     /// out0 = light::punctual::sample's (normal, pdf), out1 = (its spot_attenuation,
     /// light::directional::sample's position)
     pub const PUNCTUAL_LIGHT: u32 = 19;
-    pub const COUNT: u32 = 20;
+    /// map rotation (cos, sin) = in0.xy, (u1, u2) = in0.zw, the drawn row's marginal CDF
+    /// (r0, r1) = in1.xy and column's conditional CDF (c0, c1) = in1.zw, a unit direction d =
+    /// in2.xyz; as integers, (width, height, row, column) = in3 ([`probe_environment`]) ->
+    /// out0 = environment::direction_in_texel's (direction, pdf), out1 =
+    /// environment::map_coordinates(d)'s (u, v, sin theta) and its texel (column, row) as
+    /// column + width row
+    pub const ENVIRONMENT: u32 = 20;
+    pub const COUNT: u32 = 21;
 }
 
 #[inline]
@@ -305,6 +313,31 @@ fn probe_texel(word: u32) -> Vec3 {
     Vec3::new(c(0), c(8), c(16))
 }
 
+/// The environment probe's outputs ([`function::ENVIRONMENT`]) over any scalar [`real::Real`]:
+/// the direction and density drawn in texel `drawn` of map `map`, and unit direction `d`'s map
+/// coordinates (u, v, sin theta) with its texel as column + width row. One function for the
+/// shader, the CPU and the tests' balls, so that all three compute the same operations.
+#[inline]
+pub fn probe_environment<R: real::Real<Bits = u32>>(
+    map: MapShape<R>,
+    drawn: DrawnTexel<R>,
+    d: V3<R>,
+) -> [R; 8] {
+    let (direction, pdf) = direction_in_texel(map, drawn);
+    let (u, v, sin_theta) = map_coordinates(map.rotation, d);
+    let (i, j) = texel_of(map.width, map.height, u, v);
+    [
+        direction.x,
+        direction.y,
+        direction.z,
+        pdf,
+        u,
+        v,
+        sin_theta,
+        R::splat((i + map.width * j) as f32),
+    ]
+}
+
 /// Evaluates `function` on one input record; see [`function`] for the layouts.
 #[inline]
 pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
@@ -367,6 +400,26 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
         (
             phase::sample(g, wo, u1, u2).extend(phase::eval(g, wo, wi)),
             Vec4::new(flight.t, flight.weight.x, flight.weight.y, flight.weight.z),
+        )
+    } else if function == function::ENVIRONMENT {
+        let ints = input[3];
+        let map = MapShape {
+            rotation: [i0.x, i0.y],
+            width: ints.x,
+            height: ints.y,
+        };
+        let drawn = DrawnTexel {
+            row: ints.z,
+            row_cdf: [i1.x, i1.y],
+            u2: i0.w,
+            column: ints.w,
+            column_cdf: [i1.z, i1.w],
+            u1: i0.z,
+        };
+        let o = probe_environment(map, drawn, V3::from(i2.truncate()));
+        (
+            Vec4::new(o[0], o[1], o[2], o[3]),
+            Vec4::new(o[4], o[5], o[6], o[7]),
         )
     } else if function == function::PUNCTUAL_LIGHT {
         let l = probe_punctual_light(i1.truncate(), i0.w, i2.truncate(), (i1.w, i2.w));

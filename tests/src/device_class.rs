@@ -5,8 +5,8 @@
 //! (eps, quotients within 2.5 ULP, roots as 1 / inversesqrt), in the comment of the test that
 //! checks it against the model of such a device (`tests/tests/vulkan_precision.rs`, on
 //! [`crate::vulkan_arithmetic::Vk32`]), and collected in `docs/robustness.md`; or, for the
-//! Fresnel, microfacet, phase and mapped-normal functions, the cone's density and the
-//! intersection probes, by running the kernel's own code on [`crate::ball_arithmetic::Ball`]s
+//! Fresnel, microfacet, phase and mapped-normal functions, the BSDFs, the punctual lights, the
+//! environment map, the cone's density and the intersection probes, by running the kernel's own code on [`crate::ball_arithmetic::Ball`]s
 //! in both arithmetics.
 
 use crate::ball_arithmetic::{ieee_and_vulkan_apart, Ball};
@@ -641,4 +641,63 @@ pub fn triangle_hit_apart(
 ) -> [f64; 7] {
     let (b, v) = (Ball::exact, Ball::exact_v3);
     ieee_and_vulkan_apart(&|| triangle_probe(v(origin), v(dir), v(p0), v(e1), v(e2), b(t_max)))
+}
+
+/// A record of the environment-map probe (`kernel::probe::function::ENVIRONMENT`): the map's
+/// rotation (cos, sin) about +y, the uniform numbers (u1, u2), the drawn row's marginal CDF
+/// (r0, r1) and column's conditional CDF (c0, c1), a unit direction `d` to look up, and the
+/// integers (width, height, row, column).
+#[derive(Clone, Copy, Debug)]
+pub struct EnvironmentRecord {
+    pub rotation: [f32; 2],
+    pub u: (f32, f32),
+    pub row_cdf: [f32; 2],
+    pub column_cdf: [f32; 2],
+    pub d: [f32; 3],
+    pub size: (u32, u32),
+    pub row: u32,
+    pub column: u32,
+}
+
+/// The probe's outputs computed over any scalar [`Real`] by the kernel's own code
+/// (`kernel::probe::probe_environment`): the direction and density drawn in the texel, and
+/// `d`'s map coordinates and texel.
+impl ProbeOutputs for EnvironmentRecord {
+    fn outputs<R: Real<Bits = u32>>(&self) -> [R; 8] {
+        use kernel::environment::{DrawnTexel, MapShape};
+        let c = R::splat;
+        let map = MapShape {
+            rotation: self.rotation.map(c),
+            width: self.size.0,
+            height: self.size.1,
+        };
+        let drawn = DrawnTexel {
+            row: self.row,
+            row_cdf: self.row_cdf.map(c),
+            u2: c(self.u.1),
+            column: self.column,
+            column_cdf: self.column_cdf.map(c),
+            u1: c(self.u.0),
+        };
+        kernel::probe::probe_environment(
+            map,
+            drawn,
+            V3::new(c(self.d[0]), c(self.d[1]), c(self.d[2])),
+        )
+    }
+}
+
+/// How far apart the CPU's and a conformant device's environment-map samples and look-ups may
+/// be for the probe's record `r`, per output (out0 then out1): the kernel's code run on
+/// [`crate::ball_arithmetic::Ball`]s in IEEE and in Vulkan arithmetic, every way its tests
+/// and conversions may go. The balls carry the density's 1 / sin theta near the poles and the
+/// texel a direction within rounding of a texel's edge may read on either side (its index
+/// then apart by 1, or by the width across a row); the drawn direction is a unit vector, apart
+/// by at most 2 per component.
+pub fn environment_apart(r: &EnvironmentRecord) -> [f64; 8] {
+    let mut apart = ieee_and_vulkan_apart(&|| r.outputs::<Ball>());
+    for a in &mut apart[..3] {
+        *a = a.min(UNIT_APART);
+    }
+    apart
 }

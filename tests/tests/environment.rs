@@ -2,7 +2,9 @@
 //!
 //! 1. The sampler follows the density MIS uses for it (`environment::pdf`): chi-square over
 //!    sub-texel bins, expected counts from that pdf function integrated in solid angle, on a map
-//!    with one hot texel and on a smooth rotated map, by luminance and uniformly.
+//!    with one hot texel and on a smooth rotated map, by luminance and uniformly; the density
+//!    each sample carries (its texel's) is finite, positive, and the look-up's except within
+//!    rounding of a texel's edge.
 //! 2. A constant map returns its constant exactly in every direction.
 //! 3. A diffuse plane under a map with one bright texel matches the closed form
 //!    kd L dphi (sin^2 theta2 - sin^2 theta1) / (2 pi) in every pixel, on both backends, with
@@ -122,16 +124,37 @@ fn the_sampler_follows_its_pdf() {
             );
             let mut observed = vec![0.0; (bw * bh) as usize];
             let mut r = SampleRng::new(2024, (2 * k) as u32 + mode, 0);
+            let mut other_texel = 0;
             for _ in 0..SAMPLES {
-                let d = sample(&params, &table, mode, r.next_f32(), r.next_f32());
+                let s = sample(&params, &table, mode, r.next_f32(), r.next_f32());
+                let d = s.direction;
                 assert!((d.length() - 1.0).abs() < 1e-5, "{label}: {d} not unit");
-                let p = pdf(&params, &table, mode, d);
                 assert!(
-                    p.is_finite() && p > 0.0,
-                    "{label}: pdf {p} at a sampled {d}"
+                    s.pdf.is_finite() && s.pdf > 0.0,
+                    "{label}: pdf {} drawn at {d}",
+                    s.pdf
                 );
+                // The density drawn is its texel's; the look-up of the direction reads the
+                // same texel (the same density within the rounding of sin theta) except where
+                // the direction lies within rounding (8 eps of the coordinates, generously) of a
+                // texel's edge.
+                let p = pdf(&params, &table, mode, d);
+                if (p - s.pdf).abs() > 1e-5 * s.pdf {
+                    let (u, v) = coordinates(d.as_dvec3(), map.rotation_degrees as f64);
+                    let near_edge = |x: f64, n: u32| {
+                        let y = x * n as f64;
+                        (y - y.round()).abs() <= 8.0 * f32::EPSILON as f64 * n as f64
+                    };
+                    assert!(
+                        near_edge(u, map.width) || near_edge(v, map.height),
+                        "{label}: drawn at {d} with density {}, looked up {p}, away from an edge",
+                        s.pdf
+                    );
+                    other_texel += 1;
+                }
                 observed[bin(d)] += 1.0;
             }
+            println!("{label}: {other_texel} of {SAMPLES} looked up in a neighbouring texel");
             // Expected counts: the pdf function integrated over each bin in solid angle, by the
             // midpoint rule on 4 x 4 cells per bin, each weighted by its exact solid angle
             // dphi (cos theta1 - cos theta2).

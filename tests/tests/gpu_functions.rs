@@ -6,7 +6,7 @@
 use glam::Vec3;
 use kernel::probe::{evaluate, function};
 use twinpath::vulkan::compute::ProbeRunner;
-use twinpath_tests::device_class::{bsdf_apart, punctual_apart};
+use twinpath_tests::device_class::{bsdf_apart, environment_apart, punctual_apart};
 use twinpath_tests::gpu::{assert_validation_clean, context};
 
 const N: usize = 100_000;
@@ -363,6 +363,43 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                     w(sigma_s, d),
                 ])
             }
+            function::ENVIRONMENT => {
+                // Maps from one texel to 2048 on a side, rotated or not; the drawn row's and
+                // column's CDF bins wide, narrow (down to 1e-7) and whole, the uniform number
+                // anywhere in its bin (its lower end included, as the sampler's search allows);
+                // directions on and near the axes (the poles, the seam at u = 0).
+                let size = |g: &mut Gen| g.pick(&[1.0, 2.0, 3.0, 7.0, 64.0, 1000.0, 2048.0]) as u32;
+                let (width, height) = (size(g), size(g));
+                let (row, column) = (
+                    (g.u64() % height as u64) as u32,
+                    (g.u64() % width as u64) as u32,
+                );
+                // Bin i of n: the first one's lower end 0, the last one's upper end 1 (the
+                // host's CDFs run from 0 to 1).
+                let bin = |g: &mut Gen, i: u32, n: u32| {
+                    let lo = g.unit();
+                    let lo = if i == 0 { 0.0 } else { g.pick(&[0.0, lo]) };
+                    let any = g.range(0.0, 1.0 - lo);
+                    let hi = g.pick(&[1.0, (lo + 1e-7).min(1.0), (lo + 1e-3).min(1.0), lo + any]);
+                    let hi = if hi > lo && i + 1 < n { hi } else { 1.0 };
+                    let u = lo + (hi - lo) * g.unit();
+                    // In (0, 1) and in [lo, hi), as `u32_to_unit_f32`'s numbers and
+                    // `find_interval` give it.
+                    let u = if u < hi { u } else { lo };
+                    (lo, hi, u.max(0.5 / 8_388_608.0))
+                };
+                let ((r0, r1, u2), (c0, c1, u1)) = (bin(g, row, height), bin(g, column, width));
+                let angle = g.range(-3.2, 3.2);
+                let angle = g.pick(&[0.0, angle]);
+                let mut r = rec([
+                    [angle.cos(), angle.sin(), u1, u2],
+                    [r0, r1, c0, c1],
+                    w(g.dir(), 0.0),
+                    [0.0; 4],
+                ]);
+                r[3] = [width, height, row, column];
+                r
+            }
             _ => unreachable!(),
         })
         .collect()
@@ -478,8 +515,24 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "phase::sample / eval, free_flight::sample", func: function::MEDIUM, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "the phase sampler's azimuth (cos_sin_turns' polynomials), its factored sine, sqrt and normalisation (FMA contraction): 8 eps on a unit vector; its density a rational function of one dot product, 8 ULP; a flight's t = -ln(1 - u) / sigma under Vulkan's log (2^-21 absolute on [0.5, 2]) and its weights, quotients of exponentials (3 + 2 |x| ULP) whose exponents carry t's error, denormals flushed: derived per record in `allowed_abs`" },
     Bound { name: "surface::mapped_normal", func: function::MAPPED_NORMAL, max_ulps: 8, abs: 16.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "a blend, one Gram-Schmidt step, a cross product and two normalisations of unit-scale vectors (FMA contraction, sqrt): 16 eps on a unit vector" },
     Bound { name: "punctual and directional light samples", func: function::PUNCTUAL_LIGHT, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "a difference, a dot product, a root and a quotient (FMA contraction): 8 eps on the unit normal, 8 ULP on the density; the spot's falloff a multiply-add clamped and squared, 8 eps times (1 + |scale| + |offset|); the directional light's point 8 eps of |x| + 2 (radius + |x - centre|), per record (`allowed_abs`)" },
+    Bound { name: "environment map sample and look-up", func: function::ENVIRONMENT, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "the drawn direction: two quotients, cos_sin_turns' polynomials and the rotation (FMA contraction), 8 eps on a unit vector; the density (1 / sin theta, ill-conditioned at the bottom pole, where 1 - v is a few eps) and the look-up (u, v, sin theta and the texel: a direction within rounding of the seam or of a texel's edge may read either side), by balls per record (`environment_apart`, whose Vulkan model holds FMA contraction)" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
+
+/// The environment probe's record `r` (`kernel::probe`'s layout).
+fn environment_record(r: &[[u32; 4]; 4]) -> twinpath_tests::device_class::EnvironmentRecord {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
+    twinpath_tests::device_class::EnvironmentRecord {
+        rotation: [f(0, 0), f(0, 1)],
+        u: (f(0, 2), f(0, 3)),
+        row_cdf: [f(1, 0), f(1, 1)],
+        column_cdf: [f(1, 2), f(1, 3)],
+        d: [f(2, 0), f(2, 1), f(2, 2)],
+        size: (r[3][0], r[3][1]),
+        row: r[3][2],
+        column: r[3][3],
+    }
+}
 
 /// The punctual-light probe's record `r` (`kernel::probe`'s layout).
 fn punctual_record(r: &[[u32; 4]; 4]) -> twinpath_tests::device_class::PunctualRecord {
@@ -547,6 +600,12 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
                 (f(2, 0), f(2, 1)),
             );
             output_allowance(&apart, k, j)
+        }
+        // The Vulkan class's environment map, per record (`environment_apart`); the IEEE
+        // class's density and look-up (out0.w, out1) by the same balls, since a contracted
+        // rotation may move a direction on the seam (u = 0 or 1) or a texel's edge across it.
+        function::ENVIRONMENT if b.vulkan || k == 1 || j == 3 => {
+            output_allowance(&environment_apart(&environment_record(r)), k, j)
         }
         // The Vulkan class's punctual and directional lights, per record (`punctual_apart`).
         function::PUNCTUAL_LIGHT if b.vulkan => {
@@ -1000,6 +1059,13 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
             abs: 0.0,
             vulkan: true,
             why: "Vulkan class: the kernel's mapped normal (a blend, one Gram-Schmidt step, a cross product, two normalisations and their tests) run on balls in IEEE and in Vulkan arithmetic, every way its tests may go; the largest distance between the two, per record (`mapped_normal_apart`)",
+            ..*b
+        }),
+        function::ENVIRONMENT => Some(Bound {
+            max_ulps: 0,
+            abs: 0.0,
+            vulkan: true,
+            why: "Vulkan class: the kernel's environment-map sampler within a texel (two quotients within 2.5 ULP, cos_sin_turns, the rotation) and its density, and the look-up (the rotation, a root, atan2_turns, the conversions to a texel), run on balls in IEEE and in Vulkan arithmetic, every way their tests and conversions may go, per record (`environment_apart`), which carries 1 / sin theta near the poles and the texel's either side of an edge",
             ..*b
         }),
         function::PUNCTUAL_LIGHT => Some(Bound {

@@ -13,7 +13,8 @@ use spirv_std::glam::Vec3;
 /// A direction toward the map (light `l`, index `light`) for receiver `x`, by
 /// `environment::sample` under `mode`, as a light point: beyond the sphere bounding the scene
 /// (`l.position`, `l.radius`) along the direction, facing back along it, so the shadow ray to
-/// it crosses the whole scene. Density: the map's, times the selection probability.
+/// it crosses the whole scene. Density: that of the map's texel drawn (`environment::sample`),
+/// times the selection probability.
 #[inline]
 pub fn sample(
     l: &Light,
@@ -24,16 +25,15 @@ pub fn sample(
     u1: f32,
     u2: f32,
 ) -> LightSample {
-    let (params, table) = (scene.params, scene.environment);
-    let dir = map::sample(params, table, mode, u1, u2);
+    let s = map::sample(scene.params, scene.environment, mode, u1, u2);
     let far = 2.0 * (l.radius + (x - Vec3::from(l.position)).length());
     LightSample {
         point: SurfacePoint {
-            position: x + dir * far,
-            normal: -dir,
+            position: x + s.direction * far,
+            normal: -s.direction,
         },
         light,
-        pdf_solid_angle: l.select_pmf * map::pdf(params, table, mode, dir),
+        pdf_solid_angle: l.select_pmf * s.pdf,
     }
 }
 

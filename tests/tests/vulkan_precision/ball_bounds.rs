@@ -1,7 +1,8 @@
 //! Bounds by ball arithmetic (`twinpath_tests::ball_arithmetic`), which bounds a kernel
 //! function's error in one arithmetic by running the function on balls: the balls against the
 //! model of a Vulkan device, and with them the functions bounded so (Fresnel reflectances,
-//! the microfacet functions and normal-mapped normals, written over `Real`): a conformant
+//! the microfacet functions, normal-mapped normals, the intersections, the phase function, the
+//! BSDFs, the punctual lights and the environment map, written over `Real`): a conformant
 //! device's results differ from the CPU's by no more than the balls allow.
 
 use super::{any_device, cases};
@@ -721,6 +722,114 @@ fn punctual_lights_differ_from_the_cpu_within_their_balls() {
     }
     set_model(Model::VULKAN);
     println!("punctual and directional lights, a device against the CPU: at most {worst:.3} of the balls' bound; {beyond_ieee_class} of {outputs} outputs beyond the IEEE class's bound");
+    assert!(
+        beyond_ieee_class > 0,
+        "the IEEE class's bound holds for devices"
+    );
+}
+
+/// The environment map's sample within a texel (its direction and density) and its look-up of
+/// a direction (map coordinates, sin theta and the texel read: `kernel::environment`, through
+/// `kernel::probe::probe_environment`) under the models of a device differ from the CPU's by at
+/// most [`environment_apart`], the balls' bound for one IEEE and one Vulkan computation; and
+/// the density a sample carries is finite and positive along every way a Vulkan computation
+/// may take (so no light sample of the map is lost or divides by 0 on any device). Records as
+/// `gpu_functions.rs` draws them: maps of 1 to 2048 texels a side, rotated or not, the drawn
+/// bins wide, narrow (down to 10^-7) and whole, directions on and near the axes (the poles, the
+/// seam). A texel's look-up within rounding of its edge, or of the seam, reads either side on a
+/// device, beyond the IEEE class's 8 eps.
+#[test]
+fn environment_samples_differ_from_the_cpu_within_their_balls() {
+    use glam::Vec3;
+    use twinpath_tests::device_class::{environment_apart, EnvironmentRecord};
+    let mut g = twinpath_tests::placements::Placements(SplitMix(71));
+    seed(71);
+    let (mut worst, mut beyond_ieee_class, mut outputs, mut other_texel) = (0f64, 0, 0, 0);
+    let mut unbounded = [0usize; 8];
+    let mut beyond_per_output = [0usize; 8];
+    let sizes = [1, 2, 3, 7, 64, 1000, 2048];
+    for k in 0..cases() {
+        let (width, height) = (sizes[k % 7], sizes[(k / 7) % 7]);
+        let row = (g.unit() * height as f32) as u32 % height;
+        let column = (g.unit() * width as f32) as u32 % width;
+        // A bin of `n` of a CDF, as the sampler's search returns it: its ends in [0, 1], the
+        // first bin's lower end 0 and the last one's upper end 1 (the host's CDFs run from 0
+        // to 1), wide, narrow or whole; the uniform number in [lo, hi) and in (0, 1).
+        let mut bin = |k: usize, i: u32, n: u32| {
+            let lo = if i == 0 || k.is_multiple_of(2) {
+                0.0
+            } else {
+                g.unit()
+            };
+            let width = [1.0 - lo, 1e-7, 1e-3, (1.0 - lo) * g.unit()][k / 2 % 4];
+            let hi = if i + 1 == n {
+                1.0
+            } else {
+                (lo + width).min(1.0)
+            };
+            let hi = if hi > lo { hi } else { 1.0 };
+            let u = lo + (hi - lo) * g.unit();
+            let u = if u < hi { u } else { lo };
+            (lo, hi, u.max(0.5 / 8_388_608.0))
+        };
+        let ((r0, r1, u2), (c0, c1, u1)) = (bin(k, row, height), bin(k / 8, column, width));
+        let angle = if k % 3 == 0 {
+            0.0
+        } else {
+            -3.2 + 6.4 * g.unit()
+        };
+        // Directions uniform, on an axis (the poles, the seam) or within 10^-7..10^-4 of one.
+        let axis = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z][k % 6];
+        let direction = match k % 4 {
+            0 => axis,
+            1 => (axis + g.pow10(-7.0, -4.0) * g.dir()).normalize(),
+            _ => g.dir(),
+        };
+        let r = EnvironmentRecord {
+            rotation: [angle.cos(), angle.sin()],
+            u: (u1, u2),
+            row_cdf: [r0, r1],
+            column_cdf: [c0, c1],
+            d: direction.to_array(),
+            size: (width, height),
+            row,
+            column,
+        };
+        for way in computations(Roundoff::VULKAN, &|| r.outputs::<Ball>()) {
+            let pdf = way[3];
+            assert!(
+                pdf.radius.is_finite() && pdf.mid - pdf.radius > 0.0,
+                "the density drawn for {r:?} may be {pdf:?} on a device"
+            );
+        }
+        let (cpu, device) = cpu_and_device(&r, k);
+        let apart = environment_apart(&r);
+        other_texel += (cpu[7] != device[7]) as usize;
+        for i in 0..8 {
+            outputs += 1;
+            let d = apart_within(
+                || format!("output {i} of {r:?}"),
+                cpu[i],
+                device[i],
+                apart[i],
+            );
+            // (The texel's index is apart by a whole texel or not at all.)
+            if apart[i].is_finite() && i < 7 {
+                worst = worst.max(d / apart[i].max(f64::MIN_POSITIVE));
+            }
+            unbounded[i] += apart[i].is_infinite() as usize;
+            // The bound devices were held to before (`gpu_functions.rs`' IEEE class).
+            let ulps = (cpu[i].to_bits() as i64 - device[i].to_bits() as i64).unsigned_abs();
+            let beyond = ulps > 8 && d > 8.0 * f32::EPSILON as f64;
+            beyond_ieee_class += beyond as usize;
+            beyond_per_output[i] += beyond as usize;
+        }
+    }
+    set_model(Model::VULKAN);
+    println!(
+        "environment map: outputs beyond the IEEE class's bound, per output {beyond_per_output:?}"
+    );
+    println!("environment map, a device against the CPU: at most {worst:.3} of the balls' bound; {beyond_ieee_class} of {outputs} outputs beyond the IEEE class's bound; {other_texel} look-ups in another texel; unbounded per output {unbounded:?}");
     assert!(
         beyond_ieee_class > 0,
         "the IEEE class's bound holds for devices"
