@@ -115,9 +115,9 @@ pub struct RenderSettings {
     pub sampler: Sampler,
     /// Compile the kernel for what the scene needs (`kernel::features`); false: generic path.
     pub specialize: bool,
-    /// CPU: trace scenes without instances sixteen paths at a time, SIMD over rays
-    /// (`cpu::packet_paths`: against every primitive of a scene of at most
-    /// `cpu::packet::MAX_PRIMITIVES`, else through the BVH); false: one path at a time.
+    /// CPU: trace sixteen paths at a time, SIMD over rays (`cpu::packet_paths`: against every
+    /// primitive of a scene of at most `cpu::packet::MAX_PRIMITIVES` without instances or
+    /// holes, else through the BVH); false: one path at a time.
     pub packets: bool,
     /// Adaptive sampling's target relative error of a pixel (0: off; `kernel::adaptive`).
     pub adaptive_target: f32,

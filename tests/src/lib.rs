@@ -272,6 +272,24 @@ pub fn assert_films_identical(a: &twinpath::film::Film, b: &twinpath::film::Film
     );
 }
 
+/// Renders `scene` on the CPU as it is and with `packets` off (one path at a time), `spp`
+/// samples each, and asserts the films identical, sample for sample (`tests/tests/packets.rs`:
+/// packets never change an image).
+pub fn assert_packets_give_the_one_path_image(name: &str, scene: &SceneFile, spp: u32) {
+    use twinpath::cpu::{CpuRenderer, TileStrategy};
+    use twinpath::render::Backend;
+    let mut one_path = scene.clone();
+    one_path.settings.packets = false;
+    assert!(matches!(
+        CpuRenderer::new(&one_path.scene, &one_path.settings).tiles,
+        TileStrategy::OnePath
+    ));
+    let a = render_film(scene, Backend::Cpu, spp);
+    let b = render_film(&one_path, Backend::Cpu, spp);
+    assert_films_identical(&a, &b, name);
+    println!("{name}: packets and one path identical at {spp} spp");
+}
+
 /// How many of two films' pixel sums (per channel) are equal, bit for bit.
 pub fn equal_pixel_sums(a: &twinpath::film::Film, b: &twinpath::film::Film) -> usize {
     a.sum.iter().zip(&b.sum).filter(|(x, y)| x == y).count()

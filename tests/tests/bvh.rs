@@ -532,11 +532,39 @@ fn bvh_packets_of_sixteen_rays_match_brute_force() {
     }
 }
 
+/// Packet number `packet` of sixteen rays, lane by lane `ray(rng, lane)`, with t_max infinite,
+/// drawn up to `reach`, or 0 (no ray in the lane) by a fixed pattern over (packet, lane): the
+/// packet, its t_max and the rays.
+fn ray_packet(
+    rng: &mut Uniform,
+    packet: usize,
+    reach: f32,
+    mut ray: impl FnMut(&mut Uniform, usize) -> (Vec3, Vec3),
+) -> (
+    twinpath::cpu::RayPacket,
+    [f32; twinpath::cpu::LANES],
+    Vec<(Vec3, Vec3)>,
+) {
+    let mut p = twinpath::cpu::RayPacket::zero();
+    let mut t_max = [f32::INFINITY; twinpath::cpu::LANES];
+    let mut lanes = Vec::new();
+    for (lane, lane_t_max) in t_max.iter_mut().enumerate() {
+        let (origin, dir) = ray(rng, lane);
+        if (packet + lane) % 7 == 3 {
+            *lane_t_max = 0.0; // no ray in this lane
+        } else if (packet + lane).is_multiple_of(3) {
+            *lane_t_max = rng.f(0.0, reach);
+        }
+        p.set(lane, origin, dir);
+        lanes.push((origin, dir));
+    }
+    (p, t_max, lanes)
+}
+
 /// 96 packets against `bvh` and brute force; returns the rays that hit, the rays, and the ties
 /// (hits where another primitive is hit at exactly the same t).
 fn check_bvh_packets(name: &str, bvh: &Bvh, stream: u32, extent: f32) -> (u32, u32, u32) {
     use std::simd::Simd;
-    use twinpath::cpu::{RayPacket, LANES};
     let n = bvh.spheres.len() + bvh.triangles.len();
     let mut rng = Uniform::new(stream);
     let (mut hits, mut rays, mut ties) = (0, 0, 0);
@@ -544,11 +572,8 @@ fn check_bvh_packets(name: &str, bvh: &Bvh, stream: u32, extent: f32) -> (u32, u
         let coherent = packet % 2 == 0;
         let base = rng.point(-extent, extent);
         let target = centre(bvh, (rng.0.next_u32() as usize) % n);
-        let mut p = RayPacket::zero();
-        let mut t_max = [f32::INFINITY; LANES];
-        let mut lanes = Vec::new();
-        for (lane, lane_t_max) in t_max.iter_mut().enumerate() {
-            let (origin, dir) = if coherent {
+        let (p, t_max, lanes) = ray_packet(&mut rng, packet, 2.0 * extent, |rng, lane| {
+            if coherent {
                 let o = base + 0.01 * extent * rng.point(-1.0, 1.0);
                 let aim = target + 0.05 * extent * rng.point(-1.0, 1.0);
                 (o, (aim - o).normalize())
@@ -560,15 +585,8 @@ fn check_bvh_packets(name: &str, bvh: &Bvh, stream: u32, extent: f32) -> (u32, u
                     rng.dir()
                 };
                 (o, d)
-            };
-            if (packet + lane) % 7 == 3 {
-                *lane_t_max = 0.0; // no ray in this lane
-            } else if (packet + lane) % 3 == 0 {
-                *lane_t_max = rng.f(0.0, 2.0 * extent);
             }
-            p.set(lane, origin, dir);
-            lanes.push((origin, dir));
-        }
+        });
         let found = bvh.closest_packet(&p, Simd::from_array(t_max));
         let occluded = bvh.occluded_packet(&p, Simd::from_array(t_max)).to_array();
         for (lane, &(origin, dir)) in lanes.iter().enumerate() {
@@ -669,4 +687,160 @@ fn ties_on_shared_edges_give_the_smallest_id() {
             );
         }
     }
+}
+
+/// Packets through a two-level tree match brute force, bit for bit, lane by lane, as the
+/// one-ray traversal does: a grid placed twice at the same place (so that two instances are hit
+/// at exactly the same t) and also stored at the top level (so that the top level ties with
+/// them), twelve knots placed by random rotations, scales and translations, and a sphere. The
+/// answer is the least (t, instance, id) over every primitive of every instance (the top
+/// level's own counting as instance `NONE`), whatever order either traversal visits them in;
+/// any-hit agrees too. Rays straight down onto the grid's vertices and edges, toward random
+/// primitives and anywhere, with t_max finite, infinite or 0 (no ray).
+#[test]
+fn bvh_packets_through_instances_match_brute_force() {
+    use glam::DMat4;
+    use kernel::instance::ray_to_object;
+    use std::simd::Simd;
+    use twinpath::scene::instancing::instance_record;
+    use twinpath::scene::transform::Transform;
+    let grid = to_triangles(&grid_triangles(), 0);
+    let knot = to_triangles(&knot_mesh(3_000, Vec3::ZERO, 1.5), 0);
+    let meshes = [knot, grid.clone()];
+    let mut rng = Uniform::new(900);
+    let mut placements = vec![(1u32, DMat4::IDENTITY), (1, DMat4::IDENTITY)];
+    for _ in 0..12 {
+        let axis = rng.dir().as_dvec3();
+        let angle = rng.f(0.0, 6.3) as f64;
+        let scale = rng.f(0.3, 1.5) as f64;
+        let at = rng.point(-4.0, 4.0).as_dvec3();
+        let m = DMat4::from_translation(at)
+            * DMat4::from_axis_angle(axis, angle)
+            * DMat4::from_scale(glam::DVec3::splat(scale));
+        placements.push((0, m));
+    }
+    let instances: Vec<_> = placements
+        .iter()
+        .map(|&(_, m)| instance_record(&Transform::affine(m).unwrap().unwrap_or_default(), 0))
+        .collect();
+    let instance_meshes: Vec<u32> = placements.iter().map(|p| p.0).collect();
+    let build_meshes = || {
+        meshes
+            .iter()
+            .map(|m| Bvh::build(Vec::new(), m.clone()))
+            .collect()
+    };
+    let lamp = sphere(Vec3::new(0.5, 3.0, -0.5), 0.4);
+    let bvh = Bvh::build_with_instances(
+        vec![lamp],
+        grid.clone(),
+        build_meshes(),
+        instances.clone(),
+        instance_meshes.clone(),
+    );
+    let top = Bvh::build(vec![lamp], grid);
+    let mesh_trees: Vec<Bvh> = build_meshes();
+    // The least (t, instance, id) of every primitive hit within (0, t_max).
+    let brute_force = |o: Vec3, d: Vec3, t_max: f32| -> (u32, u32, f32) {
+        let mut best = (f32::INFINITY, NONE, NONE);
+        let mut consider = |t: f32, instance: u32, id: u32| {
+            if t >= 0.0 && t < t_max && (t, instance, id) < best {
+                best = (t, instance, id);
+            }
+        };
+        for id in 0..(1 + top.triangles.len()) as u32 {
+            consider(top.intersect_prim(id, o, d, t_max), NONE, id);
+        }
+        for (i, inst) in instances.iter().enumerate() {
+            let (oo, od) = ray_to_object(inst, o, d);
+            let mesh = &mesh_trees[instance_meshes[i] as usize];
+            for id in 0..mesh.triangles.len() as u32 {
+                consider(mesh.intersect_prim(id, oo, od, t_max), i as u32, id);
+            }
+        }
+        if best.1 == NONE && best.2 == NONE {
+            (NONE, NONE, t_max)
+        } else {
+            (best.2, best.1, best.0)
+        }
+    };
+    let (mut hits, mut rays, mut on_instances, mut ties) = (0, 0, 0, 0);
+    for packet in 0..64 {
+        let (p, t_max, lanes) = ray_packet(&mut rng, packet, 8.0, |rng, lane| {
+            match packet % 3 {
+                // Straight down onto the grid's vertices, edge middles and diagonals.
+                0 => {
+                    let (x, z) = (
+                        (rng.0.next_u32() % 8) as f32 - 4.0,
+                        (rng.0.next_u32() % 8) as f32 - 4.0,
+                    );
+                    let offset = [(0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.25, 0.25)][lane % 4];
+                    (Vec3::new(x + offset.0, 2.5, z + offset.1), Vec3::NEG_Y)
+                }
+                1 => {
+                    let o = rng.point(-5.0, 5.0);
+                    (o, (rng.point(-3.0, 3.0) - o).normalize())
+                }
+                _ => (rng.point(-5.0, 5.0), rng.dir()),
+            }
+        });
+        let found = bvh.closest_packet(&p, Simd::from_array(t_max));
+        let occluded = bvh.occluded_packet(&p, Simd::from_array(t_max)).to_array();
+        for (lane, &(origin, dir)) in lanes.iter().enumerate() {
+            let label = format!(
+                "packet {packet}, lane {lane}: ray from {origin} along {dir}, t_max {}",
+                t_max[lane]
+            );
+            if t_max[lane] == 0.0 {
+                assert_eq!(found.prim[lane], NONE, "{label}: no ray, yet a hit");
+                assert!(!occluded[lane], "{label}: no ray, yet occluded");
+                continue;
+            }
+            rays += 1;
+            let (prim, instance, t) = brute_force(origin, dir, t_max[lane]);
+            let one = bvh.closest_prim(origin, dir, t_max[lane]);
+            assert_eq!(
+                (one.prim, one.instance, one.t.to_bits()),
+                (prim, instance, t.to_bits()),
+                "{label}: one ray against brute force"
+            );
+            assert_eq!(
+                (
+                    found.prim[lane],
+                    found.instance[lane],
+                    found.t[lane].to_bits()
+                ),
+                (prim, instance, t.to_bits()),
+                "{label}: packet against brute force"
+            );
+            assert_eq!(occluded[lane], prim != NONE, "{label}: any-hit");
+            assert_eq!(
+                bvh.any_hit(origin, dir, t_max[lane]),
+                prim != NONE,
+                "{label}"
+            );
+            if prim != NONE {
+                hits += 1;
+                on_instances += (instance != NONE) as u32;
+                // Another instance, or the top level, hit at exactly the same t.
+                let other = |i: u32| {
+                    let (o, d) = ray_to_object(&instances[i as usize], origin, dir);
+                    let mesh = &mesh_trees[instance_meshes[i as usize] as usize];
+                    i != instance && mesh.closest_prim(o, d, f32::INFINITY).t == t
+                };
+                let top_tie =
+                    instance != NONE && top.closest_prim(origin, dir, f32::INFINITY).t == t;
+                ties += ((0..instances.len() as u32).any(other) || top_tie) as u32;
+            }
+        }
+    }
+    println!("instances in packets: {hits} of {rays} rays hit, {on_instances} on instances, {ties} at exactly the t of another instance or the top level");
+    assert!(
+        on_instances > rays / 4,
+        "only {on_instances} hits on instances: the test would be weak"
+    );
+    assert!(
+        ties > 100,
+        "only {ties} ties across instances: the test would be weak"
+    );
 }

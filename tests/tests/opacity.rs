@@ -470,3 +470,41 @@ fn emitters_with_holes_light_as_their_coverage_on_both_backends() {
     let b = emitter_scene("lamp_left", 4.0, 0.5, -0.5, |_| json!({}));
     assert_same_light(&a, &b, &wrong, "MASK emitter");
 }
+
+/// The CPU's packets of sixteen paths pass through holes as one path at a time does (each
+/// lane's candidates asked of its own ray, `cpu/packet_presence.rs`): the MASK plane, the
+/// instanced BLEND layers under the directional light (shadow segments through both layers)
+/// and the BLEND emitter render the same films, bit for bit, with packets on and off.
+#[test]
+fn packets_through_holes_give_the_one_path_images() {
+    use twinpath::cpu::{CpuRenderer, TileStrategy};
+    let small = |mut s: SceneFile| {
+        s.scene.camera = s.scene.camera.resized(Some(24), Some(18)).unwrap();
+        s
+    };
+    let blend = |_: &mut GltfWriter| {
+        json!({ "pbrMetallicRoughness": { "baseColorFactor": [0.0, 0.0, 0.0, 0.5] },
+                "alphaMode": "BLEND" })
+    };
+    let scenes = [
+        ("MASK plane", small(load(&mask_file(), "mask_packets.glb"))),
+        (
+            "instanced BLEND layers",
+            small(load(&blend_file(), "blend_packets.glb")),
+        ),
+        (
+            "BLEND emitter",
+            emitter_scene("lamp_blend_packets", 4.0, 1.0, 0.0, blend),
+        ),
+    ];
+    for (name, scene) in scenes {
+        assert!(
+            matches!(
+                CpuRenderer::new(&scene.scene, &scene.settings).tiles,
+                TileStrategy::BvhPackets
+            ),
+            "{name}: holes, yet no packets"
+        );
+        twinpath_tests::assert_packets_give_the_one_path_image(name, &scene, 16);
+    }
+}

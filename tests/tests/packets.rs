@@ -1,15 +1,15 @@
 //! Sixteen paths at a time (`cpu::packet_paths`) against one path at a time over the BVH: the
 //! same kernel state machine and bit-identical intersections, so the same images, bit for bit,
 //! with every kernel variant, several lights, a background, and adaptive sampling, for small
-//! scenes (rays against every primitive) and larger ones (rays through the BVH as packets). Of
-//! primitives hit at exactly the same t every tracer reports the smallest id
-//! (`tests/tests/bvh.rs`), so the traversal order cannot change an image.
+//! scenes (rays against every primitive) and larger ones and scenes with instances (rays
+//! through the BVH as packets, two-level with instances). Of primitives hit at exactly the same
+//! t every tracer reports the least (instance, id) (`tests/tests/bvh.rs`), so the traversal
+//! order cannot change an image.
 
 use twinpath::cpu::{CpuRenderer, TileStrategy};
-use twinpath::render::Backend;
 use twinpath::scene::SceneFile;
 use twinpath::settings::{LightSampling, Mis, Roulette, Sampler};
-use twinpath_tests::{assert_films_identical, render_film, repo_root};
+use twinpath_tests::repo_root;
 
 fn small(name: &str) -> SceneFile {
     let mut s = SceneFile::load(&repo_root().join("scenes").join(name)).unwrap();
@@ -139,24 +139,15 @@ fn packets_of_paths_give_the_one_path_images() {
     }
 }
 
-/// Renders `scene` as it is (with packets) and with `packets` off (one path at a time), 8 spp
-/// or 32 under adaptive sampling, and asserts the films identical, sample for sample.
+/// [`twinpath_tests::assert_packets_give_the_one_path_image`] at 8 spp, or 32 under adaptive
+/// sampling.
 fn assert_packets_give_the_one_path_image(name: &str, scene: &SceneFile) {
-    let mut one_path = scene.clone();
-    one_path.settings.packets = false;
-    assert!(matches!(
-        CpuRenderer::new(&one_path.scene, &one_path.settings).tiles,
-        TileStrategy::OnePath
-    ));
     let spp = if scene.settings.adaptive_target > 0.0 {
         32
     } else {
         8
     };
-    let a = render_film(scene, Backend::Cpu, spp);
-    let b = render_film(&one_path, Backend::Cpu, spp);
-    assert_films_identical(&a, &b, name);
-    println!("{name}: packets and one path identical at {spp} spp");
+    twinpath_tests::assert_packets_give_the_one_path_image(name, scene, spp);
 }
 
 /// The Cornell room with a generated torus knot of about 12k triangles in place of the left
@@ -228,6 +219,15 @@ fn packets_through_the_bvh_give_the_one_path_images() {
             "gltf_showcase (normal map, spot light: the Dynamic path)",
             small("gltf_showcase.toml"),
         ),
+        (
+            "instances (two meshes placed 15 times, two triangles of its own: the two-level \
+             packets, not the small scene's)",
+            small("instances.toml"),
+        ),
+        (
+            "instances in a fog (shadow segments' blockers found through instances)",
+            instances_in_fog(),
+        ),
     ];
     for (name, scene) in scenes {
         assert!(
@@ -235,21 +235,34 @@ fn packets_through_the_bvh_give_the_one_path_images() {
                 CpuRenderer::new(&scene.scene, &scene.settings).tiles,
                 TileStrategy::BvhPackets
             ),
-            "{name}: a larger scene without instances, yet no packets through the BVH"
+            "{name}: a larger scene or one with instances, yet no packets through the BVH"
         );
         assert_packets_give_the_one_path_image(name, &scene);
     }
 }
 
-/// Instanced scenes keep one path at a time (packet traversal is one-level).
-#[test]
-fn instanced_scenes_trace_one_path_at_a_time() {
-    let scene = small("instances.toml");
-    assert!(!scene.scene.instances.is_empty());
-    assert!(matches!(
-        CpuRenderer::new(&scene.scene, &scene.settings).tiles,
-        TileStrategy::OnePath
-    ));
+/// `scenes/instances.toml` inside a scattering fog (`scenes/cornell_fog.toml`'s), 48 x 48: its
+/// shadow segments ask for the surface that blocks them, on instances too.
+fn instances_in_fog() -> SceneFile {
+    let scenes = repo_root().join("scenes");
+    let text = std::fs::read_to_string(scenes.join("instances.toml")).unwrap();
+    let text = text
+        .replace(
+            "[materials]",
+            "[media]\nfog = { sigma_a = [0.03, 0.04, 0.06], sigma_s = [0.25, 0.3, 0.4], g = 0.5 }\n\
+             [scene]\nmedium = \"fog\"\n[materials]",
+        )
+        .replace("file = \"", &format!("file = \"{}/", scenes.display()))
+        .replace("map = \"", &format!("map = \"{}/", scenes.display()));
+    let dir = std::env::temp_dir().join(format!("twinpath-instances-fog-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("instances_fog.toml");
+    std::fs::write(&path, text).unwrap();
+    let mut s = SceneFile::load(&path).unwrap();
+    assert!(!s.scene.instances.is_empty() && s.scene.medium != kernel::scene::NONE);
+    s.scene.camera.width = 48;
+    s.scene.camera.height = 48;
+    s
 }
 
 /// The numbers the packets compute for sixteen streams at once (`cpu::packet_numbers`, the

@@ -9,18 +9,23 @@
 //! finish it one ray at a time ([`ONE_AT_A_TIME_LANES`]; the hybrid of Benthin, Wald, Woop, Ernst
 //! and Mark 2012), since a packet's tests cost the same for one lane as for sixteen.
 //!
+//! With instances the packet is two-level: at a leaf's instance its rays are mapped into the
+//! mesh's object space lane by lane and descend the mesh's own tree as a packet. Where
+//! materials have holes each lane's candidates are asked of its own ray
+//! (`packet_presence.rs`). The any-hit descent for shadow segments is `bvh_packet_shadows.rs`.
+//!
 //! Every lane's answer is the one-ray traversal's, bit for bit: each box verdict and each t is
 //! computed by the same IEEE operations on that lane's ray, a lane leaves a subtree only where
 //! its own slab test (or the pop test, which is looser) rejects it, and the closest hit is the
-//! least (t, id) over the primitives reached (`bvh.rs`, `closest_in`), whatever the order.
+//! least (t, instance, id) over the primitives reached (`bvh/traverse.rs`, `closest_in`),
+//! whatever the order.
 
-use super::bvh::{Bvh, Solid, LEAF, STACK, WIDTH};
+use super::bvh::{Bvh, HoleTables, Presence, Solid, LEAF, STACK, TIE, WIDTH};
 use super::packet::{PacketHits, PacketTracer, RayPacket, LANES};
-use super::simd::{
-    slab_lanes, sphere_lanes, triangle_lanes, triangle_lanes_uv, widest_simd, Boxes, SLAB_PAD,
-};
-use glam::Vec3;
-use kernel::scene::NONE;
+use super::packet_presence::{LaneHoles, LanePresence};
+use super::simd::{slab_lanes, sphere_lanes, triangle_lanes_uv, widest_simd, Boxes, SLAB_PAD};
+use kernel::instance::ray_to_object;
+use kernel::scene::{Instance, NONE};
 use std::mem::MaybeUninit;
 use std::simd::cmp::{SimdPartialEq, SimdPartialOrd};
 use std::simd::num::SimdFloat;
@@ -31,11 +36,11 @@ type Ids = Simd<u32, LANES>;
 type LaneMask = Mask<i32, LANES>;
 
 /// Subtrees wanted by at most this many lanes are traced one ray at a time.
-pub const ONE_AT_A_TIME_LANES: u32 = 2;
+pub(super) const ONE_AT_A_TIME_LANES: u32 = 2;
 
 /// The packet's rays as the slab test reads them: 1 / dir by lane, and per axis whether some
 /// active lane's ray is parallel to it (1 / dir infinite, where 0 x inf can arise).
-struct SlabRays<'a> {
+pub(super) struct SlabRays<'a> {
     rays: &'a RayPacket,
     inv_dir: [Lanes; 3],
     parallel: [bool; 3],
@@ -43,7 +48,7 @@ struct SlabRays<'a> {
 
 impl<'a> SlabRays<'a> {
     #[inline(always)]
-    fn new(rays: &'a RayPacket, active: u32) -> Self {
+    pub(super) fn new(rays: &'a RayPacket, active: u32) -> Self {
         let one = Lanes::splat(1.0);
         let inv_dir = [one / rays.dir[0], one / rays.dir[1], one / rays.dir[2]];
         let active = LaneMask::from_bitmask(active as u64);
@@ -59,7 +64,7 @@ impl<'a> SlabRays<'a> {
     /// `simd::Ray4::slab` runs it for one ray): each lane's entry distance and whether its ray
     /// enters the box within (0, t_max].
     #[inline(always)]
-    fn slab(&self, b: &Boxes<WIDTH>, c: usize, t_max: Lanes) -> (Lanes, LaneMask) {
+    pub(super) fn slab(&self, b: &Boxes<WIDTH>, c: usize, t_max: Lanes) -> (Lanes, LaneMask) {
         let b = Boxes {
             min: column(&b.min, c),
             max: column(&b.max, c),
@@ -68,17 +73,10 @@ impl<'a> SlabRays<'a> {
     }
 }
 
-/// Lane `lane`'s ray.
-#[inline(always)]
-fn lane_ray(rays: &RayPacket, lane: usize) -> (Vec3, Vec3) {
-    let v = |c: &[Lanes; 3]| Vec3::new(c[0][lane], c[1][lane], c[2][lane]);
-    (v(&rays.origin), v(&rays.dir))
-}
-
 /// Lane `j` of a vector of any width (a node's child box, a block's triangle), in every lane of
 /// a packet.
 #[inline(always)]
-fn column<const N: usize>(v: &[Simd<f32, N>; 3], j: usize) -> [Lanes; 3] {
+pub(super) fn column<const N: usize>(v: &[Simd<f32, N>; 3], j: usize) -> [Lanes; 3] {
     [
         Lanes::splat(v[0][j]),
         Lanes::splat(v[1][j]),
@@ -94,24 +92,56 @@ fn tie_limits(hits: &PacketHits) -> Lanes {
 }
 
 /// Primitive `id`'s hits t (negative: missed) with barycentrics u, v replace the `inside`
-/// lanes' hits so far where nearer, or at the same t where `id` is smaller (`bvh.rs`,
-/// `closest_in`: the least (t, id) wins).
+/// lanes' hits so far where nearer, or at the same t where (instance, id) is less, this tree's
+/// own primitives counting as instance `NONE` (`bvh.rs`, `closest_in`: the least (t, instance,
+/// id) wins; a tree traversed without `INSTANCES` has only its own).
 #[inline(always)]
-fn keep_nearer(hits: &mut PacketHits, inside: LaneMask, id: u32, t: Lanes, u: Lanes, v: Lanes) {
+fn keep_nearer<const INSTANCES: bool>(
+    hits: &mut PacketHits,
+    inside: LaneMask,
+    id: u32,
+    t: Lanes,
+    u: Lanes,
+    v: Lanes,
+) {
     let ids = Ids::splat(id);
-    let nearer = t.simd_lt(hits.t) | (t.simd_eq(hits.t) & ids.simd_lt(hits.prim));
+    let mut tie_won = t.simd_eq(hits.t) & ids.simd_lt(hits.prim);
+    if INSTANCES {
+        tie_won &= hits.instance.simd_eq(Ids::splat(NONE));
+    }
+    let nearer = t.simd_lt(hits.t) | tie_won;
     let take = inside & t.simd_ge(Lanes::splat(0.0)) & nearer;
     hits.t = take.select(t, hits.t);
     hits.u = take.select(u, hits.u);
     hits.v = take.select(v, hits.v);
     hits.prim = take.select(ids, hits.prim);
+    if INSTANCES {
+        hits.instance = take.select(Ids::splat(NONE), hits.instance);
+    }
+}
+
+/// The rays of `lanes` mapped into the object space of `instance`
+/// (`kernel::instance::ray_to_object`, lane by lane as the one-ray traversal maps them); the
+/// other lanes zero rays.
+#[inline(always)]
+pub(super) fn rays_to_object(instance: &Instance, rays: &RayPacket, lanes: u32) -> RayPacket {
+    let mut object = RayPacket::zero();
+    let mut rest = lanes;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        let (origin, dir) = rays.lane(lane);
+        let (o, d) = ray_to_object(instance, origin, dir);
+        object.set(lane, o, d);
+    }
+    object
 }
 
 impl Bvh {
     /// The root and the lanes with a ray (t_max > 0) as a bit mask; `None` when there is no
     /// tree or no ray.
     #[inline(always)]
-    fn packet_start(&self, t_max: Lanes) -> Option<(u32, u32)> {
+    pub(super) fn packet_start(&self, t_max: Lanes) -> Option<(u32, u32)> {
         let active = t_max.simd_gt(Lanes::splat(0.0)).to_bitmask() as u32;
         match self.root {
             Some(root) if active != 0 => Some((root, active)),
@@ -119,35 +149,138 @@ impl Bvh {
         }
     }
 
+    /// Each lane's closest hit in (0, t_max) (`NONE` and t_max for a miss; lanes with t_max 0
+    /// have no ray), with a triangle's barycentrics and the instance hit (`NONE` for the
+    /// tree's own primitives; the barycentrics of an instance's triangle are left 0, for
+    /// [`Bvh::surface`] to find): lane by lane what [`Bvh::closest_prim`] and the kernel's
+    /// `intersect_triangle_uv` give.
+    #[inline]
+    pub fn closest_packet(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
+        if self.instances.is_empty() {
+            self.closest_packet_one_level(rays, t_max)
+        } else {
+            self.closest_packet_two_level(rays, t_max)
+        }
+    }
+
     widest_simd! {
-        /// Each lane's closest hit in (0, t_max) of a tree without instances (`NONE` and t_max
-        /// for a miss; lanes with t_max 0 have no ray), with a triangle's barycentrics: lane by
-        /// lane what [`Bvh::closest_prim`] and the kernel's `intersect_triangle_uv` give.
-        pub fn closest_packet(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits
-            = closest_packet_any_cpu, closest_packet_avx512, closest_packet_avx2
+        /// [`Bvh::closest_packet`] of a tree without instances.
+        fn closest_packet_one_level(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits
+            = packet_one_level_any_cpu, packet_one_level_avx512, packet_one_level_avx2
     }
 
     #[inline(always)]
-    fn closest_packet_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
-        debug_assert!(self.instances().is_empty());
-        let zero = Lanes::splat(0.0);
+    fn packet_one_level_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
         let mut hits = PacketHits::miss(t_max);
-        let Some((root, active)) = self.packet_start(t_max) else {
-            return hits;
-        };
+        if let Some((root, active)) = self.packet_start(t_max) {
+            self.closest_packet_in::<false, _>(root, rays, active, &mut hits, Solid);
+        }
+        hits
+    }
+
+    widest_simd! {
+        /// [`Bvh::closest_packet`] of a tree with instances.
+        fn closest_packet_two_level(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits
+            = packet_two_level_any_cpu, packet_two_level_avx512, packet_two_level_avx2
+    }
+
+    #[inline(always)]
+    fn packet_two_level_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
+        let mut hits = PacketHits::miss(t_max);
+        if let Some((root, active)) = self.packet_start(t_max) {
+            self.closest_packet_in::<true, _>(root, rays, active, &mut hits, Solid);
+        }
+        hits
+    }
+
+    widest_simd! {
+        /// [`Bvh::closest_packet`] where materials may have holes: candidates that `tables` say
+        /// are not there are passed through (`packet_presence.rs`), lane by lane what
+        /// [`Bvh::closest_hit_through`] finds.
+        pub fn closest_packet_through(
+            &self,
+            rays: &RayPacket,
+            t_max: Lanes,
+            tables: &HoleTables<'_>
+        ) -> PacketHits = packet_through_any_cpu, packet_through_avx512, packet_through_avx2
+    }
+
+    #[inline(always)]
+    fn packet_through_any_cpu(
+        &self,
+        rays: &RayPacket,
+        t_max: Lanes,
+        tables: &HoleTables<'_>,
+    ) -> PacketHits {
+        let mut hits = PacketHits::miss(t_max);
+        if let Some((root, active)) = self.packet_start(t_max) {
+            let holes = LaneHoles::of_packet(*tables, rays);
+            if self.instances.is_empty() {
+                self.closest_packet_in::<false, _>(root, rays, active, &mut hits, holes);
+            } else {
+                self.closest_packet_in::<true, _>(root, rays, active, &mut hits, holes);
+            }
+        }
+        hits
+    }
+
+    /// `t` with the lanes of `lanes` whose candidate triangle `id` (hit at t >= 0) `presence`
+    /// says is not there set to -1 (missed): the one-ray traversal's question, asked of each
+    /// such lane's ray.
+    #[inline(always)]
+    pub(super) fn present_lanes<P: LanePresence>(
+        &self,
+        presence: P,
+        id: u32,
+        rays: &RayPacket,
+        lanes: u32,
+        mut t: Lanes,
+    ) -> Lanes {
+        let mut candidates = t.simd_ge(Lanes::splat(0.0)).to_bitmask() as u32 & lanes;
+        while candidates != 0 {
+            let lane = candidates.trailing_zeros() as usize;
+            candidates &= candidates - 1;
+            let (origin, dir) = rays.lane(lane);
+            if !self.triangle_present(presence.lane(lane), id, origin, dir) {
+                t[lane] = -1.0;
+            }
+        }
+        t
+    }
+
+    /// The closest hits in subtree `start` of the rays of lanes `active` among the candidates
+    /// `presence` counts, from their hits so far `hits` (which may hold [`TIE`] where an
+    /// instance's mesh is searched for hits at exactly a t already found), with the instance
+    /// step where `INSTANCES`.
+    #[inline(always)]
+    fn closest_packet_in<const INSTANCES: bool, P: LanePresence>(
+        &self,
+        start: u32,
+        rays: &RayPacket,
+        active: u32,
+        hits: &mut PacketHits,
+        presence: P,
+    ) {
+        let zero = Lanes::splat(0.0);
         let slab_rays = SlabRays::new(rays, active);
         // Entries: a subtree, the lanes that entered its box, and the least entry distance
         // among them. Not zero-filled: entries below `sp` are always written first.
         let mut stack = [const { MaybeUninit::<(u32, u32, f32)>::uninit() }; STACK];
         let mut sp = 0;
-        let (mut current, mut lanes) = (root, active);
+        let (mut current, mut lanes) = (start, active);
         loop {
             if lanes.count_ones() <= ONE_AT_A_TIME_LANES {
                 let mut rest = lanes;
                 while rest != 0 {
                     let lane = rest.trailing_zeros() as usize;
                     rest &= rest - 1;
-                    self.closest_of_lane(current, rays, lane, &mut hits);
+                    self.closest_of_lane::<INSTANCES, _>(
+                        current,
+                        rays,
+                        lane,
+                        hits,
+                        presence.lane(lane),
+                    );
                 }
             } else if current & LEAF == 0 {
                 let node = &self.nodes[current as usize];
@@ -199,9 +332,14 @@ impl Bvh {
                             &column(&tri.edge1, j),
                             &column(&tri.edge2, j),
                             zero,
-                            tie_limits(&hits),
+                            tie_limits(hits),
                         );
-                        keep_nearer(&mut hits, inside, id, t, u, v);
+                        let t = if P::SOLID {
+                            t
+                        } else {
+                            self.present_lanes(presence, id, rays, lanes, t)
+                        };
+                        keep_nearer::<INSTANCES>(hits, inside, id, t, u, v);
                     }
                 }
                 for block in &self.sphere_blocks[spheres] {
@@ -218,10 +356,13 @@ impl Bvh {
                             &center,
                             radius,
                             zero,
-                            tie_limits(&hits),
+                            tie_limits(hits),
                         );
-                        keep_nearer(&mut hits, inside, id, t, zero, zero);
+                        keep_nearer::<INSTANCES>(hits, inside, id, t, zero, zero);
                     }
+                }
+                if INSTANCES {
+                    self.closest_in_leaf_instances(current, rays, lanes, hits, presence);
                 }
             }
             // Pop the next subtree some of whose lanes may still find a nearer hit in it: a
@@ -229,7 +370,7 @@ impl Bvh {
             // own slab test there too.
             loop {
                 if sp == 0 {
-                    return hits;
+                    return;
                 }
                 sp -= 1;
                 // SAFETY: entry `sp` was written by a push (sp only grows by writing).
@@ -244,121 +385,72 @@ impl Bvh {
         }
     }
 
-    /// Lane `lane`'s closest hit in subtree `start` by the one-ray traversal, from its hit so
-    /// far, with a new hit's barycentrics ([`Bvh::barycentrics`]).
+    /// The instance step of [`Bvh::closest_packet_in`] at leaf `leaf` for the rays of `lanes`:
+    /// each instance's mesh searched as a packet in object space, from the lanes' hits so far
+    /// (a lane with a hit seeks ties at its t too, [`TIE`]); a hit is taken where nearer, or at
+    /// the same t where the instance is less (as `closest_in` decides it one ray at a time).
     #[inline(always)]
-    fn closest_of_lane(&self, start: u32, rays: &RayPacket, lane: usize, hits: &mut PacketHits) {
-        let (origin, dir) = lane_ray(rays, lane);
+    fn closest_in_leaf_instances<P: LanePresence>(
+        &self,
+        leaf: u32,
+        rays: &RayPacket,
+        lanes: u32,
+        hits: &mut PacketHits,
+        presence: P,
+    ) {
+        let inside = LaneMask::from_bitmask(lanes as u64);
+        for &i in &self.leaf_instances[self.instances_of_leaf(leaf)] {
+            let mesh = &self.meshes[self.instance_meshes[i as usize] as usize];
+            let Some(mesh_root) = mesh.root else { continue };
+            let object = rays_to_object(&self.instances[i as usize], rays, lanes);
+            let none = Ids::splat(NONE);
+            let mut found = PacketHits::miss(hits.t);
+            found.prim = hits.prim.simd_eq(none).select(none, Ids::splat(TIE));
+            let in_mesh = presence.in_instance(i);
+            mesh.closest_packet_in::<false, P>(mesh_root, &object, lanes, &mut found, in_mesh);
+            let ids = Ids::splat(i);
+            let wins =
+                found.t.simd_lt(hits.t) | (found.t.simd_eq(hits.t) & ids.simd_lt(hits.instance));
+            let take = inside & found.prim.simd_lt(Ids::splat(TIE)) & wins;
+            hits.t = take.select(found.t, hits.t);
+            hits.prim = take.select(found.prim, hits.prim);
+            hits.u = take.select(Lanes::splat(0.0), hits.u);
+            hits.v = take.select(Lanes::splat(0.0), hits.v);
+            hits.instance = take.select(ids, hits.instance);
+        }
+    }
+
+    /// Lane `lane`'s closest hit in subtree `start` by the one-ray traversal among the
+    /// candidates `presence` counts (with the instance step where `INSTANCES`), from its hit so
+    /// far, with a new hit's barycentrics
+    /// ([`Bvh::barycentrics`]; 0 for an instance's triangle).
+    #[inline(always)]
+    fn closest_of_lane<const INSTANCES: bool, P: Presence>(
+        &self,
+        start: u32,
+        rays: &RayPacket,
+        lane: usize,
+        hits: &mut PacketHits,
+        presence: P,
+    ) {
+        let (origin, dir) = rays.lane(lane);
         let best = (hits.prim[lane], hits.t[lane]);
-        let mut no_instance = NONE;
+        let mut instance = hits.instance[lane];
         let (prim, t) =
-            self.closest_in::<false, Solid>(start, origin, dir, best, &mut no_instance, Solid);
-        if (prim, t) == best {
+            self.closest_in::<INSTANCES, P>(start, origin, dir, best, &mut instance, presence);
+        if (prim, t) == best && instance == hits.instance[lane] {
             return;
         }
-        let (u, v) = self.barycentrics(prim, origin, dir);
+        let (u, v) = if instance == NONE {
+            self.barycentrics(prim, origin, dir)
+        } else {
+            (0.0, 0.0)
+        };
         hits.prim[lane] = prim;
         hits.t[lane] = t;
         hits.u[lane] = u;
         hits.v[lane] = v;
-    }
-
-    widest_simd! {
-        /// Whether each lane's ray meets anything within (0, t_max) in a tree without instances
-        /// (lanes with t_max 0 have no ray): lane by lane what [`Bvh::any_hit`] says.
-        pub fn occluded_packet(&self, rays: &RayPacket, t_max: Lanes) -> LaneMask
-            = occluded_packet_any_cpu, occluded_packet_avx512, occluded_packet_avx2
-    }
-
-    #[inline(always)]
-    fn occluded_packet_any_cpu(&self, rays: &RayPacket, t_max: Lanes) -> LaneMask {
-        debug_assert!(self.instances().is_empty());
-        let zero = Lanes::splat(0.0);
-        let Some((root, active)) = self.packet_start(t_max) else {
-            return LaneMask::splat(false);
-        };
-        let slab_rays = SlabRays::new(rays, active);
-        let mut stack = [const { MaybeUninit::<(u32, u32)>::uninit() }; STACK];
-        let mut sp = 0;
-        let mut occluded = 0u32;
-        let (mut current, mut lanes) = (root, active);
-        loop {
-            if lanes.count_ones() <= ONE_AT_A_TIME_LANES {
-                let mut rest = lanes;
-                while rest != 0 {
-                    let lane = rest.trailing_zeros() as usize;
-                    rest &= rest - 1;
-                    let (origin, dir) = lane_ray(rays, lane);
-                    if self.any_in::<false, Solid>(current, origin, dir, t_max[lane], Solid) {
-                        occluded |= 1 << lane;
-                    }
-                }
-            } else if current & LEAF == 0 {
-                let node = &self.nodes[current as usize];
-                let mut used = node.used;
-                while used != 0 {
-                    let c = used.trailing_zeros() as usize;
-                    used &= used - 1;
-                    let (_, hit) = slab_rays.slab(&node.boxes, c, t_max);
-                    let entered = hit.to_bitmask() as u32 & lanes;
-                    if entered != 0 {
-                        stack[sp].write((node.child[c], entered));
-                        sp += 1;
-                    }
-                }
-            } else {
-                let (blocks, spheres) = self.leaf_contents(current);
-                'leaf: for block in &self.blocks[blocks] {
-                    for (j, &id) in block.id.iter().enumerate() {
-                        if id == NONE {
-                            break;
-                        }
-                        let tri = &block.triangles;
-                        let t = triangle_lanes(
-                            &rays.origin,
-                            &rays.dir,
-                            &column(&tri.p0, j),
-                            &column(&tri.edge1, j),
-                            &column(&tri.edge2, j),
-                            zero,
-                            t_max,
-                        );
-                        occluded |= t.simd_ge(zero).to_bitmask() as u32 & lanes;
-                        if lanes & !occluded == 0 {
-                            break 'leaf;
-                        }
-                    }
-                }
-                for block in &self.sphere_blocks[spheres] {
-                    for (j, &id) in block.id.iter().enumerate() {
-                        if id == NONE || lanes & !occluded == 0 {
-                            break;
-                        }
-                        let s = &block.spheres;
-                        let center = column(&s.center, j);
-                        let radius = Lanes::splat(s.radius[j]);
-                        let t = sphere_lanes(&rays.origin, &rays.dir, &center, radius, zero, t_max);
-                        occluded |= t.simd_ge(zero).to_bitmask() as u32 & lanes;
-                    }
-                }
-            }
-            if occluded == active {
-                return LaneMask::from_bitmask(occluded as u64);
-            }
-            loop {
-                if sp == 0 {
-                    return LaneMask::from_bitmask(occluded as u64);
-                }
-                sp -= 1;
-                // SAFETY: entry `sp` was written by a push (sp only grows by writing).
-                let (r, entered) = unsafe { stack[sp].assume_init() };
-                let still = entered & !occluded;
-                if still != 0 {
-                    (current, lanes) = (r, still);
-                    break;
-                }
-            }
-        }
+        hits.instance[lane] = instance;
     }
 }
 
@@ -368,5 +460,21 @@ impl PacketTracer for Bvh {
     }
     fn occluded_lanes(&self, rays: &RayPacket, t_max: Lanes) -> LaneMask {
         self.occluded_packet(rays, t_max)
+    }
+}
+
+/// Packets through the BVH of a scene whose materials have holes (`tables`): its rays pass
+/// through the candidates that are not there, lane by lane as one ray alone does.
+pub struct PacketsThroughHoles<'a> {
+    pub bvh: &'a Bvh,
+    pub tables: HoleTables<'a>,
+}
+
+impl PacketTracer for PacketsThroughHoles<'_> {
+    fn closest_hits(&self, rays: &RayPacket, t_max: Lanes) -> PacketHits {
+        self.bvh.closest_packet_through(rays, t_max, &self.tables)
+    }
+    fn occluded_lanes(&self, rays: &RayPacket, t_max: Lanes) -> LaneMask {
+        self.bvh.occluded_packet_through(rays, t_max, &self.tables)
     }
 }

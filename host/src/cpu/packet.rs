@@ -40,6 +40,13 @@ impl RayPacket {
         }
     }
 
+    /// Lane `lane`'s ray: (origin, direction).
+    #[inline(always)]
+    pub fn lane(&self, lane: usize) -> (Vec3, Vec3) {
+        let v = |c: &[Lanes; 3]| Vec3::new(c[0][lane], c[1][lane], c[2][lane]);
+        (v(&self.origin), v(&self.dir))
+    }
+
     /// Each lane's nearest root on the sphere (centre, radius) `s` in (0, t_max), else -1.
     #[inline(always)]
     fn sphere(&self, s: &[f32; 4], t_max: Lanes) -> Lanes {
@@ -72,15 +79,18 @@ impl RayPacket {
     }
 }
 
-/// What [`SmallScene::closest`] found, lane by lane: the primitive (`NONE` for a miss), its t,
-/// and for a triangle the barycentrics u, v of the hit (as the kernel's `intersect_triangle_uv`
-/// computes them; 0 for spheres and misses).
+/// What a packet tracer found, lane by lane: the primitive (`NONE` for a miss; numbered as
+/// its instance's mesh numbers it where `instance` is not `NONE`), its t, for a triangle of the
+/// scene's own the barycentrics u, v of the hit (as the kernel's `intersect_triangle_uv`
+/// computes them; 0 for spheres, misses and instances' triangles), and the instance hit
+/// (`NONE` but in a scene with instances, `bvh_packet.rs`).
 #[derive(Clone, Copy, Debug)]
 pub struct PacketHits {
     pub prim: Ids,
     pub t: Lanes,
     pub u: Lanes,
     pub v: Lanes,
+    pub instance: Ids,
 }
 
 /// What the packets of paths (`packet_paths.rs`) need of a scene: sixteen rays' closest hits
@@ -100,7 +110,7 @@ impl PacketTracer for SmallScene {
 }
 
 impl PacketHits {
-    /// Sixteen misses: no primitive, t = t_max, barycentrics 0.
+    /// Sixteen misses: no primitive, t = t_max, barycentrics 0, no instance.
     #[inline(always)]
     pub fn miss(t_max: Lanes) -> Self {
         let zero = Lanes::splat(0.0);
@@ -109,6 +119,7 @@ impl PacketHits {
             t: t_max,
             u: zero,
             v: zero,
+            instance: Ids::splat(NONE),
         }
     }
 }

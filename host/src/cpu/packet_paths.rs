@@ -2,14 +2,14 @@
 //! each round's rays traced as packets by a [`PacketTracer`] (SIMD over rays: against every
 //! primitive of a small scene, `packet.rs`, or through the BVH, `bvh_packet.rs`). Every path
 //! runs the same kernel code as `render_sample`, and the packet tracers return the one-ray
-//! traversal's primitive, t and barycentrics bit for bit (ties at equal t go to the smallest id
-//! in both), so a pixel's samples are the ones the one-path loop computes. Each round is the
-//! kernel's step protocol, as `PathState::run` follows it: `advance` with the round's answers,
-//! the `arrival` at each vertex reached, the vertices' samples (here filled for sixteen at
-//! once), `vertex`.
+//! traversal's primitive, instance, t and barycentrics bit for bit (ties at equal t go to the
+//! least (instance, id) in both), so a pixel's samples are the ones the one-path loop computes.
+//! Each round is the kernel's step protocol, as `PathState::run` follows it: `advance` with
+//! the round's answers, the `arrival` at each vertex reached, the vertices' samples (here filled
+//! for sixteen at once), `vertex`.
 
-use super::bvh::Bvh;
-use super::packet::{PacketTracer, RayPacket, LANES};
+use super::bvh::{Bvh, PrimHit};
+use super::packet::{PacketHits, PacketTracer, RayPacket, LANES};
 use super::packet_numbers::camera_numbers;
 use super::packet_vertices::fill_vertex_samples;
 use super::tile::TileSums;
@@ -57,9 +57,7 @@ fn settle_shadows<T: PacketTracer>(
     shadow: &RayPacket,
     t_max: [f32; LANES],
 ) -> [bool; LANES] {
-    let h = tracer.closest_hits(shadow, Simd::from_array(t_max));
-    let (prims, ts) = (h.prim.to_array(), h.t.to_array());
-    let (us, vs) = (h.u.to_array(), h.v.to_array());
+    let h = LaneHits::of(&tracer.closest_hits(shadow, Simd::from_array(t_max)));
     let mut waiting = [false; LANES];
     for (lane, slot) in slots.iter_mut().enumerate() {
         let Some((_, path)) = slot else { continue };
@@ -67,13 +65,60 @@ fn settle_shadows<T: PacketTracer>(
             continue;
         }
         let mut blocker = SurfaceHit::miss();
-        if prims[lane] != NONE {
+        if h.prim[lane] != NONE {
             let (o, d) = (path.shadow_from, path.shadow_to - path.shadow_from);
-            blocker = bvh.surface_with_uv(prims[lane], o, d, ts[lane], (us[lane], vs[lane]));
+            blocker = h.surface(bvh, lane, o, d);
         }
         waiting[lane] = path.shadow_passes(scene, &blocker);
     }
     waiting
+}
+
+/// A packet tracer's hits as arrays, lane by lane.
+struct LaneHits {
+    prim: [u32; LANES],
+    t: [f32; LANES],
+    u: [f32; LANES],
+    v: [f32; LANES],
+    instance: [u32; LANES],
+}
+
+impl LaneHits {
+    fn of(h: &PacketHits) -> Self {
+        LaneHits {
+            prim: h.prim.to_array(),
+            t: h.t.to_array(),
+            u: h.u.to_array(),
+            v: h.v.to_array(),
+            instance: h.instance.to_array(),
+        }
+    }
+
+    /// Sixteen misses.
+    fn miss() -> Self {
+        LaneHits {
+            prim: [NONE; LANES],
+            t: [0.0; LANES],
+            u: [0.0; LANES],
+            v: [0.0; LANES],
+            instance: [NONE; LANES],
+        }
+    }
+
+    /// The hit record of lane `lane`, which hit something, for its ray `origin + t dir`, made
+    /// by `bvh` as the one-path tracer makes it: from the known barycentrics on the scene's own
+    /// primitives, by [`Bvh::surface`] on an instance's triangle.
+    #[inline(always)]
+    fn surface(&self, bvh: &Bvh, lane: usize, origin: Vec3, dir: Vec3) -> SurfaceHit {
+        let (prim, t) = (self.prim[lane], self.t[lane]);
+        debug_assert!(prim != NONE);
+        if self.instance[lane] == NONE {
+            bvh.surface_with_uv(prim, origin, dir, t, (self.u[lane], self.v[lane]))
+        } else {
+            let instance = self.instance[lane];
+            bvh.surface(PrimHit { prim, instance, t }, origin, dir)
+        }
+    }
 }
 
 /// A path of the packets.
@@ -146,12 +191,10 @@ pub(super) fn tile_by_packets<F: FeatureSet, T: PacketTracer>(
         let (extensions, shadows) = (lanes(&ext_t_max), lanes(&shadow_t_max));
         rays.closest += extensions;
         rays.shadow += shadows;
-        let (prims, ts, us, vs) = if extensions > 0 {
-            let h = tracer.closest_hits(&extension, Simd::from_array(ext_t_max));
-            let a = |x: Simd<f32, LANES>| x.to_array();
-            (h.prim.to_array(), a(h.t), a(h.u), a(h.v))
+        let found = if extensions > 0 {
+            LaneHits::of(&tracer.closest_hits(&extension, Simd::from_array(ext_t_max)))
         } else {
-            ([NONE; LANES], [0.0; LANES], [0.0; LANES], [0.0; LANES])
+            LaneHits::miss()
         };
         // A scene with media asks for the surface blocking each shadow segment (an interface
         // lets it pass, `kernel::medium`); any other only whether one does.
@@ -165,10 +208,8 @@ pub(super) fn tile_by_packets<F: FeatureSet, T: PacketTracer>(
         hits.fill(SurfaceHit::miss());
         for (lane, slot) in slots.iter().enumerate() {
             let Some((_, path)) = slot else { continue };
-            if path.extend && prims[lane] != NONE {
-                let (o, d) = (path.ray_origin, path.ray_dir);
-                let uv = (us[lane], vs[lane]);
-                hits[lane] = bvh.surface_with_uv(prims[lane], o, d, ts[lane], uv);
+            if path.extend && found.prim[lane] != NONE {
+                hits[lane] = found.surface(bvh, lane, path.ray_origin, path.ray_dir);
             }
         }
         // (Shadow segments that pass an interface wait again, with their extension untaken.)

@@ -3,8 +3,9 @@
 //! scene's feature bits as a const generic (one monomorphised path per common combination).
 
 use super::bvh::{Bvh, HoleTables};
+use super::bvh_packet::PacketsThroughHoles;
 use super::bvh_tracer::BvhTracer;
-use super::packet::SmallScene;
+use super::packet::{PacketTracer, SmallScene};
 use super::packet_paths::tile_by_packets;
 use super::tile::{TileSums, TILE};
 use crate::backend::RayCounts;
@@ -19,6 +20,7 @@ use kernel::path::render_sample;
 use kernel::scene::{Light, Material, RenderParams, ShadingTriangle};
 use kernel::{SceneView, Tracer};
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// A scene prepared for CPU rendering.
 pub struct CpuRenderer {
@@ -48,16 +50,17 @@ pub struct CpuRenderer {
 /// How the CPU renderer computes a tile's samples. All give the same image bit for bit
 /// (`tests/tests/packets.rs`); packets are faster (docs/performance.md).
 pub enum TileStrategy {
-    /// One path at a time through the BVH: scenes with instances or with holes (glTF's MASK
-    /// and BLEND, `kernel::opacity`, which only the one-path traversal tests), or `packets`
-    /// off.
+    /// One path at a time through the BVH: with `packets` off.
     OnePath,
     /// Sixteen paths at a time, their rays tested against every primitive by SIMD lanes
-    /// (`packet_paths.rs`): for scenes of at most `packet::MAX_PRIMITIVES` primitives unless
-    /// the scene's `packets` setting is off. Holds all the primitives.
+    /// (`packet_paths.rs`): for scenes of at most `packet::MAX_PRIMITIVES` primitives, no
+    /// instances and no holes unless the scene's `packets` setting is off. Holds all the
+    /// primitives.
     Packets(SmallScene),
     /// Sixteen paths at a time, their rays traced through the BVH as packets
-    /// (`bvh_packet.rs`): for larger scenes without instances unless `packets` is off.
+    /// (`bvh_packet.rs`, instances included, through the holes of materials that have them,
+    /// `packet_presence.rs`): for larger scenes and scenes with instances or holes unless
+    /// `packets` is off.
     BvhPackets,
 }
 
@@ -141,8 +144,10 @@ impl CpuRenderer {
     pub fn with_bvh(scene: &Scene, settings: &RenderSettings, bvh: Bvh) -> Self {
         // Primitive ids as the BVH numbers them (`Bvh::surface` reads them).
         let holes = scene.materials.iter().any(Material::has_holes);
-        let tiles = if !(settings.packets && scene.instances.is_empty()) || holes {
+        let tiles = if !settings.packets {
             TileStrategy::OnePath
+        } else if holes || !scene.instances.is_empty() {
+            TileStrategy::BvhPackets
         } else if let Some(small) = SmallScene::if_small(&bvh.spheres, &bvh.triangles) {
             TileStrategy::Packets(small)
         } else {
@@ -168,13 +173,18 @@ impl CpuRenderer {
     pub fn tracer(&self) -> BvhTracer<'_> {
         let mut tracer = BvhTracer::new(&self.bvh);
         if self.holes {
-            tracer.holes = Some(HoleTables {
-                materials: &self.materials,
-                shading: &self.shading,
-                textures: &self.textures,
-            });
+            tracer.holes = Some(self.hole_tables());
         }
         tracer
+    }
+
+    /// The tables that say where the materials with holes are not there (`kernel::opacity`).
+    fn hole_tables(&self) -> HoleTables<'_> {
+        HoleTables {
+            materials: &self.materials,
+            shading: &self.shading,
+            textures: &self.textures,
+        }
     }
 
     /// One sample of one pixel, exactly as the GPU's ray-generation shader computes it.
@@ -238,6 +248,7 @@ impl CpuRenderer {
         film: &mut Film,
         progress: Option<&ProgressBar>,
     ) -> RayCounts {
+        let samples = first..first + count;
         match &self.tiles {
             TileStrategy::OnePath => {
                 self.render_tiles_by(params, film, progress, |pixels, film| {
@@ -245,32 +256,44 @@ impl CpuRenderer {
                 })
             }
             TileStrategy::Packets(small) => {
-                self.render_tiles_by(params, film, progress, |pixels, film| {
-                    tile_by_packets(
-                        features,
-                        small,
-                        &self.view(params),
-                        &self.bvh,
-                        pixels,
-                        first..first + count,
-                        film,
-                    )
-                })
+                self.render_packet_tiles(features, small, params, samples, film, progress)
+            }
+            TileStrategy::BvhPackets if self.holes => {
+                let tracer = PacketsThroughHoles {
+                    bvh: &self.bvh,
+                    tables: self.hole_tables(),
+                };
+                self.render_packet_tiles(features, &tracer, params, samples, film, progress)
             }
             TileStrategy::BvhPackets => {
-                self.render_tiles_by(params, film, progress, |pixels, film| {
-                    tile_by_packets(
-                        features,
-                        &self.bvh,
-                        &self.view(params),
-                        &self.bvh,
-                        pixels,
-                        first..first + count,
-                        film,
-                    )
-                })
+                self.render_packet_tiles(features, &self.bvh, params, samples, film, progress)
             }
         }
+    }
+
+    /// [`Self::render_tiles_by`] sixteen paths at a time (`packet_paths.rs`), samples
+    /// `samples` of each pixel, their rays traced by `tracer`.
+    fn render_packet_tiles<F: FeatureSet + Sync, T: PacketTracer>(
+        &self,
+        features: F,
+        tracer: &T,
+        params: &RenderParams,
+        samples: Range<u32>,
+        film: &mut Film,
+        progress: Option<&ProgressBar>,
+    ) -> RayCounts {
+        self.render_tiles_by(params, film, progress, |pixels, film| {
+            let view = self.view(params);
+            tile_by_packets(
+                features,
+                tracer,
+                &view,
+                &self.bvh,
+                pixels,
+                samples.clone(),
+                film,
+            )
+        })
     }
 
     /// Runs `tile` on every image tile in parallel (it returns each pixel's sums, in row

@@ -13,16 +13,15 @@
 //! direction not normalised, so t means the same in both) and traced through the mesh's tree
 //! (a two-level BVH, as Embree and the GPU's TLAS over BLASes do). Traversal is compiled twice,
 //! with and without the instance step, so a scene without instances runs the one-level loop.
-//! The closest hit is the kernel's own intersection functions' answer (bit-identical t),
-//! whatever the traversal order.
+//! The closest hit is the kernel's own intersection functions' answer (bit-identical t), the
+//! least (t, instance, id), whatever the traversal order.
 
 mod hits;
 mod holes;
 mod traverse;
 
 pub use holes::HoleTables;
-use holes::Holes;
-pub(super) use holes::{Presence, Solid};
+pub(super) use holes::{Holes, Presence, Solid};
 
 use super::bvh_build::{Aabb, BinaryBvh, SAH_MAX_DEPTH};
 use super::huge_pages;
@@ -49,6 +48,12 @@ const BLOCK_BITS: u32 = 28;
 /// Traversal stack: each level pushes at most WIDTH - 1 entries, and the wide tree is no deeper
 /// than the binary one (< SAH_MAX_DEPTH + 32 levels for up to 2^32 primitives).
 pub(super) const STACK: usize = (WIDTH - 1) * (SAH_MAX_DEPTH + 32) + 1;
+
+/// A "best so far" for a search that must also report hits at exactly its t: a tree's own
+/// primitive beats it at that t whatever its id, and `tie_limit` admits that t. An instance's
+/// mesh is searched from it where the ray has a hit already, so that a tie with that hit is
+/// decided by the instance order (`own_tie_won`'s counterpart in `closest_in`).
+pub(super) const TIE: u32 = NONE - 1;
 
 /// Children per node.
 pub(super) const WIDTH: usize = 8;
@@ -116,12 +121,12 @@ pub struct Bvh {
     shapes: Vec<TriangleShape>,
     /// The instances, the mesh (an index into `meshes`) each places, and the meshes' own
     /// object-space trees (without instances of their own).
-    instances: Vec<Instance>,
-    instance_meshes: Vec<u32>,
-    meshes: Vec<Bvh>,
+    pub(super) instances: Vec<Instance>,
+    pub(super) instance_meshes: Vec<u32>,
+    pub(super) meshes: Vec<Bvh>,
     /// The instances of the listed leaves, leaf by leaf, and each listed leaf's range of them
     /// (by the leaf's index in `leaves`).
-    leaf_instances: Vec<u32>,
+    pub(super) leaf_instances: Vec<u32>,
     leaf_instance_ranges: Vec<(u32, u32)>,
 }
 

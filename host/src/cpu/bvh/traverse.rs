@@ -87,10 +87,10 @@ impl Bvh {
     /// in where `INSTANCES` (the hit's instance is then written to `best_instance`, `NONE` for
     /// this tree's own primitives; the one-level loop never touches it).
     ///
-    /// Of this tree's primitives hit at exactly the same t, the smallest id wins, so the answer
-    /// is the least (t, id) whatever order the nodes are visited in: packet traversal
-    /// (`bvh_packet.rs`) gives the same hits. (A tie between an instance's triangle and any
-    /// other primitive still depends on the order; packets are not used with instances.)
+    /// Of primitives hit at exactly the same t, the least (instance, id) wins (this tree's own
+    /// primitives counting as instance `NONE`, after every instance), so the answer is the
+    /// least (t, instance, id) whatever order the nodes are visited in: packet traversal
+    /// (`bvh_packet.rs`) gives the same hits.
     #[inline(always)]
     pub(in crate::cpu) fn closest_in<const INSTANCES: bool, P: Presence>(
         &self,
@@ -149,7 +149,9 @@ impl Bvh {
                     for (&t, &id) in t.iter().zip(&block.id) {
                         // Missed lanes are -1; hits are below `limit` as it was at the call.
                         if t >= 0.0
-                            && (t < best_t || (t == best_t && id < best))
+                            && (t < best_t
+                                || (t == best_t
+                                    && own_tie_won::<INSTANCES>(id, best, best_instance)))
                             && (P::SOLID || self.triangle_present(presence, id, origin, dir))
                         {
                             best_t = t;
@@ -164,7 +166,11 @@ impl Bvh {
                     let limit = tie_limit(best, best_t);
                     let t = ray.spheres(&block.spheres, 0.0, limit).to_array();
                     for (&t, &id) in t.iter().zip(&block.id) {
-                        if t >= 0.0 && (t < best_t || (t == best_t && id < best)) {
+                        if t >= 0.0
+                            && (t < best_t
+                                || (t == best_t
+                                    && own_tie_won::<INSTANCES>(id, best, best_instance)))
+                        {
                             best_t = t;
                             best = id;
                             if INSTANCES {
@@ -184,11 +190,11 @@ impl Bvh {
                             mesh_root,
                             o,
                             d,
-                            (NONE, best_t),
+                            (tie_seeker(best), best_t),
                             &mut no_instance,
                             presence.in_instance(i),
                         );
-                        if prim != NONE && t < best_t {
+                        if found(prim) && (t < best_t || (t == best_t && i < *best_instance)) {
                             best_t = t;
                             best = prim;
                             *best_instance = i;
@@ -325,7 +331,13 @@ impl Bvh {
     /// Whether primitive `id` (a triangle: blocks hold only triangles) is there for
     /// `presence`, met by `origin + t dir` in this tree's space.
     #[inline(always)]
-    fn triangle_present<P: Presence>(&self, presence: P, id: u32, origin: Vec3, dir: Vec3) -> bool {
+    pub(in crate::cpu) fn triangle_present<P: Presence>(
+        &self,
+        presence: P,
+        id: u32,
+        origin: Vec3,
+        dir: Vec3,
+    ) -> bool {
         let index = id as usize - self.spheres.len();
         presence.present(&self.triangles[index], index as u32, origin, dir)
     }
@@ -438,7 +450,7 @@ impl Bvh {
 
     /// The range of [`Bvh::leaf_instances`] that leaf reference `r` holds.
     #[inline(always)]
-    fn instances_of_leaf(&self, r: u32) -> Range<usize> {
+    pub(in crate::cpu) fn instances_of_leaf(&self, r: u32) -> Range<usize> {
         if r & LISTED == 0 {
             0..0
         } else {
@@ -446,6 +458,31 @@ impl Bvh {
             first as usize..end as usize
         }
     }
+}
+
+/// `best` as an instance's mesh search starts from it: [`TIE`] where something is hit.
+#[inline(always)]
+fn tie_seeker(best: u32) -> u32 {
+    if best == NONE {
+        NONE
+    } else {
+        TIE
+    }
+}
+
+/// Whether a search's answer is a primitive (neither a miss nor [`TIE`]).
+#[inline(always)]
+fn found(prim: u32) -> bool {
+    prim < TIE
+}
+
+/// Whether this tree's primitive `id`, hit at exactly the t of the ray's best hit so far
+/// (`best`, on instance `best_instance` or on this tree's own primitives, `NONE`; a tree
+/// traversed without `INSTANCES` has only its own), wins the tie: the least (instance, id)
+/// wins, this tree's own primitives counting as instance `NONE`.
+#[inline(always)]
+fn own_tie_won<const INSTANCES: bool>(id: u32, best: u32, best_instance: &u32) -> bool {
+    (!INSTANCES || *best_instance == NONE) && id < best
 }
 
 /// The bound below which a leaf's hits are accepted by a ray whose closest hit so far is
