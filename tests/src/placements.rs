@@ -30,13 +30,48 @@ impl Placements {
     /// A triangle (or, for a quad, the loader's two triangles sharing the diagonal) placed at
     /// random, and a ray from 0.1 to 100 sizes away toward a random point of it: (size, origin,
     /// unit direction, the triangles as (p0, edge1, edge2)). None for a degenerate shape.
+    /// Half are oriented at random; a quarter lie in a plane normal to an axis (the floors and
+    /// walls of modelled scenes, whose points are exact along that axis), half of those tilted
+    /// out of it by 10^U(-8, -2) of their size; a quarter are slivers, edges 10^U(-4, -1)
+    /// radians apart, half of those in a plane normal to an axis.
     pub fn triangle_case(&mut self, quad: bool) -> Option<TriangleCase> {
         let (s, t) = self.placement();
         let p0 = t + self.dir() * s;
-        let (e1, e2) = (
-            self.dir() * s * self.pow10(-1.0, 0.0),
-            self.dir() * s * self.pow10(-1.0, 0.0),
-        );
+        let kind = (self.unit() * 4.0) as u32;
+        let axis = ((self.unit() * 3.0) as usize).min(2);
+        let flat = |v: Vec3| {
+            let mut v = v;
+            v[axis] = 0.0;
+            v
+        };
+        let (e1, e2) = match kind {
+            0 | 1 => (
+                self.dir() * s * self.pow10(-1.0, 0.0),
+                self.dir() * s * self.pow10(-1.0, 0.0),
+            ),
+            2 => {
+                let (mut e1, e2) = (
+                    flat(self.dir()) * s * self.pow10(-1.0, 0.0),
+                    flat(self.dir()) * s * self.pow10(-1.0, 0.0),
+                );
+                if self.unit() < 0.5 {
+                    let sign = if self.unit() < 0.5 { -1.0 } else { 1.0 };
+                    e1[axis] = sign * e1.length() * self.pow10(-8.0, -2.0);
+                }
+                (e1, e2)
+            }
+            _ => {
+                let in_plane = self.unit() < 0.5;
+                let pick = |g: &mut Self| if in_plane { flat(g.dir()) } else { g.dir() };
+                let along = pick(self).normalize();
+                let other = pick(self);
+                let across = (other - along * other.dot(along)).normalize();
+                let angle = self.pow10(-4.0, -1.0);
+                let e1 = along * s * self.pow10(-1.0, 0.0);
+                let e2 = (along * angle.cos() + across * angle.sin()) * s * self.pow10(-1.0, 0.0);
+                (e1, e2)
+            }
+        };
         if !e1.cross(e2).normalize().is_finite() {
             return None;
         }

@@ -1,5 +1,7 @@
 //! Re-intersection (in the style of pbrt-v4's `Reintersect` tests): random spheres, quads and
-//! triangles at scales 10^U(-4, 5) under random translations; a ray hits a random point; rays
+//! triangles (oriented at random, in or just off a plane normal to an axis, or slivers:
+//! `Placements::triangle_case`) at scales 10^U(-4, 5) under random translations; a ray hits a
+//! random point; rays
 //! spawned from that hit (continuation rays in random directions on the side they leave from,
 //! and shadow rays toward random points on that side) never hit the same surface again. And a
 //! shadow ray toward a point sampled on a sphere light never hits that light.
