@@ -155,6 +155,7 @@ pub mod gltf_writer;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod placements;
+pub mod probe_inputs;
 pub mod reference_bsdf;
 pub mod sheen_fit;
 pub mod spherical_triangle_error;

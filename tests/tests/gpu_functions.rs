@@ -6,66 +6,14 @@
 use glam::Vec3;
 use kernel::probe::{evaluate, function};
 use twinpath::vulkan::compute::ProbeRunner;
-use twinpath_tests::device_class::{bsdf_apart, environment_apart, punctual_apart};
+use twinpath_tests::device_class::{
+    bsdf_apart, environment_apart, punctual_apart, EnvironmentRecord, PunctualRecord,
+};
 use twinpath_tests::gpu::{assert_validation_clean, context};
 
 const N: usize = 100_000;
 
-/// splitmix64: the test's own input generator (independent of the kernel's RNG under test).
-/// Edge-favouring inputs on top of the shared splitmix64 generator.
-struct Gen(twinpath_tests::SplitMix);
-impl Gen {
-    fn u64(&mut self) -> u64 {
-        self.0.u64()
-    }
-    fn unit(&mut self) -> f32 {
-        self.0.unit()
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit()
-    }
-    fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
-        xs[(self.u64() % xs.len() as u64) as usize]
-    }
-    /// A magnitude 10^U(-6, 6).
-    fn scale(&mut self) -> f32 {
-        10f32.powf(self.range(-6.0, 6.0))
-    }
-    fn vec(&mut self) -> Vec3 {
-        Vec3::new(
-            self.range(-1.0, 1.0),
-            self.range(-1.0, 1.0),
-            self.range(-1.0, 1.0),
-        )
-    }
-    /// Unit vectors: uniform, exactly on an axis, or within 1e-4..1e-7 of one.
-    fn dir(&mut self) -> Vec3 {
-        let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
-        match self.u64() % 4 {
-            0 => self.pick(&axes),
-            1 => {
-                let eps = 10f32.powf(self.range(-7.0, -4.0));
-                (self.pick(&axes) + eps * self.vec()).normalize()
-            }
-            _ => loop {
-                let v = self.vec();
-                if v.length_squared() > 1e-6 && v.length_squared() <= 1.0 {
-                    break v.normalize();
-                }
-            },
-        }
-    }
-    /// A unit direction grazing the plane of `n` (within 1e-3 .. 1e-7 radians), or any.
-    fn grazing(&mut self, n: Vec3) -> Vec3 {
-        let d = self.dir();
-        if self.u64().is_multiple_of(2) {
-            let t = (d - n * d.dot(n)).normalize_or(Vec3::X);
-            (t + n * 10f32.powf(self.range(-7.0, -3.0)) * self.pick(&[1.0, -1.0])).normalize()
-        } else {
-            d
-        }
-    }
-}
+use twinpath_tests::probe_inputs::ProbeInputs as Gen;
 
 fn rec(v: [[f32; 4]; 4]) -> [[u32; 4]; 4] {
     v.map(|r| r.map(f32::to_bits))
@@ -312,36 +260,7 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                     [v * 0.5, 0.0, 0.0, 0.0],
                 ])
             }
-            function::PUNCTUAL_LIGHT => {
-                let x = g.vec() * g.scale();
-                // A receiver at the light (density 0) now and then, else anywhere around it.
-                let position = if g.u64().is_multiple_of(16) {
-                    x
-                } else {
-                    x + g.dir() * g.scale()
-                };
-                let axis = g.dir();
-                // A point light (scale 0, offset 1) or a spot whose cones are wide or narrow
-                // apart (the falloff's slope 1 / (cos inner - cos outer) up to 10^4).
-                let spot = if g.u64().is_multiple_of(4) {
-                    (0.0, 1.0)
-                } else {
-                    let outer = g.range(-0.9, 0.99);
-                    let any = 0.01 + (0.999 - outer) * g.unit();
-                    let width = g.pick(&[1e-4, 1e-2, any]);
-                    let scale = 1.0 / width.min(0.999 - outer);
-                    (scale, -outer * scale)
-                };
-                let centre = g.vec() * g.scale();
-                let any = g.range(1e-3, 1.0);
-                let pmf = g.pick(&[1.0, 0.25, any]);
-                rec([
-                    w(x, pmf),
-                    w(position, spot.0),
-                    w(axis, spot.1),
-                    w(centre, g.scale()),
-                ])
-            }
+            function::PUNCTUAL_LIGHT => g.punctual_record().to_probe(),
             function::MEDIUM => {
                 // Phase: any g in (-1, 1) (isotropic below 1e-3 included), unit directions.
                 // Flights: coefficients over four decades, a channel of 0 at times, surfaces
@@ -363,43 +282,7 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                     w(sigma_s, d),
                 ])
             }
-            function::ENVIRONMENT => {
-                // Maps from one texel to 2048 on a side, rotated or not; the drawn row's and
-                // column's CDF bins wide, narrow (down to 1e-7) and whole, the uniform number
-                // anywhere in its bin (its lower end included, as the sampler's search allows);
-                // directions on and near the axes (the poles, the seam at u = 0).
-                let size = |g: &mut Gen| g.pick(&[1.0, 2.0, 3.0, 7.0, 64.0, 1000.0, 2048.0]) as u32;
-                let (width, height) = (size(g), size(g));
-                let (row, column) = (
-                    (g.u64() % height as u64) as u32,
-                    (g.u64() % width as u64) as u32,
-                );
-                // Bin i of n: the first one's lower end 0, the last one's upper end 1 (the
-                // host's CDFs run from 0 to 1).
-                let bin = |g: &mut Gen, i: u32, n: u32| {
-                    let lo = g.unit();
-                    let lo = if i == 0 { 0.0 } else { g.pick(&[0.0, lo]) };
-                    let any = g.range(0.0, 1.0 - lo);
-                    let hi = g.pick(&[1.0, (lo + 1e-7).min(1.0), (lo + 1e-3).min(1.0), lo + any]);
-                    let hi = if hi > lo && i + 1 < n { hi } else { 1.0 };
-                    let u = lo + (hi - lo) * g.unit();
-                    // In (0, 1) and in [lo, hi), as `u32_to_unit_f32`'s numbers and
-                    // `find_interval` give it.
-                    let u = if u < hi { u } else { lo };
-                    (lo, hi, u.max(0.5 / 8_388_608.0))
-                };
-                let ((r0, r1, u2), (c0, c1, u1)) = (bin(g, row, height), bin(g, column, width));
-                let angle = g.range(-3.2, 3.2);
-                let angle = g.pick(&[0.0, angle]);
-                let mut r = rec([
-                    [angle.cos(), angle.sin(), u1, u2],
-                    [r0, r1, c0, c1],
-                    w(g.dir(), 0.0),
-                    [0.0; 4],
-                ]);
-                r[3] = [width, height, row, column];
-                r
-            }
+            function::ENVIRONMENT => g.environment_record().to_probe(),
             _ => unreachable!(),
         })
         .collect()
@@ -519,35 +402,6 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
 
-/// The environment probe's record `r` (`kernel::probe`'s layout).
-fn environment_record(r: &[[u32; 4]; 4]) -> twinpath_tests::device_class::EnvironmentRecord {
-    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
-    twinpath_tests::device_class::EnvironmentRecord {
-        rotation: [f(0, 0), f(0, 1)],
-        u: (f(0, 2), f(0, 3)),
-        row_cdf: [f(1, 0), f(1, 1)],
-        column_cdf: [f(1, 2), f(1, 3)],
-        d: [f(2, 0), f(2, 1), f(2, 2)],
-        size: (r[3][0], r[3][1]),
-        row: r[3][2],
-        column: r[3][3],
-    }
-}
-
-/// The punctual-light probe's record `r` (`kernel::probe`'s layout).
-fn punctual_record(r: &[[u32; 4]; 4]) -> twinpath_tests::device_class::PunctualRecord {
-    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
-    let v = |i: usize| [f(i, 0), f(i, 1), f(i, 2)];
-    twinpath_tests::device_class::PunctualRecord {
-        x: v(0),
-        select_pmf: f(0, 3),
-        position: v(1),
-        axis: v(2),
-        spot: (f(1, 3), f(2, 3)),
-        bounds: [f(3, 0), f(3, 1), f(3, 2), f(3, 3)],
-    }
-}
-
 /// The BSDF probe's record `r` of function `func` (`kernel::probe`'s layout).
 fn bsdf_record(func: u32, r: &[[u32; 4]; 4]) -> twinpath_tests::device_class::BsdfRecord {
     let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
@@ -605,15 +459,15 @@ fn allowed_abs(b: &Bound, r: &[[u32; 4]; 4], k: usize, j: usize, value: f32) -> 
         // class's density and look-up (out0.w, out1) by the same balls, since a contracted
         // rotation may move a direction on the seam (u = 0 or 1) or a texel's edge across it.
         function::ENVIRONMENT if b.vulkan || k == 1 || j == 3 => {
-            output_allowance(&environment_apart(&environment_record(r)), k, j)
+            output_allowance(&environment_apart(&EnvironmentRecord::from_probe(r)), k, j)
         }
         // The Vulkan class's punctual and directional lights, per record (`punctual_apart`).
         function::PUNCTUAL_LIGHT if b.vulkan => {
-            output_allowance(&punctual_apart(&punctual_record(r)), k, j)
+            output_allowance(&punctual_apart(&PunctualRecord::from_probe(r)), k, j)
         }
         // The IEEE class's: the falloff's magnitudes (out1.x), the far point's (out1.yzw).
         function::PUNCTUAL_LIGHT if k == 1 => {
-            let r = punctual_record(r);
+            let r = PunctualRecord::from_probe(r);
             let length = |v: [f32; 3]| Vec3::from_array(v).length();
             if j == 0 {
                 b.abs * (1.0 + r.spot.0.abs() + r.spot.1.abs())

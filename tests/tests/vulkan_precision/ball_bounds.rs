@@ -12,6 +12,7 @@ use twinpath_tests::ball_arithmetic::{computations, Ball, Roundoff};
 use twinpath_tests::device_class::{
     fresnel_apart, sphere_hit_apart, sphere_probe, triangle_hit_apart, triangle_probe, ProbeOutputs,
 };
+use twinpath_tests::probe_inputs::ProbeInputs;
 use twinpath_tests::vulkan_arithmetic::{seed, set_model, Model, Vk32};
 use twinpath_tests::SplitMix;
 
@@ -658,42 +659,21 @@ fn bsdfs_differ_from_the_cpu_within_their_balls() {
 /// The point and spot light's sample (its direction, density and falloff) and the directional
 /// light's far point (`kernel::light::punctual`, `directional`) under the models of a device
 /// differ from the CPU's by at most [`punctual_apart`], the balls' bound for one IEEE and one
-/// Vulkan computation. Records as `gpu_functions.rs` draws them: receivers and lights 10^-6 to
+/// Vulkan computation. Records as `gpu_functions.rs` draws them (`ProbeInputs::punctual_record`):
+/// receivers and lights 10^-6 to
 /// 10^6 apart and from the origin, receivers at the light, point lights and spots whose cones
 /// are 10^-4 to 1 apart in cosine. The falloff near a narrow transition moves by its slope
 /// times the cosine's rounding, beyond the IEEE class's 8 eps times its magnitudes.
 #[test]
 fn punctual_lights_differ_from_the_cpu_within_their_balls() {
-    use twinpath_tests::device_class::{punctual_apart, PunctualRecord};
-    let mut g = twinpath_tests::placements::Placements(SplitMix(67));
+    use twinpath_tests::device_class::punctual_apart;
+    let mut g = ProbeInputs(SplitMix(67));
     seed(67);
     let (mut worst, mut beyond_ieee_class, mut outputs) = (0f64, 0, 0);
     for k in 0..cases() {
-        let scale = |g: &mut twinpath_tests::placements::Placements| g.pow10(-6.0, 6.0);
-        let x = g.dir() * scale(&mut g);
-        let position = if k % 16 == 0 {
-            x
-        } else {
-            x + g.dir() * scale(&mut g)
-        };
-        let axis = g.dir();
-        let spot = if k % 4 == 0 {
-            (0.0, 1.0)
-        } else {
-            let outer = -0.9 + 1.89 * g.unit();
-            let width = [1e-4, 1e-2, 0.01 + (0.999 - outer) * g.unit()][k % 3];
-            let s = 1.0 / width.min(0.999 - outer);
-            (s, -outer * s)
-        };
-        let centre = g.dir() * scale(&mut g);
-        let r = PunctualRecord {
-            x: x.to_array(),
-            select_pmf: [1.0, 0.25, 1e-3 + g.unit()][k % 3].min(1.0),
-            position: position.to_array(),
-            axis: axis.to_array(),
-            spot,
-            bounds: [centre.x, centre.y, centre.z, scale(&mut g)],
-        };
+        let r = g.punctual_record();
+        let (spot, x) = (r.spot, glam::Vec3::from(r.x));
+        let centre = glam::Vec3::new(r.bounds[0], r.bounds[1], r.bounds[2]);
         let (cpu, device) = cpu_and_device(&r, k);
         let apart = punctual_apart(&r);
         for i in 0..8 {
@@ -734,67 +714,21 @@ fn punctual_lights_differ_from_the_cpu_within_their_balls() {
 /// most [`environment_apart`], the balls' bound for one IEEE and one Vulkan computation; and
 /// the density a sample carries is finite and positive along every way a Vulkan computation
 /// may take (so no light sample of the map is lost or divides by 0 on any device). Records as
-/// `gpu_functions.rs` draws them: maps of 1 to 2048 texels a side, rotated or not, the drawn
+/// `gpu_functions.rs` draws them (`ProbeInputs::environment_record`): maps of 1 to 2048 texels
+/// a side, rotated or not, the drawn
 /// bins wide, narrow (down to 10^-7) and whole, directions on and near the axes (the poles, the
 /// seam). A texel's look-up within rounding of its edge, or of the seam, reads either side on a
 /// device, beyond the IEEE class's 8 eps.
 #[test]
 fn environment_samples_differ_from_the_cpu_within_their_balls() {
-    use glam::Vec3;
-    use twinpath_tests::device_class::{environment_apart, EnvironmentRecord};
-    let mut g = twinpath_tests::placements::Placements(SplitMix(71));
+    use twinpath_tests::device_class::environment_apart;
+    let mut g = ProbeInputs(SplitMix(71));
     seed(71);
     let (mut worst, mut beyond_ieee_class, mut outputs, mut other_texel) = (0f64, 0, 0, 0);
     let mut unbounded = [0usize; 8];
     let mut beyond_per_output = [0usize; 8];
-    let sizes = [1, 2, 3, 7, 64, 1000, 2048];
     for k in 0..cases() {
-        let (width, height) = (sizes[k % 7], sizes[(k / 7) % 7]);
-        let row = (g.unit() * height as f32) as u32 % height;
-        let column = (g.unit() * width as f32) as u32 % width;
-        // A bin of `n` of a CDF, as the sampler's search returns it: its ends in [0, 1], the
-        // first bin's lower end 0 and the last one's upper end 1 (the host's CDFs run from 0
-        // to 1), wide, narrow or whole; the uniform number in [lo, hi) and in (0, 1).
-        let mut bin = |k: usize, i: u32, n: u32| {
-            let lo = if i == 0 || k.is_multiple_of(2) {
-                0.0
-            } else {
-                g.unit()
-            };
-            let width = [1.0 - lo, 1e-7, 1e-3, (1.0 - lo) * g.unit()][k / 2 % 4];
-            let hi = if i + 1 == n {
-                1.0
-            } else {
-                (lo + width).min(1.0)
-            };
-            let hi = if hi > lo { hi } else { 1.0 };
-            let u = lo + (hi - lo) * g.unit();
-            let u = if u < hi { u } else { lo };
-            (lo, hi, u.max(0.5 / 8_388_608.0))
-        };
-        let ((r0, r1, u2), (c0, c1, u1)) = (bin(k, row, height), bin(k / 8, column, width));
-        let angle = if k % 3 == 0 {
-            0.0
-        } else {
-            -3.2 + 6.4 * g.unit()
-        };
-        // Directions uniform, on an axis (the poles, the seam) or within 10^-7..10^-4 of one.
-        let axis = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z][k % 6];
-        let direction = match k % 4 {
-            0 => axis,
-            1 => (axis + g.pow10(-7.0, -4.0) * g.dir()).normalize(),
-            _ => g.dir(),
-        };
-        let r = EnvironmentRecord {
-            rotation: [angle.cos(), angle.sin()],
-            u: (u1, u2),
-            row_cdf: [r0, r1],
-            column_cdf: [c0, c1],
-            d: direction.to_array(),
-            size: (width, height),
-            row,
-            column,
-        };
+        let r = g.environment_record();
         for way in computations(Roundoff::VULKAN, &|| r.outputs::<Ball>()) {
             let pdf = way[3];
             assert!(
