@@ -22,7 +22,7 @@ pub struct ProbeRunner {
 
 impl ProbeRunner {
     pub fn new(ctx: &Context) -> Result<ProbeRunner> {
-        let module = shader_module(ctx, crate::PROBE_SPV)?;
+        let module = shader_module(ctx, crate::PROBE_SPV, PROBE)?;
         let bindings = [0, 1].map(|b| {
             vk::DescriptorSetLayoutBinding::default()
                 .binding(b)
@@ -161,7 +161,7 @@ impl ProbeRunner {
             self.pipeline,
             self.layout,
             self.set_layout,
-            self.module,
+            &[self.module],
         );
     }
 }

@@ -5,6 +5,7 @@ pub mod accel;
 #[cfg(feature = "test-support")]
 pub mod compute;
 pub mod device;
+pub mod entry_module;
 pub mod float_controls;
 pub mod limits;
 pub mod memory;

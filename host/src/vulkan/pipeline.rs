@@ -100,7 +100,8 @@ impl HitGroups {
 /// [`RtPipeline`] renders with, and what `examples/pipeline_stats` compiles for a driver's
 /// statistics (on hardware without memory, where no table can be made).
 pub struct CompiledPipeline {
-    pub module: vk::ShaderModule,
+    /// One module per stage, in stage order (`super::entry_module`).
+    pub modules: Vec<vk::ShaderModule>,
     pub set_layout: vk::DescriptorSetLayout,
     pub layout: vk::PipelineLayout,
     pub pipeline: vk::Pipeline,
@@ -162,10 +163,16 @@ fn align_up(x: u64, a: u64) -> u64 {
     x.div_ceil(a) * a
 }
 
-/// Creates a shader module from SPIR-V bytes, asking for the float controls the device offers
+/// Creates a shader module of the entry point `entry` of SPIR-V bytes (the module cut to it,
+/// `super::entry_module`), asking for the float controls the device offers
 /// (`super::float_controls`).
-pub fn shader_module(ctx: &Context, spv: &[u8]) -> Result<vk::ShaderModule> {
+pub fn shader_module(ctx: &Context, spv: &[u8], entry: &CStr) -> Result<vk::ShaderModule> {
     let words = ash::util::read_spv(&mut std::io::Cursor::new(spv)).context("malformed SPIR-V")?;
+    let entry = entry
+        .to_str()
+        .context("an entry point's name is not UTF-8")?;
+    let words = super::entry_module::entry_point_module(&words, entry)
+        .map_err(|e| anyhow!("cannot cut the module to {entry}: {e}"))?;
     let words = super::float_controls::request(&words, ctx.float_controls.requested())
         .map_err(|e| anyhow!("cannot add float controls to the module: {e}"))?;
     unsafe {
@@ -186,7 +193,6 @@ impl CompiledPipeline {
         hit_groups: HitGroups,
         compilation: Compilation,
     ) -> Result<CompiledPipeline> {
-        let module = shader_module(ctx, spv)?;
         let all = vk::ShaderStageFlags::RAYGEN_KHR
             | vk::ShaderStageFlags::CLOSEST_HIT_KHR
             | vk::ShaderStageFlags::ANY_HIT_KHR
@@ -232,12 +238,8 @@ impl CompiledPipeline {
                 None,
             )
         }?;
-        let stage = |flags: vk::ShaderStageFlags, name: &'static CStr| {
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(flags)
-                .module(module)
-                .name(name)
-        };
+        // The stages as (kind, entry point) in pipeline order; each gets its own module below.
+        let stage = |flags: vk::ShaderStageFlags, name: &'static CStr| (flags, name);
         let spec_entries = [vk::SpecializationMapEntry {
             constant_id: 0,
             offset: 0,
@@ -248,7 +250,7 @@ impl CompiledPipeline {
             .map_entries(&spec_entries)
             .data(&spec_data);
         let mut stages = vec![
-            stage(vk::ShaderStageFlags::RAYGEN_KHR, RAYGEN).specialization_info(&spec),
+            stage(vk::ShaderStageFlags::RAYGEN_KHR, RAYGEN),
             stage(vk::ShaderStageFlags::MISS_KHR, MISS),
         ];
         let unused = vk::SHADER_UNUSED_KHR;
@@ -266,7 +268,7 @@ impl CompiledPipeline {
         ];
         // A triangle hit group of closest-hit shader `name` (world-space or instanced), with
         // any-hit shader `any` where the scene has holes.
-        let triangle_group = |stages: &mut Vec<vk::PipelineShaderStageCreateInfo<'_>>,
+        let triangle_group = |stages: &mut Vec<(vk::ShaderStageFlags, &'static CStr)>,
                               groups: &mut Vec<vk::RayTracingShaderGroupCreateInfoKHR<'_>>,
                               name: &'static CStr,
                               any: &'static CStr| {
@@ -316,6 +318,30 @@ impl CompiledPipeline {
                 ANY_HIT_INSTANCE,
             );
         }
+        let mut modules = Vec::with_capacity(stages.len());
+        for &(_, name) in &stages {
+            match shader_module(ctx, spv, name) {
+                Ok(m) => modules.push(m),
+                Err(e) => {
+                    for m in modules {
+                        unsafe { ctx.device.destroy_shader_module(m, None) };
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        let mut stages: Vec<vk::PipelineShaderStageCreateInfo<'_>> = stages
+            .iter()
+            .zip(&modules)
+            .map(|(&(flags, name), &module)| {
+                vk::PipelineShaderStageCreateInfo::default()
+                    .stage(flags)
+                    .module(module)
+                    .name(name)
+            })
+            .collect();
+        // The ray-generation stage (first) is specialized to the scene's features.
+        stages[0] = stages[0].specialization_info(&spec);
         let callable_module = if compilation == Compilation::Separate {
             let callable = unsafe {
                 ctx.device.create_shader_module(
@@ -355,7 +381,7 @@ impl CompiledPipeline {
         }
         .map_err(|(_, e)| anyhow!("cannot create the ray-tracing pipeline: {e}"))?[0];
         Ok(CompiledPipeline {
-            module,
+            modules,
             set_layout,
             layout,
             pipeline,
@@ -384,7 +410,7 @@ impl CompiledPipeline {
             self.pipeline,
             self.layout,
             self.set_layout,
-            self.module,
+            &self.modules,
         );
         if let Some(callable) = self.callable_module {
             unsafe { ctx.device.destroy_shader_module(callable, None) };
@@ -392,20 +418,22 @@ impl CompiledPipeline {
     }
 }
 
-/// Destroys a pipeline with its layout, its descriptor set layout and its shader module (the
+/// Destroys a pipeline with its layout, its descriptor set layout and its shader modules (the
 /// ray-tracing pipeline's and the compute probe's, `super::compute`).
 pub(super) fn destroy_pipeline_objects(
     ctx: &Context,
     pipeline: vk::Pipeline,
     layout: vk::PipelineLayout,
     set_layout: vk::DescriptorSetLayout,
-    module: vk::ShaderModule,
+    modules: &[vk::ShaderModule],
 ) {
     unsafe {
         ctx.device.destroy_pipeline(pipeline, None);
         ctx.device.destroy_pipeline_layout(layout, None);
         ctx.device.destroy_descriptor_set_layout(set_layout, None);
-        ctx.device.destroy_shader_module(module, None);
+        for &module in modules {
+            ctx.device.destroy_shader_module(module, None);
+        }
     }
 }
 
