@@ -3,7 +3,7 @@
 //! on the same inputs. Test support only (feature `test-support`): the renderer has no probes.
 
 use super::device::Context;
-use super::pipeline::shader_module;
+use super::pipeline::{entry_points, shader_module};
 use anyhow::{anyhow, bail, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -22,7 +22,7 @@ pub struct ProbeRunner {
 
 impl ProbeRunner {
     pub fn new(ctx: &Context) -> Result<ProbeRunner> {
-        let module = shader_module(ctx, crate::PROBE_SPV, PROBE)?;
+        let module = shader_module(ctx, &entry_points(crate::PROBE_SPV)?, PROBE)?;
         let bindings = [0, 1].map(|b| {
             vk::DescriptorSetLayoutBinding::default()
                 .binding(b)

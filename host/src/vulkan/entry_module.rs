@@ -15,72 +15,113 @@
 //! in the whole module.
 
 use rspirv::binary::Assemble;
-use rspirv::dr::{Instruction, Operand};
+use rspirv::dr::{Function, Instruction, Module, Operand};
 use rspirv::spirv::Op;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 
-/// `words` (a SPIR-V module) with only the entry point named `entry` (see the module's
-/// documentation). An error if the words do not parse or no entry point has that name.
-pub fn entry_point_module(words: &[u32], entry: &str) -> Result<Vec<u32>, String> {
-    let mut module =
-        rspirv::dr::load_words(words).map_err(|e| format!("not a SPIR-V module: {e}"))?;
-    let named = |i: &Instruction| matches!(i.operands.get(2), Some(Operand::LiteralString(s)) if s == entry);
-    let function = module
-        .entry_points
-        .iter()
-        .find(|i| named(i))
-        .and_then(|i| i.operands.get(1).and_then(id_ref))
-        .ok_or_else(|| format!("the module has no entry point {entry:?}"))?;
-    module.entry_points.retain(named);
-    module
-        .execution_modes
-        .retain(|i| i.operands.first().and_then(id_ref) == Some(function));
+/// A SPIR-V module parsed once, from which each entry point's module is cut
+/// ([`EntryPoints::module_of`]): a pipeline's stages share one parse (parsing the kernel's
+/// module is most of a cut's time).
+pub struct EntryPoints {
+    module: Module,
+    /// Each function's index in `module.functions`, by its result id.
+    function_index: HashMap<u32, usize>,
+}
 
-    // The functions `function` reaches, by their calls.
-    let id_of = |f: &rspirv::dr::Function| f.def.as_ref().and_then(|d| d.result_id);
-    let mut kept = HashSet::from([function]);
-    let mut frontier = vec![function];
-    while let Some(caller) = frontier.pop() {
-        let Some(f) = module.functions.iter().find(|f| id_of(f) == Some(caller)) else {
-            return Err(format!("entry point {entry:?} calls an undefined function"));
-        };
-        for i in f.blocks.iter().flat_map(|b| &b.instructions) {
-            if i.class.opcode == Op::FunctionCall {
-                if let Some(callee) = i.operands.first().and_then(id_ref) {
-                    if kept.insert(callee) {
-                        frontier.push(callee);
-                    }
+impl EntryPoints {
+    /// Parses `words`; an error if they are not a SPIR-V module.
+    pub fn parse(words: &[u32]) -> Result<EntryPoints, String> {
+        let module =
+            rspirv::dr::load_words(words).map_err(|e| format!("not a SPIR-V module: {e}"))?;
+        let function_index = module
+            .functions
+            .iter()
+            .enumerate()
+            .filter_map(|(i, f)| function_id(f).map(|id| (id, i)))
+            .collect();
+        Ok(EntryPoints {
+            module,
+            function_index,
+        })
+    }
+
+    /// The module with only the entry point named `entry` (see the module's documentation),
+    /// as words. An error if no entry point has that name.
+    pub fn module_of(&self, entry: &str) -> Result<Vec<u32>, String> {
+        let m = &self.module;
+        let named = |i: &&Instruction| matches!(i.operands.get(2), Some(Operand::LiteralString(s)) if s == entry);
+        let entry_point = m
+            .entry_points
+            .iter()
+            .find(named)
+            .ok_or_else(|| format!("the module has no entry point {entry:?}"))?;
+        let function = entry_point
+            .operands
+            .get(1)
+            .and_then(id_ref)
+            .ok_or_else(|| format!("entry point {entry:?} names no function"))?;
+
+        // The functions `function` reaches, by their calls.
+        let mut kept = vec![false; m.functions.len()];
+        let mut frontier = vec![function];
+        while let Some(caller) = frontier.pop() {
+            let Some(&index) = self.function_index.get(&caller) else {
+                return Err(format!("entry point {entry:?} calls an undefined function"));
+            };
+            if std::mem::replace(&mut kept[index], true) {
+                continue;
+            }
+            let f = &m.functions[index];
+            for i in f.blocks.iter().flat_map(|b| &b.instructions) {
+                if i.class.opcode == Op::FunctionCall {
+                    frontier.extend(i.operands.first().and_then(id_ref));
                 }
             }
         }
-    }
-    // Everything the removed functions defined, whose names and decorations go with them.
-    let mut removed = HashSet::new();
-    for f in module
-        .functions
-        .iter()
-        .filter(|f| !kept.contains(&id_of(f).unwrap_or(0)))
-    {
-        let blocks = f.blocks.iter();
-        let instructions = f
-            .def
+        // Everything the removed functions defined, whose names and decorations go with them.
+        let removed: HashSet<u32> = m
+            .functions
             .iter()
-            .chain(&f.parameters)
-            .chain(blocks.flat_map(|b| b.label.iter().chain(&b.instructions)));
-        removed.extend(instructions.filter_map(|i| i.result_id));
+            .zip(&kept)
+            .filter(|(_, &k)| !k)
+            .flat_map(|(f, _)| f.all_inst_iter().filter_map(|i| i.result_id))
+            .collect();
+        let targets_kept = |i: &&Instruction| {
+            i.operands
+                .first()
+                .and_then(id_ref)
+                .is_none_or(|t| !removed.contains(&t))
+        };
+        let modes_of_entry =
+            |i: &&Instruction| i.operands.first().and_then(id_ref) == Some(function);
+
+        // Assembled section by section, in the module's order (`Module::all_inst_iter`).
+        let mut words = m.header.as_ref().map(|h| h.assemble()).unwrap_or_default();
+        let instructions = m
+            .capabilities
+            .iter()
+            .chain(&m.extensions)
+            .chain(&m.ext_inst_imports)
+            .chain(&m.memory_model)
+            .chain([entry_point])
+            .chain(m.execution_modes.iter().filter(modes_of_entry))
+            .chain(&m.debug_string_source)
+            .chain(m.debug_names.iter().filter(targets_kept))
+            .chain(&m.debug_module_processed)
+            .chain(m.annotations.iter().filter(targets_kept))
+            .chain(&m.types_global_values);
+        for i in instructions {
+            words.extend(i.assemble());
+        }
+        for (f, _) in m.functions.iter().zip(&kept).filter(|(_, &k)| k) {
+            words.extend(f.assemble());
+        }
+        Ok(words)
     }
-    module
-        .functions
-        .retain(|f| kept.contains(&id_of(f).unwrap_or(0)));
-    let targets_kept = |i: &Instruction| {
-        i.operands
-            .first()
-            .and_then(id_ref)
-            .is_none_or(|t| !removed.contains(&t))
-    };
-    module.debug_names.retain(targets_kept);
-    module.annotations.retain(targets_kept);
-    Ok(module.assemble())
+}
+
+fn function_id(f: &Function) -> Option<u32> {
+    f.def.as_ref().and_then(|d| d.result_id)
 }
 
 fn id_ref(o: &Operand) -> Option<u32> {
@@ -100,12 +141,13 @@ mod tests {
     fn each_cut_keeps_its_entry_point_and_its_function_word_for_word() {
         let words = ash::util::read_spv(&mut std::io::Cursor::new(crate::KERNEL_SPV)).unwrap();
         let whole = rspirv::dr::load_words(&words).unwrap();
+        let entry_points = EntryPoints::parse(&words).unwrap();
         assert!(whole.entry_points.len() > 1);
         for e in &whole.entry_points {
             let Some(Operand::LiteralString(name)) = e.operands.get(2) else {
                 panic!("an entry point without a name")
             };
-            let cut = rspirv::dr::load_words(entry_point_module(&words, name).unwrap()).unwrap();
+            let cut = rspirv::dr::load_words(entry_points.module_of(name).unwrap()).unwrap();
             assert_eq!(cut.entry_points.len(), 1);
             assert_eq!(cut.entry_points[0].assemble(), e.assemble(), "{name}");
             assert_eq!(cut.functions.len(), 1, "{name}");
@@ -125,6 +167,6 @@ mod tests {
                 .iter()
                 .all(|m| id_ref(&m.operands[0]) == Some(f)));
         }
-        assert!(entry_point_module(&words, "shaders::no_such_stage").is_err());
+        assert!(entry_points.module_of("shaders::no_such_stage").is_err());
     }
 }

@@ -2,6 +2,7 @@
 //! shader binding table laid out from the device's handle size and alignments.
 
 use super::device::Context;
+use super::entry_module::EntryPoints;
 use super::memory::Buffer;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -163,15 +164,26 @@ fn align_up(x: u64, a: u64) -> u64 {
     x.div_ceil(a) * a
 }
 
-/// Creates a shader module of the entry point `entry` of SPIR-V bytes (the module cut to it,
+/// The entry points of SPIR-V bytes, parsed once for the stages cut from them
+/// (`super::entry_module`).
+pub fn entry_points(spv: &[u8]) -> Result<EntryPoints> {
+    let words = ash::util::read_spv(&mut std::io::Cursor::new(spv)).context("malformed SPIR-V")?;
+    EntryPoints::parse(&words).map_err(|e| anyhow!("cannot parse the module: {e}"))
+}
+
+/// Creates a shader module of the entry point `entry` of `module` (the module cut to it,
 /// `super::entry_module`), asking for the float controls the device offers
 /// (`super::float_controls`).
-pub fn shader_module(ctx: &Context, spv: &[u8], entry: &CStr) -> Result<vk::ShaderModule> {
-    let words = ash::util::read_spv(&mut std::io::Cursor::new(spv)).context("malformed SPIR-V")?;
+pub fn shader_module(
+    ctx: &Context,
+    module: &EntryPoints,
+    entry: &CStr,
+) -> Result<vk::ShaderModule> {
     let entry = entry
         .to_str()
         .context("an entry point's name is not UTF-8")?;
-    let words = super::entry_module::entry_point_module(&words, entry)
+    let words = module
+        .module_of(entry)
         .map_err(|e| anyhow!("cannot cut the module to {entry}: {e}"))?;
     let words = super::float_controls::request(&words, ctx.float_controls.requested())
         .map_err(|e| anyhow!("cannot add float controls to the module: {e}"))?;
@@ -318,9 +330,10 @@ impl CompiledPipeline {
                 ANY_HIT_INSTANCE,
             );
         }
+        let entry_points = entry_points(spv)?;
         let mut modules = Vec::with_capacity(stages.len());
         for &(_, name) in &stages {
-            match shader_module(ctx, spv, name) {
+            match shader_module(ctx, &entry_points, name) {
                 Ok(m) => modules.push(m),
                 Err(e) => {
                     for m in modules {
