@@ -41,8 +41,6 @@ use crate::free_flight::{self, component, Flight};
 use crate::hash::pcg4d;
 use crate::medium::transmittance as majorant_transmittance;
 use crate::rng::u32_to_unit_f32;
-#[cfg(target_arch = "spirv")]
-use crate::Float;
 use spirv_std::glam::Vec3;
 
 /// A stream of uniform numbers for one tracking loop: number n is the first word of
@@ -69,12 +67,6 @@ impl TrackingStream {
         self.n = self.n.wrapping_add(1);
         u32_to_unit_f32(bits)
     }
-}
-
-/// A unit exponential number from uniform `u` in [0, 1).
-#[inline]
-fn exponential(u: f32) -> f32 {
-    -(1.0 - u).ln()
 }
 
 /// The path's flight weight and ratios after an event of densities `p` and contribution `f`
@@ -104,7 +96,7 @@ pub fn flight(
     // The majorant's optical depth per channel since the last event, and what is left of the
     // hero's exponential number.
     let mut depth = Vec3::ZERO;
-    let mut left = exponential(stream.next_f32());
+    let mut left = free_flight::unit_exponential(stream.next_f32());
     while walk.more() {
         let segment = walk.next(grid);
         let majorant = segment.majorant;
@@ -135,7 +127,7 @@ pub fn flight(
             let null = sigma_t * ((majorant - rho) * tr);
             (weight, ratios) = weigh(weight, ratios, null, null);
             depth = Vec3::ZERO;
-            left = exponential(stream.next_f32());
+            left = free_flight::unit_exponential(stream.next_f32());
         }
     }
     let tr = majorant_transmittance(depth, 1.0);

@@ -28,8 +28,7 @@
 //! bounded.
 
 use crate::medium::transmittance;
-#[cfg(target_arch = "spirv")]
-use crate::Float;
+use crate::real::Logarithm;
 use spirv_std::glam::Vec3;
 
 /// A sampled free flight along a ray: a collision at `t` (`scattered`) or none before the
@@ -61,12 +60,23 @@ pub fn hero_channel(u: f32) -> u32 {
     ((u * 3.0) as u32).min(2)
 }
 
-/// The distance a hero channel of extinction `sigma` draws from uniform `u` in [0, 1)
+/// A unit exponential number, -ln(1 - u), from uniform `u` in (0, 1), never negative.
+/// Under IEEE arithmetic ln(1 - u) <= 0 for every such u, but a Vulkan device's `log` may err
+/// by 2^-21 absolutely on [0.5, 2], so for 1 - u within 2^-21 of 1 it may return a positive
+/// number: the flight would run backwards, its collision behind the ray's origin and perhaps
+/// across the surface the ray left (`docs/robustness.md`, "Under Vulkan's arithmetic"). The
+/// clamp to 0 changes no number IEEE arithmetic gives but the sign of a zero.
+#[inline]
+pub fn unit_exponential<R: Logarithm>(u: R) -> R {
+    (-(R::splat(1.0) - u).ln()).max(R::splat(0.0))
+}
+
+/// The distance a hero channel of extinction `sigma` draws from uniform `u` in (0, 1)
 /// (`f32::MAX` where it does not attenuate: it never collides).
 #[inline]
 pub fn distance(sigma: f32, u: f32) -> f32 {
     if sigma > 0.0 {
-        -(1.0 - u).ln() / sigma
+        unit_exponential(u) / sigma
     } else {
         f32::MAX
     }

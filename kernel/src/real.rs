@@ -124,6 +124,29 @@ fn polynomial_cos_sin_turns<R: Real>(u: R) -> (R, R) {
     )
 }
 
+/// The natural logarithm, for the free flights' exponential numbers
+/// (`free_flight::unit_exponential`); apart from [`Real`] because neither the packets nor the
+/// tests' interval type need it. A Vulkan device's `log` errs by up to 3 ULP, or by 2^-21
+/// absolutely on [0.5, 2] ("Precision and Operation of SPIR-V Instructions"), which a test's
+/// type implements to check that the flights stay within what the kernel assumes.
+pub trait Logarithm: Real {
+    fn ln(self) -> Self;
+}
+
+impl Logarithm for f32 {
+    #[inline]
+    fn ln(self) -> Self {
+        #[cfg(target_arch = "spirv")]
+        {
+            <f32 as crate::Float>::ln(self)
+        }
+        #[cfg(not(target_arch = "spirv"))]
+        {
+            f32::ln(self)
+        }
+    }
+}
+
 /// |x| of each lane ([`Real::abs`]).
 #[inline]
 pub fn abs<R: Real>(x: R) -> R {

@@ -9,6 +9,7 @@
 //!   result is decorated `NoContraction`;
 //! - `OpFDiv`: within 2.5 ULP of the exact quotient;
 //! - `sqrt`: inherited from `1.0 / inversesqrt(x)`, `inversesqrt` within 2 ULP;
+//! - `log`: within 3 ULP, or within 2^-21 absolutely for x in [0.5, 2];
 //! - any denormal input or result may be flushed to zero, and the sign of a zero is
 //!   unspecified unless the module preserves them (float controls);
 //! - comparisons, `min`, `max`, negation and bit casts: exact.
@@ -19,7 +20,7 @@
 //! Every result is one a conformant device may return: [`Vk32`]'s own test checks each against
 //! the exact value computed in `f64`.
 
-use kernel::real::Real;
+use kernel::real::{Logarithm, Real};
 use std::cell::Cell;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -31,7 +32,8 @@ pub struct Model {
     /// Fuse a multiply into the add or subtract that consumes it on a coin flip.
     pub contract: bool,
     /// Divisions off by up to 2 ULP of the correctly rounded quotient (2.5 ULP of the exact
-    /// one), square roots as 1 / inversesqrt with each step off by what the table allows.
+    /// one), square roots as 1 / inversesqrt with each step off by what the table allows,
+    /// logarithms off by what `log` may be.
     pub loose_division_and_sqrt: bool,
     /// Flush denormal inputs and results to a zero of either sign on a coin flip.
     pub flush_denormals: bool,
@@ -176,6 +178,26 @@ fn within_leaning(exact: f64, ulps: f64, sign: i32) -> f32 {
     }
 }
 
+/// An `f32` less than `abs` from `exact` (an absolute allowance): the nearest `f32` to a random
+/// point of (exact - abs, exact + abs), or under [`Model::worst`] to the end [`lean`] points at,
+/// stepped toward `exact` until it is inside.
+fn within_absolute(exact: f64, abs: f64) -> f32 {
+    let offset = if model().worst {
+        abs * LEAN.with(|l| l.get()) as f64
+    } else {
+        abs * ((bits() >> 11) as f64 * 2f64.powi(-52) - 1.0)
+    };
+    let mut candidate = (exact + offset) as f32;
+    while (candidate as f64 - exact).abs() >= abs {
+        candidate = if (candidate as f64) > exact {
+            candidate.next_down()
+        } else {
+            candidate.next_up()
+        };
+    }
+    candidate
+}
+
 /// `x`, or on a coin flip a zero of random sign if `x` is denormal (the model allowing).
 fn flush(x: f32) -> f32 {
     if model().flush_denormals && x != 0.0 && x.is_subnormal() && coin() {
@@ -285,6 +307,21 @@ impl Div for Vk32 {
             0.0
         };
         Vk32::exact(within(exact, ulps))
+    }
+}
+
+impl Logarithm for Vk32 {
+    fn ln(self) -> Self {
+        let x = self.get();
+        let exact = (x as f64).ln();
+        if !model().loose_division_and_sqrt || !exact.is_finite() {
+            return Vk32::exact(x.ln());
+        }
+        if (0.5..=2.0).contains(&x) {
+            Vk32::exact(within_absolute(exact, 2f64.powi(-21)))
+        } else {
+            Vk32::exact(within(exact, 3.0))
+        }
     }
 }
 

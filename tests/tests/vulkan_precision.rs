@@ -19,7 +19,7 @@ use kernel::geometry::{
     triangle_point_error_v3, triangle_point_v3, TRIANGLE_ERROR_EPS,
 };
 use kernel::intersect;
-use kernel::real::{Real, V3};
+use kernel::real::{Logarithm, Real, V3};
 use kernel::sampling::{sample_cosine_hemisphere_v3, sample_sphere_cone_v3};
 use twinpath_tests::device_class::{
     cone_density_apart, cone_points_apart, geometry_factor_apart, sphere_hit_may_flip,
@@ -30,6 +30,8 @@ use twinpath_tests::SplitMix;
 
 #[path = "vulkan_precision/ball_bounds.rs"]
 mod ball_bounds;
+#[path = "vulkan_precision/free_flights.rs"]
+mod free_flights;
 #[path = "vulkan_precision/normal_map_frames.rs"]
 mod normal_map_frames;
 #[path = "vulkan_precision/spherical_triangles.rs"]
@@ -111,6 +113,7 @@ fn vk32_returns_only_what_vulkan_allows_and_takes_its_liberties() {
     seed(1);
     let mut g = SplitMix(11);
     let (mut rz, mut fused, mut div_off, mut sqrt_off, mut flushed) = (0, 0, 0, 0, 0);
+    let mut ln_off = 0;
     for _ in 0..100_000 {
         let pick = |g: &mut SplitMix| {
             let m = 1.0 + g.unit();
@@ -153,15 +156,28 @@ fn vk32_returns_only_what_vulkan_allows_and_takes_its_liberties() {
             "sqrt {a} = {r}"
         );
         sqrt_off += (r != a.abs().sqrt()) as usize;
+        // `log`: within 2^-21 absolutely on [0.5, 2], within 3 ULP beyond.
+        for x in [a.abs(), 0.5 + 1.5 * g.unit()] {
+            let l = f(x).ln().value;
+            let exact = (x as f64).ln();
+            let allowed = if (0.5..=2.0).contains(&x) {
+                (l as f64 - exact).abs() < 2f64.powi(-21)
+            } else {
+                (l as f64 - exact).abs() <= 3.0 * ulp(exact)
+            };
+            assert!(allowed, "ln {x} = {l}");
+            ln_off += (l != x.ln()) as usize;
+        }
         let tiny = f32::from_bits(1 + (g.0 % 1000) as u32);
         flushed += ((f(tiny) * f(1.0)).value == 0.0) as usize;
     }
-    println!("of 1e5: {rz} sums not to nearest, {fused} multiply-adds fused or toward zero, {div_off} quotients and {sqrt_off} roots off the IEEE result, {flushed} denormals flushed");
+    println!("of 1e5: {rz} sums not to nearest, {fused} multiply-adds fused or toward zero, {div_off} quotients, {sqrt_off} roots and {ln_off} of 2e5 logarithms off the IEEE result, {flushed} denormals flushed");
     for (what, n) in [
         ("sums rounded toward zero", rz),
         ("multiply-adds fused", fused),
         ("quotients off", div_off),
         ("roots off", sqrt_off),
+        ("logarithms off", ln_off),
         ("denormals flushed", flushed),
     ] {
         assert!(n > 10_000, "{what}: only {n} of 1e5");
@@ -173,6 +189,7 @@ fn vk32_returns_only_what_vulkan_allows_and_takes_its_liberties() {
         assert_eq!((f(a) * f(b) + f(c)).value, a * b + c);
         assert_eq!((f(a) / f(b)).value, a / b);
         assert_eq!(f(b).sqrt().value, b.sqrt());
+        assert_eq!(f(b).ln().value, b.ln());
     }
     set_model(Model::VULKAN);
 }
