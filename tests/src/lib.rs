@@ -291,6 +291,26 @@ pub fn assert_packets_give_the_one_path_image(name: &str, scene: &SceneFile, spp
     println!("{name}: packets and one path identical at {spp} spp");
 }
 
+/// [`assert_packets_give_the_one_path_image`] for a scene that must take the packets through
+/// the BVH (a larger scene, instances or holes: `TileStrategy::BvhPackets`); `what` says why it
+/// must, for the message when it does not.
+pub fn assert_bvh_packets_give_the_one_path_image(
+    name: &str,
+    scene: &SceneFile,
+    spp: u32,
+    what: &str,
+) {
+    use twinpath::cpu::{CpuRenderer, TileStrategy};
+    assert!(
+        matches!(
+            CpuRenderer::new(&scene.scene, &scene.settings).tiles,
+            TileStrategy::BvhPackets
+        ),
+        "{name}: {what}, yet no packets through the BVH"
+    );
+    assert_packets_give_the_one_path_image(name, scene, spp);
+}
+
 /// How many of two films' pixel sums (per channel) are equal, bit for bit.
 pub fn equal_pixel_sums(a: &twinpath::film::Film, b: &twinpath::film::Film) -> usize {
     a.sum.iter().zip(&b.sum).filter(|(x, y)| x == y).count()

@@ -477,7 +477,6 @@ fn emitters_with_holes_light_as_their_coverage_on_both_backends() {
 /// and the BLEND emitter render the same films, bit for bit, with packets on and off.
 #[test]
 fn packets_through_holes_give_the_one_path_images() {
-    use twinpath::cpu::{CpuRenderer, TileStrategy};
     let small = |mut s: SceneFile| {
         s.scene.camera = s.scene.camera.resized(Some(24), Some(18)).unwrap();
         s
@@ -498,13 +497,6 @@ fn packets_through_holes_give_the_one_path_images() {
         ),
     ];
     for (name, scene) in scenes {
-        assert!(
-            matches!(
-                CpuRenderer::new(&scene.scene, &scene.settings).tiles,
-                TileStrategy::BvhPackets
-            ),
-            "{name}: holes, yet no packets"
-        );
-        twinpath_tests::assert_packets_give_the_one_path_image(name, &scene, 16);
+        twinpath_tests::assert_bvh_packets_give_the_one_path_image(name, &scene, 16, "holes");
     }
 }

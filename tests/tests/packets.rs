@@ -139,15 +139,18 @@ fn packets_of_paths_give_the_one_path_images() {
     }
 }
 
-/// [`twinpath_tests::assert_packets_give_the_one_path_image`] at 8 spp, or 32 under adaptive
-/// sampling.
+/// [`twinpath_tests::assert_packets_give_the_one_path_image`] at [`packet_test_spp`].
 fn assert_packets_give_the_one_path_image(name: &str, scene: &SceneFile) {
-    let spp = if scene.settings.adaptive_target > 0.0 {
+    twinpath_tests::assert_packets_give_the_one_path_image(name, scene, packet_test_spp(scene));
+}
+
+/// The samples per pixel of these comparisons: 32 under adaptive sampling, else 8.
+fn packet_test_spp(scene: &SceneFile) -> u32 {
+    if scene.settings.adaptive_target > 0.0 {
         32
     } else {
         8
-    };
-    twinpath_tests::assert_packets_give_the_one_path_image(name, scene, spp);
+    }
 }
 
 /// The Cornell room with a generated torus knot of about 12k triangles in place of the left
@@ -230,14 +233,12 @@ fn packets_through_the_bvh_give_the_one_path_images() {
         ),
     ];
     for (name, scene) in scenes {
-        assert!(
-            matches!(
-                CpuRenderer::new(&scene.scene, &scene.settings).tiles,
-                TileStrategy::BvhPackets
-            ),
-            "{name}: a larger scene or one with instances, yet no packets through the BVH"
+        twinpath_tests::assert_bvh_packets_give_the_one_path_image(
+            name,
+            &scene,
+            packet_test_spp(&scene),
+            "a larger scene or one with instances",
         );
-        assert_packets_give_the_one_path_image(name, &scene);
     }
 }
 
