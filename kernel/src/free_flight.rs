@@ -27,8 +27,8 @@
 //! throughput f / mean(r p) and r p / mean(r p), which keeps mean(r) = 1 and every number
 //! bounded.
 
-use crate::medium::transmittance;
-use crate::real::Logarithm;
+use crate::medium::transmittance_v3;
+use crate::real::{Exponential, Real, V3};
 use spirv_std::glam::Vec3;
 
 /// A sampled free flight along a ray: a collision at `t` (`scattered`) or none before the
@@ -45,6 +45,12 @@ pub struct Flight {
 /// The component `channel` (0, 1 or 2) of `v`.
 #[inline]
 pub fn component(v: Vec3, channel: u32) -> f32 {
+    component_v3(v.into(), channel)
+}
+
+/// [`component`] of a [`V3`].
+#[inline]
+pub fn component_v3<R: Real>(v: V3<R>, channel: u32) -> R {
     if channel == 0 {
         v.x
     } else if channel == 1 {
@@ -67,7 +73,7 @@ pub fn hero_channel(u: f32) -> u32 {
 /// across the surface the ray left (`docs/robustness.md`, "Under Vulkan's arithmetic"). The
 /// clamp to 0 changes no number IEEE arithmetic gives but the sign of a zero.
 #[inline]
-pub fn unit_exponential<R: Logarithm>(u: R) -> R {
+pub fn unit_exponential<R: Exponential>(u: R) -> R {
     (-(R::splat(1.0) - u).ln()).max(R::splat(0.0))
 }
 
@@ -75,31 +81,59 @@ pub fn unit_exponential<R: Logarithm>(u: R) -> R {
 /// (`f32::MAX` where it does not attenuate: it never collides).
 #[inline]
 pub fn distance(sigma: f32, u: f32) -> f32 {
-    if sigma > 0.0 {
-        unit_exponential(u) / sigma
-    } else {
-        f32::MAX
-    }
+    distance_v3(sigma, u)
+}
+
+/// [`distance`] over any [`Exponential`] number.
+#[inline]
+pub fn distance_v3<R: Exponential>(sigma: R, u: R) -> R {
+    let attenuates = sigma.greater_than(R::splat(0.0));
+    R::select(attenuates, unit_exponential(u) / sigma, R::splat(f32::MAX))
 }
 
 /// The free flight of a ray in a medium of extinction `sigma_t` and scattering `sigma_s`
 /// whose surface (or the scene's end: `f32::MAX`) lies at distance `d`, drawn by channel
-/// `hero` from uniform `u` in [0, 1), for a path whose ratios are `ratios` (see the module's
+/// `hero` from uniform `u` in (0, 1), for a path whose ratios are `ratios` (see the module's
 /// documentation).
 #[inline]
 pub fn sample(sigma_t: Vec3, sigma_s: Vec3, d: f32, hero: u32, u: f32, ratios: Vec3) -> Flight {
-    let t = distance(component(sigma_t, hero), u);
-    let scattered = t < d;
-    let at = if scattered { t } else { d };
-    let tr = transmittance(sigma_t, at);
-    // Each technique's density of this event, and the path's contribution.
-    let (p, f) = if scattered {
-        (sigma_t * tr, sigma_s * tr)
-    } else {
-        (tr, tr)
-    };
-    let (weight, ratios) = weigh(ratios, p, f);
+    let f = sample_v3(sigma_t.into(), sigma_s.into(), d, hero, u, ratios.into());
     Flight {
+        scattered: f.scattered != 0,
+        t: f.t,
+        weight: f.weight.into(),
+        ratios: f.ratios.into(),
+    }
+}
+
+/// A [`Flight`] over any [`Exponential`] number: `scattered` is all ones where the ray collides.
+#[derive(Clone, Copy, Debug)]
+pub struct FlightV3<R: Real> {
+    pub scattered: R::Bits,
+    pub t: R,
+    pub weight: V3<R>,
+    pub ratios: V3<R>,
+}
+
+/// [`sample`] over any [`Exponential`] number.
+#[inline]
+pub fn sample_v3<R: Exponential>(
+    sigma_t: V3<R>,
+    sigma_s: V3<R>,
+    d: R,
+    hero: u32,
+    u: R,
+    ratios: V3<R>,
+) -> FlightV3<R> {
+    let t = distance_v3(component_v3(sigma_t, hero), u);
+    let scattered = t.less_than(d);
+    let at = R::select(scattered, t, d);
+    let tr = transmittance_v3(sigma_t, at);
+    // Each technique's density of this event, and the path's contribution.
+    let p = V3::select(scattered, sigma_t * tr, tr);
+    let f = V3::select(scattered, sigma_s * tr, tr);
+    let (weight, ratios) = weigh_v3(ratios, p, f);
+    FlightV3 {
         scattered,
         t: at,
         weight,
@@ -113,7 +147,14 @@ pub fn sample(sigma_t: Vec3, sigma_s: Vec3, d: f32, hero: u32, u: f32, ratios: V
 /// (`crate::delta_tracking`).
 #[inline]
 pub fn weigh(ratios: Vec3, p: Vec3, f: Vec3) -> (Vec3, Vec3) {
+    let (weight, ratios) = weigh_v3(ratios.into(), p.into(), f.into());
+    (weight.into(), ratios.into())
+}
+
+/// [`weigh`] over any [`Real`] number.
+#[inline]
+pub fn weigh_v3<R: Real>(ratios: V3<R>, p: V3<R>, f: V3<R>) -> (V3<R>, V3<R>) {
     let q = ratios * p;
-    let m = (q.x + q.y + q.z) * (1.0 / 3.0);
+    let m = q.element_sum() * R::splat(1.0 / 3.0);
     (f / m, q / m)
 }

@@ -31,9 +31,8 @@
 //! one continues from the far side with the transmittance of the part it crossed.
 
 use crate::bsdf::DELTA_ALPHA;
+use crate::real::{Exponential, V3};
 use crate::scene::{material_kind, Material};
-#[cfg(target_arch = "spirv")]
-use crate::Float;
 use spirv_std::glam::Vec3;
 
 /// The media table's record 0: no medium (every coefficient zero).
@@ -108,11 +107,15 @@ impl Medium {
 /// the scene): then 0 where the medium attenuates, 1 where it does not.
 #[inline]
 pub fn transmittance(sigma_t: Vec3, distance: f32) -> Vec3 {
-    Vec3::new(
-        (-(sigma_t.x * distance)).exp(),
-        (-(sigma_t.y * distance)).exp(),
-        (-(sigma_t.z * distance)).exp(),
-    )
+    transmittance_v3(sigma_t.into(), distance).into()
+}
+
+/// [`transmittance`] over any [`Exponential`] number (the kernel's `f32`, or a test's model of
+/// a device's arithmetic).
+#[inline]
+pub fn transmittance_v3<R: Exponential>(sigma_t: V3<R>, distance: R) -> V3<R> {
+    let channel = |sigma: R| (-(sigma * distance)).exp();
+    V3::new(channel(sigma_t.x), channel(sigma_t.y), channel(sigma_t.z))
 }
 
 /// The transmittance of the segment from `from` to `to` in homogeneous medium `medium` of

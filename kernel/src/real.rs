@@ -124,16 +124,30 @@ fn polynomial_cos_sin_turns<R: Real>(u: R) -> (R, R) {
     )
 }
 
-/// The natural logarithm, for the free flights' exponential numbers
-/// (`free_flight::unit_exponential`); apart from [`Real`] because neither the packets nor the
-/// tests' interval type need it. A Vulkan device's `log` errs by up to 3 ULP, or by 2^-21
-/// absolutely on [0.5, 2] ("Precision and Operation of SPIR-V Instructions"), which a test's
-/// type implements to check that the flights stay within what the kernel assumes.
-pub trait Logarithm: Real {
+/// The exponential function and the natural logarithm, for the media's flights (the unit
+/// exponential numbers of `free_flight::unit_exponential`, the transmittances of
+/// `medium::transmittance_v3`); apart from [`Real`] because neither the packets nor the tests'
+/// interval type need them. On a Vulkan device `exp(x)` errs by up to 3 + 2 |x| ULP and `log`
+/// by up to 3 ULP, or by 2^-21 absolutely on [0.5, 2] ("Precision and Operation of SPIR-V
+/// Instructions"), which a test's type implements to check the flights against their bounds.
+pub trait Exponential: Real {
+    fn exp(self) -> Self;
     fn ln(self) -> Self;
 }
 
-impl Logarithm for f32 {
+impl Exponential for f32 {
+    #[inline]
+    fn exp(self) -> Self {
+        #[cfg(target_arch = "spirv")]
+        {
+            <f32 as crate::Float>::exp(self)
+        }
+        #[cfg(not(target_arch = "spirv"))]
+        {
+            f32::exp(self)
+        }
+    }
+
     #[inline]
     fn ln(self) -> Self {
         #[cfg(target_arch = "spirv")]

@@ -9,7 +9,8 @@
 //!   result is decorated `NoContraction`;
 //! - `OpFDiv`: within 2.5 ULP of the exact quotient;
 //! - `sqrt`: inherited from `1.0 / inversesqrt(x)`, `inversesqrt` within 2 ULP;
-//! - `log`: within 3 ULP, or within 2^-21 absolutely for x in [0.5, 2];
+//! - `exp`: within 3 + 2 |x| ULP; `log`: within 3 ULP, or within 2^-21 absolutely for x in
+//!   [0.5, 2];
 //! - any denormal input or result may be flushed to zero, and the sign of a zero is
 //!   unspecified unless the module preserves them (float controls);
 //! - comparisons, `min`, `max`, negation and bit casts: exact.
@@ -20,7 +21,7 @@
 //! Every result is one a conformant device may return: [`Vk32`]'s own test checks each against
 //! the exact value computed in `f64`.
 
-use kernel::real::{Logarithm, Real};
+use kernel::real::{Exponential, Real};
 use std::cell::Cell;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -33,7 +34,7 @@ pub struct Model {
     pub contract: bool,
     /// Divisions off by up to 2 ULP of the correctly rounded quotient (2.5 ULP of the exact
     /// one), square roots as 1 / inversesqrt with each step off by what the table allows,
-    /// logarithms off by what `log` may be.
+    /// exponentials and logarithms off by what `exp` and `log` may be.
     pub loose_division_and_sqrt: bool,
     /// Flush denormal inputs and results to a zero of either sign on a coin flip.
     pub flush_denormals: bool,
@@ -310,7 +311,16 @@ impl Div for Vk32 {
     }
 }
 
-impl Logarithm for Vk32 {
+impl Exponential for Vk32 {
+    fn exp(self) -> Self {
+        let x = self.get();
+        let exact = (x as f64).exp();
+        if !model().loose_division_and_sqrt {
+            return Vk32::exact(x.exp());
+        }
+        Vk32::exact(within(exact, 3.0 + 2.0 * (x as f64).abs()))
+    }
+
     fn ln(self) -> Self {
         let x = self.get();
         let exact = (x as f64).ln();

@@ -22,7 +22,7 @@ use kernel::geometry::{
     triangle_point_error_v3, triangle_point_v3, TRIANGLE_ERROR_EPS,
 };
 use kernel::intersect;
-use kernel::real::{Logarithm, Real, V3};
+use kernel::real::{Exponential, Real, V3};
 use kernel::sampling::{sample_cosine_hemisphere_v3, sample_sphere_cone_v3};
 use twinpath_tests::device_class::{
     cone_density_apart, cone_points_apart, geometry_factor_apart, sphere_hit_may_flip,
