@@ -80,13 +80,7 @@ pub fn unit_exponential<R: Exponential>(u: R) -> R {
 /// The distance a hero channel of extinction `sigma` draws from uniform `u` in (0, 1)
 /// (`f32::MAX` where it does not attenuate: it never collides).
 #[inline]
-pub fn distance(sigma: f32, u: f32) -> f32 {
-    distance_v3(sigma, u)
-}
-
-/// [`distance`] over any [`Exponential`] number.
-#[inline]
-pub fn distance_v3<R: Exponential>(sigma: R, u: R) -> R {
+pub fn distance<R: Exponential>(sigma: R, u: R) -> R {
     let attenuates = sigma.greater_than(R::splat(0.0));
     R::select(attenuates, unit_exponential(u) / sigma, R::splat(f32::MAX))
 }
@@ -125,7 +119,7 @@ pub fn sample_v3<R: Exponential>(
     u: R,
     ratios: V3<R>,
 ) -> FlightV3<R> {
-    let t = distance_v3(component_v3(sigma_t, hero), u);
+    let t = distance(component_v3(sigma_t, hero), u);
     let scattered = t.less_than(d);
     let at = R::select(scattered, t, d);
     let tr = transmittance_v3(sigma_t, at);
