@@ -53,138 +53,124 @@ def main():
     a, b1, b2 = (np.stack([load(f"{images}/{n}_{s}.exr") for s in range(1, k + 1)])
                  for n in ("a", "b1", "b2"))
     weight = 1.0 / (reference * reference + 0.01)
-    total, c1, c2 = covariance(a, a), covariance(a, b1), covariance(a, b2)
-    va = np.maximum(box5(c1), 0.0)
-    vb = np.maximum(box5(c2 - c1), 0.0)
-    vc = np.maximum(box5(total - c2), 0.0)
     cost = np.array([t1, t2 - t1, t - t2]) / t
-    e0 = (weight * (va + vb + vc)).mean()
-    print(f"variance shares: up to vertex 1's light sample {(weight * va).mean() / e0:.3f}, "
-          f"vertex 1's continuation to vertex 2's light sample {(weight * vb).mean() / e0:.3f}, "
-          f"the rest {(weight * vc).mean() / e0:.3f}")
+
+    def parts(lo, hi):
+        """The weighted variance parts (V_a, V_b, V_c) of seeds lo..hi per pixel, the three
+        channels summed: a split or a sample count applies to all of them at once."""
+        total, c1, c2 = (covariance(x[lo:hi], y[lo:hi]) for x, y in ((a, a), (a, b1), (a, b2)))
+        return [(weight * np.maximum(box5(v), 0.0)).sum(-1) for v in (c1, c2 - c1, total - c2)]
+
+    def error(v, n1, m):
+        """A sample's weighted variance with n1 continuations from vertex 1, m = n1 n2 from 2."""
+        return v[0] + v[1] / n1 + v[2] / m
+
+    def time(n1, m):
+        return cost[0] + cost[1] * n1 + cost[2] * m
+
+    v = parts(0, k)
+    e0 = sum(v).mean()
+    print(f"variance shares: up to vertex 1's light sample {v[0].mean() / e0:.3f}, "
+          f"vertex 1's continuation to vertex 2's light sample {v[1].mean() / e0:.3f}, "
+          f"the rest {v[2].mean() / e0:.3f}")
     print(f"cost shares: {cost[0]:.3f}, {cost[1]:.3f}, {cost[2]:.3f}")
 
-    def product(n1, m):
-        """E T for n1 continuations from vertex 1 and m = n1 n2 from vertex 2 per pixel."""
-        e = weight * (va + vb / n1 + vc / m)
-        return e, cost[0] + cost[1] * n1 + cost[2] * m
-
     grid = np.exp(np.linspace(-4.0, 4.0, 161))
-    best1 = min((np.mean(e) * np.mean(c), n) for n in grid for e, c in [product(n, n)])
-    best2 = min((np.mean(e) * np.mean(c), n1, m)
-                for n1 in grid for m in grid for e, c in [product(n1, m)])
+    coarse = grid[::2]
+    pairs = [(n1, m) for n1 in coarse for m in coarse]
+    best1 = min((error(v, n, n).mean() * time(n, n), n) for n in grid)
+    best2 = min((error(v, n1, m).mean() * time(n1, m), n1, m) for n1 in grid for m in grid)
     print(f"one split for the image, at vertex 1: gain {e0 / best1[0]:.3f} (n1 = {best1[1]:.2f})")
     print(f"one split for the image, at vertices 1 and 2: gain {e0 / best2[0]:.3f} "
           f"(n1 = {best2[1]:.2f}, n1 n2 = {best2[2]:.2f})")
-    plain = weight * (va + vb + vc)
-    allocation = np.sqrt(plain).mean() ** 2
+
     def least(values):
-        """The elementwise minimum of arrays given one at a time (a list of them all would
-        not fit in memory)."""
+        """The elementwise minimum of arrays given one at a time."""
         out = None
-        for v in values:
-            out = v if out is None else np.minimum(out, v)
+        for x in values:
+            out = x if out is None else np.minimum(out, x)
         return out
 
-    per_pixel_1 = least(np.multiply(*product(n, n)) for n in grid)
-    coarse = grid[::2]
-    per_pixel_2 = least(np.multiply(*product(n1, m)) for n1 in coarse for m in coarse)
-    g_alloc = e0 / allocation
-    g1 = e0 / np.sqrt(per_pixel_1).mean() ** 2
-    g2 = e0 / np.sqrt(per_pixel_2).mean() ** 2
+    def allocated(e_t):
+        """The gain of the best spp per pixel (or tile) given each one's E T: the least E T is
+        (mean sqrt(e_p t_p))^2 (Cauchy-Schwarz)."""
+        return e0 / np.sqrt(e_t).mean() ** 2
+
+    g_alloc = allocated(sum(v))
+    g1 = allocated(least(error(v, n, n) * time(n, n) for n in grid))
+    g2 = allocated(least(error(v, n1, m) * time(n1, m) for n1, m in pairs))
     print(f"spp per pixel (adaptive sampling's ceiling): gain {g_alloc:.3f}")
     print(f"spp and split at vertex 1 per pixel: gain {g1:.3f} ({g1 / g_alloc:.3f} over the spp alone)")
     print(f"spp and splits at vertices 1 and 2 per pixel: gain {g2:.3f} "
           f"({g2 / g_alloc:.3f} over the spp alone)")
-    # The same, chosen per tile of 16 x 16 pixels (what a rule learned at that resolution
-    # could reach): each tile's mean e_p in place of a pixel's.
-    def tiles(x):
-        h, w = x.shape[:2]
-        return x[:h - h % 16, :w - w % 16].reshape(h // 16, 16, w // 16, 16, -1).mean((1, 3))
 
-    tile_alloc = np.sqrt(tiles(plain)).mean() ** 2
-    tile_best = least(tiles(e) * c for n1 in coarse for m in coarse for e, c in [product(n1, m)])
-    t_alloc, t2 = e0 / tile_alloc, e0 / np.sqrt(tile_best).mean() ** 2
+    # The same, chosen per tile of 16 x 16 pixels (what a rule learned at that resolution
+    # could reach): each tile's mean in place of a pixel's.
+    def tiles(x):
+        h, w = x.shape
+        return x[:h - h % 16, :w - w % 16].reshape(h // 16, 16, w // 16, 16).mean((1, 3))
+
+    vt = [tiles(x) for x in v]
+    t_alloc = allocated(sum(vt))
+    t2 = allocated(least(error(vt, n1, m) * time(n1, m) for n1, m in pairs))
     print(f"per tile of 16 x 16 pixels: spp {t_alloc:.3f}, spp and splits at vertices 1 and 2 "
           f"{t2:.3f} ({t2 / t_alloc:.3f} over the spp alone)")
 
-    # Learned: each tile's spp and splits chosen from the variances of the first `pilots`
-    # seeds only, and judged by those of the others (held out, so the choice cannot fit
-    # their noise).
+    # Learned: each tile's choice made from the variances of the first `pilots` seeds only,
+    # and judged by those of the others (held out, so the choice cannot fit their noise).
     pilots = 16
+    learn = [tiles(x) for x in parts(0, pilots)]
+    judge = [tiles(x) for x in parts(pilots, k)]
+    e0_judge = sum(judge).mean()
+    index = np.argmin(np.stack([error(learn, n1, m) * time(n1, m) for n1, m in pairs]), axis=0)
+    n1 = np.array([x for x, _ in pairs])[index]
+    m = np.array([y for _, y in pairs])[index]
 
-    def parts(lo, hi):
-        t_, c1_, c2_ = (covariance(x[lo:hi], y[lo:hi]) for x, y in ((a, a), (a, b1), (a, b2)))
-        return [tiles(weight * np.maximum(box5(v), 0.0)) for v in (c1_, c2_ - c1_, t_ - c2_)]
-
-    learn, judge = parts(0, pilots), parts(pilots, k)
-
-    def chosen(n1, m):
-        return np.argmin(np.stack([(learn[0] + learn[1] / x + learn[2] / y) * (
-            cost[0] + cost[1] * x + cost[2] * y) for x in n1 for y in m]), axis=0)
-
-
-    pairs = [(x, y) for x in coarse for y in coarse]
-    best = chosen(coarse, coarse)
-    n1 = np.array([x for x, _ in pairs])[best]
-    m = np.array([y for _, y in pairs])[best]
-    e_learn = learn[0] + learn[1] / n1 + learn[2] / m
-    c_learn = cost[0] + cost[1] * n1 + cost[2] * m
-    e_judge = judge[0] + judge[1] / n1 + judge[2] / m
-    plain_learn, plain_judge = sum(learn), sum(judge)
-    e0_judge = plain_judge.mean()
     # spp per tile proportional to sqrt(e / t), from the pilots' numbers, and at least an
     # eighth of the mean (a tile whose pilots saw no variance must still be sampled).
-    def floored(x):
+    def spp_of(e, c):
+        x = np.sqrt(e / c)
         return np.maximum(x, x.mean() / 8.0)
 
-    spp_plain = floored(np.sqrt(plain_learn))
-    spp_split = floored(np.sqrt(e_learn / c_learn))
-    g_spp = e0_judge / ((plain_judge / spp_plain).mean() * spp_plain.mean())
-    g_split = e0_judge / ((e_judge / spp_split).mean() * (spp_split * c_learn).mean())
+    def judged(spp, e, c):
+        return e0_judge / ((e / spp).mean() * (spp * c).mean())
+
+    g_spp = judged(spp_of(sum(learn), 1.0), sum(judge), 1.0)
+    g_split = judged(spp_of(error(learn, n1, m), time(n1, m)), error(judge, n1, m), time(n1, m))
     print(f"learned per tile from {pilots} samples, judged on the other {k - pilots}: "
           f"spp {g_spp:.3f}, spp and splits {g_split:.3f} ({g_split / g_spp:.3f} over the spp alone)")
-    # Splits alone, every pixel the same spp (so the pilots' samples may stay in the image
-    # unbiased: no sample count depends on them): per tile the split minimising e + lambda t,
-    # lambda the best for the image, all from the pilots, judged on the rest.
-    learned_e = np.stack([learn[0] + learn[1] / x + learn[2] / y for x, y in pairs])
-    learned_c = np.stack([np.full(learn[0].shape, cost[0] + cost[1] * x + cost[2] * y)
-                          for x, y in pairs])
-    judged_e = np.stack([judge[0] + judge[1] / x + judge[2] / y for x, y in pairs])
-    best_splits = None
-    for lam in np.exp(np.linspace(-8.0, 8.0, 321)) * plain_learn.mean():
-        pick = np.argmin(learned_e + lam * learned_c, axis=0)[None]
-        e = np.take_along_axis(learned_e, pick, 0).mean()
-        c = np.take_along_axis(learned_c, pick, 0).mean()
-        if best_splits is None or e * c < best_splits[0]:
-            best_splits = (e * c, pick)
-    pick = best_splits[1]
-    g_splits = e0_judge / (np.take_along_axis(judged_e, pick, 0).mean()
-                           * np.take_along_axis(learned_c, pick, 0).mean())
+
+    def learned_splits(candidates):
+        """Splits alone, every pixel the same spp (so the pilots' samples may stay in the image
+        unbiased: no sample count depends on them): per tile the candidate (n1, m) minimising
+        e + lambda t, lambda the best for the image, all from the pilots; the gain judged on the
+        rest, and each tile's pick."""
+        learned = np.stack([error(learn, n1, m) for n1, m in candidates])
+        held_out = np.stack([error(judge, n1, m) for n1, m in candidates])
+        times = np.array([time(n1, m) for n1, m in candidates])
+        best = None
+        for lam in np.exp(np.linspace(-8.0, 8.0, 641)) * sum(learn).mean():
+            pick = np.argmin(learned + lam * times[:, None, None], axis=0)
+            score = np.take_along_axis(learned, pick[None], 0).mean() * times[pick].mean()
+            if best is None or score < best[0]:
+                best = (score, pick)
+        pick = best[1]
+        gain = e0_judge / (np.take_along_axis(held_out, pick[None], 0).mean() * times[pick].mean())
+        return gain, pick, times[pick].mean()
+
+    g_splits, _, _ = learned_splits(pairs)
     print(f"learned splits alone per tile, the same spp everywhere: gain {g_splits:.3f}")
 
     # The tile map scripts/split_sobol.py renders with Sobol's numbers: whole splits at vertex 1
     # only (n1 = 1 to 4, n2 = 1), learned from the pilots as above.
-    counts = np.array([1.0, 2.0, 3.0, 4.0])
-    learned_e = np.stack([learn[0] + (learn[1] + learn[2]) / n for n in counts])
-    judged_e = np.stack([judge[0] + (judge[1] + judge[2]) / n for n in counts])
-    unit_cost = cost[0] + (cost[1] + cost[2]) * counts
-    best_map = None
-    for lam in np.exp(np.linspace(-8.0, 8.0, 641)) * plain_learn.mean():
-        pick = np.argmin((learned_e + lam * unit_cost[:, None, None, None]).sum(-1), axis=0)
-        e = np.take_along_axis(learned_e.sum(-1), pick[None], 0).mean()
-        c = unit_cost[pick].mean()
-        if best_map is None or e * c < best_map[0]:
-            best_map = (e * c, pick)
-    pick = best_map[1]
-    g_map = judged_e.sum(-1).mean(axis=(1, 2))[0] / (
-        np.take_along_axis(judged_e.sum(-1), pick[None], 0).mean() * unit_cost[pick].mean())
+    counts = [1, 2, 3, 4]
+    g_map, pick, mean_time = learned_splits([(n, n) for n in counts])
     print(f"whole splits at vertex 1 per tile (1 to 4), learned: gain {g_map:.3f}, "
-          f"mean cost {unit_cost[pick].mean():.3f}, tiles with 1, 2, 3, 4: "
+          f"mean cost {mean_time:.3f}, tiles with 1, 2, 3, 4: "
           f"{[int((pick == i).sum()) for i in range(4)]}")
     if len(sys.argv) > 7:
         with open(sys.argv[7], "w") as f:
-            f.write(" ".join(str(int(counts[i])) for i in pick.ravel()) + "\n")
+            f.write(" ".join(str(counts[i]) for i in pick.ravel()) + "\n")
 
 
 if __name__ == "__main__":
