@@ -15,6 +15,7 @@ pub mod render;
 pub mod sample_range;
 pub mod scene;
 pub mod settings;
+pub mod split_pilot;
 #[cfg(feature = "gpu")]
 pub mod vulkan;
 

@@ -8,6 +8,7 @@ use crate::film::Film;
 use crate::sample_range::SampleRange;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
+use crate::split_pilot::split_table;
 use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -98,6 +99,10 @@ pub fn render(
         .progress
         .then(|| progress_bar(scene.pixel_count() as u64 * spp as u64));
     let t1 = Instant::now();
+    // The split table's pilot, if any, is part of the render's time.
+    if let Some(table) = split_table(backend.as_mut(), scene, settings)? {
+        backend.set_splits(&table)?;
+    }
     let mut spp_done = 0;
     while spp_done < spp && !INTERRUPTED.load(Ordering::SeqCst) {
         let count = backend.next_pass(spp_done, spp);

@@ -95,6 +95,40 @@ choice! {
     }
 }
 
+/// Whether and how often paths split at their first vertex (`kernel::split`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Split {
+    /// One continuation: every path as it always was.
+    Off,
+    /// Continuations per 16 x 16 tile, learned by a pilot render (`crate::split_pilot`).
+    Auto,
+    /// This many continuations (1 to `kernel::split::MAX_CONTINUATIONS`) everywhere.
+    Fixed(u32),
+}
+
+impl Split {
+    /// The value written `text`: "off", "auto" or a count.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        match text {
+            "off" => Ok(Split::Off),
+            "auto" => Ok(Split::Auto),
+            _ => match integer(text, 1, kernel::split::MAX_CONTINUATIONS as u64) {
+                Ok(n) => Ok(Split::Fixed(n)),
+                Err(e) => Err(format!("{e} (split: off, auto or a count)")),
+            },
+        }
+    }
+
+    /// Its name in the vocabulary.
+    pub fn name(self) -> String {
+        match self {
+            Split::Off => "off".to_string(),
+            Split::Auto => "auto".to_string(),
+            Split::Fixed(n) => n.to_string(),
+        }
+    }
+}
+
 /// Integrator settings of a render. `Default` holds every default (the best measured choices,
 /// `docs/performance.md`); [`RenderSettings::set`] is the only way the outside changes one.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -121,6 +155,8 @@ pub struct RenderSettings {
     pub packets: bool,
     /// Adaptive sampling's target relative error of a pixel (0: off; `kernel::adaptive`).
     pub adaptive_target: f32,
+    /// Splitting at the first vertex (`kernel::split`).
+    pub split: Split,
 }
 
 impl Default for RenderSettings {
@@ -139,6 +175,7 @@ impl Default for RenderSettings {
             specialize: true,
             packets: true,
             adaptive_target: 0.0,
+            split: Split::Off,
         }
     }
 }
@@ -166,6 +203,10 @@ pub const SETTINGS: &[(&str, &str)] = &[
     (
         "adaptive_target",
         "adaptive sampling's relative error per pixel, >= 0 (0: off)",
+    ),
+    (
+        "split",
+        "continuations at the first vertex: off | auto (learned per tile) | 1..=4",
     ),
 ];
 
@@ -216,6 +257,7 @@ impl RenderSettings {
                 }
                 self.adaptive_target = t;
             }
+            "split" => self.split = Split::parse(value)?,
             _ => {
                 let keys: Vec<&str> = SETTINGS.iter().map(|(k, _)| *k).collect();
                 return Err(format!(
@@ -245,6 +287,7 @@ impl RenderSettings {
             "specialize" => on_off(self.specialize),
             "packets" => on_off(self.packets),
             "adaptive_target" => self.adaptive_target.to_string(),
+            "split" => self.split.name(),
             _ => unreachable!("every key of SETTINGS has a value"),
         };
         SETTINGS.iter().map(|&(k, _)| (k, value(k))).collect()
@@ -318,6 +361,7 @@ mod tests {
             ("specialize", "off"),
             ("packets", "off"),
             ("adaptive_target", "0.05"),
+            ("split", "3"),
         ] {
             changed.set(k, v).unwrap();
         }

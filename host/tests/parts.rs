@@ -99,7 +99,7 @@ fn assert_merges_are_exact(dir: &Path, scene: &Path, spp: u32, flags: &[&str]) {
 fn merged_parts_are_the_single_render_byte_for_byte() {
     let dir = temp_dir("exact");
     // Cornell: sixteen-path packets; textures.toml: meshes and textures over the BVH, one path
-    // at a time. Both samplers.
+    // at a time. Both samplers, and Cornell with split paths.
     let cornell = repo("scenes/cornell.toml");
     let textures = repo("scenes/textures.toml");
     assert_merges_are_exact(&dir, &cornell, 13, &["--width", "40"]);
@@ -110,6 +110,14 @@ fn merged_parts_are_the_single_render_byte_for_byte() {
         &["--width", "40", "--sampler", "independent"],
     );
     assert_merges_are_exact(&dir, &textures, 9, &["--width", "48"]);
+    // Split paths with the learned table: every part learns the same table from the same
+    // pilot, and a sample's continuations are numbered from its own index.
+    assert_merges_are_exact(
+        &dir,
+        &cornell,
+        13,
+        &["--width", "40", "--set", "split=auto"],
+    );
     assert_merges_are_exact(
         &dir,
         &textures,

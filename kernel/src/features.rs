@@ -9,7 +9,7 @@
 
 use crate::adaptive::is_adaptive;
 use crate::scene::{
-    light_sampling, mis, roulette, shading_flags, texture_slot, Material, RenderParams,
+    light_sampling, mis, roulette, shading_flags, split_mode, texture_slot, Material, RenderParams,
     ShadingTriangle, NONE,
 };
 
@@ -85,6 +85,10 @@ pub const MEDIA: u32 = 1 << 24;
 /// record live across its trace calls (`crate::shaders::raygen`); the CPU counts pilots in its
 /// film and masks the bit before choosing its monomorphised path.
 pub const ADAPTIVE: u32 = 1 << 25;
+/// Paths split at their first vertex (`crate::split`: a split table or the pilot). Read by the
+/// GPU's ray-generation shader only, so that a render without it keeps no first vertex live
+/// across its trace calls; the CPU masks it and asks the parameters.
+pub const SPLIT: u32 = 1 << 26;
 
 /// The surface bits of a scene with these materials and shading records: [`TEXTURES`] if a
 /// material has a texture, [`SHADING_NORMALS`] if a triangle has vertex normals,
@@ -176,6 +180,9 @@ pub fn scene_features(params: &RenderParams) -> u32 {
     }
     if is_adaptive(params) {
         f |= ADAPTIVE;
+    }
+    if params.split.mode != split_mode::OFF {
+        f |= SPLIT;
     }
     f
 }
@@ -339,6 +346,12 @@ pub trait FeatureSet: Copy {
     #[inline]
     fn adaptive(self, p: &RenderParams) -> bool {
         self.answer(ADAPTIVE, is_adaptive(p))
+    }
+    /// Whether paths split at their first vertex ([`SPLIT`]: asked by the GPU's ray
+    /// generation only).
+    #[inline]
+    fn split(self, p: &RenderParams) -> bool {
+        self.answer(SPLIT, p.split.mode != split_mode::OFF)
     }
 }
 

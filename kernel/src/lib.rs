@@ -40,6 +40,7 @@ pub mod scene_view;
 pub mod shaders;
 pub mod sobol;
 pub mod spherical_triangle;
+pub mod split;
 pub mod surface;
 pub mod texture;
 pub mod turns;

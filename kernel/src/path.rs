@@ -213,26 +213,9 @@ impl PathState {
         features: F,
         scene: &SceneView,
     ) -> Self {
+        let mut hit = SurfaceHit::miss();
         loop {
-            // A scene with media asks for the surface that blocks the segment (it may be an
-            // interface, which the segment passes); any other only whether one does.
-            if self.shadow {
-                if features.media() {
-                    let blocker = tracer.first_hit_on(self.shadow_from, self.shadow_to);
-                    if self.shadow_passes(scene, &blocker) {
-                        continue;
-                    }
-                } else {
-                    let occluded = tracer.occluded(self.shadow_from, self.shadow_to);
-                    self.settle_shadow(occluded);
-                }
-            }
-            let hit = if self.extend {
-                tracer.closest_hit(self.ray_origin, self.ray_dir)
-            } else {
-                SurfaceHit::miss()
-            };
-            if self.advance(features, scene, &hit, false) {
+            if self.round(tracer, features, scene, &mut hit) {
                 let arrival = self.arrival(features, scene, &hit);
                 let samples = VertexSamples::draw(&arrival.query, &mut self.rng);
                 self.vertex(
@@ -248,6 +231,39 @@ impl PathState {
                 return self;
             }
         }
+    }
+
+    /// The first half of a round of [`PathState::run`]: traces the waiting rays through
+    /// `tracer` and [`PathState::advance`]s with their answers, the extension's hit left in
+    /// `hit`. Returns whether that reached a vertex (at `hit`), whose arrival, samples and
+    /// [`PathState::vertex`] are the caller's.
+    #[inline]
+    pub fn round<T: Tracer, F: FeatureSet>(
+        &mut self,
+        tracer: &mut T,
+        features: F,
+        scene: &SceneView,
+        hit: &mut SurfaceHit,
+    ) -> bool {
+        // A scene with media asks for the surface that blocks the segment (it may be an
+        // interface, which the segment passes); any other only whether one does.
+        if self.shadow {
+            if features.media() {
+                let blocker = tracer.first_hit_on(self.shadow_from, self.shadow_to);
+                if self.shadow_passes(scene, &blocker) {
+                    return false;
+                }
+            } else {
+                let occluded = tracer.occluded(self.shadow_from, self.shadow_to);
+                self.settle_shadow(occluded);
+            }
+        }
+        *hit = if self.extend {
+            tracer.closest_hit(self.ray_origin, self.ray_dir)
+        } else {
+            SurfaceHit::miss()
+        };
+        self.advance(features, scene, hit, false)
     }
 
     /// The vertex [`PathState::advance`] reached at `hit`: its surface (`surface::shade`) and

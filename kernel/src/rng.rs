@@ -34,11 +34,22 @@ pub fn u32_to_unit_f32(x: u32) -> f32 {
 pub struct SampleRng {
     pub seed: u32,
     pub pixel: u32,
+    /// The sequence index of the dimensions below [`CONTINUED_FROM`].
     pub sample: u32,
     pub dimension: u32,
     /// One of `scene::sampler`.
     pub sampler: u32,
+    /// The sequence index of the dimensions from [`CONTINUED_FROM`] on: `sample`, except in a
+    /// continuation of a path split at its first vertex (`crate::split`).
+    pub continuation: u32,
 }
+
+/// The first dimension a continuation of a split path reads from its own sequence index
+/// (`SampleRng::continuation`): the first vertex's roulette number. The dimensions below it
+/// (the camera's pair, the first vertex's light choice and point) are the sample's. The
+/// layout is `crate::vertex_samples`', which asserts this is its first vertex's roulette
+/// dimension (named here by value: `vertex_samples` draws through this module).
+pub const CONTINUED_FROM: u32 = 5;
 
 impl SampleRng {
     /// The independent stream of sample `sample` of pixel `pixel` (row-major index) under `seed`.
@@ -56,6 +67,18 @@ impl SampleRng {
             sample,
             dimension: 0,
             sampler,
+            continuation: sample,
+        }
+    }
+
+    /// The sequence index the current dimension is drawn from: `sample` below
+    /// [`CONTINUED_FROM`], `continuation` from it on.
+    #[inline]
+    fn index(&self) -> u32 {
+        if self.dimension < CONTINUED_FROM {
+            self.sample
+        } else {
+            self.continuation
         }
     }
 
@@ -63,7 +86,7 @@ impl SampleRng {
     /// advances the dimension.
     #[inline]
     pub fn next_u32(&mut self) -> u32 {
-        let x = independent_bits(self.seed, self.pixel, self.sample, self.dimension);
+        let x = independent_bits(self.seed, self.pixel, self.index(), self.dimension);
         self.dimension = self.dimension.wrapping_add(1);
         x
     }
@@ -74,7 +97,7 @@ impl SampleRng {
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
         if self.sampler == sampler::SOBOL {
-            let x = sobol_single(self.seed, self.pixel, self.sample, self.dimension);
+            let x = sobol_single(self.seed, self.pixel, self.index(), self.dimension);
             self.dimension = self.dimension.wrapping_add(1);
             u32_to_unit_f32(x)
         } else {
@@ -88,7 +111,7 @@ impl SampleRng {
     #[inline]
     pub fn next_2d(&mut self) -> (f32, f32) {
         if self.sampler == sampler::SOBOL {
-            let (x, y) = sobol_pair(self.seed, self.pixel, self.sample, self.dimension);
+            let (x, y) = sobol_pair(self.seed, self.pixel, self.index(), self.dimension);
             self.dimension = self.dimension.wrapping_add(2);
             (u32_to_unit_f32(x), u32_to_unit_f32(y))
         } else {

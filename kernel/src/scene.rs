@@ -521,7 +521,7 @@ pub mod sampler {
 
 /// Everything a launch of the kernel needs besides the scene's tables, one part per concern:
 /// the camera, which samples of which image, how a path is estimated, adaptive sampling, and
-/// what rays that leave the scene see. 176 bytes; every part is 4-byte words, so the host's
+/// what rays that leave the scene see, and where paths split. 192 bytes; every part is 4-byte words, so the host's
 /// `repr(C)` layout is the std430 layout the GPU reads (checked by `tests/tests/spirv_module.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
@@ -532,6 +532,7 @@ pub struct RenderParams {
     pub integrator: IntegratorParams,
     pub adaptive: AdaptiveParams,
     pub environment: EnvironmentParams,
+    pub split: SplitParams,
 }
 
 /// Which samples a launch computes: the image's size, and samples `first..first + count` of
@@ -586,6 +587,31 @@ pub struct AdaptiveParams {
     pub pilot_period: u32,
     /// Pilot samples a pixel needs before it may be declared converged.
     pub min_pilot_samples: u32,
+}
+
+/// Whether and how paths split at their first vertex (`crate::split`). 16 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
+#[repr(C)]
+pub struct SplitParams {
+    /// One of [`split_mode`].
+    pub mode: u32,
+    /// The side of a tile of the split table, in pixels.
+    pub tile_size: u32,
+    /// Tiles per row of the split table: `width.div_ceil(tile_size)`.
+    pub tile_columns: u32,
+    pub _pad: u32,
+}
+
+/// How a path treats its first vertex (`crate::split`).
+pub mod split_mode {
+    /// One continuation: the path as it always was.
+    pub const OFF: u32 = 0;
+    /// As many continuations as the split table gives the pixel's tile.
+    pub const TABLE: u32 = 1;
+    /// The pilot's measurement: two continuations, and the sample's value is what the pilot
+    /// reads (`crate::split::pilot_value`), not radiance.
+    pub const PILOT: u32 = 2;
 }
 
 /// What rays that leave the scene see: the uniform `background`, or the environment map

@@ -23,4 +23,7 @@ pub struct SceneView<'a> {
     pub media: &'a [Medium],
     /// The grid table (`crate::density_grid`; one word when no medium has a grid).
     pub grids: &'a [u32],
+    /// The split table: continuations at the first vertex per tile (`crate::split`; read only
+    /// under `split_mode::TABLE`).
+    pub splits: &'a [u32],
 }

@@ -1,5 +1,6 @@
 //! The SPIR-V entry points (compiled only for `target_arch = "spirv"`; ray-tracing intrinsics
-//! are GPU-only). The ray-generation shader runs [`crate::path::render_sample`] with a
+//! are GPU-only). The ray-generation shader runs [`crate::path::render_sample`] (or, where
+//! paths split or the kernel is not specialized, [`crate::split::render_split_sample`]) with a
 //! [`Tracer`] built on `trace_ray`; the other shaders answer its rays.
 //!
 //! Bindings (descriptor set 0): 0 TLAS, 1 running mean (rgba32f: rgb mean, a sample count),
@@ -10,7 +11,8 @@
 //! 10 the shading table (`ShadingTriangle`s; one zero record when there is none),
 //! 11 the texture table (`crate::texture`), 12 the instance table (`Instance`s; one zero record
 //! when there is none), 13 the media table (`crate::medium`; record 0, vacuum, always there),
-//! 14 the grid table (`crate::density_grid`; one word when no medium has a grid).
+//! 14 the grid table (`crate::density_grid`; one word when no medium has a grid),
+//! 15 the split table (`crate::split`; one word when paths do not split).
 //! Specialization constant 0: the feature bits of `crate::features` (0: generic path).
 //! Hit groups: 0 triangles (closest hit), then 1 spheres (intersection + closest hit), then
 //! instanced triangles (closest hit), each present only where the scene has that geometry;
@@ -30,6 +32,7 @@ use crate::scene::{
     Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle, NONE,
 };
 use crate::scene_view::SceneView;
+use crate::split::render_split_sample;
 #[cfg(feature = "probe")]
 use spirv_std::glam::UVec4;
 use spirv_std::glam::{UVec2, UVec3, Vec2, Vec3, Vec4};
@@ -181,6 +184,7 @@ pub fn raygen(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] instances: &[Instance],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 13)] media: &[Medium],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 14)] grids: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 15)] splits: &[u32],
     #[spirv(descriptor_set = 0, binding = 7)] accum_m2: &Image!(
         2D,
         format = rgba32f,
@@ -229,11 +233,20 @@ pub fn raygen(
         instances,
         media,
         grids,
+        splits,
     };
+    // Split paths where the render splits; and in the kernel compiled with every feature
+    // (not specialized) always, whose one loop then serves both (one copy of the path's code:
+    // two made that shader's compile on lavapipe minutes longer).
+    let split = !Dynamic(features).specialized() || Dynamic(features).split(params);
     let mut s = 0;
     while s < params.samples.count {
         let index = params.samples.first + s;
-        let l = render_sample(&mut tracer, Dynamic(features), &scene, px, py, index);
+        let l = if split {
+            render_split_sample(&mut tracer, Dynamic(features), &scene, px, py, index)
+        } else {
+            render_sample(&mut tracer, Dynamic(features), &scene, px, py, index)
+        };
         let class = classify(params, index, l);
         if class == sample_use::DISCARDED {
             discarded += 1.0;

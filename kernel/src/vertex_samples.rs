@@ -28,6 +28,9 @@ pub const BRDF_DIMENSION: u32 = 4;
 /// The camera's pair (the position inside the pixel), before the first vertex's block.
 pub const CAMERA_DIMENSION: u32 = 0;
 pub const CAMERA_DIMENSIONS: u32 = 2;
+// Split paths' continuations read their own sequence index from the first vertex's roulette
+// number on (`crate::split`).
+const _: () = assert!(crate::rng::CONTINUED_FROM == CAMERA_DIMENSIONS + ROULETTE_DIMENSION);
 /// The lobe choice of the vertex at depth d (a BSDF that mixes lobes, `bsdf::BsdfFlags::chooses_lobe`) is
 /// dimension `LOBE_DIMENSION + d`: outside every vertex's block, so scenes without such a
 /// material draw exactly the numbers they drew before it existed. (Both samplers hash the

@@ -134,6 +134,7 @@ pub fn shade_at(
         instances,
         media: &[kernel::medium::Medium::VACUUM],
         grids: &[0],
+        splits: &[1],
     };
     let hit = kernel::SurfaceHit {
         material,

@@ -99,6 +99,10 @@ fn a_sphere_of_absorbing_medium_transmits_exp_of_minus_sigma_times_the_chord() {
     println!("darkest pixel (blue) {darkest:.4} of {L}");
     assert!(darkest < 0.1 * L, "the medium absorbs visibly");
     assert_backends_agree_with(&file, &exact, 256);
+    // Paths split at their first vertex, the sphere's interface (`kernel::split`).
+    let mut split = file.clone();
+    split.settings.split = twinpath::settings::Split::Fixed(3);
+    assert_backends_agree_with(&split, &exact, 64);
     // The same sphere without its medium is the environment everywhere: rejected.
     let clear: SceneFile = scene_from_toml(&scene(""));
     assert_eq!(

@@ -382,7 +382,12 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
             } else {
                 sampler::SOBOL
             };
-            let rng = SampleRng::with_sampler(h(lane, 1), h(lane, 2), h(lane, 3) % 4096, kind);
+            let mut rng = SampleRng::with_sampler(h(lane, 1), h(lane, 2), h(lane, 3) % 4096, kind);
+            // Half the lanes continue a split path (`kernel::split`): their dimensions from
+            // the first vertex's roulette on are another sample index's.
+            if h(lane, 23) % 2 == 0 {
+                rng.continuation = h(lane, 24) % 16384;
+            }
             let l = &lights[(h(lane, 8) % lights.len() as u32) as usize];
             let c = Vec3::from(l.position);
             let x = if h(lane, 7) % 6 == 0 {
@@ -449,6 +454,7 @@ fn vertex_samples_filled_for_sixteen_vertices_are_the_kernel_samples() {
             instances: &[],
             media: &[kernel::medium::Medium::VACUUM],
             grids: &[0],
+            splits: &[1],
         };
         for (lane, entry) in queries.iter().enumerate() {
             let Some((rng, q)) = entry else { continue };

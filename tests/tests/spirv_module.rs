@@ -7,7 +7,7 @@
 use kernel::medium::Medium;
 use kernel::scene::{
     AdaptiveParams, Camera, EnvironmentParams, Instance, IntegratorParams, Light, Material,
-    RenderParams, SampleParams, ShadingTriangle, Sphere, Triangle,
+    RenderParams, SampleParams, ShadingTriangle, Sphere, SplitParams, Triangle,
 };
 use std::collections::BTreeSet;
 use std::mem::{offset_of, size_of};
@@ -266,7 +266,7 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
             binding::PARAMS,
             host_layout!(
                 RenderParams,
-                [camera, samples, integrator, adaptive, environment],
+                [camera, samples, integrator, adaptive, environment, split],
                 false
             ),
         ),
@@ -418,6 +418,11 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                 [background, width, height, light, scale, rotation, medium, _pad],
                 false
             ),
+        ),
+        (
+            "SplitParams",
+            5,
+            host_layout!(SplitParams, [mode, tile_size, tile_columns, _pad], false),
         ),
     ];
     for (name, member, host) in parts {

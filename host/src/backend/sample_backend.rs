@@ -27,6 +27,12 @@ pub trait SampleBackend {
     ) -> Result<()>;
     /// The film with every sample added so far.
     fn read_film(&self) -> Result<Film>;
+    /// Forgets every sample added so far: the film as new (after the split pilot,
+    /// `crate::split_pilot`). The rays counted stay counted.
+    fn clear_film(&mut self) -> Result<()>;
+    /// The split table the next passes read (`kernel::split`: continuations per tile, row
+    /// by row, tiles of `SPLIT_TILE` pixels; one word `1` where nothing splits).
+    fn set_splits(&mut self, splits: &[u32]) -> Result<()>;
     /// Of the set-up: building the acceleration structure (the CPU's BVH, the GPU's BLAS and
     /// TLAS) and creating the pipeline (zero on the CPU).
     fn setup_times(&self) -> (Duration, Duration);

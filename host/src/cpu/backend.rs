@@ -66,6 +66,16 @@ impl SampleBackend for CpuBackend {
         Ok(self.film.clone())
     }
 
+    fn clear_film(&mut self) -> Result<()> {
+        self.film = Film::new(self.film.width, self.film.height);
+        Ok(())
+    }
+
+    fn set_splits(&mut self, splits: &[u32]) -> Result<()> {
+        self.renderer.splits = splits.to_vec();
+        Ok(())
+    }
+
     fn setup_times(&self) -> (Duration, Duration) {
         (self.build_time, Duration::ZERO)
     }

@@ -10,6 +10,7 @@ mod bvh_packet_shadows;
 mod bvh_tracer;
 mod huge_pages;
 mod packet;
+mod packet_forks;
 mod packet_numbers;
 mod packet_paths;
 mod packet_presence;

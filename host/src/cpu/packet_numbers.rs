@@ -5,10 +5,11 @@
 
 use super::packet::LANES;
 use super::simd::widest_simd;
-use kernel::rng::{independent_bits, u32_to_unit_f32, SampleRng};
+use kernel::rng::{independent_bits, u32_to_unit_f32, SampleRng, CONTINUED_FROM};
 use kernel::scene::sampler;
 use kernel::sobol::{sobol_pair, sobol_single};
 use kernel::vertex_samples::CAMERA_DIMENSION;
+use std::simd::cmp::{SimdPartialEq, SimdPartialOrd};
 use std::simd::{Mask, Select, Simd};
 
 type Words = Simd<u32, LANES>;
@@ -31,6 +32,7 @@ pub struct NumberRequests {
     seed: [u32; LANES],
     pixel: [u32; LANES],
     sample: [u32; LANES],
+    continuation: [u32; LANES],
     sobol: [bool; LANES],
     pairs: [[u32; LANES]; 2],
     singles: [[u32; LANES]; 2],
@@ -42,6 +44,7 @@ impl Default for NumberRequests {
             seed: [0; LANES],
             pixel: [0; LANES],
             sample: [0; LANES],
+            continuation: [0; LANES],
             sobol: [false; LANES],
             pairs: [[EMPTY; LANES]; 2],
             singles: [[EMPTY; LANES]; 2],
@@ -56,6 +59,7 @@ impl NumberRequests {
         self.seed[lane] = rng.seed;
         self.pixel[lane] = rng.pixel;
         self.sample[lane] = rng.sample;
+        self.continuation[lane] = rng.continuation;
         self.sobol[lane] = rng.sampler == sampler::SOBOL;
         for p in 0..2 {
             self.pairs[p][lane] = pairs[p];
@@ -82,11 +86,22 @@ impl NumberRequests {
 
     #[inline(always)]
     fn compute_any_cpu(&self) -> ([[[u32; LANES]; 2]; 2], [[u32; LANES]; 2]) {
-        let (seed, pixel, sample) = (
-            Words::from_array(self.seed),
-            Words::from_array(self.pixel),
+        let (seed, pixel) = (Words::from_array(self.seed), Words::from_array(self.pixel));
+        let (sample, continuation) = (
             Words::from_array(self.sample),
+            Words::from_array(self.continuation),
         );
+        // Each lane's sequence index for dimension d (`SampleRng::index`); the sample's
+        // where no lane is a continuation of a split path.
+        let continued = sample.simd_ne(continuation).any();
+        let index = |d: Words| {
+            if continued {
+                d.simd_lt(Words::splat(CONTINUED_FROM))
+                    .select(sample, continuation)
+            } else {
+                sample
+            }
+        };
         let sobol = Mask::<i32, LANES>::from_array(self.sobol);
         let (any_sobol, any_independent) = (sobol.any(), !sobol.all());
         let wanted = |d: &[u32; LANES]| d.iter().any(|&d| d != EMPTY);
@@ -96,6 +111,7 @@ impl NumberRequests {
                 continue;
             }
             let d = Words::from_array(*dims);
+            let sample = index(d);
             let (mut x, mut y) = (Words::splat(0), Words::splat(0));
             if any_sobol {
                 (x, y) = sobol_pair(seed, pixel, sample, d);
@@ -114,6 +130,7 @@ impl NumberRequests {
                 continue;
             }
             let d = Words::from_array(*dims);
+            let sample = index(d);
             let mut x = Words::splat(0);
             if any_sobol {
                 x = sobol_single(seed, pixel, sample, d);

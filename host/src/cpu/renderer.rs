@@ -17,7 +17,8 @@ use indicatif::ProgressBar;
 use kernel::features::{self, Dynamic, DynamicWithout, FeatureSet, Static};
 use kernel::medium::Medium;
 use kernel::path::render_sample;
-use kernel::scene::{Light, Material, RenderParams, ShadingTriangle};
+use kernel::scene::{split_mode, Light, Material, RenderParams, ShadingTriangle};
+use kernel::split::render_split_sample;
 use kernel::{SceneView, Tracer};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -38,8 +39,11 @@ pub struct CpuRenderer {
     /// The grid table (`kernel::density_grid`).
     pub grids: Vec<u32>,
     /// The kernel's feature bits (`kernel::features`; 0: generic path), without
-    /// `features::ADAPTIVE` (the GPU's ray generation reads it; this film counts pilots itself).
+    /// `features::ADAPTIVE` (the GPU's ray generation reads it; this film counts pilots itself)
+    /// and `features::SPLIT` (asked of the parameters here).
     pub features: u32,
+    /// The split table (`kernel::split`; `[1]`: no split).
+    pub splits: Vec<u32>,
     /// How a tile's samples are computed, chosen once when the renderer is built.
     pub tiles: TileStrategy,
     /// Whether a material has holes (`Material::has_holes`): rays then pass through the
@@ -162,7 +166,10 @@ impl CpuRenderer {
             textures: scene.textures.words.clone(),
             media: scene.media.clone(),
             grids: scene.grids.words.clone(),
-            features: with_all_extended(scene.features(settings) & !features::ADAPTIVE),
+            features: with_all_extended(
+                scene.features(settings) & !(features::ADAPTIVE | features::SPLIT),
+            ),
+            splits: vec![1],
             tiles,
             holes,
         }
@@ -205,7 +212,12 @@ impl CpuRenderer {
         py: u32,
         sample: u32,
     ) -> Vec3 {
-        render_sample(tracer, features, &self.view(params), px, py, sample)
+        let scene = self.view(params);
+        if params.split.mode == split_mode::OFF {
+            render_sample(tracer, features, &scene, px, py, sample)
+        } else {
+            render_split_sample(tracer, features, &scene, px, py, sample)
+        }
     }
 
     /// The scene's tables as the kernel reads them, with the render's parameters.
@@ -220,6 +232,7 @@ impl CpuRenderer {
             instances: self.bvh.instances(),
             media: &self.media,
             grids: &self.grids,
+            splits: &self.splits,
         }
     }
 

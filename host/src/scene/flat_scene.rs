@@ -12,11 +12,11 @@ use super::instancing;
 use super::light_table;
 use super::limits;
 use super::textures;
-use crate::settings::RenderSettings;
+use crate::settings::{RenderSettings, Split};
 use glam::Vec3;
 use kernel::scene::{
-    AdaptiveParams, Camera, EnvironmentParams, Instance, IntegratorParams, Light, Material,
-    RenderParams, SampleParams, ShadingTriangle, Sphere, Triangle,
+    split_mode, AdaptiveParams, Camera, EnvironmentParams, Instance, IntegratorParams, Light,
+    Material, RenderParams, SampleParams, ShadingTriangle, Sphere, SplitParams, Triangle,
 };
 use std::ops::Range;
 
@@ -82,6 +82,9 @@ impl CameraDesc {
         }
     }
 }
+
+/// The side of a tile of the split table (`kernel::split`), in pixels.
+pub const SPLIT_TILE: u32 = 16;
 
 /// With adaptive sampling, every PILOT_PERIOD-th sample is a pilot (`kernel::adaptive`).
 pub const PILOT_PERIOD: u32 = 4;
@@ -205,6 +208,16 @@ impl Scene {
                 scale: map.map_or(1.0, |m| m.scale),
                 rotation: [rotation.cos(), rotation.sin()],
                 medium: self.medium,
+                _pad: 0,
+            },
+            split: SplitParams {
+                mode: if r.split == Split::Off {
+                    split_mode::OFF
+                } else {
+                    split_mode::TABLE
+                },
+                tile_size: SPLIT_TILE,
+                tile_columns: self.camera.width.div_ceil(SPLIT_TILE),
                 _pad: 0,
             },
         }

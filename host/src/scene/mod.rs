@@ -30,6 +30,6 @@ pub mod transform;
 pub use error::SceneError;
 pub use flat_scene::{
     triangle, CameraDesc, Scene, SceneFile, TriangleGroup, ADAPTIVE_PASS, MIN_PILOT_SAMPLES,
-    PILOT_PERIOD,
+    PILOT_PERIOD, SPLIT_TILE,
 };
 pub use toml::{parse_scene, parse_scene_with_camera, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};

@@ -197,6 +197,33 @@ impl Context {
         })
     }
 
+    /// Sets every texel of a storage image (in `GENERAL` layout) to zero, after every earlier
+    /// dispatch's writes to it.
+    pub fn clear_image(&self, image: &Image) -> Result<()> {
+        self.submit_and_wait(|cmd| unsafe {
+            self.image_barrier(
+                cmd,
+                image.image,
+                (vk::ImageLayout::GENERAL, vk::ImageLayout::GENERAL),
+                (
+                    vk::AccessFlags::SHADER_WRITE,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags::RAY_TRACING_SHADER_KHR,
+                    vk::PipelineStageFlags::TRANSFER,
+                ),
+            );
+            self.device.cmd_clear_color_image(
+                cmd,
+                image.image,
+                vk::ImageLayout::GENERAL,
+                &vk::ClearColorValue { float32: [0.0; 4] },
+                &[color_range()],
+            );
+        })
+    }
+
     /// Copies an RGBA32F image to host memory, row-major, 4 floats per pixel.
     pub fn read_image(&self, image: &Image, width: u32, height: u32) -> Result<Vec<[f32; 4]>> {
         let bytes = width as u64 * height as u64 * 16;

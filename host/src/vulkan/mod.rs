@@ -14,7 +14,7 @@ pub mod pipeline;
 use crate::backend::SampleBackend;
 use crate::film::Film;
 use crate::fixed_sum::FixedSum;
-use crate::scene::{Scene, ADAPTIVE_PASS};
+use crate::scene::{Scene, ADAPTIVE_PASS, SPLIT_TILE};
 use crate::settings::RenderSettings;
 use accel::SceneAccel;
 use anyhow::{Context as _, Result};
@@ -51,6 +51,8 @@ struct Resources {
     accel: SceneAccel,
     params: Buffer,
     tables: Vec<Buffer>,
+    /// The split table (`kernel::split`), host-visible: one word per tile.
+    splits: Buffer,
     accum: Image,
     accum_sq: Image,
     pilots: Image,
@@ -86,6 +88,17 @@ impl GpuRenderer {
             std::mem::size_of::<RenderParams>() as u64,
             STORAGE,
             MemoryLocation::CpuToGpu,
+        )?;
+        let tiles = w.div_ceil(SPLIT_TILE) as u64 * h.div_ceil(SPLIT_TILE) as u64;
+        let mut splits = ctx.create_buffer(
+            "splits",
+            4 * tiles.max(1),
+            STORAGE,
+            MemoryLocation::CpuToGpu,
+        )?;
+        ctx.write_buffer(
+            &mut splits,
+            bytemuck::cast_slice(&vec![1u32; tiles as usize]),
         )?;
         // Empty tables still need a buffer behind their binding.
         let tables = vec![
@@ -135,7 +148,7 @@ impl GpuRenderer {
             },
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 11,
+                descriptor_count: 12,
             },
         ];
         let (pool, set) = ctx.create_descriptor_set(pipeline.compiled.set_layout, &sizes)?;
@@ -168,6 +181,7 @@ impl GpuRenderer {
             buffer_info(&tables[7]),
             buffer_info(&tables[8]),
             buffer_info(&tables[9]),
+            buffer_info(&splits),
         ];
         let buffer_bindings = [
             binding::PARAMS,
@@ -181,6 +195,7 @@ impl GpuRenderer {
             binding::INSTANCES,
             binding::MEDIA,
             binding::GRIDS,
+            binding::SPLITS,
         ];
         let mut writes = vec![
             vk::WriteDescriptorSet::default()
@@ -221,6 +236,7 @@ impl GpuRenderer {
                 accel,
                 params,
                 tables,
+                splits,
                 accum,
                 accum_sq,
                 pilots,
@@ -357,6 +373,28 @@ impl SampleBackend for GpuRenderer {
         GpuRenderer::read_film(self)
     }
 
+    fn clear_film(&mut self) -> Result<()> {
+        let res = self.res();
+        for image in [&res.accum, &res.accum_sq, &res.pilots] {
+            self.ctx.clear_image(image)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the table into the split buffer (no dispatch is in flight between passes:
+    /// each waits for its end).
+    fn set_splits(&mut self, splits: &[u32]) -> Result<()> {
+        let res = self.resources.as_mut().expect("resources live until drop");
+        let room = (res.splits.size / 4) as usize;
+        anyhow::ensure!(
+            splits.len() <= room,
+            "split table of {} tiles for {room}",
+            splits.len()
+        );
+        self.ctx
+            .write_buffer(&mut res.splits, bytemuck::cast_slice(splits))
+    }
+
     fn setup_times(&self) -> (Duration, Duration) {
         (self.accel_build_time, self.pipeline_time)
     }
@@ -380,6 +418,7 @@ impl Drop for GpuRenderer {
             for b in r.tables {
                 ctx.destroy_buffer(b);
             }
+            ctx.destroy_buffer(r.splits);
             ctx.destroy_image(r.accum);
             ctx.destroy_image(r.accum_sq);
             ctx.destroy_image(r.pilots);

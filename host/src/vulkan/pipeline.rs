@@ -39,6 +39,7 @@ pub mod binding {
     pub const INSTANCES: u32 = 12;
     pub const MEDIA: u32 = 13;
     pub const GRIDS: u32 = 14;
+    pub const SPLITS: u32 = 15;
 }
 
 /// Which hit groups a pipeline has: a scene without world-space triangles (or spheres, or
@@ -236,6 +237,7 @@ impl CompiledPipeline {
             b(binding::INSTANCES, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::MEDIA, vk::DescriptorType::STORAGE_BUFFER),
             b(binding::GRIDS, vk::DescriptorType::STORAGE_BUFFER),
+            b(binding::SPLITS, vk::DescriptorType::STORAGE_BUFFER),
         ];
         let set_layout = unsafe {
             ctx.device.create_descriptor_set_layout(
