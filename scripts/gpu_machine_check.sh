@@ -49,7 +49,7 @@ queue() { for t in "$@"; do [ $(date +%s) -ge $end ] && { echo "-- $t: not run, 
 run gpu_functions 150 $B/gpu_functions --test-threads=1 --nocapture &
 (queue spirv_module gpu_render; TWINPATH_FURNACE_GPU_SPP=24576 run furnace 90 $B/furnace gpu --nocapture) &
 QT=235 queue specialize_adaptive &
-queue gltf sobol media_grids normal_maps camera vertex_colours &
+queue gltf sobol media_grids normal_maps camera vertex_colours split &
 queue instances opacity light_selection textures reflecting_lights &
 queue media punctual_lights closed_form_materials hard_lighting scene_scale triangle_lights environment texture_sets shading_normals &
 (run hang_validation 75 $B/sobol gpu both_backends --test-threads=2
@@ -83,6 +83,9 @@ if [ -e $B/twinpath_baseline ]; then
   for bin in twinpath_baseline twinpath; do gpu $bin /tmp/gs/mesh_4000.toml; done
 fi
 for sc in scenes/materials.toml /tmp/gs/mesh_1000000.toml scenes/gltf_showcase.toml; do gpu twinpath $sc; done
+# Splitting at the first vertex (docs/performance.md): what a split sample costs on this GPU
+# (two continuations halve Cornell's error; on the CPU's packets they cost 1.95x).
+for v in off 2 off 2; do gpu twinpath "scenes/cornell.toml --set split=$v"; done
 # Against Mitsuba 3 cuda_ad_rgb (gpu_machine_prepare.sh's bundle): both render the four Cornell
 # scenes at the same sample count; scripts/gpu_peer_table.py measures the images' error here
 # (from $OUT/peer.tar.gz: a run returns at most 8 files).
