@@ -3,8 +3,8 @@
 //! goes on in its sample's lane; continuations 1 to n - 1 draw their first vertex's samples in
 //! the SIMD fill of a later round, in query slots no lane uses that round (or sixteen at a
 //! time when they pile up), then wait for a lane with their rays ready. Each draws exactly the
-//! numbers `FirstVertex::continuation` draws one at a time (the fill's contract), so the image
-//! is the one-path loop's.
+//! numbers `kernel::split::render_split_sample` draws one at a time (the fill's contract), so
+//! the image is the one-path loop's.
 
 use super::packet::LANES;
 use super::packet_vertices::fill_vertex_samples;
