@@ -1,7 +1,7 @@
 //! The SPIR-V entry points (compiled only for `target_arch = "spirv"`; ray-tracing intrinsics
-//! are GPU-only). The ray-generation shader runs [`crate::path::render_sample`] (or, where
-//! paths split or the kernel is not specialized, [`crate::split::render_split_sample`]) with a
-//! [`Tracer`] built on `trace_ray`; the other shaders answer its rays.
+//! are GPU-only). The ray-generation shader runs [`crate::split::render_split_sample`] (which
+//! is [`crate::path::render_sample`] where paths do not split) with a [`Tracer`] built on
+//! `trace_ray`; the other shaders answer its rays.
 //!
 //! Bindings (descriptor set 0): 0 TLAS, 1 running mean (rgba32f: rgb mean, a sample count),
 //! 2 params ([`RenderParams`]), 3 materials, 4 lights, 5 triangles, 6 spheres,
@@ -27,7 +27,7 @@ use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::hit::SurfaceHit;
 use crate::medium::Medium;
 use crate::opacity::{covers, CandidateRay, HoleTables};
-use crate::path::{render_sample, Tracer};
+use crate::path::Tracer;
 use crate::scene::{
     Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle, NONE,
 };
@@ -235,18 +235,13 @@ pub fn raygen(
         grids,
         splits,
     };
-    // Split paths where the render splits; and in the kernel compiled with every feature
-    // (not specialized) always, whose one loop then serves both (one copy of the path's code:
-    // two made that shader's compile on lavapipe minutes longer).
-    let split = !Dynamic(features).specialized() || Dynamic(features).split(params);
+    let split = Dynamic(features).split(params);
     let mut s = 0;
     while s < params.samples.count {
         let index = params.samples.first + s;
-        let l = if split {
-            render_split_sample(&mut tracer, Dynamic(features), &scene, px, py, index)
-        } else {
-            render_sample(&mut tracer, Dynamic(features), &scene, px, py, index)
-        };
+        // One loop for split and unsplit paths: one copy of the path's code in the module.
+        let f = Dynamic(features);
+        let l = render_split_sample(&mut tracer, f, &scene, px, py, index, split);
         let class = classify(params, index, l);
         if class == sample_use::DISCARDED {
             discarded += 1.0;

@@ -187,7 +187,10 @@ pub fn split_value(continued: Vec3, n: u32) -> Vec3 {
 /// empty). One loop runs the prefix and every continuation, with one call of each step
 /// (`round`, `arrival`, `vertex`): a continuation restarts from the path as it reached the
 /// vertex and arrives there again (the arrival is a function of that state and the hit), so
-/// that a shader compiled with every feature holds one copy of the path's code.
+/// that the ray generation shader, which runs it for every render, holds one copy of the
+/// path's code. `may_split` false: one continuation, whatever the table says (the shader
+/// passes `features::SPLIT`'s answer, a constant in a specialized kernel, which then keeps
+/// nothing of the fork and is `render_sample`).
 #[inline]
 pub fn render_split_sample<T: Tracer, F: FeatureSet>(
     tracer: &mut T,
@@ -196,9 +199,14 @@ pub fn render_split_sample<T: Tracer, F: FeatureSet>(
     px: u32,
     py: u32,
     sample: u32,
+    may_split: bool,
 ) -> Vec3 {
     let params = scene.params;
-    let n = continuations_at(scene, px, py);
+    let n = if may_split {
+        continuations_at(scene, px, py)
+    } else {
+        1
+    };
     let mut path = start_sample(features, params, px, py, sample);
     let mut hit = SurfaceHit::miss();
     // The path as it reached its first vertex, once it has (where it splits), and where.

@@ -216,7 +216,7 @@ impl CpuRenderer {
         if params.split.mode == split_mode::OFF {
             render_sample(tracer, features, &scene, px, py, sample)
         } else {
-            render_split_sample(tracer, features, &scene, px, py, sample)
+            render_split_sample(tracer, features, &scene, px, py, sample, true)
         }
     }
 
