@@ -104,6 +104,22 @@ pub fn white_cornell_toml() -> String {
     text
 }
 
+/// The room of [`white_cornell_toml`] as a white furnace: a uniform background `lb`, `render`
+/// in place of its `[render]` table's `seed = 1`, `width` x `height` pixels.
+pub fn white_furnace(render: &str, width: u32, height: u32, lb: f32) -> SceneFile {
+    let mut text = white_cornell_toml();
+    for (from, to) in [
+        ("seed = 1", render.to_string()),
+        ("width = 256", format!("width = {width}")),
+        ("height = 256", format!("height = {height}")),
+    ] {
+        assert!(text.contains(from), "{from}");
+        text = text.replace(from, &to);
+    }
+    text.push_str(&format!("\n[background]\nradiance = [{lb}, {lb}, {lb}]\n"));
+    scene_from_toml(&text)
+}
+
 /// The repository root.
 pub fn repo_root() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")

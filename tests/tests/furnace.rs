@@ -21,7 +21,7 @@ use twinpath::film::Film;
 use twinpath::render::Backend;
 use twinpath::scene::SceneFile;
 use twinpath_tests::gpu::assert_validation_clean;
-use twinpath_tests::{render_film, scene_from_toml, white_cornell_toml};
+use twinpath_tests::{render_film, white_furnace};
 
 /// The background radiance: a power of two, so that sums and means of it are exact.
 const LB: f32 = 0.5;
@@ -35,20 +35,8 @@ const GPU_SPP: u32 = 4096;
 /// The Cornell room (five quads, two diffuse spheres) with every albedo 1 and the light sphere
 /// made a third white sphere; background Lb; throughput roulette.
 fn furnace(sampler: &str, seed: u32) -> SceneFile {
-    let mut text = white_cornell_toml();
-    for (from, to) in [
-        (
-            "seed = 1",
-            &format!("seed = {seed}\nroulette = \"throughput\"\nsampler = \"{sampler}\""),
-        ),
-        ("width = 256", &format!("width = {WIDTH}")),
-        ("height = 256", &format!("height = {HEIGHT}")),
-    ] {
-        assert!(text.contains(from), "{from}");
-        text = text.replace(from, to);
-    }
-    text.push_str(&format!("\n[background]\nradiance = [{LB}, {LB}, {LB}]\n"));
-    let scene = scene_from_toml(&text);
+    let render = format!("seed = {seed}\nroulette = \"throughput\"\nsampler = \"{sampler}\"");
+    let scene = white_furnace(&render, WIDTH, HEIGHT, LB);
     assert!(scene.scene.lights.is_empty());
     assert_eq!(scene.scene.spheres.len(), 3);
     assert_eq!(scene.scene.triangles.len(), 10);

@@ -24,8 +24,7 @@ use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::{
     assert_backends_agree_with, assert_bvh_packets_give_the_one_path_image, assert_films_identical,
     assert_packets_give_the_one_path_image, image_mean_z, plane_exact, plane_under_lamps,
-    render_film, repo_root, scene_from_toml, white_cornell_toml, with_independent_samples,
-    z_critical, Lamp,
+    render_film, repo_root, white_furnace, with_independent_samples, z_critical, Lamp,
 };
 
 /// The furnace's background: a power of two, so that sums of it and their quotients by 2, 3
@@ -41,17 +40,7 @@ fn with_split(scene: &SceneFile, split: Split) -> SceneFile {
 /// The Cornell room with every albedo 1 and no light under a uniform background Lb, throughput
 /// roulette, `size` x `size` pixels.
 fn furnace(size: u32) -> SceneFile {
-    let mut text = white_cornell_toml();
-    for (from, to) in [
-        ("seed = 1", "seed = 6\nroulette = \"throughput\""),
-        ("width = 256", &format!("width = {size}")),
-        ("height = 256", &format!("height = {size}")),
-    ] {
-        assert!(text.contains(from), "{from}");
-        text = text.replace(from, to);
-    }
-    text.push_str(&format!("\n[background]\nradiance = [{LB}, {LB}, {LB}]\n"));
-    let scene = scene_from_toml(&text);
+    let scene = white_furnace("seed = 6\nroulette = \"throughput\"", size, size, LB);
     assert!(scene.scene.lights.is_empty());
     scene
 }

@@ -220,11 +220,10 @@ fn packets<const SPLITS: bool, F: FeatureSet, T: PacketTracer>(
     let n = work.len() * count as usize;
     let pixel_of = |k: usize| work[k / count as usize];
     // Continuations at each pixel's first vertices (1 where nothing splits).
-    let splits = SPLITS;
     let continuations: Vec<u32> = work
         .iter()
         .map(|&(px, py)| {
-            if splits {
+            if SPLITS {
                 continuations_at(scene, px, py)
             } else {
                 1
@@ -232,7 +231,7 @@ fn packets<const SPLITS: bool, F: FeatureSet, T: PacketTracer>(
         })
         .collect();
     let continuations_of = |k: usize| continuations[k / count as usize];
-    let mut values = SlotValues::new(n, splits);
+    let mut values = SlotValues::new(n, SPLITS);
     let mut slots: [Option<Job>; LANES] = [None; LANES];
     // Continuations waiting to leave their first vertex, and those waiting for a lane.
     let mut forks = Forks::default();
@@ -340,7 +339,7 @@ fn packets<const SPLITS: bool, F: FeatureSet, T: PacketTracer>(
             }
             if job.path.advance(features, scene, hit, occluded[lane]) {
                 reached[lane] = true;
-                let n = if splits { continuations_of(job.k) } else { 1 };
+                let n = if SPLITS { continuations_of(job.k) } else { 1 };
                 if n > 1 && job.part == Part::Whole {
                     let vertex = FirstVertex::reached(job.path, features, scene, hit);
                     forks.fork(job.k, n, vertex);
