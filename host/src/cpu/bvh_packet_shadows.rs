@@ -1,11 +1,11 @@
 //! Shadow segments through the 8-wide BVH as packets of sixteen (`bvh_packet.rs`, whose
 //! descent this is, for any-hit): a lane leaves the traversal once something blocks it, a leaf's
 //! triangles and spheres are tested on the lanes still open, subtrees wanted by at most
-//! [`ONE_AT_A_TIME_LANES`] lanes go one ray at a time, and each lane's answer is the one-ray
+//! [`ONE_AT_A_TIME_SHADOW_LANES`] lanes go one ray at a time, and each lane's answer is the one-ray
 //! [`Bvh::any_hit`]'s (or [`Bvh::any_hit_through`]'s, where materials have holes).
 
 use super::bvh::{Bvh, HoleTables, Solid, LEAF, STACK};
-use super::bvh_packet::{column, rays_to_object, SlabRays, ONE_AT_A_TIME_LANES};
+use super::bvh_packet::{column, rays_to_object, SlabRays, ONE_AT_A_TIME_SHADOW_LANES};
 use super::packet::{RayPacket, LANES};
 use super::packet_presence::{LaneHoles, LanePresence};
 use super::simd::{sphere_lanes, triangle_lanes, widest_simd};
@@ -112,7 +112,7 @@ impl Bvh {
         let mut occluded = 0u32;
         let (mut current, mut lanes) = (start, active);
         loop {
-            if lanes.count_ones() <= ONE_AT_A_TIME_LANES {
+            if lanes.count_ones() <= ONE_AT_A_TIME_SHADOW_LANES {
                 let mut rest = lanes;
                 while rest != 0 {
                     let lane = rest.trailing_zeros() as usize;
