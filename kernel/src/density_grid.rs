@@ -25,6 +25,7 @@
 //!   first voxel and the word of the first majorant cell, two unused words;
 //! - voxels and majorant cells: f32 bits, x fastest, then y, then z.
 
+use crate::real::{Real, V3};
 use spirv_std::glam::{IVec3, UVec3, Vec3};
 
 /// Words per grid record.
@@ -111,25 +112,39 @@ impl<'a> DensityGrid<'a> {
 
     /// The density at `p` taken to lie inside the box (a point of a walk's piece: one a
     /// rounding error outside it reads the face's density, not 0).
+    #[inline]
     pub fn density_inside(&self, p: Vec3) -> f32 {
+        self.density_inside_v3(V3::from(p))
+    }
+
+    /// [`DensityGrid::density_inside`] over any scalar [`Real`] (the `f32` instance is it,
+    /// operation for operation): the voxel coordinate clamped to the outermost centres, its
+    /// floor as the first of the eight voxels read, and the trilinear blend.
+    pub fn density_inside_v3<R: Real<Bits = u32>>(&self, p: V3<R>) -> R {
         let (lo, hi) = self.bounds();
         let n = self.resolution();
         let last = (n - UVec3::ONE).as_vec3();
-        let x = ((p - lo) / (hi - lo) * n.as_vec3() - Vec3::splat(0.5))
-            .max(Vec3::ZERO)
-            .min(last);
-        let base = x.floor();
-        let f = x - base;
-        let i0 = base.as_uvec3();
+        let coordinate = |p: R, lo: f32, hi: f32, n: u32, last: f32| {
+            ((p - R::splat(lo)) / (R::splat(hi) - R::splat(lo)) * R::splat(n as f32)
+                - R::splat(0.5))
+            .max(R::splat(0.0))
+            .min(R::splat(last))
+        };
+        let x = coordinate(p.x, lo.x, hi.x, n.x, last.x);
+        let y = coordinate(p.y, lo.y, hi.y, n.y, last.y);
+        let z = coordinate(p.z, lo.z, hi.z, n.z, last.z);
+        let (bx, by, bz) = (x.floor(), y.floor(), z.floor());
+        let (fx, fy, fz) = (x - bx, y - by, z - bz);
+        let i0 = UVec3::new(bx.to_i32_bits(), by.to_i32_bits(), bz.to_i32_bits());
         let i1 = (i0 + UVec3::ONE).min(n - UVec3::ONE);
         let first = self.words[self.record + VOXELS] as usize;
-        let v = |i: u32, j: u32, k: u32| self.voxel(first, n, i, j, k);
-        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-        let c00 = lerp(v(i0.x, i0.y, i0.z), v(i1.x, i0.y, i0.z), f.x);
-        let c10 = lerp(v(i0.x, i1.y, i0.z), v(i1.x, i1.y, i0.z), f.x);
-        let c01 = lerp(v(i0.x, i0.y, i1.z), v(i1.x, i0.y, i1.z), f.x);
-        let c11 = lerp(v(i0.x, i1.y, i1.z), v(i1.x, i1.y, i1.z), f.x);
-        lerp(lerp(c00, c10, f.y), lerp(c01, c11, f.y), f.z)
+        let v = |i: u32, j: u32, k: u32| R::splat(self.voxel(first, n, i, j, k));
+        let lerp = |a: R, b: R, t: R| a + (b - a) * t;
+        let c00 = lerp(v(i0.x, i0.y, i0.z), v(i1.x, i0.y, i0.z), fx);
+        let c10 = lerp(v(i0.x, i1.y, i0.z), v(i1.x, i1.y, i0.z), fx);
+        let c01 = lerp(v(i0.x, i0.y, i1.z), v(i1.x, i0.y, i1.z), fx);
+        let c11 = lerp(v(i0.x, i1.y, i1.z), v(i1.x, i1.y, i1.z), fx);
+        lerp(lerp(c00, c10, fy), lerp(c01, c11, fy), fz)
     }
 
     /// The majorant of majorant cell `cell` (each component below the majorant resolution).
@@ -149,7 +164,8 @@ impl<'a> DensityGrid<'a> {
 pub fn optical_depth(grid: &DensityGrid, origin: Vec3, dir: Vec3, t_max: f32) -> f32 {
     let (lo, hi) = grid.bounds();
     let cells = grid.resolution() + UVec3::ONE;
-    let mut walk = CellWalk::new((lo, hi), cells, 0.5, (origin, dir), (0.0, t_max));
+    let ray = (V3::from(origin), V3::from(dir));
+    let mut walk = CellWalk::new((lo, hi), cells, 0.5, ray, (0.0, t_max));
     let mut tau = 0.0;
     let mut start = f32::NAN;
     while walk.more() {
@@ -168,29 +184,35 @@ pub fn optical_depth(grid: &DensityGrid, origin: Vec3, dir: Vec3, t_max: f32) ->
 
 /// A piece of a ray inside one cell of a [`CellWalk`]: parameters `t0` to `t1`, and the cell.
 #[derive(Clone, Copy, Debug)]
-pub struct CellPiece {
-    pub t0: f32,
-    pub t1: f32,
+pub struct CellPiece<R = f32> {
+    pub t0: R,
+    pub t1: R,
     pub cell: UVec3,
 }
 
 /// The walk of a ray `origin + t dir` (t from `t_min` to `t_max`, clipped to a box) through
 /// a regular grid of cells over the box, in order (Amanatides and Woo's 3D DDA): each
-/// [`CellWalk::next_piece`] is the next cell's piece.
+/// [`CellWalk::next_piece`] is the next cell's piece. Written over any scalar [`Real`], so
+/// that tests run it under a Vulkan device's arithmetic; the kernel's is `CellWalk<f32>`.
+///
+/// Invariants under any arithmetic (each step is an integer step of one cell along one axis,
+/// and the pieces' ends are clamped, not computed): the cells stay inside the grid, each
+/// piece starts where the last ended and does not end before it starts, and the walk ends
+/// after at most the sum of the cell counts of the three axes pieces.
 #[derive(Clone, Copy, Debug)]
-pub struct CellWalk {
+pub struct CellWalk<R = f32> {
     cell: IVec3,
     step: IVec3,
     cells: IVec3,
     /// The parameter at which the ray leaves the current cell across each axis's next plane.
-    t_next: Vec3,
+    t_next: V3<R>,
     /// The parameter the ray takes to cross one cell along each axis.
-    t_delta: Vec3,
-    t: f32,
-    t_end: f32,
+    t_delta: V3<R>,
+    t: R,
+    t_end: R,
 }
 
-impl CellWalk {
+impl<R: Real<Bits = u32>> CellWalk<R> {
     /// The walk of `origin + t dir` (`dir` need not be normalised: parameters are in its
     /// units) for t in [`t_min`, `t_max`] inside the box `lo` to `hi`, through `cells` cells
     /// per axis of size (hi - lo) / (cells - 2 `shift`), the box's min corner at cell
@@ -200,18 +222,20 @@ impl CellWalk {
         (lo, hi): (Vec3, Vec3),
         cells: UVec3,
         shift: f32,
-        (origin, dir): (Vec3, Vec3),
-        (t_min, t_max): (f32, f32),
+        (origin, dir): (V3<R>, V3<R>),
+        (t_min, t_max): (R, R),
     ) -> Self {
         let count = cells.as_ivec3();
+        let zero = R::splat(0.0);
         // The box's slabs, axis by axis (an axis the ray runs parallel to clips it only when
         // the origin lies outside that slab).
         let mut t0 = t_min;
         let mut t1 = t_max;
-        let clip = |o: f32, d: f32, a: f32, b: f32, t0: &mut f32, t1: &mut f32| {
-            if d == 0.0 {
-                if o < a || o > b {
-                    *t1 = -1.0;
+        let clip = |o: R, d: R, a: f32, b: f32, t0: &mut R, t1: &mut R| {
+            let (a, b) = (R::splat(a), R::splat(b));
+            if d.not_equal(zero) == 0 {
+                if (o.less_than(a) | o.greater_than(b)) != 0 {
+                    *t1 = R::splat(-1.0);
                 }
             } else {
                 let (ta, tb) = ((a - o) / d, (b - o) / d);
@@ -223,22 +247,30 @@ impl CellWalk {
         clip(origin.y, dir.y, lo.y, hi.y, &mut t0, &mut t1);
         clip(origin.z, dir.z, lo.z, hi.z, &mut t0, &mut t1);
         // Cell coordinates: (p - lo) * scale + shift, one unit per cell.
-        let scale = (cells.as_vec3() - Vec3::splat(2.0 * shift)) / (hi - lo);
-        let o = (origin - lo) * scale + Vec3::splat(shift);
+        let (lo, hi) = (V3::<R>::splat(lo), V3::<R>::splat(hi));
+        let size = hi - lo;
+        let shift2 = R::splat(2.0 * shift);
+        let scale = V3::new(
+            (R::splat(cells.x as f32) - shift2) / size.x,
+            (R::splat(cells.y as f32) - shift2) / size.y,
+            (R::splat(cells.z as f32) - shift2) / size.z,
+        );
+        let shift = R::splat(shift);
+        let o = (origin - lo) * scale + V3::new(shift, shift, shift);
         let d = dir * scale;
         let entry = o + d * t0;
-        let cell = entry
-            .floor()
-            .as_ivec3()
+        let floor = |x: R| x.floor().to_i32_bits() as i32;
+        let cell = IVec3::new(floor(entry.x), floor(entry.y), floor(entry.z))
             .max(IVec3::ZERO)
             .min(count - IVec3::ONE);
-        let axis = |o: f32, d: f32, c: i32| -> (i32, f32, f32) {
-            if d > 0.0 {
-                (1, ((c + 1) as f32 - o) / d, 1.0 / d)
-            } else if d < 0.0 {
-                (-1, (c as f32 - o) / d, -1.0 / d)
+        let one = R::splat(1.0);
+        let axis = |o: R, d: R, c: i32| -> (i32, R, R) {
+            if d.greater_than(zero) != 0 {
+                (1, (R::from_i32_bits((c + 1) as u32) - o) / d, one / d)
+            } else if d.less_than(zero) != 0 {
+                (-1, (R::from_i32_bits(c as u32) - o) / d, -one / d)
             } else {
-                (0, f32::MAX, f32::MAX)
+                (0, R::splat(f32::MAX), R::splat(f32::MAX))
             }
         };
         let (sx, nx, dx) = axis(o.x, d.x, cell.x);
@@ -248,8 +280,8 @@ impl CellWalk {
             cell,
             step: IVec3::new(sx, sy, sz),
             cells: count,
-            t_next: Vec3::new(nx, ny, nz),
-            t_delta: Vec3::new(dx, dy, dz),
+            t_next: V3::new(nx, ny, nz),
+            t_delta: V3::new(dx, dy, dz),
             t: t0,
             t_end: t1,
         }
@@ -258,16 +290,17 @@ impl CellWalk {
     /// Whether pieces are left.
     #[inline]
     pub fn more(&self) -> bool {
-        self.t < self.t_end
+        self.t.less_than(self.t_end) != 0
     }
 
     /// The next piece (call only while [`CellWalk::more`]); pieces follow each other (each
     /// starts where the last ended).
-    pub fn next_piece(&mut self) -> CellPiece {
+    pub fn next_piece(&mut self) -> CellPiece<R> {
         let t_next = self.t_next;
-        let (axis, t_exit) = if t_next.x <= t_next.y && t_next.x <= t_next.z {
+        let at_most = |a: R, b: R| a.at_most(b) != 0;
+        let (axis, t_exit) = if at_most(t_next.x, t_next.y) && at_most(t_next.x, t_next.z) {
             (0, t_next.x)
-        } else if t_next.y <= t_next.z {
+        } else if at_most(t_next.y, t_next.z) {
             (1, t_next.y)
         } else {
             (2, t_next.z)
@@ -281,15 +314,15 @@ impl CellWalk {
         self.t = t1;
         let (c, n) = if axis == 0 {
             self.cell.x += self.step.x;
-            self.t_next.x += self.t_delta.x;
+            self.t_next.x = self.t_next.x + self.t_delta.x;
             (self.cell.x, self.cells.x)
         } else if axis == 1 {
             self.cell.y += self.step.y;
-            self.t_next.y += self.t_delta.y;
+            self.t_next.y = self.t_next.y + self.t_delta.y;
             (self.cell.y, self.cells.y)
         } else {
             self.cell.z += self.step.z;
-            self.t_next.z += self.t_delta.z;
+            self.t_next.z = self.t_next.z + self.t_delta.z;
             (self.cell.z, self.cells.z)
         };
         if c < 0 || c >= n {
@@ -320,7 +353,7 @@ impl MajorantWalk {
     /// cells.
     pub fn new(grid: &DensityGrid, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
         let cells = grid.majorant_resolution();
-        let ray = (origin, dir);
+        let ray = (V3::from(origin), V3::from(dir));
         Self {
             walk: CellWalk::new(grid.bounds(), cells, 0.0, ray, (t_min, t_max)),
         }

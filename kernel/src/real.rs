@@ -53,6 +53,15 @@ pub trait Real:
     /// The `i32` whose bits are `bits`, `as f32` (rounded to nearest).
     fn from_i32_bits(bits: Self::Bits) -> Self;
 
+    /// The largest integer not above each lane, for |x| < 2^31: written on the conversions to
+    /// and from `i32` (toward zero, then one less where that rounded up), which are exact under
+    /// any arithmetic for such values, as Vulkan's `floor` is. `f32` uses its own `floor`.
+    #[inline]
+    fn floor(self) -> Self {
+        let t = Self::from_i32_bits(self.to_i32_bits());
+        Self::select(t.greater_than(self), t - Self::splat(1.0), t)
+    }
+
     // Operations written on the bits, which a type that has none (a test's interval type)
     // provides otherwise.
 
@@ -190,6 +199,18 @@ impl Real for f32 {
         #[cfg(not(target_arch = "spirv"))]
         {
             f32::sqrt(self)
+        }
+    }
+
+    #[inline]
+    fn floor(self) -> Self {
+        #[cfg(target_arch = "spirv")]
+        {
+            <f32 as crate::Float>::floor(self)
+        }
+        #[cfg(not(target_arch = "spirv"))]
+        {
+            f32::floor(self)
         }
     }
 

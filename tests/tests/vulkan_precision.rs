@@ -10,7 +10,7 @@
 //! domains, all within the bounds derived for Vulkan; and [`Vk32`] itself returns only what a
 //! conformant device may, and does take its liberties (else the rest would prove nothing).
 //! The files under `vulkan_precision/`: the samplers (`samplers.rs`), the media's flights
-//! (`free_flights.rs`), spherical triangles, normal-map frames, the bounds derived by ball
+//! (`free_flights.rs`), density grids' walks and majorants (`grid_walks.rs`), spherical triangles, normal-map frames, the bounds derived by ball
 //! arithmetic checked against `Vk32` (`ball_bounds.rs`), and the equivalence per device class
 //! (`device_class.rs`).
 
@@ -37,6 +37,8 @@ mod ball_bounds;
 mod device_class;
 #[path = "vulkan_precision/free_flights.rs"]
 mod free_flights;
+#[path = "vulkan_precision/grid_walks.rs"]
+mod grid_walks;
 #[path = "vulkan_precision/normal_map_frames.rs"]
 mod normal_map_frames;
 #[path = "vulkan_precision/samplers.rs"]
