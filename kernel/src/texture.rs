@@ -23,6 +23,7 @@
 
 use crate::bsdf;
 use crate::features::{Dynamic, FeatureSet};
+use crate::real::{Real, V3};
 use crate::scene::{texture_slot, Material, NONE};
 #[cfg(target_arch = "spirv")]
 use crate::Float;
@@ -98,13 +99,13 @@ impl TexCoords {
 /// `x1` (x1 is x0's right neighbour, wrapped or clamped), rows `y0`, `y1` (y1 below y0), and the
 /// weights `fx`, `fy` of x1 and y1.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Footprint {
+pub struct Footprint<R = f32> {
     pub x0: u32,
     pub x1: u32,
     pub y0: u32,
     pub y1: u32,
-    pub fx: f32,
-    pub fy: f32,
+    pub fx: R,
+    pub fy: R,
 }
 
 /// The bilinear footprint of texture coordinates `uv` on a `width` x `height` image, u wrapping
@@ -118,10 +119,31 @@ pub struct Footprint {
 /// against that definition in f64).
 #[inline]
 pub fn footprint(uv: Vec2, width: u32, height: u32, wrap_u: u32, wrap_v: u32) -> Footprint {
-    let (u, v) = (unit_coordinate(uv.x, wrap_u), unit_coordinate(uv.y, wrap_v));
-    let (x0, x1, fx) = axis(u * width as f32 - 0.5, width, wrap_u != wrap::REPEAT);
+    footprint_of(uv.x, uv.y, width, height, wrap_u, wrap_v)
+}
+
+/// [`footprint`] over any scalar [`Real`] (the `f32` instance is it, operation for operation),
+/// so that tests run it under a Vulkan device's arithmetic. The indices are in range under any
+/// arithmetic: the unit coordinate is clamped or reduced into [0, 1] and [`axis`] wraps or
+/// clamps the indices it gets from it.
+#[inline]
+pub fn footprint_of<R: Real<Bits = u32>>(
+    u: R,
+    v: R,
+    width: u32,
+    height: u32,
+    wrap_u: u32,
+    wrap_v: u32,
+) -> Footprint<R> {
+    let (u, v) = (unit_coordinate_of(u, wrap_u), unit_coordinate_of(v, wrap_v));
+    let half = R::splat(0.5);
+    let (x0, x1, fx) = axis(
+        u * R::splat(width as f32) - half,
+        width,
+        wrap_u != wrap::REPEAT,
+    );
     let (y0, y1, fy) = axis(
-        (1.0 - v) * height as f32 - 0.5,
+        (R::splat(1.0) - v) * R::splat(height as f32) - half,
         height,
         wrap_v != wrap::REPEAT,
     );
@@ -140,17 +162,24 @@ pub fn footprint(uv: Vec2, width: u32, height: u32, wrap_u: u32, wrap_v: u32) ->
 /// non-finite `t`.
 #[inline]
 pub fn unit_coordinate(t: f32, mode: u32) -> f32 {
-    if !t.is_finite() {
-        return 0.0;
+    unit_coordinate_of(t, mode)
+}
+
+/// [`unit_coordinate`] over any scalar [`Real`].
+#[inline]
+pub fn unit_coordinate_of<R: Real<Bits = u32>>(t: R, mode: u32) -> R {
+    let (zero, one, two) = (R::splat(0.0), R::splat(1.0), R::splat(2.0));
+    if t.finite() == 0 {
+        return zero;
     }
     if mode == wrap::REPEAT {
         t - t.floor()
     } else if mode == wrap::CLAMP {
-        t.clamp(0.0, 1.0)
+        t.clamp(zero, one)
     } else {
-        let r = t - 2.0 * (0.5 * t).floor();
-        if r > 1.0 {
-            2.0 - r
+        let r = t - two * (R::splat(0.5) * t).floor();
+        if r.greater_than(one) != 0 {
+            two - r
         } else {
             r
         }
@@ -161,11 +190,11 @@ pub fn unit_coordinate(t: f32, mode: u32) -> f32 {
 /// texels whose centres enclose it and the second one's weight. Repeating, texel -1 is n - 1
 /// and texel n is 0; clamping, both are the edge texel.
 #[inline]
-fn axis(x: f32, n: u32, clamp: bool) -> (u32, u32, f32) {
+fn axis<R: Real<Bits = u32>>(x: R, n: u32, clamp: bool) -> (u32, u32, R) {
     let floor = x.floor();
     let f = x - floor;
     let last = n as i32 - 1;
-    let i0 = floor as i32;
+    let i0 = floor.to_i32_bits() as i32;
     let i1 = i0 + 1;
     if clamp {
         (clamp_index(i0, last), clamp_index(i1, last), f)
@@ -202,9 +231,17 @@ fn wrap_index(i: i32, last: i32) -> u32 {
 /// (x1, y1) at weights (fx, fy).
 #[inline]
 pub fn bilerp(c00: Vec3, c10: Vec3, c01: Vec3, c11: Vec3, fx: f32, fy: f32) -> Vec3 {
-    let top = c00 * (1.0 - fx) + c10 * fx;
-    let bottom = c01 * (1.0 - fx) + c11 * fx;
-    top * (1.0 - fy) + bottom * fy
+    let c = |c: Vec3| V3::from(c);
+    bilerp_of(c(c00), c(c10), c(c01), c(c11), fx, fy).into()
+}
+
+/// [`bilerp`] over any scalar [`Real`].
+#[inline]
+pub fn bilerp_of<R: Real>(c00: V3<R>, c10: V3<R>, c01: V3<R>, c11: V3<R>, fx: R, fy: R) -> V3<R> {
+    let one = R::splat(1.0);
+    let top = c00 * (one - fx) + c10 * fx;
+    let bottom = c01 * (one - fx) + c11 * fx;
+    top * (one - fy) + bottom * fy
 }
 
 /// The value of texel (x, y) of texture `record` (its first word `offset`, its `width` and
@@ -316,7 +353,7 @@ pub fn ggx_albedo(table: &[u32], roughness: f32, mu: f32) -> Vec3 {
     if record == NONE {
         return Vec3::ONE;
     }
-    at_nodes(table, record, roughness, mu.sqrt())
+    at_nodes(table, record, roughness, Real::sqrt(mu))
 }
 
 /// The sheen's linearly transformed cosine (A, B, R) at sheen roughness `roughness` and view

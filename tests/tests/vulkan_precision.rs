@@ -10,9 +10,10 @@
 //! domains, all within the bounds derived for Vulkan; and [`Vk32`] itself returns only what a
 //! conformant device may, and does take its liberties (else the rest would prove nothing).
 //! The files under `vulkan_precision/`: the samplers (`samplers.rs`), the media's flights
-//! (`free_flights.rs`), density grids' walks and majorants (`grid_walks.rs`), spherical triangles, normal-map frames, the bounds derived by ball
-//! arithmetic checked against `Vk32` (`ball_bounds.rs`), and the equivalence per device class
-//! (`device_class.rs`).
+//! (`free_flights.rs`), density grids' walks and majorants (`grid_walks.rs`), texture
+//! footprints and blends (`textures.rs`), spherical triangles, normal-map frames, the bounds
+//! derived by ball arithmetic checked against `Vk32` (`ball_bounds.rs`), and the equivalence
+//! per device class (`device_class.rs`).
 
 use glam::Vec3;
 use kernel::frame::orthonormal_basis_v3;
@@ -45,6 +46,8 @@ mod normal_map_frames;
 mod samplers;
 #[path = "vulkan_precision/spherical_triangles.rs"]
 mod spherical_triangles;
+#[path = "vulkan_precision/textures.rs"]
+mod textures;
 
 type V = V3<Vk32>;
 
