@@ -7,8 +7,8 @@ use crate::backend::{open, RayCounts};
 use crate::film::Film;
 use crate::sample_range::SampleRange;
 use crate::scene::Scene;
-use crate::settings::RenderSettings;
-use crate::split_pilot::split_table;
+use crate::settings::{RenderSettings, Split};
+use crate::split_pilot::{pilot_spp, split_table};
 use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -78,11 +78,41 @@ pub fn install_interrupt_handler() {
 }
 
 /// Renders `scene` with `settings`: `settings.spp` samples per pixel, or the range
-/// `opts.samples` of them.
+/// `opts.samples` of them, with a progress bar on stderr where `opts.progress`.
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
     opts: &RenderOptions,
+) -> Result<RenderOutput> {
+    let progress = opts
+        .progress
+        .then(|| progress_bar(samples_to_count(scene, settings, opts)));
+    let out = render_counting(scene, settings, opts, progress.as_ref());
+    if let Some(p) = progress {
+        p.finish_and_clear();
+    }
+    out
+}
+
+/// The samples a render counts on its progress bar: the pixels times the samples per pixel
+/// asked for, and the split table's pilot samples where `split = auto`
+/// (`split_pilot::pilot_spp`), which the render renders first.
+pub fn samples_to_count(scene: &Scene, settings: &RenderSettings, opts: &RenderOptions) -> u64 {
+    let spp = opts.samples.unwrap_or(SampleRange::all(settings.spp)).len();
+    let pilot = match settings.split {
+        Split::Auto => pilot_spp(settings.spp),
+        Split::Off | Split::Fixed(_) => 0,
+    };
+    scene.pixel_count() as u64 * (spp + pilot) as u64
+}
+
+/// [`render`], counting each sample on `progress` as it finishes, the pilot's included (the bar
+/// ends at [`samples_to_count`] unless Ctrl-C stops the render).
+pub fn render_counting(
+    scene: &Scene,
+    settings: &RenderSettings,
+    opts: &RenderOptions,
+    progress: Option<&ProgressBar>,
 ) -> Result<RenderOutput> {
     if let (Some(range), true) = (opts.samples, settings.adaptive()) {
         bail!(
@@ -95,12 +125,9 @@ pub fn render(
     let (mut backend, kind) = open(opts.backend, scene, settings, opts.device, opts.validation)?;
     let setup = t0.elapsed();
     let spp = range.len();
-    let progress = opts
-        .progress
-        .then(|| progress_bar(scene.pixel_count() as u64 * spp as u64));
     let t1 = Instant::now();
     // The split table's pilot, if any, is part of the render's time.
-    if let Some(table) = split_table(backend.as_mut(), scene, settings)? {
+    if let Some(table) = split_table(backend.as_mut(), scene, settings, progress)? {
         backend.set_splits(&table)?;
     }
     let mut spp_done = 0;
@@ -108,14 +135,11 @@ pub fn render(
         let count = backend.next_pass(spp_done, spp);
         let first = range.start + spp_done;
         let params = scene.params(settings, first, count);
-        backend.add_samples(&params, first, count, progress.as_ref())?;
+        backend.add_samples(&params, first, count, progress)?;
         spp_done += count;
     }
     let film = backend.read_film()?;
     let render = t1.elapsed();
-    if let Some(p) = progress {
-        p.finish_and_clear();
-    }
     let (accel_build, pipeline) = backend.setup_times();
     Ok(RenderOutput {
         film,

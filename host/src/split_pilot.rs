@@ -31,6 +31,7 @@ use crate::film::Film;
 use crate::scene::{Scene, SPLIT_TILE};
 use crate::settings::{RenderSettings, Sampler, Split};
 use anyhow::Result;
+use indicatif::ProgressBar;
 use kernel::scene::split_mode;
 use kernel::split::MAX_CONTINUATIONS;
 
@@ -56,12 +57,13 @@ pub fn tile_grid(width: u32, height: u32) -> (u32, u32) {
 }
 
 /// The split table `settings.split` asks for, `None` where paths do not split: N everywhere for
-/// `split = N`, the pilot's choice (rendered on `backend`, whose film it leaves empty) for
-/// `auto`.
+/// `split = N`, the pilot's choice (rendered on `backend`, whose film it leaves empty, its
+/// samples counted on `progress`) for `auto`.
 pub fn split_table(
     backend: &mut dyn SampleBackend,
     scene: &Scene,
     settings: &RenderSettings,
+    progress: Option<&ProgressBar>,
 ) -> Result<Option<Vec<u32>>> {
     let (columns, rows) = tile_grid(scene.camera.width, scene.camera.height);
     let tiles = (columns * rows) as usize;
@@ -69,7 +71,7 @@ pub fn split_table(
         Split::Off => Ok(None),
         Split::Fixed(n) => Ok(Some(vec![n; tiles])),
         Split::Auto => {
-            let film = pilot_film(backend, scene, settings)?;
+            let film = pilot_film(backend, scene, settings, progress)?;
             backend.clear_film()?;
             let stats = tile_statistics(&film, columns, rows);
             Ok(Some(choose(&stats)))
@@ -82,6 +84,7 @@ fn pilot_film(
     backend: &mut dyn SampleBackend,
     scene: &Scene,
     settings: &RenderSettings,
+    progress: Option<&ProgressBar>,
 ) -> Result<Film> {
     let pilot = RenderSettings {
         seed: settings.seed ^ PILOT_SEED,
@@ -95,7 +98,7 @@ fn pilot_film(
         let count = backend.next_pass(done, spp);
         let mut params = scene.params(&pilot, done, count);
         params.split.mode = split_mode::PILOT;
-        backend.add_samples(&params, done, count, None)?;
+        backend.add_samples(&params, done, count, progress)?;
         done += count;
     }
     backend.read_film()

@@ -265,3 +265,38 @@ fn the_split_table_never_scores_worse_than_one_n_everywhere() {
         }
     }
 }
+
+/// The progress bar counts every sample a render renders, the pilot of `split = auto`
+/// included, and ends at its length (`render::samples_to_count`): on both backends, with and
+/// without the pilot, for a whole render and for a part.
+#[test]
+fn the_progress_bar_counts_the_pilot_and_ends_full() {
+    use twinpath::render::{render_counting, samples_to_count, RenderOptions};
+    use twinpath::sample_range::SampleRange;
+    for backend in [Backend::Cpu, Backend::Gpu] {
+        for split in [Split::Off, Split::Fixed(2), Split::Auto] {
+            for samples in [None, Some(SampleRange { start: 8, end: 24 })] {
+                let mut s = with_split(&small("cornell.toml", 24), split);
+                s.settings.spp = 64;
+                let opts = RenderOptions {
+                    backend,
+                    samples,
+                    ..RenderOptions::default()
+                };
+                let total = samples_to_count(&s.scene, &s.settings, &opts);
+                let bar = indicatif::ProgressBar::hidden();
+                bar.set_length(total);
+                let out = render_counting(&s.scene, &s.settings, &opts, Some(&bar)).unwrap();
+                assert!(!out.interrupted);
+                let pilot = if split == Split::Auto { 2 } else { 0 };
+                let spp = samples.map_or(64, |r| r.len());
+                assert_eq!(
+                    total,
+                    24 * 24 * (spp + pilot) as u64,
+                    "{backend:?} {split:?}"
+                );
+                assert_eq!(bar.position(), total, "{backend:?} {split:?} {samples:?}");
+            }
+        }
+    }
+}
