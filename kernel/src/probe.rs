@@ -85,9 +85,11 @@ pub mod function {
     /// out0 = light::triangle::sample's (position, pdf) for [`probe_triangle_light`],
     /// out1 = (its normal, spherical_triangle::solid_angle(x, vertices))
     pub const TRIANGLE_LIGHT: u32 = 15;
-    /// uv = in0.xy, (width, height) = in0.zw as u32, wrap modes (u, v) = in1.xy as u32, four
-    /// RGBA8 texels (x0 y0, x1 y0, x0 y1, x1 y1) = in2 as u32, read as byte / 256 -> out0 =
-    /// texture::footprint's (x0, x1, y0, y1) as u32, out1 = (texture::bilerp of the texels, fx)
+    /// uv = in0.xy, (width, height) = in0.zw as u32, wrap modes (u, v) = in1.xy as u32, an
+    /// image keyed by in2.xy as u32 (texel (x, y) the RGBA8 word pcg4d(key x, x, y, key y),
+    /// read as byte / 256: a value per texel, so that a device taking the neighbouring pair of
+    /// texels at a boundary blends the same image) -> out0 = texture::footprint's (x0, x1, y0,
+    /// y1) as u32, out1 = (texture::bilerp of the four texels, fx)
     pub const TEXTURE: u32 = 16;
     /// base normal = in0.xyz, scale = in0.w, tangent (at all three vertices) = in1.xyz,
     /// sign = in1.w, texel = in2.xyz, barycentrics = (in2.w, in3.x) -> out0.xyz =
@@ -305,10 +307,12 @@ fn probe_light(kind: u32, position: Vec3, edge1: Vec3, edge2: Vec3) -> Light {
     }
 }
 
-/// An RGBA8 word's red, green and blue as byte / 256 (exact in f32), the texture probe's
-/// stand-in for the decoding tables.
+/// Texel (x, y) of the texture probe's image keyed by (`a`, `b`): the word pcg4d(a, x, y, b)'s
+/// red, green and blue as byte / 256 (exact in f32), the probe's stand-in for a texture and
+/// its decoding tables.
 #[inline]
-fn probe_texel(word: u32) -> Vec3 {
+pub fn probe_image(a: u32, b: u32, x: u32, y: u32) -> Vec3 {
+    let word = crate::hash::pcg4d([a, x, y, b])[0];
     let c = |shift: u32| ((word >> shift) & 0xff) as f32 * (1.0 / 256.0);
     Vec3::new(c(0), c(8), c(16))
 }
@@ -514,12 +518,12 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
     } else if function == function::TEXTURE {
         let i = input[0];
         let fp = footprint(Vec2::new(i0.x, i0.y), i.z, i.w, input[1].x, input[1].y);
-        let t = input[2];
+        let key = input[2];
         let c = bilerp(
-            probe_texel(t.x),
-            probe_texel(t.y),
-            probe_texel(t.z),
-            probe_texel(t.w),
+            probe_image(key.x, key.y, fp.x0, fp.y0),
+            probe_image(key.x, key.y, fp.x1, fp.y0),
+            probe_image(key.x, key.y, fp.x0, fp.y1),
+            probe_image(key.x, key.y, fp.x1, fp.y1),
             fp.fx,
             fp.fy,
         );

@@ -526,11 +526,11 @@ pub fn phase_density_apart(g: f32, wo: [f32; 3], wi: [f32; 3]) -> f64 {
 /// `width` x `height` image, wrap modes, texel values in [0, 1]): per output, (x0, x1, y0, y1,
 /// the blend's three channels, fx), infinite for an axis's indices and fx where the texel
 /// coordinate lies within both computations' rounding of a texel centre boundary (there the
-/// floor may differ, and fx with it by 1: in a texture the same blend by another pair of
-/// texels, but the probe gives its four texel values per slot, so there the blend is of other
-/// values and is unchecked too; found by `vulkan_precision.rs`' `textures`, where a device's
-/// v = 0.10486576 on 596 rows took rows 532 and 533 at weight 0.99994 against the CPU's 533
-/// and 534 at 0).
+/// floor may differ, and fx with it by 1: the same blend, by another pair of texels, since the
+/// probe's image has a value per texel, `kernel::probe::probe_image`; when it gave its four
+/// values per slot of the footprint, `vulkan_precision.rs`' `textures` found a device's
+/// v = 0.10486576 on 596 rows taking rows 532 and 533 at weight 0.99994 against the CPU's 533
+/// and 534 at 0, and so blending other values).
 ///
 /// Along an axis of n texels: the wrapped coordinate (a difference and a fold) is off by at
 /// most two roundings, 2 u; x = u' n - 1/2 (or (1 - v') n - 1/2) adds n times that, the product's
@@ -554,14 +554,7 @@ pub fn texture_apart(uv: [f32; 2], width: u32, height: u32, wrap_u: u32, wrap_v:
     let (dx, x_boundary) = axis(uv[0], width, wrap_u, false);
     let (dy, y_boundary) = axis(uv[1], height, wrap_v, true);
     let index = |boundary: bool| if boundary { f64::INFINITY } else { 0.0 };
-    // The probe's four texel values are given per slot of the footprint, not per texel, so
-    // where a device may take the other pair of texels on an axis its blend is of other
-    // values: unchecked there.
-    let blend = if x_boundary || y_boundary {
-        f64::INFINITY
-    } else {
-        9.0 * APART_U + 2.0 * (dx + dy)
-    };
+    let blend = 9.0 * APART_U + 2.0 * (dx + dy);
     [
         index(x_boundary),
         index(x_boundary),

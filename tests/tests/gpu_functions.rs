@@ -866,7 +866,7 @@ fn vulkan_class(b: &Bound) -> Option<Bound> {
         }),
         function::TEXTURE => Some(Bound {
             vulkan: true,
-            why: "Vulkan class: the wrapped coordinate (two roundings), x = u n - 1/2 and fx = x - floor(x): u (4 n + 1/2) per computation; the blend Lipschitz in x and y (2 max|c|) with 9 u max|c| of its own roundings; an axis's indices, fx and the blend unchecked where x is within that of a texel boundary (a device may take the next pair, and the probe gives its texel values per slot, not per texel), per record (`texture_apart`)",
+            why: "Vulkan class: the wrapped coordinate (two roundings), x = u n - 1/2 and fx = x - floor(x): u (4 n + 1/2) per computation; the blend Lipschitz in x and y (2 max|c|) with 9 u max|c| of its own roundings; an axis's indices and fx unchecked where x is within that of a texel boundary (the same blend by the next pair: the probe's image has a value per texel), per record (`texture_apart`)",
             ..*b
         }),
         function::SAMPLE_SPHERE_CONE => Some(Bound {

@@ -2,23 +2,18 @@
 //! coordinate, the texel pair and the weight along each axis: `kernel::texture::footprint_of`)
 //! and the blend (`bilerp_of`), run on [`Vk32`] as the GPU probe computes them, held to the
 //! bound `gpu_functions.rs` holds a Vulkan-class device to (`device_class::texture_apart`,
-//! derived by hand in its documentation): the texel indices equal unless the texel coordinate
-//! lies within the two computations' rounding of a texel boundary, fx and the blend within
-//! u (4 n + 1/2) and 9 u + 2 (dx + dy).
+//! derived by hand in its documentation): the texel indices and fx equal, and within u (4 n +
+//! 1/2), unless the texel coordinate lies within the two computations' rounding of a texel
+//! boundary; the blend of the probe's image (`kernel::probe::probe_image`, a value per texel)
+//! within 9 u + 2 (dx + dy) everywhere, boundaries included (the blend is continuous there).
 
 use super::{f, use_model};
-use glam::Vec3;
+use kernel::probe::probe_image;
 use kernel::real::V3;
 use kernel::texture::{bilerp, bilerp_of, footprint, footprint_of, wrap};
 use twinpath_tests::device_class::texture_apart;
 use twinpath_tests::vulkan_arithmetic::{seed, Vk32};
 use twinpath_tests::SplitMix;
-
-/// A texel word's red, green and blue as byte / 256, as `kernel::probe` reads them.
-fn texel(word: u32) -> Vec3 {
-    let c = |shift: u32| ((word >> shift) & 0xff) as f32 / 256.0;
-    Vec3::new(c(0), c(8), c(16))
-}
 
 /// A texture coordinate: uniform over three periods (a third of them), near a texel centre
 /// boundary of an image `n` texels wide (within a few ULP, a third), or far out (10^3, the
@@ -55,16 +50,21 @@ fn texture_footprints_and_blends_stay_within_their_vulkan_bound() {
         let (width, height) = (size(&mut g), size(&mut g));
         let (wrap_u, wrap_v) = (modes[(g.u64() % 3) as usize], modes[(g.u64() % 3) as usize]);
         let (u, v) = (coordinate(&mut g, width), coordinate(&mut g, height));
-        let words = [0; 4].map(|_| g.u64() as u32);
-        let c = words.map(texel);
+        let key = [g.u64() as u32, g.u64() as u32];
+        let image = |x: u32, y: u32| probe_image(key[0], key[1], x, y);
         // The CPU: the kernel's f32 functions, as `kernel::probe` calls them.
         let cpu = footprint(glam::Vec2::new(u, v), width, height, wrap_u, wrap_v);
+        let corners = |x0: u32, x1: u32, y0: u32, y1: u32| {
+            [image(x0, y0), image(x1, y0), image(x0, y1), image(x1, y1)]
+        };
+        let c = corners(cpu.x0, cpu.x1, cpu.y0, cpu.y1);
         let cpu_blend = bilerp(c[0], c[1], c[2], c[3], cpu.fx, cpu.fy);
         let bound = texture_apart([u, v], width, height, wrap_u, wrap_v);
         for model in 1..4 {
             use_model(model);
             seed((case * 4 + model) as u64);
             let device = footprint_of(f(u), f(v), width, height, wrap_u, wrap_v);
+            let c = corners(device.x0, device.x1, device.y0, device.y1);
             let cv = c.map(|c| V3::<Vk32>::new(f(c.x), f(c.y), f(c.z)));
             let blend = bilerp_of(cv[0], cv[1], cv[2], cv[3], device.fx, device.fy);
             let device_indices = [device.x0, device.x1, device.y0, device.y1];
@@ -106,14 +106,14 @@ fn texture_footprints_and_blends_stay_within_their_vulkan_bound() {
         worst[0], worst[1]
     );
     // The models must take their liberties (the bound of an IEEE device, bit for bit, fails
-    // on every output counted here), and most outputs must be checked: the coordinates near a
-    // texel boundary are a third of the cases.
+    // on every output counted here), and most outputs must be checked: only fx goes unchecked,
+    // at a boundary, and the coordinates near one are a third of the cases.
     assert!(
         apart > checked / 100,
         "only {apart} of {checked} outputs differ"
     );
     assert!(
-        unchecked < checked / 2,
+        unchecked < checked / 8,
         "{unchecked} unchecked against {checked}"
     );
 }
