@@ -284,6 +284,7 @@ impl Bvh {
                     bits &= bits - 1;
                     stack[sp].write(node.child[lane]);
                     sp += 1;
+                    self.prefetch(node.child[lane]);
                 }
             } else {
                 let (blocks, spheres) = self.leaf_contents(current);
