@@ -39,6 +39,13 @@ impl Default for RenderOptions {
     }
 }
 
+impl RenderOptions {
+    /// The sample indices to render with `settings`: `samples`, or all of `0..settings.spp`.
+    pub fn sample_range(&self, settings: &RenderSettings) -> SampleRange {
+        self.samples.unwrap_or(SampleRange::all(settings.spp))
+    }
+}
+
 /// What a render produced and what it cost.
 pub struct RenderOutput {
     pub film: Film,
@@ -98,7 +105,7 @@ pub fn render(
 /// asked for, and the split table's pilot samples where `split = auto`
 /// (`split_pilot::pilot_spp`), which the render renders first.
 pub fn samples_to_count(scene: &Scene, settings: &RenderSettings, opts: &RenderOptions) -> u64 {
-    let spp = opts.samples.unwrap_or(SampleRange::all(settings.spp)).len();
+    let spp = opts.sample_range(settings).len();
     let pilot = match settings.split {
         Split::Auto => pilot_spp(settings.spp),
         Split::Off | Split::Fixed(_) => 0,
@@ -120,7 +127,7 @@ pub fn render_counting(
              which samples a pixel takes depends on all its earlier ones (docs/parts.md)"
         );
     }
-    let range = opts.samples.unwrap_or(SampleRange::all(settings.spp));
+    let range = opts.sample_range(settings);
     let t0 = Instant::now();
     let (mut backend, kind) = open(opts.backend, scene, settings, opts.device, opts.validation)?;
     let setup = t0.elapsed();

@@ -35,10 +35,9 @@ type Lanes = Simd<f32, LANES>;
 type Ids = Simd<u32, LANES>;
 type LaneMask = Mask<i32, LANES>;
 
-/// Subtrees wanted by at most this many lanes are traced one ray at a time (closest hits).
-pub(super) const ONE_AT_A_TIME_LANES: u32 = 4;
-/// The same for shadow segments' any-hit descent (`bvh_packet_shadows.rs`).
-pub(super) const ONE_AT_A_TIME_SHADOW_LANES: u32 = 5;
+/// Subtrees wanted by at most this many lanes are traced one ray at a time (closest hits;
+/// `bvh_packet_shadows.rs` has its own threshold for shadow segments).
+const ONE_AT_A_TIME_LANES: u32 = 4;
 
 /// The packet's rays as the slab test reads them: 1 / dir by lane, and per axis whether some
 /// active lane's ray is parallel to it (1 / dir infinite, where 0 x inf can arise).

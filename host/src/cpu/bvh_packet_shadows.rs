@@ -5,7 +5,7 @@
 //! [`Bvh::any_hit`]'s (or [`Bvh::any_hit_through`]'s, where materials have holes).
 
 use super::bvh::{Bvh, HoleTables, Solid, LEAF, STACK};
-use super::bvh_packet::{column, rays_to_object, SlabRays, ONE_AT_A_TIME_SHADOW_LANES};
+use super::bvh_packet::{column, rays_to_object, SlabRays};
 use super::packet::{RayPacket, LANES};
 use super::packet_presence::{LaneHoles, LanePresence};
 use super::simd::{sphere_lanes, triangle_lanes, widest_simd};
@@ -16,6 +16,10 @@ use std::simd::{Mask, Simd};
 
 type Lanes = Simd<f32, LANES>;
 type LaneMask = Mask<i32, LANES>;
+
+/// Subtrees wanted by at most this many lanes are traced one ray at a time (closest hits use
+/// `bvh_packet.rs`' own threshold; both measured in docs/performance.md).
+const ONE_AT_A_TIME_SHADOW_LANES: u32 = 5;
 
 impl Bvh {
     /// Whether each lane's ray meets anything within (0, t_max) (lanes with t_max 0 have no
