@@ -11,7 +11,8 @@
 //! conformant device may, and does take its liberties (else the rest would prove nothing).
 //! The files under `vulkan_precision/`: the samplers (`samplers.rs`), the media's flights
 //! (`free_flights.rs`), density grids' walks and majorants (`grid_walks.rs`), texture
-//! footprints and blends (`textures.rs`), spherical triangles, normal-map frames, the bounds
+//! footprints and blends (`textures.rs`), environment maps' tables under flushed denormals
+//! (`environment_tables.rs`), spherical triangles, normal-map frames, the bounds
 //! derived by ball arithmetic checked against `Vk32` (`ball_bounds.rs`), and the equivalence
 //! per device class (`device_class.rs`).
 
@@ -36,6 +37,8 @@ use twinpath_tests::SplitMix;
 mod ball_bounds;
 #[path = "vulkan_precision/device_class.rs"]
 mod device_class;
+#[path = "vulkan_precision/environment_tables.rs"]
+mod environment_tables;
 #[path = "vulkan_precision/free_flights.rs"]
 mod free_flights;
 #[path = "vulkan_precision/grid_walks.rs"]

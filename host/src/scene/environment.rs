@@ -149,7 +149,24 @@ impl EnvironmentMap {
     }
 }
 
-/// The CDF of `weights`: n + 1 numbers from exactly 0 to exactly 1 (uniform if they sum to 0).
+/// The smallest non-zero entry of a stored CDF: entries below it are stored as 0.
+///
+/// Why: a device may flush denormals to zero (Vulkan without float controls), so the sampler
+/// and its density must never meet one. With every entry 0 or at least 2^-32, a bin's
+/// probability (a difference of two entries) is 0 or at least 2^-55, a texel's (row times
+/// column) 0 or at least 2^-110, and its density (times the texel count, over 2 pi^2 sin
+/// theta) at least 2^-115: every value the kernel's `environment::sample` and `pdf` compute is
+/// 0 or normal, so a flushing device computes what an IEEE one does (`docs/robustness.md`,
+/// "Environment-map tables"). Only a CDF's first bins can fall below it (a CDF rises): their
+/// probability goes to the first bin whose upper entry reaches 2^-32, they get 0, the sampler
+/// never chooses them and `pdf` reads 0 there, which leaves their light to the BSDF strategy
+/// under MIS (unbiased, as for any texel of zero probability). A table changes only where a
+/// CDF's first non-zero entry lies below 2^-32: a row whose first lit texels hold less than
+/// 2^-32 of its weight, or a map whose first lit rows hold less than 2^-32 of its own.
+pub const CDF_FLOOR: f64 = 1.0 / 4_294_967_296.0;
+
+/// The CDF of `weights`: n + 1 numbers from exactly 0 to exactly 1 (uniform if they sum to 0),
+/// each 0 or at least [`CDF_FLOOR`].
 fn cdf(weights: &[f64]) -> Vec<f32> {
     let n = weights.len();
     let total: f64 = weights.iter().sum();
@@ -161,6 +178,8 @@ fn cdf(weights: &[f64]) -> Vec<f32> {
         let value = running / if total > 0.0 { total } else { n as f64 };
         out.push(if k + 1 == n {
             1.0
+        } else if value < CDF_FLOOR {
+            0.0
         } else {
             value.min(1.0) as f32
         });
