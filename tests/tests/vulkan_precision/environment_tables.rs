@@ -59,6 +59,15 @@ fn params_of(map: &EnvironmentMap) -> RenderParams {
     scene.params(0, 1)
 }
 
+/// `map`'s shape as the sampler sees it, its rotation's (cos, sin) read by `real`.
+fn shape_of<R>(map: &EnvironmentMap, params: &RenderParams, real: fn(f32) -> R) -> MapShape<R> {
+    MapShape {
+        rotation: params.environment.rotation.map(real),
+        width: map.width,
+        height: map.height,
+    }
+}
+
 /// A grey map (luminance = the value) of `w` x `h` texels of `texel(i, j)`.
 fn grey_map(w: u32, h: u32, rotation: f32, texel: impl Fn(u32, u32) -> f32) -> EnvironmentMap {
     let mut m = EnvironmentMap::constant(w, h, [0.0; 3]);
@@ -167,11 +176,7 @@ fn a_device_that_flushes_denormals_samples_environment_maps_as_ieee_does() {
         let params = params_of(&map);
         let table = map.table();
         let all = cdfs(&map, &table);
-        let shape = MapShape {
-            rotation: params.environment.rotation.map(f),
-            width: map.width,
-            height: map.height,
-        };
+        let shape = shape_of(&map, &params, f);
         let mut g = SplitMix(11);
         let mut flushed_reads = 0u32;
         let draws = 200_000;
@@ -242,11 +247,7 @@ fn a_device_that_flushes_denormals_gives_every_texel_the_ieee_density() {
     for (name, map) in hostile_maps() {
         let params = params_of(&map);
         let table = map.table();
-        let shape = MapShape {
-            rotation: params.environment.rotation,
-            width: map.width,
-            height: map.height,
-        };
+        let shape = shape_of(&map, &params, |x| x);
         let (mut floored, mut least) = (0, f32::INFINITY);
         for j in 0..map.height {
             for i in 0..map.width {
