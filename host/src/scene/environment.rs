@@ -163,7 +163,7 @@ impl EnvironmentMap {
 /// under MIS (unbiased, as for any texel of zero probability). A table changes only where a
 /// CDF's first non-zero entry lies below 2^-32: a row whose first lit texels hold less than
 /// 2^-32 of its weight, or a map whose first lit rows hold less than 2^-32 of its own.
-pub const CDF_FLOOR: f64 = 1.0 / 4_294_967_296.0;
+const CDF_FLOOR: f64 = 1.0 / 4_294_967_296.0;
 
 /// The CDF of `weights`: n + 1 numbers from exactly 0 to exactly 1 (uniform if they sum to 0),
 /// each 0 or at least [`CDF_FLOOR`].

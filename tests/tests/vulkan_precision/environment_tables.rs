@@ -12,11 +12,12 @@
 //! included), and the density at every texel's centre. Without the floor the density fails
 //! (texels whose CDF step is denormal), and the table's own check fails first.
 
-use super::f;
+use super::{back, f};
+use glam::Vec3;
 use kernel::environment::{
     direction_in_texel, map_coordinates, pdf, sample, texel_density, texel_of, DrawnTexel, MapShape,
 };
-use kernel::real::{Real, V3};
+use kernel::real::Real;
 use kernel::rng::u32_to_unit_f32;
 use kernel::scene::{light_sampling, RenderParams};
 use twinpath::scene::environment::EnvironmentMap;
@@ -136,16 +137,16 @@ fn device_search(cdf: &[f32], u: Vk32) -> u32 {
 }
 
 /// `environment::pdf`'s density of direction `d`, its arithmetic on [`Vk32`]: the texel's
-/// coordinates, the differences of the stored CDF entries around it, [`texel_density`].
-fn device_pdf(map: &EnvironmentMap, params: &RenderParams, table: &[f32], d: glam::Vec3) -> f32 {
+/// coordinates, the differences of the stored CDF entries around it (`all`, [`cdfs`] of the
+/// map's table), [`texel_density`].
+fn device_pdf(map: &EnvironmentMap, params: &RenderParams, all: &[Vec<f32>], d: Vec3) -> f32 {
     let (w, h) = (map.width, map.height);
     let rotation = params.environment.rotation.map(f);
-    let (u, v, sin_theta) = map_coordinates(rotation, V3::new(f(d.x), f(d.y), f(d.z)));
+    let (u, v, sin_theta) = map_coordinates(rotation, super::v(d));
     if !(sin_theta.value > 0.0) {
         return 0.0;
     }
     let (i, j) = texel_of(w, h, u, v);
-    let all = cdfs(map, table);
     let (row, column) = (&all[0], &all[1 + j as usize]);
     let p_row = f(row[j as usize + 1]) - f(row[j as usize]);
     let p_column = f(column[i as usize + 1]) - f(column[i as usize]);
@@ -212,7 +213,7 @@ fn a_device_that_flushes_denormals_samples_environment_maps_as_ieee_does() {
                 u1: f(u1),
             };
             let (direction, density) = direction_in_texel(shape, drawn);
-            let device = glam::Vec3::new(direction.x.value, direction.y.value, direction.z.value);
+            let device = back(direction);
             assert_eq!(
                 (device.to_array().map(f32::to_bits), density.value.to_bits()),
                 (
@@ -225,7 +226,7 @@ fn a_device_that_flushes_denormals_samples_environment_maps_as_ieee_does() {
                 ieee.direction,
                 ieee.pdf
             );
-            let device_density = device_pdf(&map, &params, &table, ieee.direction);
+            let device_density = device_pdf(&map, &params, &all, ieee.direction);
             assert_eq!(
                 device_density.to_bits(),
                 ieee_pdf.to_bits(),
@@ -247,6 +248,7 @@ fn a_device_that_flushes_denormals_gives_every_texel_the_ieee_density() {
     for (name, map) in hostile_maps() {
         let params = params_of(&map);
         let table = map.table();
+        let all = cdfs(&map, &table);
         let shape = shape_of(&map, &params, |x| x);
         let (mut floored, mut least) = (0, f32::INFINITY);
         for j in 0..map.height {
@@ -261,16 +263,16 @@ fn a_device_that_flushes_denormals_gives_every_texel_the_ieee_density() {
                     column_cdf: [0.0, 1.0],
                     u1: 0.5,
                 };
-                let d: glam::Vec3 = direction_in_texel(shape, centre).0.into();
+                let d: Vec3 = direction_in_texel(shape, centre).0.into();
                 set_model(Model::IEEE);
                 let ieee = pdf(&params, &table, light_sampling::SOLID_ANGLE, d);
                 assert_eq!(
-                    device_pdf(&map, &params, &table, d).to_bits(),
+                    device_pdf(&map, &params, &all, d).to_bits(),
                     ieee.to_bits(),
                     "{name}: the IEEE model does not compute environment::pdf"
                 );
                 set_model(FLUSHING);
-                let device = device_pdf(&map, &params, &table, d);
+                let device = device_pdf(&map, &params, &all, d);
                 assert_eq!(
                     device.to_bits(),
                     ieee.to_bits(),
