@@ -180,6 +180,7 @@ pub mod spirv;
 pub mod stats;
 pub mod triangle_bins;
 pub mod vulkan_arithmetic;
+pub mod watertight;
 
 /// Whether the GPU tests turn the validation layers on: always, unless the environment sets
 /// `TWINPATH_TESTS_NO_VALIDATION`, which only the device check uses, to tell whether the layers

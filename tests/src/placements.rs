@@ -95,6 +95,50 @@ impl Placements {
             triangles,
         })
     }
+
+    /// A needle: a right triangle whose legs differ by 10^U(1, 5) in length (its other two
+    /// angles 10^U(-5, -1) radians and nearly 90 degrees), placed as [`Self::triangle_case`]
+    /// places its shapes (half oriented at random, half in a plane normal to an axis), its
+    /// vertices listed from any of the three, and a ray toward a random point of it. Long thin
+    /// triangles are common in modelled meshes (a wall or a strip triangulated edge to edge),
+    /// and they are where a watertight test's distance is least accurate.
+    pub fn needle_case(&mut self) -> Option<TriangleCase> {
+        let (s, t) = self.placement();
+        let corner = t + self.dir() * s;
+        let axis = ((self.unit() * 3.0) as usize).min(2);
+        let in_plane = self.unit() < 0.5;
+        let pick = |g: &mut Self| {
+            let mut v = g.dir();
+            if in_plane {
+                v[axis] = 0.0;
+            }
+            v
+        };
+        let along = pick(self).normalize();
+        let other = pick(self);
+        let across = (other - along * other.dot(along)).normalize();
+        let long = along * s * self.pow10(-1.0, 0.0);
+        let short = across * long.length() * self.pow10(-5.0, -1.0);
+        if !long.cross(short).normalize().is_finite() {
+            return None;
+        }
+        let mut v = [corner, corner + long, corner + short];
+        v.rotate_left(((self.unit() * 3.0) as usize).min(2));
+        let (a, b) = (self.unit(), self.unit());
+        let (a, b) = if a + b > 1.0 {
+            (1.0 - a, 1.0 - b)
+        } else {
+            (a, b)
+        };
+        let target = v[0] + (v[1] - v[0]) * a + (v[2] - v[0]) * b;
+        let origin = target + self.dir() * s * self.pow10(-1.0, 2.0);
+        Some(TriangleCase {
+            size: s,
+            origin,
+            dir: (target - origin).normalize(),
+            triangles: vec![(v[0], v[1] - v[0], v[2] - v[0])],
+        })
+    }
 }
 
 /// A ray toward a random point of a triangle or a quad ([`Placements::triangle_case`]).
@@ -103,4 +147,20 @@ pub struct TriangleCase {
     pub origin: Vec3,
     pub dir: Vec3,
     pub triangles: Vec<(Vec3, Vec3, Vec3)>,
+}
+
+impl TriangleCase {
+    /// The triangles as a renderer holds them: vertices (p0, p0 + edge1, p0 + edge2), rounded
+    /// to `f32` as a scene's vertex data are, for the device's test ([`crate::watertight`]),
+    /// and the kernel's (p0, p1 - p0, p2 - p0) computed from them, as the host computes a
+    /// triangle's edges.
+    pub fn loaded(&self) -> Vec<([Vec3; 3], (Vec3, Vec3, Vec3))> {
+        self.triangles
+            .iter()
+            .map(|&(p0, e1, e2)| {
+                let (p1, p2) = (p0 + e1, p0 + e2);
+                ([p0, p1, p2], (p0, p1 - p0, p2 - p0))
+            })
+            .collect()
+    }
 }

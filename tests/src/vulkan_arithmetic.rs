@@ -238,6 +238,13 @@ impl Vk32 {
     }
 }
 
+/// The value a device would hold (a pending product rounded as the last operation left it).
+impl From<Vk32> for f32 {
+    fn from(x: Vk32) -> f32 {
+        x.value
+    }
+}
+
 impl From<f32> for Vk32 {
     fn from(x: f32) -> Self {
         Self::new(x)

@@ -9,6 +9,12 @@
 //! Hits are computed as the renderer computes them: triangle points from barycentrics with
 //! `triangle_point_error`, sphere points re-projected with `sphere_point_error`, offsets by
 //! `offset_ray_origin`, shadow-ray ends by `shadow_ray_end`.
+//!
+//! The CPU meets triangles with the kernel's Moller-Trumbore test; a GPU with its own, which
+//! `twinpath_tests::watertight` models (the watertight test lavapipe runs). Rays leaving
+//! triangles and quads are held to both; rays leaving needles (long thin triangles) to the
+//! CPU's, since under a watertight test they do hit their triangle again (`docs/robustness.md`,
+//! "Known limits").
 
 use glam::Vec3;
 use kernel::geometry::{
@@ -87,6 +93,84 @@ fn rays_leaving_triangles_and_quads_never_hit_them_again() {
     println!("triangles/quads: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
     assert!(tested > cases() / 2);
     assert_eq!((cont_fail, shadow_fail), (0, 0));
+}
+
+/// What rays spawned from a random hit on each case of `case` meet again: (hits tested,
+/// continuation and shadow rays that hit their triangle again under the CPU's test, the same
+/// under the watertight test a GPU runs). The triangles are the renderer's: vertices in `f32`,
+/// the kernel's edges their differences ([`twinpath_tests::placements::TriangleCase::loaded`]).
+fn leaving_triangles(
+    seed: u64,
+    case: &mut dyn FnMut(&mut Gen, usize) -> Option<twinpath_tests::placements::TriangleCase>,
+) -> (usize, [usize; 2], [usize; 2]) {
+    use twinpath_tests::watertight::watertight_triangle;
+    let mut g = Gen(twinpath_tests::SplitMix(seed));
+    let (mut tested, mut cpu, mut gpu) = (0, [0; 2], [0; 2]);
+    for k in 0..cases() {
+        let Some(c) = case(&mut g, k) else {
+            continue;
+        };
+        let tris = c.loaded();
+        let best = tris
+            .iter()
+            .map(|&(_, (q, f1, f2))| {
+                let h = intersect_triangle_uv(c.origin, c.dir, q, f1, f2, 0.0, f32::INFINITY);
+                (h, q, f1, f2)
+            })
+            .filter(|(h, ..)| h.t >= 0.0)
+            .min_by(|a, b| a.0.t.total_cmp(&b.0.t));
+        let Some((h, q, f1, f2)) = best else {
+            continue; // the ray slipped past an edge
+        };
+        tested += 1;
+        let p = triangle_point(q, f1, f2, h.u, h.v);
+        let nn = triangle_normal(f1, f2);
+        let n_side = if nn.dot(c.dir) < 0.0 { nn } else { -nn };
+        let err = triangle_point_error(q, f1, f2, h.u, h.v);
+        let o = offset_ray_origin(p, n_side, err);
+        let on_cpu = |d: Vec3, t_max: f32| {
+            tris.iter()
+                .any(|&(_, (q, f1, f2))| intersect_triangle(o, d, q, f1, f2, 0.0, t_max) >= 0.0)
+        };
+        let on_gpu = |d: Vec3, t_max: f32| {
+            tris.iter().any(|&(v, _)| {
+                let v = v.map(kernel::real::V3::<f32>::from);
+                watertight_triangle(o.into(), d.into(), d, v, 0.0, t_max).is_some()
+            })
+        };
+        let w = sample_cosine_hemisphere(n_side, g.unit(), g.unit());
+        let target =
+            p + (n_side * g.unit().max(1e-3) + g.dir() * 0.5) * c.size * g.pow10(-2.0, 1.0);
+        if w.dot(n_side) > 0.0 {
+            cpu[0] += on_cpu(w, f32::INFINITY) as usize;
+            gpu[0] += on_gpu(w, f32::INFINITY) as usize;
+        }
+        if (target - p).dot(n_side) > err {
+            cpu[1] += on_cpu(target - o, 1.0) as usize;
+            gpu[1] += on_gpu(target - o, 1.0) as usize;
+        }
+    }
+    (tested, cpu, gpu)
+}
+
+/// The GPU's side of [`rays_leaving_triangles_and_quads_never_hit_them_again`]: the same
+/// shapes, met by the watertight test a device runs.
+#[test]
+fn rays_leaving_triangles_and_quads_miss_them_under_a_watertight_test_too() {
+    let (tested, cpu, gpu) = leaving_triangles(5, &mut |g, k| g.triangle_case(k % 2 == 0));
+    println!("triangles/quads: {tested} hits; [continuation, shadow] rays that hit their own surface again: {cpu:?} under Moller-Trumbore, {gpu:?} under a watertight test");
+    assert!(tested > cases() / 2);
+    assert_eq!((cpu, gpu), ([0, 0], [0, 0]));
+}
+
+/// Needles (`Placements::needle_case`) under the CPU's test. Under a watertight test some of
+/// these rays meet their needle again (printed; `docs/robustness.md`, "Known limits").
+#[test]
+fn rays_leaving_needles_never_hit_them_again_on_the_cpu() {
+    let (tested, cpu, gpu) = leaving_triangles(6, &mut |g, _| g.needle_case());
+    println!("needles: {tested} hits; [continuation, shadow] rays that hit their own needle again: {cpu:?} under Moller-Trumbore, {gpu:?} under a watertight test (a known limit)");
+    assert!(tested > cases() / 2);
+    assert_eq!(cpu, [0, 0]);
 }
 
 #[test]

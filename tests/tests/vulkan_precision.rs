@@ -31,6 +31,7 @@ use twinpath_tests::device_class::{
     triangle_hit_may_flip, BASIS_APART_EPS, IEEE_ROUNDOFF, VULKAN_ROUNDOFF,
 };
 use twinpath_tests::vulkan_arithmetic::{lean, seed, set_model, ulp, Model, Vk32};
+use twinpath_tests::watertight::watertight_triangle;
 use twinpath_tests::SplitMix;
 
 #[path = "vulkan_precision/ball_bounds.rs"]
@@ -220,16 +221,20 @@ fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
         let Some(c) = g.triangle_case(case % 2 == 0) else {
             continue;
         };
-        let (s, origin, dir, tris) = (c.size, c.origin, c.dir, c.triangles);
+        let (s, origin, dir, tris) = (c.size, c.origin, c.dir, c.loaded());
+        // Met by the CPU's test (the kernel's Moller-Trumbore) or by a GPU's (a watertight
+        // test, `twinpath_tests::watertight`), both under Vulkan's arithmetic.
         let hit = |o: V, d: V, t_max: Vk32| {
-            tris.iter().any(|&(q, f1, f2)| {
+            tris.iter().any(|&(vertices, (q, f1, f2))| {
                 let (t, _, _) = intersect::triangle(o, d, v(q), v(f1), v(f2), f(0.0), t_max);
                 t.value >= 0.0
+                    || watertight_triangle(o, d, back(d), vertices.map(v), 0.0, t_max.value)
+                        .is_some()
             })
         };
         let best = tris
             .iter()
-            .map(|&(q, f1, f2)| {
+            .map(|&(_, (q, f1, f2))| {
                 let h = intersect::triangle(
                     v(origin),
                     v(dir),
@@ -257,7 +262,7 @@ fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
         cont_fail += c as usize;
         shadow_fail += sh as usize;
     }
-    println!("triangles/quads under Vulkan arithmetic: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
+    println!("triangles/quads under Vulkan arithmetic, Moller-Trumbore and watertight: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
     assert!(tested > cases() / 2);
     assert_eq!((cont_fail, shadow_fail), (0, 0));
 }
