@@ -55,6 +55,22 @@ fn spawned_self_hits(
     (continuation, shadow)
 }
 
+/// The first of `triangles` (p0, edge1, edge2) that the ray `origin + t dir` meets, with the
+/// kernel's hit record of it, as the CPU finds it.
+fn first_hit(
+    origin: Vec3,
+    dir: Vec3,
+    triangles: impl Iterator<Item = (Vec3, Vec3, Vec3)>,
+) -> Option<(kernel::geometry::TriangleHit, Vec3, Vec3, Vec3)> {
+    triangles
+        .map(|(q, f1, f2)| {
+            let h = intersect_triangle_uv(origin, dir, q, f1, f2, 0.0, f32::INFINITY);
+            (h, q, f1, f2)
+        })
+        .filter(|(h, ..)| h.t >= 0.0)
+        .min_by(|a, b| a.0.t.total_cmp(&b.0.t))
+}
+
 #[test]
 fn rays_leaving_triangles_and_quads_never_hit_them_again() {
     let mut g = Gen(twinpath_tests::SplitMix(1));
@@ -69,15 +85,7 @@ fn rays_leaving_triangles_and_quads_never_hit_them_again() {
             tris.iter()
                 .any(|&(q, f1, f2)| intersect_triangle(o, d, q, f1, f2, 0.0, t_max) >= 0.0)
         };
-        let best = tris
-            .iter()
-            .map(|&(q, f1, f2)| {
-                let h = intersect_triangle_uv(origin, dir, q, f1, f2, 0.0, f32::INFINITY);
-                (h, q, f1, f2)
-            })
-            .filter(|(h, ..)| h.t >= 0.0)
-            .min_by(|a, b| a.0.t.total_cmp(&b.0.t));
-        let Some((h, q, f1, f2)) = best else {
+        let Some((h, q, f1, f2)) = first_hit(origin, dir, tris.iter().copied()) else {
             continue; // the ray slipped past an edge
         };
         tested += 1;
@@ -111,15 +119,7 @@ fn leaving_triangles(
             continue;
         };
         let tris = c.loaded();
-        let best = tris
-            .iter()
-            .map(|&(_, (q, f1, f2))| {
-                let h = intersect_triangle_uv(c.origin, c.dir, q, f1, f2, 0.0, f32::INFINITY);
-                (h, q, f1, f2)
-            })
-            .filter(|(h, ..)| h.t >= 0.0)
-            .min_by(|a, b| a.0.t.total_cmp(&b.0.t));
-        let Some((h, q, f1, f2)) = best else {
+        let Some((h, q, f1, f2)) = first_hit(c.origin, c.dir, tris.iter().map(|t| t.1)) else {
             continue; // the ray slipped past an edge
         };
         tested += 1;
