@@ -25,6 +25,7 @@ use kernel::geometry::{
 use kernel::sampling::{sample_cosine_hemisphere, sample_sphere_cone};
 
 use twinpath_tests::placements::Placements as Gen;
+use twinpath_tests::watertight::watertight_triangle;
 
 /// Cases per test: 10^6 by default; `REINTERSECT_CASES=10000000` for the long run.
 fn cases() -> usize {
@@ -111,7 +112,6 @@ fn leaving_triangles(
     seed: u64,
     case: &mut dyn FnMut(&mut Gen, usize) -> Option<twinpath_tests::placements::TriangleCase>,
 ) -> (usize, [usize; 2], [usize; 2]) {
-    use twinpath_tests::watertight::watertight_triangle;
     let mut g = Gen(twinpath_tests::SplitMix(seed));
     let (mut tested, mut cpu, mut gpu) = (0, [0; 2], [0; 2]);
     for k in 0..cases() {
@@ -242,7 +242,7 @@ fn shadow_rays_never_hit_the_light_they_sample() {
 
 /// The same for triangle lights: a shadow ray toward a point sampled on a triangle light (by
 /// area or as a spherical triangle, one- and two-sided, with the light's own error bound as the
-/// renderer builds it) never hits that triangle, for receivers 1e-3 to 1e4 sizes away on the
+/// renderer builds it) never hits that triangle, under the CPU's test or a GPU's watertight one, for receivers 1e-3 to 1e4 sizes away on the
 /// side the light faces (the renderer casts no shadow ray where cos theta_light <= 0).
 #[test]
 fn shadow_rays_never_hit_the_triangle_light_they_sample() {
@@ -280,7 +280,12 @@ fn shadow_rays_never_hit_the_triangle_light_they_sample() {
         }
         tested += 1;
         let end = shadow_ray_end(x, y, ls.point.normal, l.point_error);
-        if intersect_triangle(x, end - x, p0, e1, e2, 0.0, 1.0) >= 0.0 {
+        // The CPU's test, and a GPU's (a watertight test of the light's vertices).
+        let vertices = [p0, p0 + e1, p0 + e2].map(kernel::real::V3::<f32>::from);
+        let d = end - x;
+        if intersect_triangle(x, d, p0, e1, e2, 0.0, 1.0) >= 0.0
+            || watertight_triangle(x.into(), d.into(), d, vertices, 0.0, 1.0).is_some()
+        {
             fails += 1;
         }
     }
