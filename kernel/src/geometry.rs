@@ -274,11 +274,13 @@ fn max_abs<R: real::Real<Bits = u32>>(v: V3<R>) -> R {
 /// from the cross product of nearly parallel edges, so the edge terms carry 1 / sin(theta)
 /// (found by the re-intersection tests: slivers with sin(theta) = 0.002 self-intersected).
 /// 1 / sin(theta) is capped at f32::MAX: for a denormal sin(theta) it overflows to infinity,
-/// and a hit at u = v = 0 then computed 0 x inf = NaN (found by `properties.rs`).
+/// and a hit at u = v = 0 then computed 0 x inf = NaN (found by `properties.rs`). The bound
+/// also holds the rounding of the triangle test a GPU runs ([`triangle_watertight_error_v3`]),
+/// so that it sizes the offset of rays leaving the point on either backend.
 #[inline]
 pub fn triangle_point_error(p0: Vec3, edge1: Vec3, edge2: Vec3, u: f32, v: f32) -> f32 {
-    let condition = triangle_error_condition(edge1, edge2);
-    triangle_point_error_conditioned(p0, edge1, edge2, u, v, condition)
+    let shape = TriangleShape::of(edge1, edge2);
+    triangle_point_error_conditioned(p0, edge1, edge2, u, v, &shape)
 }
 
 /// The factor of [`triangle_point_error`] that depends on the triangle's shape alone:
@@ -304,12 +306,14 @@ pub fn triangle_error_condition_v3<R: real::Real>(edge1: V3<R>, edge2: V3<R>) ->
 }
 
 /// What a triangle's hit records need that depends on its shape alone: its unit normal
-/// ([`triangle_normal`]) and its [`triangle_error_condition`] (four square roots and two
-/// divisions, which a renderer may compute once per triangle, as the CPU's BVH does).
+/// ([`triangle_normal`]), its [`triangle_error_condition`] and its
+/// [`triangle_watertight_scale_v3`] (four square roots and three divisions, which a renderer
+/// may compute once per triangle, as the CPU's BVH does).
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleShape {
     pub normal: Vec3,
     pub condition: f32,
+    pub watertight_scale: f32,
 }
 
 impl TriangleShape {
@@ -318,11 +322,12 @@ impl TriangleShape {
         Self {
             normal: triangle_normal(edge1, edge2),
             condition: triangle_error_condition(edge1, edge2),
+            watertight_scale: triangle_watertight_scale_v3(V3::from(edge1), V3::from(edge2)),
         }
     }
 }
 
-/// [`triangle_point_error`] with the triangle's [`triangle_error_condition`] given.
+/// [`triangle_point_error`] with the factors of the triangle's [`TriangleShape`] given.
 #[inline]
 pub fn triangle_point_error_conditioned(
     p0: Vec3,
@@ -330,13 +335,24 @@ pub fn triangle_point_error_conditioned(
     edge2: Vec3,
     u: f32,
     v: f32,
-    condition: f32,
+    shape: &TriangleShape,
 ) -> f32 {
     let (p0, edge1, edge2) = (V3::from(p0), V3::from(edge1), V3::from(edge2));
-    triangle_point_error_v3(p0, edge1, edge2, u, v, condition)
+    triangle_point_error_v3(
+        p0,
+        edge1,
+        edge2,
+        u,
+        v,
+        shape.condition,
+        shape.watertight_scale,
+    )
 }
 
-/// [`triangle_point_error_conditioned`] over any scalar [`real::Real`].
+/// [`triangle_point_error_conditioned`] over any scalar [`real::Real`]: the point's rounding
+/// and its plane's (8 eps of the terms, the edge terms times `condition`) plus
+/// [`triangle_watertight_error_v3`] (`watertight_scale` its per-triangle factor), the rounding
+/// of the triangle test a GPU runs, so that the offset clears both.
 #[inline]
 pub fn triangle_point_error_v3<R: real::Real<Bits = u32>>(
     p0: V3<R>,
@@ -345,9 +361,78 @@ pub fn triangle_point_error_v3<R: real::Real<Bits = u32>>(
     u: R,
     v: R,
     condition: R,
+    watertight_scale: R,
 ) -> R {
     R::splat(TRIANGLE_ERROR_EPS * f32::EPSILON)
         * (max_abs(p0) + (max_abs(edge1 * u) + max_abs(edge2 * v)) * condition)
+        + triangle_watertight_error_v3(edge1, edge2, u, v, watertight_scale)
+}
+
+/// The rounding of a watertight triangle test, per eps of the product of a ray origin's three
+/// distances to the vertices over |edge1 x edge2| (derived in docs/robustness.md,
+/// "Needles under a watertight test"): each 2-D edge function is rounded by at most
+/// 2 u |P_j| |P_k| (u <= eps on any conformant device), the sheared distances |P| are at most
+/// sqrt(3) times the distances, and the three errors are weighed by the vertices' depths.
+pub const WATERTIGHT_ERROR_EPS: f32 = 18.0;
+
+/// How far off its triangle's plane (along the normal) a ray leaving the triangle at
+/// barycentrics (`u`, `v`) must start so that a GPU's triangle test cannot meet it again:
+/// [`WATERTIGHT_ERROR_EPS`] eps |p - p0| |p - p1| |p - p2| / |edge1 x edge2|, `scale` being the
+/// triangle's [`triangle_watertight_scale_v3`]. A device decides a hit by three edge functions
+/// in the plane normal to the ray (a watertight test, as lavapipe's; Woop, Benthin and Wald,
+/// JCGT 2013) and interpolates the vertices' depths with them, so its t errs by their rounding
+/// over the triangle's projected area; the ray's cosine cancels against the exact t of the plane
+/// behind it, -h / cos. The term is the triangle's elongation: about eps times the longest edge
+/// for a well-shaped triangle, but the ratio of its legs times that for a needle, whose angle at
+/// p0 ([`triangle_error_condition`]) may be right. Every product is capped at f32::MAX, so the
+/// result is never NaN.
+#[inline]
+pub fn triangle_watertight_error_v3<R: real::Real<Bits = u32>>(
+    edge1: V3<R>,
+    edge2: V3<R>,
+    u: R,
+    v: R,
+    scale: R,
+) -> R {
+    let from_p0 = edge1 * u + edge2 * v;
+    let big = R::splat(f32::MAX);
+    let scaled = (from_p0.length() * scale).min(big);
+    let scaled = (scaled * (from_p0 - edge1).length()).min(big);
+    (scaled * (from_p0 - edge2).length()).min(big)
+}
+
+/// A triangle's factor of [`triangle_watertight_error_v3`]: WATERTIGHT_ERROR_EPS eps /
+/// |edge1 x edge2|, capped at f32::MAX; 0 for a degenerate triangle, which no test meets.
+#[inline]
+pub fn triangle_watertight_scale_v3<R: real::Real<Bits = u32>>(edge1: V3<R>, edge2: V3<R>) -> R {
+    let area = edge1.cross(edge2).length();
+    real::select(
+        area.greater_than(R::splat(0.0)),
+        (R::splat(WATERTIGHT_ERROR_EPS * f32::EPSILON) / area).min(R::splat(f32::MAX)),
+        R::splat(0.0),
+    )
+}
+
+/// A bound on [`triangle_point_error`] over every point of the triangle (a triangle light's
+/// `scene::Light::point_error`): the rounding part at u = v = 1, which bounds every point's,
+/// plus [`triangle_watertight_error_bound`].
+#[inline]
+pub fn triangle_light_point_error(p0: Vec3, edge1: Vec3, edge2: Vec3) -> f32 {
+    triangle_point_error(p0, edge1, edge2, 1.0, 1.0) + triangle_watertight_error_bound(edge1, edge2)
+}
+
+/// The largest [`triangle_watertight_error_v3`] over the whole triangle: every distance from a
+/// point of it to a vertex is at most its longest edge E, so WATERTIGHT_ERROR_EPS eps
+/// E^3 / |edge1 x edge2|.
+#[inline]
+pub fn triangle_watertight_error_bound(edge1: Vec3, edge2: Vec3) -> f32 {
+    let longest = edge1
+        .length()
+        .max(edge2.length())
+        .max((edge2 - edge1).length());
+    let scale = triangle_watertight_scale_v3(V3::from(edge1), V3::from(edge2));
+    let scaled = (longest * scale).min(f32::MAX);
+    ((scaled * longest).min(f32::MAX) * longest).min(f32::MAX)
 }
 
 /// Absolute error bound of a point on a sphere (centre `center`, radius `radius`), re-projected

@@ -23,7 +23,8 @@ pub struct SurfaceHit {
     /// Index into the light table if the surface is a light, else [`NONE`].
     pub light: u32,
     /// Absolute bound on the rounding error of `position` (per component), which sizes the
-    /// offset of rays leaving it (`geometry::offset_ray_origin`).
+    /// offset of rays leaving it (`geometry::offset_ray_origin`); for a triangle it also holds
+    /// the rounding of a GPU's triangle test (`geometry::triangle_point_error`).
     pub error: f32,
     /// Whether the ray arrived from the side `normal` points away from (a sphere's inside, a
     /// triangle's back). Decided where the record is made, and robustly for spheres: by which
@@ -106,7 +107,7 @@ impl SurfaceHit {
             normal: shape.normal,
             material: tri.material,
             light: tri.light,
-            error: triangle_point_error_conditioned(p0, e1, e2, u, v, shape.condition),
+            error: triangle_point_error_conditioned(p0, e1, e2, u, v, &shape),
             arrived_behind: Self::behind_plane(shape.normal, dir),
             shading: tri.shading,
             barycentrics: Vec2::new(u, v),

@@ -440,8 +440,8 @@ pub struct Light {
     pub alias: u32,
     /// TRIANGLE: the area |edge1 x edge2| / 2.
     pub area: f32,
-    /// TRIANGLE: a bound on the rounding error of any point sampled on it
-    /// (`geometry::triangle_point_error` at u = v = 1, which bounds every point of it).
+    /// TRIANGLE: a bound on the rounding error of any point sampled on it, which sizes the lift
+    /// of shadow rays' ends off it (`geometry::triangle_light_point_error`).
     pub point_error: f32,
     /// TRIANGLE with `emission_texture`: the texture coordinates of p0, p1 and p2.
     pub uv: [f32; 6],

@@ -602,7 +602,8 @@ pub fn triangle_probe<R: Real<Bits = u32>>(
     let (t, u, v) = kernel::intersect::triangle(origin, dir, p0, e1, e2, zero, t_max);
     if t.at_least(zero) != 0 {
         let condition = kernel::geometry::triangle_error_condition_v3(e1, e2);
-        let error = kernel::geometry::triangle_point_error_v3(p0, e1, e2, u, v, condition);
+        let scale = kernel::geometry::triangle_watertight_scale_v3(e1, e2);
+        let error = kernel::geometry::triangle_point_error_v3(p0, e1, e2, u, v, condition, scale);
         let p = kernel::geometry::triangle_point_v3(p0, e1, e2, u, v);
         [t, u, v, error, p.x, p.y, p.z]
     } else {

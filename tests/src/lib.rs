@@ -373,12 +373,10 @@ pub fn transform_scene(scene: &SceneFile, scale: f32, translate: glam::Vec3) -> 
         l.edge1 = e(l.edge1);
         l.edge2 = e(l.edge2);
         l.area *= scale * scale;
-        l.point_error = kernel::geometry::triangle_point_error(
+        l.point_error = kernel::geometry::triangle_light_point_error(
             Vec3::from(l.position),
             Vec3::from(l.edge1),
             Vec3::from(l.edge2),
-            1.0,
-            1.0,
         );
     }
     for t in &mut s.triangles {

@@ -5,7 +5,8 @@
 //! (`twinpath_tests::vulkan_arithmetic`). Derivations: `docs/robustness.md`, "Under Vulkan's
 //! arithmetic".
 //!
-//! The guarantees: rays leaving a triangle or a sphere never hit it again, shadow rays never hit
+//! The guarantees: rays leaving a triangle or a sphere never hit it again (a triangle met by the
+//! kernel's test or by a model of a GPU's, `twinpath_tests::watertight`), shadow rays never hit
 //! the light they sample, the orthonormal frame is orthonormal and the samplers stay in their
 //! domains, all within the bounds derived for Vulkan; and [`Vk32`] itself returns only what a
 //! conformant device may, and does take its liberties (else the rest would prove nothing).
@@ -21,7 +22,7 @@ use kernel::frame::orthonormal_basis_v3;
 use kernel::geometry::{
     geometry_factor_v3, offset_ray_origin_v3, reproject_to_sphere_v3, shadow_ray_end_v3,
     sphere_point_error, sphere_point_error_v3, triangle_error_condition_v3, triangle_normal_v3,
-    triangle_point_error_v3, triangle_point_v3, TRIANGLE_ERROR_EPS,
+    triangle_point_error_v3, triangle_point_v3, triangle_watertight_scale_v3, TRIANGLE_ERROR_EPS,
 };
 use kernel::intersect;
 use kernel::real::{Exponential, Real, V3};
@@ -210,15 +211,20 @@ fn vk32_returns_only_what_vulkan_allows_and_takes_its_liberties() {
     set_model(Model::VULKAN);
 }
 
-#[test]
-fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
+/// Rays leaving the shapes `case` draws, under [`Vk32`]: (hits tested, continuation and shadow
+/// rays that met their triangle again under the CPU's test or a GPU's).
+fn leaving_triangles_under_vulkan(
+    seed_model: u64,
+    seed_shapes: u64,
+    case: &mut dyn FnMut(&mut Gen, usize) -> Option<twinpath_tests::placements::TriangleCase>,
+) -> (usize, usize, usize) {
     set_model(Model::VULKAN);
-    seed(2);
-    let mut g = Gen(SplitMix(21));
+    seed(seed_model);
+    let mut g = Gen(SplitMix(seed_shapes));
     let (mut tested, mut cont_fail, mut shadow_fail) = (0, 0, 0);
-    for case in 0..cases() {
-        any_device(case);
-        let Some(c) = g.triangle_case(case % 2 == 0) else {
+    for k in 0..cases() {
+        any_device(k);
+        let Some(c) = case(&mut g, k) else {
             continue;
         };
         let (s, origin, dir, tris) = (c.size, c.origin, c.dir, c.loaded());
@@ -257,12 +263,30 @@ fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
         let nn = triangle_normal_v3(f1, f2);
         let n_side = if nn.dot(v(dir)).value < 0.0 { nn } else { -nn };
         let condition = triangle_error_condition_v3(f1, f2);
-        let err = triangle_point_error_v3(q, f1, f2, hu, hv, condition);
+        let scale = triangle_watertight_scale_v3(f1, f2);
+        let err = triangle_point_error_v3(q, f1, f2, hu, hv, condition, scale);
         let (c, sh) = spawned_self_hits(&mut g, p, n_side, err, s, &hit);
         cont_fail += c as usize;
         shadow_fail += sh as usize;
     }
+    (tested, cont_fail, shadow_fail)
+}
+
+#[test]
+fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
+    let (tested, cont_fail, shadow_fail) =
+        leaving_triangles_under_vulkan(2, 21, &mut |g, k| g.triangle_case(k % 2 == 0));
     println!("triangles/quads under Vulkan arithmetic, Moller-Trumbore and watertight: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
+    assert!(tested > cases() / 2);
+    assert_eq!((cont_fail, shadow_fail), (0, 0));
+}
+
+/// Needles (`Placements::needle_case`), whose watertight test errs most, under [`Vk32`].
+#[test]
+fn rays_leaving_needles_never_hit_them_again_under_vulkan_arithmetic() {
+    let (tested, cont_fail, shadow_fail) =
+        leaving_triangles_under_vulkan(3, 22, &mut |g, _| g.needle_case());
+    println!("needles under Vulkan arithmetic, Moller-Trumbore and watertight: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own needle again");
     assert!(tested > cases() / 2);
     assert_eq!((cont_fail, shadow_fail), (0, 0));
 }
@@ -341,8 +365,11 @@ fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic
         tested += 1;
         let (qv, e1, e2) = (v(q), v(f1), v(f2));
         let p_object = triangle_point_v3(qv, e1, e2, hu, hv);
-        let object_error =
-            triangle_point_error_v3(qv, e1, e2, hu, hv, triangle_error_condition_v3(e1, e2));
+        let (condition, scale) = (
+            triangle_error_condition_v3(e1, e2),
+            triangle_watertight_scale_v3(e1, e2),
+        );
+        let object_error = triangle_point_error_v3(qv, e1, e2, hu, hv, condition, scale);
         let p = point_to_world_v3(&inst, p_object);
         let err = world_point_error_v3(&inst, p_object, object_error, p);
         let n = normal_to_world_v3(&inst, triangle_normal_v3(e1, e2));

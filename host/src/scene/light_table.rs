@@ -3,7 +3,7 @@
 //! power-proportional light selection.
 
 use glam::Vec3;
-use kernel::geometry::triangle_point_error;
+use kernel::geometry::triangle_light_point_error;
 use kernel::scene::{light_kind, light_selection, Light, Sphere, Triangle, NONE};
 
 /// The light of an emissive sphere (selection filled later by [`assign_light_selection`]).
@@ -138,7 +138,7 @@ pub fn triangle_light(tri: &Triangle, radiance: [f32; 3], two_sided: bool) -> Li
         alias_threshold: 0.0,
         alias: 0,
         area: area as f32,
-        point_error: triangle_point_error(p0, e1, e2, 1.0, 1.0),
+        point_error: triangle_light_point_error(p0, e1, e2),
         uv: [0.0; 6],
         emission_texture: NONE,
         material: NONE,
