@@ -6,11 +6,11 @@
 //! Why a model: on the GPU the device's own test decides whether a ray leaving a triangle meets
 //! it again, not the kernel's Moller-Trumbore, and Vulkan specifies no precision for it.
 //! lavapipe's is watertight (it shears the vertices into the ray's frame, as below); an RTX
-//! GPU's is not published. A watertight test is the family every conformant device's must
-//! resemble: it decides inside/outside by the signs of three 2-D edge functions in the plane
-//! normal to the ray, which is what makes it watertight, and the distance by interpolating the
-//! vertices' depths with them, which is what makes its distance error grow with the
-//! triangle's elongation (`docs/robustness.md`, "Known limits").
+//! GPU's is not published. A watertight test decides inside/outside by the signs of three 2-D
+//! edge functions in the plane normal to the ray, which is what makes it watertight, and the
+//! distance by interpolating the vertices' depths with them, which is what makes its distance
+//! error grow with the triangle's elongation (`docs/robustness.md`, "Needles under a watertight
+//! test", where the kernel's offset is derived to clear it).
 //!
 //! Invariant: the operations are the paper's, in its order; a zero edge function is not
 //! recomputed in double precision (the paper's optional fallback), so an edge is decided in
