@@ -5,7 +5,8 @@
 //!
 //! Why a model: on the GPU the device's own test decides whether a ray leaving a triangle meets
 //! it again, not the kernel's Moller-Trumbore, and Vulkan specifies no precision for it.
-//! lavapipe's is watertight (it shears the vertices into the ray's frame, as below); an RTX
+//! lavapipe's follows this paper but forms the edge functions and t in double precision (Mesa,
+//! `lvp_build_intersect_ray_tri`), radv's software path in single precision as here; an RTX
 //! GPU's is not published. A watertight test decides inside/outside by the signs of three 2-D
 //! edge functions in the plane normal to the ray, which is what makes it watertight, and the
 //! distance by interpolating the vertices' depths with them, which is what makes its distance
