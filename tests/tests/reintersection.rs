@@ -11,7 +11,7 @@
 //! `offset_ray_origin`, shadow-ray ends by `shadow_ray_end`.
 //!
 //! The CPU meets triangles with the kernel's Moller-Trumbore test; a GPU with its own, which
-//! `twinpath_tests::watertight` models (the watertight test lavapipe runs). Rays leaving
+//! `twinpath_tests::watertight` models (the watertight test in single precision). Rays leaving
 //! triangles, quads and needles (long thin triangles, whose watertight test errs most:
 //! `docs/robustness.md`, "Needles under a watertight test") are held to both.
 
@@ -242,8 +242,9 @@ fn shadow_rays_never_hit_the_light_they_sample() {
 
 /// The same for triangle lights: a shadow ray toward a point sampled on a triangle light (by
 /// area or as a spherical triangle, one- and two-sided, with the light's own error bound as the
-/// renderer builds it) never hits that triangle, under the CPU's test or a GPU's watertight one, for receivers 1e-3 to 1e4 sizes away on the
-/// side the light faces (the renderer casts no shadow ray where cos theta_light <= 0).
+/// renderer builds it) never hits that triangle, under the CPU's test or a GPU's watertight
+/// one, for receivers 1e-3 to 1e4 sizes away on the side the light faces (the renderer casts no
+/// shadow ray where cos theta_light <= 0).
 #[test]
 fn shadow_rays_never_hit_the_triangle_light_they_sample() {
     use kernel::light::triangle::sample as sample_triangle_light;
