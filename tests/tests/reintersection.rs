@@ -34,8 +34,29 @@ fn cases() -> usize {
         .unwrap_or(1_000_000)
 }
 
-/// Rays spawned from a hit at `p` (normal `n_side` on the leaving side, error bound `err`, size
-/// of the surface `size`): whether a continuation ray and a shadow ray hit it again (`hits`).
+/// The rays spawned from a hit at `p` (normal `n_side` on the leaving side, error bound `err`,
+/// size of the surface `size`), each as (origin, direction, t_max): a continuation ray in a
+/// cosine-distributed direction, and a shadow ray toward a point on the leaving side, as far as
+/// 10 sizes; `None` where the direction does not leave, or the target is not farther from the
+/// surface than the surface's own rounding (`err`: closer, which side it is on is not defined
+/// in f32).
+fn spawned_rays(
+    g: &mut Gen,
+    p: Vec3,
+    n_side: Vec3,
+    err: f32,
+    size: f32,
+) -> [Option<(Vec3, Vec3, f32)>; 2] {
+    let o = offset_ray_origin(p, n_side, err);
+    let w = sample_cosine_hemisphere(n_side, g.unit(), g.unit());
+    let continuation = (w.dot(n_side) > 0.0).then_some((o, w, f32::INFINITY));
+    let target = p + (n_side * g.unit().max(1e-3) + g.dir() * 0.5) * size * g.pow10(-2.0, 1.0);
+    let shadow = ((target - p).dot(n_side) > err).then_some((o, target - o, 1.0));
+    [continuation, shadow]
+}
+
+/// [`spawned_rays`]: whether the continuation ray and the shadow ray hit the surface again
+/// (`hits`).
 fn spawned_self_hits(
     g: &mut Gen,
     p: Vec3,
@@ -44,15 +65,9 @@ fn spawned_self_hits(
     size: f32,
     hits: &dyn Fn(Vec3, Vec3, f32) -> bool,
 ) -> (bool, bool) {
-    let o = offset_ray_origin(p, n_side, err);
-    let w = sample_cosine_hemisphere(n_side, g.unit(), g.unit());
-    let continuation = w.dot(n_side) > 0.0 && hits(o, w, f32::INFINITY);
-    // Shadow ray toward a point on the leaving side, as far as 10 sizes. The target must be
-    // farther from the surface than the surface's own rounding (`err`): closer, which side it
-    // is on is not defined in f32.
-    let target = p + (n_side * g.unit().max(1e-3) + g.dir() * 0.5) * size * g.pow10(-2.0, 1.0);
-    let shadow = (target - p).dot(n_side) > err && hits(o, target - o, 1.0);
-    (continuation, shadow)
+    let [c, s] =
+        spawned_rays(g, p, n_side, err, size).map(|r| r.is_some_and(|(o, d, t)| hits(o, d, t)));
+    (c, s)
 }
 
 /// The first of `triangles` (p0, edge1, edge2) that the ray `origin + t dir` meets, with the
@@ -126,27 +141,24 @@ fn leaving_triangles(
         let nn = triangle_normal(f1, f2);
         let n_side = if nn.dot(c.dir) < 0.0 { nn } else { -nn };
         let err = triangle_point_error(q, f1, f2, h.u, h.v);
-        let o = offset_ray_origin(p, n_side, err);
-        let on_cpu = |d: Vec3, t_max: f32| {
+        let on_cpu = |(o, d, t_max): (Vec3, Vec3, f32)| {
             tris.iter()
                 .any(|&(_, (q, f1, f2))| intersect_triangle(o, d, q, f1, f2, 0.0, t_max) >= 0.0)
         };
-        let on_gpu = |d: Vec3, t_max: f32| {
+        let on_gpu = |(o, d, t_max): (Vec3, Vec3, f32)| {
             tris.iter().any(|&(v, _)| {
                 let v = v.map(kernel::real::V3::<f32>::from);
                 watertight_triangle(o.into(), d.into(), d, v, 0.0, t_max).is_some()
             })
         };
-        let w = sample_cosine_hemisphere(n_side, g.unit(), g.unit());
-        let target =
-            p + (n_side * g.unit().max(1e-3) + g.dir() * 0.5) * c.size * g.pow10(-2.0, 1.0);
-        if w.dot(n_side) > 0.0 {
-            cpu[0] += on_cpu(w, f32::INFINITY) as usize;
-            gpu[0] += on_gpu(w, f32::INFINITY) as usize;
-        }
-        if (target - p).dot(n_side) > err {
-            cpu[1] += on_cpu(target - o, 1.0) as usize;
-            gpu[1] += on_gpu(target - o, 1.0) as usize;
+        for (k, ray) in spawned_rays(&mut g, p, n_side, err, c.size)
+            .into_iter()
+            .enumerate()
+        {
+            if let Some(ray) = ray {
+                cpu[k] += on_cpu(ray) as usize;
+                gpu[k] += on_gpu(ray) as usize;
+            }
         }
     }
     (tested, cpu, gpu)
