@@ -414,8 +414,9 @@ pub fn triangle_watertight_scale_v3<R: real::Real<Bits = u32>>(edge1: V3<R>, edg
 }
 
 /// A bound on [`triangle_point_error`] over every point of the triangle (a triangle light's
-/// `scene::Light::point_error`): the rounding part at u = v = 1, which bounds every point's,
-/// plus [`triangle_watertight_error_bound`].
+/// `scene::Light::point_error`): [`triangle_point_error`] at u = v = 1, whose rounding part
+/// bounds every point's (its edge terms are the largest there), plus
+/// [`triangle_watertight_error_bound`], which bounds every point's watertight part.
 #[inline]
 pub fn triangle_light_point_error(p0: Vec3, edge1: Vec3, edge2: Vec3) -> f32 {
     triangle_point_error(p0, edge1, edge2, 1.0, 1.0) + triangle_watertight_error_bound(edge1, edge2)

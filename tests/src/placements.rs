@@ -139,6 +139,46 @@ impl Placements {
             triangles: vec![(v[0], v[1] - v[0], v[2] - v[0])],
         })
     }
+
+    /// A right-angled needle and a well-shaped neighbour that shares its long leg, both in a
+    /// plane normal to an axis (so that they are coplanar in `f32`, as a modelled floor's
+    /// triangles are), and a ray toward a point of the neighbour 10^U(-6, -1) of its height from
+    /// the shared leg: the triangles (needle first, vertices listed from any corner), where a
+    /// ray leaving the neighbour may meet the needle's plane just behind its origin. The
+    /// needle's short leg is 10^U(-4, -1) of its long one, the neighbour's apex 0.2 to 1 of it
+    /// from the leg. None for a degenerate shape.
+    pub fn needle_neighbour_case(&mut self) -> Option<TriangleCase> {
+        let (s, t) = self.placement();
+        let corner = t + self.dir() * s;
+        let axis = ((self.unit() * 3.0) as usize).min(2);
+        let in_plane = |mut v: Vec3| {
+            v[axis] = 0.0;
+            v
+        };
+        let along = in_plane(self.dir()).normalize();
+        let other = in_plane(self.dir());
+        let across = (other - along * other.dot(along)).normalize();
+        let long = along * s * self.pow10(-1.0, 0.0);
+        let short = across * long.length() * self.pow10(-4.0, -1.0);
+        if !long.cross(short).normalize().is_finite() {
+            return None;
+        }
+        let apex = -across * long.length() * (0.2 + 0.8 * self.unit());
+        let mut needle = [corner, corner + long, corner + short];
+        needle.rotate_left(((self.unit() * 3.0) as usize).min(2));
+        let mut neighbour = [corner, corner + long, corner + apex];
+        neighbour.rotate_left(((self.unit() * 3.0) as usize).min(2));
+        let (a, b) = (self.unit(), self.pow10(-6.0, -1.0));
+        let target = corner + long * a * (1.0 - b) + apex * b;
+        let origin = target + self.dir() * s * self.pow10(-1.0, 2.0);
+        let edges = |v: [Vec3; 3]| (v[0], v[1] - v[0], v[2] - v[0]);
+        Some(TriangleCase {
+            size: s,
+            origin,
+            dir: (target - origin).normalize(),
+            triangles: vec![edges(needle), edges(neighbour)],
+        })
+    }
 }
 
 /// A ray toward a random point of a triangle or a quad ([`Placements::triangle_case`]).

@@ -87,3 +87,79 @@ pub fn watertight_triangle<R: Real + Into<f32>>(
     let t: f32 = ((ur * az + vr * bz + wr * cz) / det).into();
     (t > t_min && t < t_max && t.is_finite()).then_some(t)
 }
+
+/// Whether the watertight test could meet the triangle with vertices `p` on the ray
+/// `origin + t dir` at some t in (0, `t_max`) if every rounding it makes were as large as
+/// Vulkan's rules allow (unit roundoff eps, quotients within 2.5 ULP) and all fell the way that
+/// brings the triangle toward the ray's origin: the derivation of the kernel's offset
+/// (`docs/robustness.md`, "Needles under a watertight test") played out by an adversary, in
+/// `f64`. `toward_origin` is the triangle's unit normal on the origin's side.
+///
+/// The adversary moves each vertex as the test's roundings may (its difference from the
+/// origin, the shear and the depths: 2 eps |A_kx| + 4.5 eps |S_x| |A_k| along the axis kx, the
+/// same along ky, eps |A_k| along k, 4 eps |A_k| / |d_k| along the ray, each toward
+/// `toward_origin`'s side), then errs each edge function by 2 eps |P_j| |P_k| in the direction
+/// that raises t, and reports a hit where the three keep one sign and t > 0.
+pub fn worst_case_watertight_hit(
+    origin: Vec3,
+    dir: Vec3,
+    p: [Vec3; 3],
+    toward_origin: Vec3,
+    t_max: f32,
+) -> bool {
+    let eps = f32::EPSILON as f64;
+    let (o, d, n) = (origin.as_dvec3(), dir.as_dvec3(), toward_origin.as_dvec3());
+    let a = dir.abs();
+    let kz = if a.x > a.y {
+        if a.x > a.z {
+            0
+        } else {
+            2
+        }
+    } else if a.y > a.z {
+        1
+    } else {
+        2
+    };
+    let mut kx = (kz + 1) % 3;
+    let mut ky = (kx + 1) % 3;
+    if dir[kz] < 0.0 {
+        core::mem::swap(&mut kx, &mut ky);
+    }
+    let (sx, sy) = (d[kx] / d[kz], d[ky] / d[kz]);
+    let unit = |k: usize| glam::DVec3::from_array(core::array::from_fn(|i| (i == k) as u8 as f64));
+    let toward = |axis: glam::DVec3| if axis.dot(n) >= 0.0 { axis } else { -axis };
+    let moved = p.map(|q| {
+        let rel = q.as_dvec3() - o;
+        let (ax, ay, ak) = (rel[kx].abs(), rel[ky].abs(), rel[kz].abs());
+        let m = toward(unit(kx)) * eps * (2.0 * ax + 4.5 * sx.abs() * ak)
+            + toward(unit(ky)) * eps * (2.0 * ay + 4.5 * sy.abs() * ak)
+            + toward(unit(kz)) * eps * ak
+            + toward(d) * eps * 4.0 * ak / d[kz].abs();
+        rel + m
+    });
+    let sheared = moved.map(|r| (r[kx] - sx * r[kz], r[ky] - sy * r[kz], r[kz] / d[kz]));
+    let [(ax, ay, az), (bx, by, bz), (cx, cy, cz)] = sheared;
+    let exact = [cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax];
+    let size = [
+        (bx.hypot(by)) * (cx.hypot(cy)),
+        (cx.hypot(cy)) * (ax.hypot(ay)),
+        (ax.hypot(ay)) * (bx.hypot(by)),
+    ];
+    let depth = [az, bz, cz];
+    let det: f64 = exact.iter().sum();
+    if det == 0.0 {
+        return false;
+    }
+    let t = exact.iter().zip(depth).map(|(e, z)| e * z).sum::<f64>() / det;
+    // dt / dU_i = (Z_i - t) / det: each error pushed the way that raises t.
+    let edges: [f64; 3] =
+        core::array::from_fn(|i| exact[i] + 2.0 * eps * size[i] * ((depth[i] - t) / det).signum());
+    let inside = edges.iter().all(|&e| e >= 0.0) || edges.iter().all(|&e| e <= 0.0);
+    let det: f64 = edges.iter().sum();
+    if !inside || det == 0.0 {
+        return false;
+    }
+    let t = edges.iter().zip(depth).map(|(e, z)| e * z).sum::<f64>() / det;
+    t > 0.0 && t < t_max as f64
+}

@@ -13,7 +13,10 @@
 //! The CPU meets triangles with the kernel's Moller-Trumbore test; a GPU with its own, which
 //! `twinpath_tests::watertight` models (the watertight test in single precision). Rays leaving
 //! triangles, quads and needles (long thin triangles, whose watertight test errs most:
-//! `docs/robustness.md`, "Needles under a watertight test") are held to both.
+//! `docs/robustness.md`, "Needles under a watertight test") are held to both, and their own
+//! triangle to the same test with every rounding at its worst (`worst_case_watertight_hit`).
+//! A needle beside the triangle a ray leaves is held to the CPU's test only ("Neighbours under
+//! a watertight test").
 
 use glam::Vec3;
 use kernel::geometry::{
@@ -24,7 +27,7 @@ use kernel::geometry::{
 use kernel::sampling::{sample_cosine_hemisphere, sample_sphere_cone};
 
 use twinpath_tests::placements::Placements as Gen;
-use twinpath_tests::watertight::watertight_triangle;
+use twinpath_tests::watertight::{watertight_triangle, worst_case_watertight_hit};
 
 /// Cases per test: 10^6 by default; `REINTERSECT_CASES=10000000` for the long run.
 fn cases() -> usize {
@@ -118,16 +121,18 @@ fn rays_leaving_triangles_and_quads_never_hit_them_again() {
     assert_eq!((cont_fail, shadow_fail), (0, 0));
 }
 
-/// What rays spawned from a random hit on each case of `case` meet again: (hits tested,
-/// continuation and shadow rays that hit their triangle again under the CPU's test, the same
-/// under the watertight test a GPU runs). The triangles are the renderer's: vertices in `f32`,
-/// the kernel's edges their differences ([`twinpath_tests::placements::TriangleCase::loaded`]).
+/// What rays spawned from a random hit on each case of `case` meet again: (hits tested, then
+/// per [continuation, shadow] ray: those that hit a triangle of the case again under the CPU's
+/// test, the same under the watertight test a GPU runs, and those that the worst-case
+/// watertight test ([`worst_case_watertight_hit`]) could meet the hit triangle itself with).
+/// The triangles are the renderer's: vertices in `f32`, the kernel's edges their differences
+/// ([`twinpath_tests::placements::TriangleCase::loaded`]).
 fn leaving_triangles(
     seed: u64,
     case: &mut dyn FnMut(&mut Gen, usize) -> Option<twinpath_tests::placements::TriangleCase>,
-) -> (usize, [usize; 2], [usize; 2]) {
+) -> (usize, [usize; 2], [usize; 2], [usize; 2]) {
     let mut g = Gen(twinpath_tests::SplitMix(seed));
-    let (mut tested, mut cpu, mut gpu) = (0, [0; 2], [0; 2]);
+    let (mut tested, mut cpu, mut gpu, mut worst) = (0, [0; 2], [0; 2], [0; 2]);
     for k in 0..cases() {
         let Some(c) = case(&mut g, k) else {
             continue;
@@ -141,6 +146,7 @@ fn leaving_triangles(
         let nn = triangle_normal(f1, f2);
         let n_side = if nn.dot(c.dir) < 0.0 { nn } else { -nn };
         let err = triangle_point_error(q, f1, f2, h.u, h.v);
+        let own = tris.iter().find(|t| t.1 == (q, f1, f2)).map(|t| t.0);
         let on_cpu = |(o, d, t_max): (Vec3, Vec3, f32)| {
             tris.iter()
                 .any(|&(_, (q, f1, f2))| intersect_triangle(o, d, q, f1, f2, 0.0, t_max) >= 0.0)
@@ -155,23 +161,25 @@ fn leaving_triangles(
             .into_iter()
             .enumerate()
         {
-            if let Some(ray) = ray {
-                cpu[k] += on_cpu(ray) as usize;
-                gpu[k] += on_gpu(ray) as usize;
+            if let Some((o, d, t_max)) = ray {
+                cpu[k] += on_cpu((o, d, t_max)) as usize;
+                gpu[k] += on_gpu((o, d, t_max)) as usize;
+                worst[k] +=
+                    own.is_some_and(|v| worst_case_watertight_hit(o, d, v, n_side, t_max)) as usize;
             }
         }
     }
-    (tested, cpu, gpu)
+    (tested, cpu, gpu, worst)
 }
 
 /// The GPU's side of [`rays_leaving_triangles_and_quads_never_hit_them_again`]: the same
 /// shapes, met by the watertight test a device runs.
 #[test]
 fn rays_leaving_triangles_and_quads_miss_them_under_a_watertight_test_too() {
-    let (tested, cpu, gpu) = leaving_triangles(5, &mut |g, k| g.triangle_case(k % 2 == 0));
-    println!("triangles/quads: {tested} hits; [continuation, shadow] rays that hit their own surface again: {cpu:?} under Moller-Trumbore, {gpu:?} under a watertight test");
+    let (tested, cpu, gpu, worst) = leaving_triangles(5, &mut |g, k| g.triangle_case(k % 2 == 0));
+    println!("triangles/quads: {tested} hits; [continuation, shadow] rays that hit their own surface again: {cpu:?} under Moller-Trumbore, {gpu:?} under a watertight test, {worst:?} their own triangle under the worst-case watertight test");
     assert!(tested > cases() / 2);
-    assert_eq!((cpu, gpu), ([0, 0], [0, 0]));
+    assert_eq!((cpu, gpu, worst), ([0, 0], [0, 0], [0, 0]));
 }
 
 /// Needles (`Placements::needle_case`), under both tests. Without the offset's watertight term
@@ -179,10 +187,23 @@ fn rays_leaving_triangles_and_quads_miss_them_under_a_watertight_test_too() {
 /// under the watertight test, none under Moller-Trumbore.
 #[test]
 fn rays_leaving_needles_never_hit_them_again() {
-    let (tested, cpu, gpu) = leaving_triangles(6, &mut |g, _| g.needle_case());
-    println!("needles: {tested} hits; [continuation, shadow] rays that hit their own needle again: {cpu:?} under Moller-Trumbore, {gpu:?} under a watertight test");
+    let (tested, cpu, gpu, worst) = leaving_triangles(6, &mut |g, _| g.needle_case());
+    println!("needles: {tested} hits; [continuation, shadow] rays that hit their own needle again: {cpu:?} under Moller-Trumbore, {gpu:?} under a watertight test, {worst:?} under the worst-case watertight test");
     assert!(tested > cases() / 2);
-    assert_eq!((cpu, gpu), ([0, 0], [0, 0]));
+    assert_eq!((cpu, gpu, worst), ([0, 0], [0, 0], [0, 0]));
+}
+
+/// A needle's well-shaped neighbour (`Placements::needle_neighbour_case`): rays leaving either
+/// triangle never meet either again under the CPU's test, nor their own triangle under the
+/// worst-case watertight test. What a single-precision watertight test does with the needle
+/// behind a ray leaving its neighbour is a known limit (`docs/robustness.md`, "Neighbours
+/// under a watertight test"): the count is printed, not asserted.
+#[test]
+fn rays_leaving_a_needles_neighbour_never_hit_either_on_the_cpu() {
+    let (tested, cpu, gpu, worst) = leaving_triangles(7, &mut |g, _| g.needle_neighbour_case());
+    println!("needle neighbours: {tested} hits; [continuation, shadow] rays that hit either triangle again: {cpu:?} under Moller-Trumbore, {gpu:?} under a watertight test (known limit); {worst:?} their own triangle under the worst-case watertight test");
+    assert!(tested > cases() / 2);
+    assert_eq!((cpu, worst), ([0, 0], [0, 0]));
 }
 
 #[test]
@@ -255,7 +276,7 @@ fn shadow_rays_never_hit_the_light_they_sample() {
 /// The same for triangle lights: a shadow ray toward a point sampled on a triangle light (by
 /// area or as a spherical triangle, one- and two-sided, with the light's own error bound as the
 /// renderer builds it) never hits that triangle, under the CPU's test or a GPU's watertight
-/// one, for receivers 1e-3 to 1e4 sizes away on the side the light faces (the renderer casts no
+/// one (at its worst rounding too), for receivers 1e-3 to 1e4 sizes away on the side the light faces (the renderer casts no
 /// shadow ray where cos theta_light <= 0).
 #[test]
 fn shadow_rays_never_hit_the_triangle_light_they_sample() {
@@ -293,11 +314,14 @@ fn shadow_rays_never_hit_the_triangle_light_they_sample() {
         }
         tested += 1;
         let end = shadow_ray_end(x, y, ls.point.normal, l.point_error);
-        // The CPU's test, and a GPU's (a watertight test of the light's vertices).
-        let vertices = [p0, p0 + e1, p0 + e2].map(kernel::real::V3::<f32>::from);
+        // The CPU's test, and a GPU's (a watertight test of the light's vertices), also with
+        // every rounding at its worst.
+        let corners = [p0, p0 + e1, p0 + e2];
+        let vertices = corners.map(kernel::real::V3::<f32>::from);
         let d = end - x;
         if intersect_triangle(x, d, p0, e1, e2, 0.0, 1.0) >= 0.0
             || watertight_triangle(x.into(), d.into(), d, vertices, 0.0, 1.0).is_some()
+            || worst_case_watertight_hit(x, d, corners, ls.point.normal, 1.0)
         {
             fails += 1;
         }

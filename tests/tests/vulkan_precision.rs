@@ -32,7 +32,7 @@ use twinpath_tests::device_class::{
     triangle_hit_may_flip, BASIS_APART_EPS, IEEE_ROUNDOFF, VULKAN_ROUNDOFF,
 };
 use twinpath_tests::vulkan_arithmetic::{lean, seed, set_model, ulp, Model, Vk32};
-use twinpath_tests::watertight::watertight_triangle;
+use twinpath_tests::watertight::{watertight_triangle, worst_case_watertight_hit};
 use twinpath_tests::SplitMix;
 
 #[path = "vulkan_precision/ball_bounds.rs"]
@@ -228,16 +228,6 @@ fn leaving_triangles_under_vulkan(
             continue;
         };
         let (s, origin, dir, tris) = (c.size, c.origin, c.dir, c.loaded());
-        // Met by the CPU's test (the kernel's Moller-Trumbore) or by a GPU's (a watertight
-        // test, `twinpath_tests::watertight`), both under Vulkan's arithmetic.
-        let hit = |o: V, d: V, t_max: Vk32| {
-            tris.iter().any(|&(vertices, (q, f1, f2))| {
-                let (t, _, _) = intersect::triangle(o, d, v(q), v(f1), v(f2), f(0.0), t_max);
-                t.value >= 0.0
-                    || watertight_triangle(o, d, back(d), vertices.map(v), 0.0, t_max.value)
-                        .is_some()
-            })
-        };
         let best = tris
             .iter()
             .map(|&(_, (q, f1, f2))| {
@@ -257,6 +247,20 @@ fn leaving_triangles_under_vulkan(
         let Some(((_, hu, hv), q, f1, f2)) = best else {
             continue;
         };
+        let own = tris.iter().find(|t| t.1 == (q, f1, f2)).map(|t| t.0);
+        // Met by the CPU's test (the kernel's Moller-Trumbore) or by a GPU's (a watertight
+        // test, `twinpath_tests::watertight`), both under Vulkan's arithmetic, or the triangle
+        // left by the watertight test with every rounding at its worst.
+        let hit = |o: V, d: V, t_max: Vk32, leaving: Vec3| {
+            tris.iter().any(|&(vertices, (q, f1, f2))| {
+                let (t, _, _) = intersect::triangle(o, d, v(q), v(f1), v(f2), f(0.0), t_max);
+                t.value >= 0.0
+                    || watertight_triangle(o, d, back(d), vertices.map(v), 0.0, t_max.value)
+                        .is_some()
+            }) || own.is_some_and(|own| {
+                worst_case_watertight_hit(back(o), back(d), own, leaving, t_max.value)
+            })
+        };
         tested += 1;
         let (q, f1, f2) = (v(q), v(f1), v(f2));
         let p = triangle_point_v3(q, f1, f2, hu, hv);
@@ -265,6 +269,8 @@ fn leaving_triangles_under_vulkan(
         let condition = triangle_error_condition_v3(f1, f2);
         let scale = triangle_watertight_scale_v3(f1, f2);
         let err = triangle_point_error_v3(q, f1, f2, hu, hv, condition, scale);
+        let leaving = back(n_side);
+        let hit = |o: V, d: V, t_max: Vk32| hit(o, d, t_max, leaving);
         let (c, sh) = spawned_self_hits(&mut g, p, n_side, err, s, &hit);
         cont_fail += c as usize;
         shadow_fail += sh as usize;
