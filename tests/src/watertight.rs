@@ -29,6 +29,30 @@ fn axis<R: Real>(v: V3<R>, k: usize) -> R {
     }
 }
 
+/// The watertight test's frame for a ray along `dir`: (kx, ky, kz), kz the axis of `dir`'s
+/// largest component and kx, ky the next two in cyclic order, swapped where that component is
+/// negative so that the frame keeps the triangle's winding.
+fn ray_axes(dir: Vec3) -> (usize, usize, usize) {
+    let a = dir.abs();
+    let kz = if a.x > a.y {
+        if a.x > a.z {
+            0
+        } else {
+            2
+        }
+    } else if a.y > a.z {
+        1
+    } else {
+        2
+    };
+    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if dir[kz] < 0.0 {
+        (ky, kx, kz)
+    } else {
+        (kx, ky, kz)
+    }
+}
+
 /// The ray `origin + t dir` against the triangle with vertices `p`: its t where t is in
 /// (`t_min`, `t_max`) and the ray meets the triangle (either face), else `None`. `dir_f32` is
 /// `dir` as data, which picks the ray's dominant axis (a comparison of magnitudes, exact in any
@@ -41,24 +65,7 @@ pub fn watertight_triangle<R: Real + Into<f32>>(
     t_min: f32,
     t_max: f32,
 ) -> Option<f32> {
-    let a = dir_f32.abs();
-    let kz = if a.x > a.y {
-        if a.x > a.z {
-            0
-        } else {
-            2
-        }
-    } else if a.y > a.z {
-        1
-    } else {
-        2
-    };
-    let mut kx = (kz + 1) % 3;
-    let mut ky = (kx + 1) % 3;
-    // Keep the winding: a negative dominant component mirrors the frame.
-    if dir_f32[kz] < 0.0 {
-        core::mem::swap(&mut kx, &mut ky);
-    }
+    let (kx, ky, kz) = ray_axes(dir_f32);
     let dz = axis(dir, kz);
     let sx = axis(dir, kx) / dz;
     let sy = axis(dir, ky) / dz;
@@ -109,23 +116,7 @@ pub fn worst_case_watertight_hit(
 ) -> bool {
     let eps = f32::EPSILON as f64;
     let (o, d, n) = (origin.as_dvec3(), dir.as_dvec3(), toward_origin.as_dvec3());
-    let a = dir.abs();
-    let kz = if a.x > a.y {
-        if a.x > a.z {
-            0
-        } else {
-            2
-        }
-    } else if a.y > a.z {
-        1
-    } else {
-        2
-    };
-    let mut kx = (kz + 1) % 3;
-    let mut ky = (kx + 1) % 3;
-    if dir[kz] < 0.0 {
-        core::mem::swap(&mut kx, &mut ky);
-    }
+    let (kx, ky, kz) = ray_axes(dir);
     let (sx, sy) = (d[kx] / d[kz], d[ky] / d[kz]);
     let unit = |k: usize| glam::DVec3::from_array(core::array::from_fn(|i| (i == k) as u8 as f64));
     let toward = |axis: glam::DVec3| if axis.dot(n) >= 0.0 { axis } else { -axis };
