@@ -106,22 +106,8 @@ impl Placements {
         let (s, t) = self.placement();
         let corner = t + self.dir() * s;
         let axis = ((self.unit() * 3.0) as usize).min(2);
-        let in_plane = self.unit() < 0.5;
-        let pick = |g: &mut Self| {
-            let mut v = g.dir();
-            if in_plane {
-                v[axis] = 0.0;
-            }
-            v
-        };
-        let along = pick(self).normalize();
-        let other = pick(self);
-        let across = (other - along * other.dot(along)).normalize();
-        let long = along * s * self.pow10(-1.0, 0.0);
-        let short = across * long.length() * self.pow10(-5.0, -1.0);
-        if !long.cross(short).normalize().is_finite() {
-            return None;
-        }
+        let flat = (self.unit() < 0.5).then_some(axis);
+        let (long, short, _) = self.needle_legs(s, flat, -5.0)?;
         let mut v = [corner, corner + long, corner + short];
         v.rotate_left(((self.unit() * 3.0) as usize).min(2));
         let (a, b) = (self.unit(), self.unit());
@@ -140,6 +126,34 @@ impl Placements {
         })
     }
 
+    /// The legs of a right-angled needle at a placement of size `s`: (long, short, the unit
+    /// direction of short). The long leg is 10^U(-1, 0) of `s` along a random direction, the
+    /// short one across it, 10^U(`shortest`, -1) of the long one; with `flat` an axis, both lie
+    /// in a plane normal to it (their component there is 0). None where they are degenerate.
+    fn needle_legs(
+        &mut self,
+        s: f32,
+        flat: Option<usize>,
+        shortest: f32,
+    ) -> Option<(Vec3, Vec3, Vec3)> {
+        let mut pick = || {
+            let mut v = self.dir();
+            if let Some(axis) = flat {
+                v[axis] = 0.0;
+            }
+            v
+        };
+        let along = pick().normalize();
+        let other = pick();
+        let across = (other - along * other.dot(along)).normalize();
+        let long = along * s * self.pow10(-1.0, 0.0);
+        let short = across * long.length() * self.pow10(shortest, -1.0);
+        long.cross(short)
+            .normalize()
+            .is_finite()
+            .then_some((long, short, across))
+    }
+
     /// A right-angled needle and a well-shaped neighbour that shares its long leg, both in a
     /// plane normal to an axis (so that they are coplanar in `f32`, as a modelled floor's
     /// triangles are), and a ray toward a point of the neighbour 10^U(-6, -1) of its height from
@@ -151,18 +165,7 @@ impl Placements {
         let (s, t) = self.placement();
         let corner = t + self.dir() * s;
         let axis = ((self.unit() * 3.0) as usize).min(2);
-        let in_plane = |mut v: Vec3| {
-            v[axis] = 0.0;
-            v
-        };
-        let along = in_plane(self.dir()).normalize();
-        let other = in_plane(self.dir());
-        let across = (other - along * other.dot(along)).normalize();
-        let long = along * s * self.pow10(-1.0, 0.0);
-        let short = across * long.length() * self.pow10(-4.0, -1.0);
-        if !long.cross(short).normalize().is_finite() {
-            return None;
-        }
+        let (long, short, across) = self.needle_legs(s, Some(axis), -4.0)?;
         let apex = -across * long.length() * (0.2 + 0.8 * self.unit());
         let mut needle = [corner, corner + long, corner + short];
         needle.rotate_left(((self.unit() * 3.0) as usize).min(2));

@@ -118,7 +118,7 @@ pub fn worst_case_watertight_hit(
     let (o, d, n) = (origin.as_dvec3(), dir.as_dvec3(), toward_origin.as_dvec3());
     let (kx, ky, kz) = ray_axes(dir);
     let (sx, sy) = (d[kx] / d[kz], d[ky] / d[kz]);
-    let unit = |k: usize| glam::DVec3::from_array(core::array::from_fn(|i| (i == k) as u8 as f64));
+    let unit = |k: usize| glam::DVec3::AXES[k];
     let toward = |axis: glam::DVec3| if axis.dot(n) >= 0.0 { axis } else { -axis };
     let moved = p.map(|q| {
         let rel = q.as_dvec3() - o;
@@ -132,11 +132,8 @@ pub fn worst_case_watertight_hit(
     let sheared = moved.map(|r| (r[kx] - sx * r[kz], r[ky] - sy * r[kz], r[kz] / d[kz]));
     let [(ax, ay, az), (bx, by, bz), (cx, cy, cz)] = sheared;
     let exact = [cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax];
-    let size = [
-        (bx.hypot(by)) * (cx.hypot(cy)),
-        (cx.hypot(cy)) * (ax.hypot(ay)),
-        (ax.hypot(ay)) * (bx.hypot(by)),
-    ];
+    let norm = [ax.hypot(ay), bx.hypot(by), cx.hypot(cy)];
+    let size: [f64; 3] = core::array::from_fn(|i| norm[(i + 1) % 3] * norm[(i + 2) % 3]);
     let depth = [az, bz, cz];
     let det: f64 = exact.iter().sum();
     if det == 0.0 {

@@ -74,16 +74,17 @@ fn spawned_self_hits(
 }
 
 /// The first of `triangles` (p0, edge1, edge2) that the ray `origin + t dir` meets, with the
-/// kernel's hit record of it, as the CPU finds it.
+/// kernel's hit record of it, as the CPU finds it, and its place among them.
 fn first_hit(
     origin: Vec3,
     dir: Vec3,
     triangles: impl Iterator<Item = (Vec3, Vec3, Vec3)>,
-) -> Option<(kernel::geometry::TriangleHit, Vec3, Vec3, Vec3)> {
+) -> Option<(kernel::geometry::TriangleHit, usize, Vec3, Vec3, Vec3)> {
     triangles
-        .map(|(q, f1, f2)| {
+        .enumerate()
+        .map(|(i, (q, f1, f2))| {
             let h = intersect_triangle_uv(origin, dir, q, f1, f2, 0.0, f32::INFINITY);
-            (h, q, f1, f2)
+            (h, i, q, f1, f2)
         })
         .filter(|(h, ..)| h.t >= 0.0)
         .min_by(|a, b| a.0.t.total_cmp(&b.0.t))
@@ -103,7 +104,7 @@ fn rays_leaving_triangles_and_quads_never_hit_them_again() {
             tris.iter()
                 .any(|&(q, f1, f2)| intersect_triangle(o, d, q, f1, f2, 0.0, t_max) >= 0.0)
         };
-        let Some((h, q, f1, f2)) = first_hit(origin, dir, tris.iter().copied()) else {
+        let Some((h, _, q, f1, f2)) = first_hit(origin, dir, tris.iter().copied()) else {
             continue; // the ray slipped past an edge
         };
         tested += 1;
@@ -138,7 +139,8 @@ fn leaving_triangles(
             continue;
         };
         let tris = c.loaded();
-        let Some((h, q, f1, f2)) = first_hit(c.origin, c.dir, tris.iter().map(|t| t.1)) else {
+        let Some((h, index, q, f1, f2)) = first_hit(c.origin, c.dir, tris.iter().map(|t| t.1))
+        else {
             continue; // the ray slipped past an edge
         };
         tested += 1;
@@ -146,7 +148,7 @@ fn leaving_triangles(
         let nn = triangle_normal(f1, f2);
         let n_side = if nn.dot(c.dir) < 0.0 { nn } else { -nn };
         let err = triangle_point_error(q, f1, f2, h.u, h.v);
-        let own = tris.iter().find(|t| t.1 == (q, f1, f2)).map(|t| t.0);
+        let own = tris[index].0;
         let on_cpu = |(o, d, t_max): (Vec3, Vec3, f32)| {
             tris.iter()
                 .any(|&(_, (q, f1, f2))| intersect_triangle(o, d, q, f1, f2, 0.0, t_max) >= 0.0)
@@ -164,8 +166,7 @@ fn leaving_triangles(
             if let Some((o, d, t_max)) = ray {
                 cpu[k] += on_cpu((o, d, t_max)) as usize;
                 gpu[k] += on_gpu((o, d, t_max)) as usize;
-                worst[k] +=
-                    own.is_some_and(|v| worst_case_watertight_hit(o, d, v, n_side, t_max)) as usize;
+                worst[k] += worst_case_watertight_hit(o, d, own, n_side, t_max) as usize;
             }
         }
     }

@@ -230,7 +230,7 @@ fn leaving_triangles_under_vulkan(
         let (s, origin, dir, tris) = (c.size, c.origin, c.dir, c.loaded());
         let best = tris
             .iter()
-            .map(|&(_, (q, f1, f2))| {
+            .map(|&(vertices, (q, f1, f2))| {
                 let h = intersect::triangle(
                     v(origin),
                     v(dir),
@@ -240,26 +240,12 @@ fn leaving_triangles_under_vulkan(
                     f(0.0),
                     f(f32::INFINITY),
                 );
-                (h, q, f1, f2)
+                (h, vertices, q, f1, f2)
             })
             .filter(|(h, ..)| h.0.value >= 0.0)
             .min_by(|a, b| a.0 .0.value.total_cmp(&b.0 .0.value));
-        let Some(((_, hu, hv), q, f1, f2)) = best else {
+        let Some(((_, hu, hv), own, q, f1, f2)) = best else {
             continue;
-        };
-        let own = tris.iter().find(|t| t.1 == (q, f1, f2)).map(|t| t.0);
-        // Met by the CPU's test (the kernel's Moller-Trumbore) or by a GPU's (a watertight
-        // test, `twinpath_tests::watertight`), both under Vulkan's arithmetic, or the triangle
-        // left by the watertight test with every rounding at its worst.
-        let hit = |o: V, d: V, t_max: Vk32, leaving: Vec3| {
-            tris.iter().any(|&(vertices, (q, f1, f2))| {
-                let (t, _, _) = intersect::triangle(o, d, v(q), v(f1), v(f2), f(0.0), t_max);
-                t.value >= 0.0
-                    || watertight_triangle(o, d, back(d), vertices.map(v), 0.0, t_max.value)
-                        .is_some()
-            }) || own.is_some_and(|own| {
-                worst_case_watertight_hit(back(o), back(d), own, leaving, t_max.value)
-            })
         };
         tested += 1;
         let (q, f1, f2) = (v(q), v(f1), v(f2));
@@ -269,8 +255,18 @@ fn leaving_triangles_under_vulkan(
         let condition = triangle_error_condition_v3(f1, f2);
         let scale = triangle_watertight_scale_v3(f1, f2);
         let err = triangle_point_error_v3(q, f1, f2, hu, hv, condition, scale);
+        // Met by the CPU's test (the kernel's Moller-Trumbore) or by a GPU's (a watertight
+        // test, `twinpath_tests::watertight`), both under Vulkan's arithmetic, or the triangle
+        // left by the watertight test with every rounding at its worst.
         let leaving = back(n_side);
-        let hit = |o: V, d: V, t_max: Vk32| hit(o, d, t_max, leaving);
+        let hit = |o: V, d: V, t_max: Vk32| {
+            tris.iter().any(|&(vertices, (q, f1, f2))| {
+                let (t, _, _) = intersect::triangle(o, d, v(q), v(f1), v(f2), f(0.0), t_max);
+                t.value >= 0.0
+                    || watertight_triangle(o, d, back(d), vertices.map(v), 0.0, t_max.value)
+                        .is_some()
+            }) || worst_case_watertight_hit(back(o), back(d), own, leaving, t_max.value)
+        };
         let (c, sh) = spawned_self_hits(&mut g, p, n_side, err, s, &hit);
         cont_fail += c as usize;
         shadow_fail += sh as usize;
