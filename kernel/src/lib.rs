@@ -29,6 +29,7 @@ pub mod opacity;
 pub mod path;
 pub mod path_media;
 pub mod phase;
+pub mod plane_side;
 #[cfg(feature = "probe")]
 pub mod probe;
 pub mod real;

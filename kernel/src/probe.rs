@@ -20,6 +20,7 @@ use crate::geometry::{
 };
 use crate::light::{directional, punctual, triangle};
 use crate::phase;
+use crate::plane_side::ray_leaves_triangle_plane;
 use crate::real::{self, V3};
 use crate::rng::{pcg4d, u32_to_unit_f32};
 use crate::sampling::{sample_lobe, sample_sphere, sample_sphere_cone};
@@ -113,7 +114,10 @@ pub mod function {
     /// environment::map_coordinates(d)'s (u, v, sin theta) and its texel (column, row) as
     /// column + width row
     pub const ENVIRONMENT: u32 = 20;
-    pub const COUNT: u32 = 21;
+    /// o = in0.xyz, d = in1.xyz, p0 = in2.xyz, e1 = in3.xyz, e2 = (in0.w, in1.w, in2.w) ->
+    /// out0.x = 1 where `plane_side::ray_leaves_triangle_plane(o, d, p0, e1, e2)`, else 0
+    pub const PLANE_SIDE: u32 = 21;
+    pub const COUNT: u32 = 22;
 }
 
 #[inline]
@@ -386,6 +390,14 @@ pub fn evaluate(function: u32, input: [UVec4; 4]) -> [UVec4; 2] {
         } else {
             (Vec4::new(h.t, 0.0, 0.0, 0.0), Vec4::ZERO)
         }
+    } else if function == function::PLANE_SIDE {
+        let e2 = Vec3::new(i0.w, i1.w, i2.w);
+        let (o, d, p0, e1) = (i0.truncate(), i1.truncate(), i2.truncate(), i3.truncate());
+        let leaves = ray_leaves_triangle_plane(o, d, p0, e1, e2);
+        (
+            Vec4::new(if leaves { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0),
+            Vec4::ZERO,
+        )
     } else if function == function::OFFSET_RAY_ORIGIN {
         (
             v3(offset_ray_origin(i0.truncate(), i1.truncate(), i1.w)),

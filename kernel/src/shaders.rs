@@ -19,6 +19,12 @@
 //! where a material has holes (`crate::opacity`), the triangle groups have any-hit shaders
 //! too, which run for the triangles of BLASes built without the OPAQUE flag, and rays are
 //! traced without `RayFlags::OPAQUE`. Miss shader 0 serves both kinds of ray.
+//!
+//! A hit on a triangle whose plane the ray certainly leaves (`crate::plane_side`) is the
+//! device's rounding, not the surface: the triangles' closest-hit shaders mark it
+//! ([`answer::REJECTED`]) and the ray is traced on past it
+//! ([`crate::plane_side::trace_past_rejected_hits`]). Shadow rays therefore run the closest-hit
+//! shader of the hit that ends them, which then only answers whether it stands.
 
 use crate::adaptive::{luminance, pixel_converged};
 use crate::features::{Dynamic, FeatureSet};
@@ -28,6 +34,7 @@ use crate::hit::SurfaceHit;
 use crate::medium::Medium;
 use crate::opacity::{covers, CandidateRay, HoleTables};
 use crate::path::Tracer;
+use crate::plane_side::{ray_leaves_triangle_plane, trace_past_rejected_hits};
 use crate::scene::{
     Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle, NONE,
 };
@@ -40,6 +47,20 @@ use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
 use spirv_std::spirv;
 
+/// [`HitPayload::hit`]: what the ray-generation shader asks before a trace, and what the hit
+/// and miss shaders answer.
+mod answer {
+    /// The ray missed (the miss shader's answer); before a trace, a full hit record is wanted.
+    pub const MISS: u32 = 0;
+    /// A hit that stands.
+    pub const HIT: u32 = 1;
+    /// A hit on a triangle whose plane the ray certainly leaves (`crate::plane_side`), at
+    /// `position_t.w`: to be traced past.
+    pub const REJECTED: u32 = 2;
+    /// Before a shadow ray's trace: only whether the hit stands, and its t, are wanted.
+    pub const OCCLUSION: u32 = 3;
+}
+
 /// What a closest-hit or miss shader hands back to the ray-generation shader.
 #[derive(Clone, Copy)]
 #[repr(C)]
@@ -50,7 +71,7 @@ pub struct HitPayload {
     pub normal: Vec4,
     pub material: u32,
     pub light: u32,
-    /// 1 if the ray hit something; the miss shader clears it.
+    /// One of [`answer`]: asked by the ray-generation shader, answered by the others.
     pub hit: u32,
     /// 1 if the ray arrived from behind the normal (`SurfaceHit::arrived_behind`).
     pub behind: u32,
@@ -62,22 +83,47 @@ pub struct HitPayload {
 }
 
 impl HitPayload {
-    /// Stores a closest-hit shader's record (and marks the ray as having hit).
-    fn store(&mut self, h: &SurfaceHit) {
+    /// Stores a closest-hit shader's record, marked as a hit that stands, or as rejected where
+    /// `rejected`.
+    fn store(&mut self, h: &SurfaceHit, rejected: bool) {
         self.position_t = h.position.extend(h.t);
         self.normal = h.normal.extend(h.error);
         self.material = h.material;
         self.light = h.light;
-        self.hit = 1;
+        self.hit = if rejected {
+            answer::REJECTED
+        } else {
+            answer::HIT
+        };
         self.behind = h.arrived_behind as u32;
         self.barycentrics = h.barycentrics;
         self.shading = h.shading;
         self.instance = h.instance;
     }
 
-    /// The record a closest-hit shader stored, or a miss.
+    /// A shadow ray's answer from a closest-hit shader: whether its hit at `t` stands.
+    fn answer_occlusion(&mut self, rejected: bool, t: f32) {
+        self.position_t.w = t;
+        self.hit = if rejected {
+            answer::REJECTED
+        } else {
+            answer::HIT
+        };
+    }
+
+    /// The distance of a rejected hit, or `None` where the hit stands or the ray missed.
+    fn rejected_at(&self) -> Option<f32> {
+        if self.hit == answer::REJECTED {
+            Some(self.position_t.w)
+        } else {
+            None
+        }
+    }
+
+    /// The record a closest-hit shader stored (a rejected one too: one that stands after
+    /// `MAX_REJECTED_HITS`), or a miss.
     fn surface(&self) -> SurfaceHit {
-        if self.hit == 0 {
+        if self.hit == answer::MISS {
             return SurfaceHit::miss();
         }
         SurfaceHit {
@@ -104,24 +150,23 @@ struct RayTracer<'a> {
 }
 
 impl RayTracer<'_> {
-    /// The closest hit along `origin + t dir`, t in (0, t_max), through the closest-hit and
-    /// miss shaders.
-    fn trace_closest(&mut self, origin: Vec3, dir: Vec3, t_max: f32) -> SurfaceHit {
-        self.payload.hit = 0;
+    /// One trace of `origin + t dir`, t in [t_min, t_max], asking `ask` ([`answer`]).
+    fn trace(&mut self, flags: RayFlags, ask: u32, origin: Vec3, dir: Vec3, t: (f32, f32)) {
+        self.payload.hit = ask;
         unsafe {
-            self.tlas.trace_ray(
-                self.opaque,
-                0xff,
-                0,
-                1,
-                0,
-                origin,
-                0.0,
-                dir,
-                t_max,
-                self.payload,
-            );
+            self.tlas
+                .trace_ray(flags, 0xff, 0, 1, 0, origin, t.0, dir, t.1, self.payload);
         }
+    }
+
+    /// The closest hit along `origin + t dir`, t in (0, t_max), through the closest-hit and
+    /// miss shaders, past rejected hits.
+    fn trace_closest(&mut self, origin: Vec3, dir: Vec3, t_max: f32) -> SurfaceHit {
+        let flags = self.opaque;
+        trace_past_rejected_hits(false, |t_min, _| {
+            self.trace(flags, answer::MISS, origin, dir, (t_min, t_max));
+            self.payload.rejected_at()
+        });
         self.payload.surface()
     }
 }
@@ -132,23 +177,19 @@ impl Tracer for RayTracer<'_> {
     }
 
     fn occluded(&mut self, from: Vec3, to: Vec3) -> bool {
-        // Any hit ends the ray at once and no closest-hit shader runs; only a miss clears `hit`.
-        self.payload.hit = 1;
-        unsafe {
-            self.tlas.trace_ray(
-                self.opaque | RayFlags::TERMINATE_ON_FIRST_HIT | RayFlags::SKIP_CLOSEST_HIT_SHADER,
-                0xff,
-                0,
-                1,
-                0,
-                from,
-                0.0,
-                to - from,
-                1.0,
-                self.payload,
-            );
-        }
-        self.payload.hit != 0
+        // Any hit ends the ray at once; its closest-hit shader answers whether it stands. Where
+        // it does not, the segment is searched for its closest hits, past rejected ones.
+        let (dir, opaque) = (to - from, self.opaque);
+        trace_past_rejected_hits(true, |t_min, any| {
+            let flags = if any {
+                opaque | RayFlags::TERMINATE_ON_FIRST_HIT
+            } else {
+                opaque
+            };
+            self.trace(flags, answer::OCCLUSION, from, dir, (t_min, 1.0));
+            self.payload.rejected_at()
+        });
+        self.payload.hit != answer::MISS
     }
 
     fn first_hit_on(&mut self, from: Vec3, to: Vec3) -> SurfaceHit {
@@ -283,43 +324,56 @@ pub fn raygen(
 /// Miss: the ray left the scene.
 #[spirv(miss)]
 pub fn miss(#[spirv(incoming_ray_payload)] payload: &mut HitPayload) {
-    payload.hit = 0;
+    payload.hit = answer::MISS;
 }
 
 /// Closest hit on a triangle: the record of `SurfaceHit::triangle`, as on the CPU, from the
-/// triangle table (`instance_custom_index` is the instance's first triangle).
+/// triangle table (`instance_custom_index` is the instance's first triangle), rejected where
+/// the ray certainly leaves the triangle's plane; a shadow ray's answer alone.
 #[spirv(closest_hit)]
 pub fn closest_hit_triangle(
     #[spirv(incoming_ray_payload)] payload: &mut HitPayload,
     #[spirv(hit_attribute)] barycentrics: &Vec2,
     #[spirv(primitive_id)] primitive: u32,
     #[spirv(instance_custom_index)] first: u32,
+    #[spirv(world_ray_origin)] origin: Vec3,
     #[spirv(world_ray_direction)] dir: Vec3,
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
 ) {
     let tri = &triangles[(first + primitive) as usize];
+    let rejected = leaves_plane(tri, origin, dir);
+    if payload.hit == answer::OCCLUSION {
+        payload.answer_occlusion(rejected, t);
+        return;
+    }
     let shape = TriangleShape::of(Vec3::from(tri.edge1), Vec3::from(tri.edge2));
-    payload.store(&SurfaceHit::triangle(
-        tri,
-        shape,
-        dir,
-        t,
-        barycentrics.x,
-        barycentrics.y,
-    ));
+    let hit = SurfaceHit::triangle(tri, shape, dir, t, barycentrics.x, barycentrics.y);
+    payload.store(&hit, rejected);
+}
+
+/// Whether the ray `origin + t dir` certainly leaves the plane of `tri`
+/// (`plane_side::ray_leaves_triangle_plane`, in the triangle's own space).
+#[inline]
+fn leaves_plane(tri: &Triangle, origin: Vec3, dir: Vec3) -> bool {
+    let (p0, e1, e2) = (tri.p0.into(), tri.edge1.into(), tri.edge2.into());
+    ray_leaves_triangle_plane(origin, dir, p0, e1, e2)
 }
 
 /// Closest hit on an instanced triangle: the record of `SurfaceHit::instanced_triangle`, as on
 /// the CPU, from the instance table (`instance_custom_index` is the instance's record) and the
 /// triangle table (the instance's mesh from `Instance::first_triangle`). The hardware's `t` and
-/// barycentrics are the object-space ray's, which an affine map keeps.
+/// barycentrics are the object-space ray's, which an affine map keeps. Rejected where the
+/// object-space ray (the one the device met the triangle with) certainly leaves the
+/// triangle's plane; a shadow ray's answer alone.
 #[spirv(closest_hit)]
 pub fn closest_hit_instance(
     #[spirv(incoming_ray_payload)] payload: &mut HitPayload,
     #[spirv(hit_attribute)] barycentrics: &Vec2,
     #[spirv(primitive_id)] primitive: u32,
     #[spirv(instance_custom_index)] index: u32,
+    #[spirv(object_ray_origin)] object_origin: Vec3,
+    #[spirv(object_ray_direction)] object_dir: Vec3,
     #[spirv(world_ray_direction)] dir: Vec3,
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
@@ -327,17 +381,15 @@ pub fn closest_hit_instance(
 ) {
     let instance = &instances[index as usize];
     let tri = &triangles[(instance.first_triangle + primitive) as usize];
+    let rejected = leaves_plane(tri, object_origin, object_dir);
+    if payload.hit == answer::OCCLUSION {
+        payload.answer_occlusion(rejected, t);
+        return;
+    }
     let shape = TriangleShape::of(Vec3::from(tri.edge1), Vec3::from(tri.edge2));
-    payload.store(&SurfaceHit::instanced_triangle(
-        tri,
-        shape,
-        instance,
-        index,
-        dir,
-        t,
-        barycentrics.x,
-        barycentrics.y,
-    ));
+    let (u, v) = (barycentrics.x, barycentrics.y);
+    let hit = SurfaceHit::instanced_triangle(tri, shape, instance, index, dir, t, u, v);
+    payload.store(&hit, rejected);
 }
 
 /// Any hit on a triangle with holes: the candidate is ignored where `opacity::covers` says the
@@ -433,7 +485,8 @@ pub fn intersect_sphere_shader(
     }
 }
 
-/// Closest hit on a sphere: the point re-projected onto the surface, the outward normal.
+/// Closest hit on a sphere: the point re-projected onto the surface, the outward normal; a
+/// shadow ray's answer alone (a sphere's hit always stands: the kernel's own test).
 #[spirv(closest_hit)]
 pub fn closest_hit_sphere(
     #[spirv(incoming_ray_payload)] payload: &mut HitPayload,
@@ -444,12 +497,12 @@ pub fn closest_hit_sphere(
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] spheres: &[Sphere],
 ) {
-    payload.store(&SurfaceHit::sphere(
-        origin,
-        dir,
-        t,
-        &spheres[(first + primitive) as usize],
-    ));
+    if payload.hit == answer::OCCLUSION {
+        payload.answer_occlusion(false, t);
+        return;
+    }
+    let sphere = &spheres[(first + primitive) as usize];
+    payload.store(&SurfaceHit::sphere(origin, dir, t, sphere), false);
 }
 
 /// Push constants of [`probe`] (feature `probe`: tests only).

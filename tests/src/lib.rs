@@ -172,6 +172,7 @@ pub mod gltf_writer;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod placements;
+pub mod plane_side;
 pub mod probe_inputs;
 pub mod reference_bsdf;
 pub mod sheen_fit;

@@ -94,6 +94,29 @@ fn inputs(func: u32, g: &mut Gen) -> Vec<[[u32; 4]; 4]> {
                 let d = (target - o).normalize_or(g.dir());
                 rec([w(o, f32::INFINITY), w(d, e2.x), w(p0, e2.y), w(e1, e2.z)])
             }
+            function::PLANE_SIDE => {
+                // A triangle (a quarter in a plane normal to z, a third translated by 10^3 of
+                // its size), an origin on it or 10^-7 to 1 of its size off its plane, either
+                // side, and a random or grazing direction.
+                let s = g.scale();
+                let p0 = g.vec() * s * g.pick(&[1.0, 1.0, 1e3]);
+                let (mut e1, mut e2) = (g.vec() * s, g.vec() * s);
+                if g.u64().is_multiple_of(4) {
+                    (e1.z, e2.z) = (0.0, 0.0);
+                }
+                // The edges as the host computes them, from f32 vertices.
+                let (e1, e2) = ((p0 + e1) - p0, (p0 + e2) - p0);
+                let n = e1.cross(e2).normalize_or(Vec3::Z);
+                let p = p0 + e1 * (0.5 * g.unit()) + e2 * (0.5 * g.unit());
+                let h = g.pick(&[0.0, 1e-7, 1e-5, 1e-3, 1.0]) * g.pick(&[1.0, -1.0]);
+                let o = p + n * h * s;
+                let d = if g.u64().is_multiple_of(3) {
+                    g.grazing(n)
+                } else {
+                    g.dir()
+                };
+                rec([w(o, e2.x), w(d, e2.y), w(p0, e2.z), w(e1, 0.0)])
+            }
             function::OFFSET_RAY_ORIGIN => {
                 let s = g.scale();
                 let m = g.pick(&[s, 1e-3, 0.03, 1.0, 1e4]);
@@ -399,6 +422,7 @@ const BOUNDS: &[Bound] = &[
     Bound { name: "surface::mapped_normal", func: function::MAPPED_NORMAL, max_ulps: 8, abs: 16.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "a blend, one Gram-Schmidt step, a cross product and two normalisations of unit-scale vectors (FMA contraction, sqrt): 16 eps on a unit vector" },
     Bound { name: "punctual and directional light samples", func: function::PUNCTUAL_LIGHT, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "a difference, a dot product, a root and a quotient (FMA contraction): 8 eps on the unit normal, 8 ULP on the density; the spot's falloff a multiply-add clamped and squared, 8 eps times (1 + |scale| + |offset|); the directional light's point 8 eps of |x| + 2 (radius + |x - centre|), per record (`allowed_abs`)" },
     Bound { name: "environment map sample and look-up", func: function::ENVIRONMENT, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "the drawn direction: two quotients, cos_sin_turns' polynomials and the rotation (FMA contraction), 8 eps on a unit vector; the density (1 / sin theta, ill-conditioned at the bottom pole, where 1 - v is a few eps) and the look-up (u, v, sin theta and the texel: a direction within rounding of the seam or of a texel's edge may read either side), by balls per record (`environment_apart`, whose Vulkan model holds FMA contraction)" },
+    Bound { name: "plane_side::ray_leaves_triangle_plane", func: function::PLANE_SIDE, max_ulps: 0, abs: 0.0, flip_fraction: 1e-3, ill_conditioned: None, vulkan: false, why: "a sure answer (1) from either side is held to the exact one (f64): never wrong on any device; the two may differ only where one is sure and the other within its bound (FMA contraction), counted as flips" },
     Bound { name: "camera_ray_direction", func: function::CAMERA_RAY, max_ulps: 8, abs: 8.0 * f32::EPSILON, flip_fraction: 0.0, ill_conditioned: None, vulkan: false, why: "multiply-adds and a normalisation (FMA contraction, sqrt): 8 eps on unit vectors" },
 ];
 
@@ -418,6 +442,16 @@ fn bsdf_record(func: u32, r: &[[u32; 4]; 4]) -> twinpath_tests::device_class::Bs
         third: v(2),
         albedo: (f(3, 2), f(3, 3)),
     }
+}
+
+/// Whether the exact ray of a `PLANE_SIDE` record leaves its triangle's plane (decided in
+/// `f64`; `false` where `f64` cannot decide, far inside any bound an `f32` answer is sure
+/// beyond).
+fn plane_side_is_right(r: &[[u32; 4]; 4]) -> bool {
+    let f = |i: usize, j: usize| f32::from_bits(r[i][j]);
+    let v = |i: usize| Vec3::new(f(i, 0), f(i, 1), f(i, 2));
+    let e2 = Vec3::new(f(0, 3), f(1, 3), f(2, 3));
+    twinpath_tests::plane_side::exact(v(0), v(1), v(2), v(3), e2).is_some_and(|x| x.leaves())
 }
 
 /// The absolute error allowed for output component (k, j) of record `r` under bound `b`, whose
@@ -1024,6 +1058,21 @@ fn functions_agree(ctx: &twinpath::vulkan::device::Context, ieee_device: bool) {
                 b.func,
                 function::INTERSECT_SPHERE | function::INTERSECT_TRIANGLE
             );
+            if b.func == function::PLANE_SIDE {
+                let (sure_c, sure_g) =
+                    (c_out[0][0] == 1f32.to_bits(), g_out[0][0] == 1f32.to_bits());
+                if sure_c != sure_g {
+                    flips += 1;
+                }
+                // Either side's sure answer must be the exact one (`kernel::plane_side`'s bounds
+                // hold on any conformant device).
+                if (sure_c || sure_g) && !plane_side_is_right(r) {
+                    bad += 1;
+                    unexplained_flips += 1;
+                    bad_records.insert(*r);
+                }
+                continue;
+            }
             if is_t {
                 let (tc, tg) = (f32::from_bits(c_out[0][0]), f32::from_bits(g_out[0][0]));
                 if (tc >= 0.0) != (tg >= 0.0) {

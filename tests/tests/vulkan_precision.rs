@@ -25,6 +25,7 @@ use kernel::geometry::{
     triangle_point_error_v3, triangle_point_v3, triangle_watertight_scale_v3, TRIANGLE_ERROR_EPS,
 };
 use kernel::intersect;
+use kernel::plane_side::ray_leaves_triangle_plane_v3;
 use kernel::real::{Exponential, Real, V3};
 use kernel::sampling::{sample_cosine_hemisphere_v3, sample_sphere_cone_v3};
 use twinpath_tests::device_class::{
@@ -47,6 +48,8 @@ mod free_flights;
 mod grid_walks;
 #[path = "vulkan_precision/normal_map_frames.rs"]
 mod normal_map_frames;
+#[path = "vulkan_precision/plane_side.rs"]
+mod plane_side;
 #[path = "vulkan_precision/samplers.rs"]
 mod samplers;
 #[path = "vulkan_precision/spherical_triangles.rs"]
@@ -256,15 +259,17 @@ fn leaving_triangles_under_vulkan(
         let scale = triangle_watertight_scale_v3(f1, f2);
         let err = triangle_point_error_v3(q, f1, f2, hu, hv, condition, scale);
         // Met by the CPU's test (the kernel's Moller-Trumbore) or by a GPU's (a watertight
-        // test, `twinpath_tests::watertight`), both under Vulkan's arithmetic, or the triangle
-        // left by the watertight test with every rounding at its worst.
+        // test, `twinpath_tests::watertight`, whose hits on a plane the ray certainly leaves
+        // the GPU's tracer rejects: `kernel::plane_side`), all under Vulkan's arithmetic, or
+        // the triangle left by the watertight test with every rounding at its worst.
         let leaving = back(n_side);
         let hit = |o: V, d: V, t_max: Vk32| {
             tris.iter().any(|&(vertices, (q, f1, f2))| {
                 let (t, _, _) = intersect::triangle(o, d, v(q), v(f1), v(f2), f(0.0), t_max);
                 t.value >= 0.0
-                    || watertight_triangle(o, d, back(d), vertices.map(v), 0.0, t_max.value)
+                    || (watertight_triangle(o, d, back(d), vertices.map(v), 0.0, t_max.value)
                         .is_some()
+                        && !ray_leaves_triangle_plane_v3(o, d, v(q), v(f1), v(f2)))
             }) || worst_case_watertight_hit(back(o), back(d), own, leaving, t_max.value)
         };
         let (c, sh) = spawned_self_hits(&mut g, p, n_side, err, s, &hit);
@@ -289,6 +294,18 @@ fn rays_leaving_needles_never_hit_them_again_under_vulkan_arithmetic() {
     let (tested, cont_fail, shadow_fail) =
         leaving_triangles_under_vulkan(3, 22, &mut |g, _| g.needle_case());
     println!("needles under Vulkan arithmetic, Moller-Trumbore and watertight: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own needle again");
+    assert!(tested > cases() / 2);
+    assert_eq!((cont_fail, shadow_fail), (0, 0));
+}
+
+/// A needle's neighbour (`Placements::needle_neighbour_case`) under [`Vk32`]: the watertight
+/// test's hits on the needle behind a ray leaving its neighbour are all rejected by the
+/// plane-side test, computed under the same arithmetic.
+#[test]
+fn rays_leaving_a_needles_neighbour_never_hit_either_under_vulkan_arithmetic() {
+    let (tested, cont_fail, shadow_fail) =
+        leaving_triangles_under_vulkan(4, 23, &mut |g, _| g.needle_neighbour_case());
+    println!("needle neighbours under Vulkan arithmetic, Moller-Trumbore and watertight (rejected where the ray certainly leaves the plane): {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit a triangle again");
     assert!(tested > cases() / 2);
     assert_eq!((cont_fail, shadow_fail), (0, 0));
 }
