@@ -2,7 +2,9 @@
 //! and its direction not toward it, decided only where no rounding can change the answer. Such a
 //! ray cannot meet the triangle at any t > 0, so a hit that a device's triangle test reports on
 //! it is that test's rounding, not the surface (`docs/robustness.md`, "Hits a ray cannot
-//! make"); the GPU's tracer rejects it and traces on (`crate::shaders`).
+//! make"), which a tracer may reject. The GPU's tracer does not yet: a first version that did
+//! cost the ray-generation shader too much (robustness.md); the tests hold the function to its
+//! bounds under every arithmetic and on the device (`kernel::probe`).
 //!
 //! The triangle is the one the device holds: vertices p0, p1 = fl(p0 + edge1) and
 //! p2 = fl(p0 + edge2), as the host writes them into the acceleration structure (in IEEE
@@ -139,50 +141,4 @@ fn bound<R: Real>(factor: V3<R>, permanent: V3<R>, vertices: V3<R>, eps_count: f
     R::splat(eps_count * f32::EPSILON) * factor.dot(permanent)
         + R::splat(VERTEX_ROUNDING_FACTOR) * factor.dot(vertices)
         + flushed
-}
-
-/// How many rejected hits in a row a trace passes over ([`trace_past_rejected_hits`]) before it
-/// lets the next one stand. A rejected hit is the device's rounding on a triangle whose plane the
-/// ray leaves, found near the ray's origin; more than one in a row takes several such triangles
-/// there (a fan of needles), and a ray that meets more than eight lets the ninth stand, as every
-/// hit stood before the test existed.
-pub const MAX_REJECTED_HITS: u32 = 8;
-
-/// Traces a ray past the hits a tracer rejects: `trace(t_min, any)` traces it from `t_min` and
-/// returns `Some(t)` where the hit it ended at, at t, was rejected, `None` where that hit stands
-/// or the ray missed; `any` asks for any hit (a shadow ray's first trace, which ends at the first
-/// hit found), else the closest. From t_min = 0, each rejected closest hit at t is passed over by
-/// tracing again from the float after t: every surface nearer than it was passed over by the
-/// search that found it, so the next trace finds the next one (a surface at exactly the same
-/// computed t is lost, which only an exact tie of two computed distances can cause). A rejected
-/// hit of a trace for any hit need not be the closest, so the ray is then traced again from 0
-/// for its closest. After [`MAX_REJECTED_HITS`] rejected closest hits the last trace's hit
-/// stands. One call of `trace` in the loop, so a shader that inlines it holds one trace call.
-/// Returns how many closest hits were passed over.
-#[inline]
-pub fn trace_past_rejected_hits<F: FnMut(f32, bool) -> Option<f32>>(
-    any_first: bool,
-    mut trace: F,
-) -> u32 {
-    let mut t_min = 0.0;
-    let mut passed = 0;
-    let mut any = any_first;
-    while let Some(t) = trace(t_min, any) {
-        if any {
-            any = false;
-        } else if passed == MAX_REJECTED_HITS {
-            break;
-        } else {
-            passed += 1;
-            t_min = float_after(t);
-        }
-    }
-    passed
-}
-
-/// The smallest float above `t` (t >= 0 and finite, a hit's distance), at least the smallest
-/// normal float: a device may flush a denormal t_min to 0, which would find the same hit again.
-#[inline]
-pub fn float_after(t: f32) -> f32 {
-    f32::from_bits(t.to_bits() + 1).max(f32::MIN_POSITIVE)
 }

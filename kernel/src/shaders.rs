@@ -19,12 +19,6 @@
 //! where a material has holes (`crate::opacity`), the triangle groups have any-hit shaders
 //! too, which run for the triangles of BLASes built without the OPAQUE flag, and rays are
 //! traced without `RayFlags::OPAQUE`. Miss shader 0 serves both kinds of ray.
-//!
-//! A hit on a triangle whose plane the ray certainly leaves (`crate::plane_side`) is the
-//! device's rounding, not the surface: the triangles' closest-hit shaders mark it
-//! ([`answer::REJECTED`]) and the ray is traced on past it
-//! ([`crate::plane_side::trace_past_rejected_hits`]). Shadow rays therefore run the closest-hit
-//! shader of the hit that ends them, which then only answers whether it stands.
 
 use crate::adaptive::{luminance, pixel_converged};
 use crate::features::{Dynamic, FeatureSet};
@@ -34,7 +28,6 @@ use crate::hit::SurfaceHit;
 use crate::medium::Medium;
 use crate::opacity::{covers, CandidateRay, HoleTables};
 use crate::path::Tracer;
-use crate::plane_side::{ray_leaves_triangle_plane, trace_past_rejected_hits};
 use crate::scene::{
     Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle, NONE,
 };
@@ -47,20 +40,6 @@ use spirv_std::image::Image;
 use spirv_std::ray_tracing::{AccelerationStructure, RayFlags};
 use spirv_std::spirv;
 
-/// [`HitPayload::hit`]: what the ray-generation shader asks before a trace, and what the hit
-/// and miss shaders answer.
-mod answer {
-    /// The ray missed (the miss shader's answer); before a trace, a full hit record is wanted.
-    pub const MISS: u32 = 0;
-    /// A hit that stands.
-    pub const HIT: u32 = 1;
-    /// A hit on a triangle whose plane the ray certainly leaves (`crate::plane_side`), at
-    /// `position_t.w`: to be traced past.
-    pub const REJECTED: u32 = 2;
-    /// Before a shadow ray's trace: only whether the hit stands, and its t, are wanted.
-    pub const OCCLUSION: u32 = 3;
-}
-
 /// What a closest-hit or miss shader hands back to the ray-generation shader.
 #[derive(Clone, Copy)]
 #[repr(C)]
@@ -71,7 +50,7 @@ pub struct HitPayload {
     pub normal: Vec4,
     pub material: u32,
     pub light: u32,
-    /// One of [`answer`]: asked by the ray-generation shader, answered by the others.
+    /// 1 if the ray hit something; the miss shader clears it.
     pub hit: u32,
     /// 1 if the ray arrived from behind the normal (`SurfaceHit::arrived_behind`).
     pub behind: u32,
@@ -83,47 +62,22 @@ pub struct HitPayload {
 }
 
 impl HitPayload {
-    /// Stores a closest-hit shader's record, marked as a hit that stands, or as rejected where
-    /// `rejected`.
-    fn store(&mut self, h: &SurfaceHit, rejected: bool) {
+    /// Stores a closest-hit shader's record (and marks the ray as having hit).
+    fn store(&mut self, h: &SurfaceHit) {
         self.position_t = h.position.extend(h.t);
         self.normal = h.normal.extend(h.error);
         self.material = h.material;
         self.light = h.light;
-        self.hit = if rejected {
-            answer::REJECTED
-        } else {
-            answer::HIT
-        };
+        self.hit = 1;
         self.behind = h.arrived_behind as u32;
         self.barycentrics = h.barycentrics;
         self.shading = h.shading;
         self.instance = h.instance;
     }
 
-    /// A shadow ray's answer from a closest-hit shader: whether its hit at `t` stands.
-    fn answer_occlusion(&mut self, rejected: bool, t: f32) {
-        self.position_t.w = t;
-        self.hit = if rejected {
-            answer::REJECTED
-        } else {
-            answer::HIT
-        };
-    }
-
-    /// The distance of a rejected hit, or `None` where the hit stands or the ray missed.
-    fn rejected_at(&self) -> Option<f32> {
-        if self.hit == answer::REJECTED {
-            Some(self.position_t.w)
-        } else {
-            None
-        }
-    }
-
-    /// The record a closest-hit shader stored (a rejected one too: one that stands after
-    /// `MAX_REJECTED_HITS`), or a miss.
+    /// The record a closest-hit shader stored, or a miss.
     fn surface(&self) -> SurfaceHit {
-        if self.hit == answer::MISS {
+        if self.hit == 0 {
             return SurfaceHit::miss();
         }
         SurfaceHit {
@@ -150,23 +104,24 @@ struct RayTracer<'a> {
 }
 
 impl RayTracer<'_> {
-    /// One trace of `origin + t dir`, t in [t_min, t_max], asking `ask` ([`answer`]).
-    fn trace(&mut self, flags: RayFlags, ask: u32, origin: Vec3, dir: Vec3, t: (f32, f32)) {
-        self.payload.hit = ask;
-        unsafe {
-            self.tlas
-                .trace_ray(flags, 0xff, 0, 1, 0, origin, t.0, dir, t.1, self.payload);
-        }
-    }
-
     /// The closest hit along `origin + t dir`, t in (0, t_max), through the closest-hit and
-    /// miss shaders, past rejected hits.
+    /// miss shaders.
     fn trace_closest(&mut self, origin: Vec3, dir: Vec3, t_max: f32) -> SurfaceHit {
-        let flags = self.opaque;
-        trace_past_rejected_hits(false, |t_min, _| {
-            self.trace(flags, answer::MISS, origin, dir, (t_min, t_max));
-            self.payload.rejected_at()
-        });
+        self.payload.hit = 0;
+        unsafe {
+            self.tlas.trace_ray(
+                self.opaque,
+                0xff,
+                0,
+                1,
+                0,
+                origin,
+                0.0,
+                dir,
+                t_max,
+                self.payload,
+            );
+        }
         self.payload.surface()
     }
 }
@@ -177,19 +132,23 @@ impl Tracer for RayTracer<'_> {
     }
 
     fn occluded(&mut self, from: Vec3, to: Vec3) -> bool {
-        // Any hit ends the ray at once; its closest-hit shader answers whether it stands. Where
-        // it does not, the segment is searched for its closest hits, past rejected ones.
-        let (dir, opaque) = (to - from, self.opaque);
-        trace_past_rejected_hits(true, |t_min, any| {
-            let flags = if any {
-                opaque | RayFlags::TERMINATE_ON_FIRST_HIT
-            } else {
-                opaque
-            };
-            self.trace(flags, answer::OCCLUSION, from, dir, (t_min, 1.0));
-            self.payload.rejected_at()
-        });
-        self.payload.hit != answer::MISS
+        // Any hit ends the ray at once and no closest-hit shader runs; only a miss clears `hit`.
+        self.payload.hit = 1;
+        unsafe {
+            self.tlas.trace_ray(
+                self.opaque | RayFlags::TERMINATE_ON_FIRST_HIT | RayFlags::SKIP_CLOSEST_HIT_SHADER,
+                0xff,
+                0,
+                1,
+                0,
+                from,
+                0.0,
+                to - from,
+                1.0,
+                self.payload,
+            );
+        }
+        self.payload.hit != 0
     }
 
     fn first_hit_on(&mut self, from: Vec3, to: Vec3) -> SurfaceHit {
@@ -324,56 +283,43 @@ pub fn raygen(
 /// Miss: the ray left the scene.
 #[spirv(miss)]
 pub fn miss(#[spirv(incoming_ray_payload)] payload: &mut HitPayload) {
-    payload.hit = answer::MISS;
+    payload.hit = 0;
 }
 
 /// Closest hit on a triangle: the record of `SurfaceHit::triangle`, as on the CPU, from the
-/// triangle table (`instance_custom_index` is the instance's first triangle), rejected where
-/// the ray certainly leaves the triangle's plane; a shadow ray's answer alone.
+/// triangle table (`instance_custom_index` is the instance's first triangle).
 #[spirv(closest_hit)]
 pub fn closest_hit_triangle(
     #[spirv(incoming_ray_payload)] payload: &mut HitPayload,
     #[spirv(hit_attribute)] barycentrics: &Vec2,
     #[spirv(primitive_id)] primitive: u32,
     #[spirv(instance_custom_index)] first: u32,
-    #[spirv(world_ray_origin)] origin: Vec3,
     #[spirv(world_ray_direction)] dir: Vec3,
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
 ) {
     let tri = &triangles[(first + primitive) as usize];
-    let rejected = leaves_plane(tri, origin, dir);
-    if payload.hit == answer::OCCLUSION {
-        payload.answer_occlusion(rejected, t);
-        return;
-    }
     let shape = TriangleShape::of(Vec3::from(tri.edge1), Vec3::from(tri.edge2));
-    let hit = SurfaceHit::triangle(tri, shape, dir, t, barycentrics.x, barycentrics.y);
-    payload.store(&hit, rejected);
-}
-
-/// Whether the ray `origin + t dir` certainly leaves the plane of `tri`
-/// (`plane_side::ray_leaves_triangle_plane`, in the triangle's own space).
-#[inline]
-fn leaves_plane(tri: &Triangle, origin: Vec3, dir: Vec3) -> bool {
-    let (p0, e1, e2) = (tri.p0.into(), tri.edge1.into(), tri.edge2.into());
-    ray_leaves_triangle_plane(origin, dir, p0, e1, e2)
+    payload.store(&SurfaceHit::triangle(
+        tri,
+        shape,
+        dir,
+        t,
+        barycentrics.x,
+        barycentrics.y,
+    ));
 }
 
 /// Closest hit on an instanced triangle: the record of `SurfaceHit::instanced_triangle`, as on
 /// the CPU, from the instance table (`instance_custom_index` is the instance's record) and the
 /// triangle table (the instance's mesh from `Instance::first_triangle`). The hardware's `t` and
-/// barycentrics are the object-space ray's, which an affine map keeps. Rejected where the
-/// object-space ray (the one the device met the triangle with) certainly leaves the
-/// triangle's plane; a shadow ray's answer alone.
+/// barycentrics are the object-space ray's, which an affine map keeps.
 #[spirv(closest_hit)]
 pub fn closest_hit_instance(
     #[spirv(incoming_ray_payload)] payload: &mut HitPayload,
     #[spirv(hit_attribute)] barycentrics: &Vec2,
     #[spirv(primitive_id)] primitive: u32,
     #[spirv(instance_custom_index)] index: u32,
-    #[spirv(object_ray_origin)] object_origin: Vec3,
-    #[spirv(object_ray_direction)] object_dir: Vec3,
     #[spirv(world_ray_direction)] dir: Vec3,
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
@@ -381,15 +327,17 @@ pub fn closest_hit_instance(
 ) {
     let instance = &instances[index as usize];
     let tri = &triangles[(instance.first_triangle + primitive) as usize];
-    let rejected = leaves_plane(tri, object_origin, object_dir);
-    if payload.hit == answer::OCCLUSION {
-        payload.answer_occlusion(rejected, t);
-        return;
-    }
     let shape = TriangleShape::of(Vec3::from(tri.edge1), Vec3::from(tri.edge2));
-    let (u, v) = (barycentrics.x, barycentrics.y);
-    let hit = SurfaceHit::instanced_triangle(tri, shape, instance, index, dir, t, u, v);
-    payload.store(&hit, rejected);
+    payload.store(&SurfaceHit::instanced_triangle(
+        tri,
+        shape,
+        instance,
+        index,
+        dir,
+        t,
+        barycentrics.x,
+        barycentrics.y,
+    ));
 }
 
 /// Any hit on a triangle with holes: the candidate is ignored where `opacity::covers` says the
@@ -485,8 +433,7 @@ pub fn intersect_sphere_shader(
     }
 }
 
-/// Closest hit on a sphere: the point re-projected onto the surface, the outward normal; a
-/// shadow ray's answer alone (a sphere's hit always stands: the kernel's own test).
+/// Closest hit on a sphere: the point re-projected onto the surface, the outward normal.
 #[spirv(closest_hit)]
 pub fn closest_hit_sphere(
     #[spirv(incoming_ray_payload)] payload: &mut HitPayload,
@@ -497,12 +444,12 @@ pub fn closest_hit_sphere(
     #[spirv(ray_tmax)] t: f32,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] spheres: &[Sphere],
 ) {
-    if payload.hit == answer::OCCLUSION {
-        payload.answer_occlusion(false, t);
-        return;
-    }
-    let sphere = &spheres[(first + primitive) as usize];
-    payload.store(&SurfaceHit::sphere(origin, dir, t, sphere), false);
+    payload.store(&SurfaceHit::sphere(
+        origin,
+        dir,
+        t,
+        &spheres[(first + primitive) as usize],
+    ));
 }
 
 /// Push constants of [`probe`] (feature `probe`: tests only).

@@ -215,10 +215,12 @@ fn vk32_returns_only_what_vulkan_allows_and_takes_its_liberties() {
 }
 
 /// Rays leaving the shapes `case` draws, under [`Vk32`]: (hits tested, continuation and shadow
-/// rays that met their triangle again under the CPU's test or a GPU's).
+/// rays that met their triangle again under the CPU's test or a GPU's; with `rejecting`, a
+/// GPU's hits on a plane the ray certainly leaves do not count).
 fn leaving_triangles_under_vulkan(
     seed_model: u64,
     seed_shapes: u64,
+    rejecting: bool,
     case: &mut dyn FnMut(&mut Gen, usize) -> Option<twinpath_tests::placements::TriangleCase>,
 ) -> (usize, usize, usize) {
     set_model(Model::VULKAN);
@@ -259,9 +261,9 @@ fn leaving_triangles_under_vulkan(
         let scale = triangle_watertight_scale_v3(f1, f2);
         let err = triangle_point_error_v3(q, f1, f2, hu, hv, condition, scale);
         // Met by the CPU's test (the kernel's Moller-Trumbore) or by a GPU's (a watertight
-        // test, `twinpath_tests::watertight`, whose hits on a plane the ray certainly leaves
-        // the GPU's tracer rejects: `kernel::plane_side`), all under Vulkan's arithmetic, or
-        // the triangle left by the watertight test with every rounding at its worst.
+        // test, `twinpath_tests::watertight`; with `rejecting`, not where the ray certainly
+        // leaves the triangle's plane: `kernel::plane_side`), all under Vulkan's arithmetic,
+        // or the triangle left by the watertight test with every rounding at its worst.
         let leaving = back(n_side);
         let hit = |o: V, d: V, t_max: Vk32| {
             tris.iter().any(|&(vertices, (q, f1, f2))| {
@@ -269,7 +271,7 @@ fn leaving_triangles_under_vulkan(
                 t.value >= 0.0
                     || (watertight_triangle(o, d, back(d), vertices.map(v), 0.0, t_max.value)
                         .is_some()
-                        && !ray_leaves_triangle_plane_v3(o, d, v(q), v(f1), v(f2)))
+                        && !(rejecting && ray_leaves_triangle_plane_v3(o, d, v(q), v(f1), v(f2))))
             }) || worst_case_watertight_hit(back(o), back(d), own, leaving, t_max.value)
         };
         let (c, sh) = spawned_self_hits(&mut g, p, n_side, err, s, &hit);
@@ -282,7 +284,7 @@ fn leaving_triangles_under_vulkan(
 #[test]
 fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
     let (tested, cont_fail, shadow_fail) =
-        leaving_triangles_under_vulkan(2, 21, &mut |g, k| g.triangle_case(k % 2 == 0));
+        leaving_triangles_under_vulkan(2, 21, false, &mut |g, k| g.triangle_case(k % 2 == 0));
     println!("triangles/quads under Vulkan arithmetic, Moller-Trumbore and watertight: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own surface again");
     assert!(tested > cases() / 2);
     assert_eq!((cont_fail, shadow_fail), (0, 0));
@@ -292,7 +294,7 @@ fn rays_leaving_triangles_never_hit_them_again_under_vulkan_arithmetic() {
 #[test]
 fn rays_leaving_needles_never_hit_them_again_under_vulkan_arithmetic() {
     let (tested, cont_fail, shadow_fail) =
-        leaving_triangles_under_vulkan(3, 22, &mut |g, _| g.needle_case());
+        leaving_triangles_under_vulkan(3, 22, false, &mut |g, _| g.needle_case());
     println!("needles under Vulkan arithmetic, Moller-Trumbore and watertight: {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit their own needle again");
     assert!(tested > cases() / 2);
     assert_eq!((cont_fail, shadow_fail), (0, 0));
@@ -300,11 +302,13 @@ fn rays_leaving_needles_never_hit_them_again_under_vulkan_arithmetic() {
 
 /// A needle's neighbour (`Placements::needle_neighbour_case`) under [`Vk32`]: the watertight
 /// test's hits on the needle behind a ray leaving its neighbour are all rejected by the
-/// plane-side test, computed under the same arithmetic.
+/// plane-side test, computed under the same arithmetic (the cure of `docs/robustness.md`,
+/// "Hits a ray cannot make", which the GPU's tracer does not apply yet; without it 105
+/// continuation and 62 shadow rays meet the needle here).
 #[test]
 fn rays_leaving_a_needles_neighbour_never_hit_either_under_vulkan_arithmetic() {
     let (tested, cont_fail, shadow_fail) =
-        leaving_triangles_under_vulkan(4, 23, &mut |g, _| g.needle_neighbour_case());
+        leaving_triangles_under_vulkan(4, 23, true, &mut |g, _| g.needle_neighbour_case());
     println!("needle neighbours under Vulkan arithmetic, Moller-Trumbore and watertight (rejected where the ray certainly leaves the plane): {tested} hits, {cont_fail} continuation and {shadow_fail} shadow rays hit a triangle again");
     assert!(tested > cases() / 2);
     assert_eq!((cont_fail, shadow_fail), (0, 0));

@@ -94,7 +94,7 @@ pub const MIN_PILOT_SAMPLES: u32 = 4;
 pub const ADAPTIVE_PASS: u32 = 8;
 
 /// The kernel's triangle with vertices `p` (p0 and the edges p1 - p0, p2 - p0) and `material`,
-/// not a light (`light` is set where it emits). Every triangle record is made here: the GPU's
+/// not a light (`light` is set where it emits). Every triangle record is made here: the
 /// plane-side test (`kernel::plane_side`) relies on the edges being these `f32` differences of
 /// vertices, whose sum with p0 gives the acceleration structure's vertices back exactly where
 /// they lie within a factor of two of p0.
