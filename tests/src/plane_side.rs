@@ -52,16 +52,11 @@ pub fn exact(o: Vec3, d: Vec3, p0: Vec3, e1: Vec3, e2: Vec3) -> Option<Exact> {
             (0.5 * eps * (p.abs() + e.abs())).min(e.abs())
         }
     };
-    let r1 = DVec3::new(
-        vertex(p0.x as f64, e1d.x),
-        vertex(p0.y as f64, e1d.y),
-        vertex(p0.z as f64, e1d.z),
-    );
-    let r2 = DVec3::new(
-        vertex(p0.x as f64, e2d.x),
-        vertex(p0.y as f64, e2d.y),
-        vertex(p0.z as f64, e2d.z),
-    );
+    let rounding = |e: DVec3| {
+        let p = p0.as_dvec3();
+        DVec3::new(vertex(p.x, e.x), vertex(p.y, e.y), vertex(p.z, e.z))
+    };
+    let (r1, r2) = (rounding(e1d), rounding(e2d));
     let vertices = perm(r1, e2d.abs()) + perm(e1d.abs(), r2);
     let edges = perm(e1d, e2d);
     let count = |f: DVec3, k: f64| k * eps * f.abs().dot(edges) + 2.0 * f.abs().dot(vertices);

@@ -158,13 +158,16 @@ fn leaving_triangles(
                 .any(|&(_, (q, f1, f2))| intersect_triangle(o, d, q, f1, f2, 0.0, t_max) >= 0.0)
         };
         // Whether the watertight test meets a triangle again, and whether it meets one that the
-        // plane-side test does not reject.
-        let on_gpu = |(o, d, t_max): (Vec3, Vec3, f32), rejecting: bool| {
-            tris.iter().any(|&(v, (q, f1, f2))| {
-                let v = v.map(kernel::real::V3::<f32>::from);
-                watertight_triangle(o.into(), d.into(), d, v, 0.0, t_max).is_some()
-                    && !(rejecting && ray_leaves_triangle_plane(o, d, q, f1, f2))
-            })
+        // plane-side test does not reject (each triangle met once).
+        let on_gpu = |(o, d, t_max): (Vec3, Vec3, f32)| {
+            tris.iter()
+                .fold((false, false), |(met, left), &(v, (q, f1, f2))| {
+                    let v = v.map(kernel::real::V3::<f32>::from);
+                    if watertight_triangle(o.into(), d.into(), d, v, 0.0, t_max).is_none() {
+                        return (met, left);
+                    }
+                    (true, left || !ray_leaves_triangle_plane(o, d, q, f1, f2))
+                })
         };
         for (k, ray) in spawned_rays(&mut g, p, n_side, err, c.size)
             .into_iter()
@@ -172,8 +175,9 @@ fn leaving_triangles(
         {
             if let Some((o, d, t_max)) = ray {
                 cpu[k] += on_cpu((o, d, t_max)) as usize;
-                gpu[k] += on_gpu((o, d, t_max), false) as usize;
-                kept[k] += on_gpu((o, d, t_max), true) as usize;
+                let (met, left) = on_gpu((o, d, t_max));
+                gpu[k] += met as usize;
+                kept[k] += left as usize;
                 worst[k] += worst_case_watertight_hit(o, d, own, n_side, t_max) as usize;
             }
         }
