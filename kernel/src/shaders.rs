@@ -14,11 +14,12 @@
 //! 14 the grid table (`crate::density_grid`; one word when no medium has a grid),
 //! 15 the split table (`crate::split`; one word when paths do not split).
 //! Specialization constant 0: the feature bits of `crate::features` (0: generic path).
-//! Hit groups: 0 triangles (closest hit), then 1 spheres (intersection + closest hit), then
-//! instanced triangles (closest hit), each present only where the scene has that geometry;
-//! where a material has holes (`crate::opacity`), the triangle groups have any-hit shaders
-//! too, which run for the triangles of BLASes built without the OPAQUE flag, and rays are
-//! traced without `RayFlags::OPAQUE`. Miss shader 0 serves both kinds of ray.
+//! Hit groups: 0 triangles (closest hit + any hit), then 1 spheres (intersection + closest
+//! hit), then instanced triangles (closest hit + any hit), each present only where the scene
+//! has that geometry. Triangle BLASes are built without the OPAQUE flag and rays traced without
+//! `RayFlags::OPAQUE`, so the any-hit shaders see every candidate and drop those the ray cannot
+//! make (`crate::plane_side`) or that fall in a hole (`crate::opacity`). Miss shader 0 serves
+//! both kinds of ray.
 
 use crate::adaptive::{luminance, pixel_converged};
 use crate::features::{Dynamic, FeatureSet};
@@ -28,6 +29,7 @@ use crate::hit::SurfaceHit;
 use crate::medium::Medium;
 use crate::opacity::{covers, CandidateRay, HoleTables};
 use crate::path::Tracer;
+use crate::plane_side::ray_leaves_triangle_plane;
 use crate::scene::{
     Instance, Light, Material, RenderParams, ShadingTriangle, Sphere, Triangle, NONE,
 };
@@ -95,12 +97,12 @@ impl HitPayload {
     }
 }
 
-/// [`Tracer`] over the top-level acceleration structure. `opaque` is `RayFlags::OPAQUE` in a
-/// scene without holes (no any-hit shader runs) and `RayFlags::NONE` in one with them.
+/// [`Tracer`] over the top-level acceleration structure. Rays carry no opacity flag: the
+/// geometry's decides (triangles without OPAQUE, so their any-hit shaders see every candidate;
+/// spheres OPAQUE).
 struct RayTracer<'a> {
     tlas: &'a AccelerationStructure,
     payload: &'a mut HitPayload,
-    opaque: RayFlags,
 }
 
 impl RayTracer<'_> {
@@ -110,7 +112,7 @@ impl RayTracer<'_> {
         self.payload.hit = 0;
         unsafe {
             self.tlas.trace_ray(
-                self.opaque,
+                RayFlags::NONE,
                 0xff,
                 0,
                 1,
@@ -136,7 +138,7 @@ impl Tracer for RayTracer<'_> {
         self.payload.hit = 1;
         unsafe {
             self.tlas.trace_ray(
-                self.opaque | RayFlags::TERMINATE_ON_FIRST_HIT | RayFlags::SKIP_CLOSEST_HIT_SHADER,
+                RayFlags::TERMINATE_ON_FIRST_HIT | RayFlags::SKIP_CLOSEST_HIT_SHADER,
                 0xff,
                 0,
                 1,
@@ -209,16 +211,7 @@ pub fn raygen(
             return;
         }
     }
-    let opaque = if Dynamic(features).opacity() {
-        RayFlags::NONE
-    } else {
-        RayFlags::OPAQUE
-    };
-    let mut tracer = RayTracer {
-        tlas,
-        payload,
-        opaque,
-    };
+    let mut tracer = RayTracer { tlas, payload };
     let mut n_b = 0.0;
     let mut mean_b = Vec3::ZERO;
     let mut m2_b = Vec3::ZERO;
@@ -340,12 +333,16 @@ pub fn closest_hit_instance(
     ));
 }
 
-/// Any hit on a triangle with holes: the candidate is ignored where `opacity::covers` says the
-/// surface is not there, as the CPU's leaf test ignores it (`instance_custom_index` is the
-/// instance's first triangle). It asks the generic path's questions, so only the
-/// ray-generation shader reads the specialization constant.
+/// Any hit on a triangle: the candidate is ignored where the ray certainly leaves the
+/// triangle's plane ([`plane_side`](crate::plane_side): a hit the device's triangle test made by
+/// its rounding) or where `opacity::covers` says the surface is not there, as the CPU's leaf
+/// test ignores it (`instance_custom_index` is the instance's first triangle; the instance's
+/// transform is the identity, so the world-space ray is the one the device met it with). It
+/// asks the generic path's questions, so only the ray-generation shader reads the
+/// specialization constant.
 #[spirv(any_hit)]
 pub fn any_hit_triangle(
+    #[spirv(spec_constant(id = 0, default = 0))] features: u32,
     #[spirv(hit_attribute)] barycentrics: &Vec2,
     #[spirv(primitive_id)] primitive: u32,
     #[spirv(instance_custom_index)] first: u32,
@@ -369,18 +366,22 @@ pub fn any_hit_triangle(
         shading,
         textures,
     };
-    ignore_unless_there(&tables, tri, *barycentrics, &ray);
+    ignore_unless_met(features, &tables, tri, *barycentrics, &ray, origin, dir);
 }
 
-/// Any hit on an instanced triangle with holes: as [`any_hit_triangle`], the triangle from the
-/// instance's mesh (`instance_custom_index` is the instance's record).
+/// Any hit on an instanced triangle: as [`any_hit_triangle`], the triangle from the instance's
+/// mesh (`instance_custom_index` is the instance's record) and its plane tested against the
+/// object-space ray, the one the device met the mesh's triangle with.
 #[spirv(any_hit)]
 pub fn any_hit_instance(
+    #[spirv(spec_constant(id = 0, default = 0))] features: u32,
     #[spirv(hit_attribute)] barycentrics: &Vec2,
     #[spirv(primitive_id)] primitive: u32,
     #[spirv(instance_custom_index)] index: u32,
     #[spirv(world_ray_origin)] origin: Vec3,
     #[spirv(world_ray_direction)] dir: Vec3,
+    #[spirv(object_ray_origin)] object_origin: Vec3,
+    #[spirv(object_ray_direction)] object_dir: Vec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] materials: &[Material],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] shading: &[ShadingTriangle],
@@ -399,15 +400,40 @@ pub fn any_hit_instance(
         shading,
         textures,
     };
-    ignore_unless_there(&tables, tri, *barycentrics, &ray);
+    ignore_unless_met(
+        features,
+        &tables,
+        tri,
+        *barycentrics,
+        &ray,
+        object_origin,
+        object_dir,
+    );
 }
 
-/// Ignores the candidate hit of `ray` on `tri` at barycentrics `bary` where `opacity::covers`
-/// says the surface is not there (the generic path's questions, `Dynamic(0)`: the same answers
-/// as specialized); what both any-hit shaders do.
+/// Ignores the candidate hit of `ray` on `tri` at barycentrics `bary` where the ray as the
+/// device met the triangle (`origin`, `dir`, in the triangle's space) certainly leaves its plane,
+/// or where `opacity::covers` says the surface is not there (the generic path's questions,
+/// `Dynamic(0)`: the same answers as specialized); what both any-hit shaders do. The plane test
+/// comes first: it reads the record's three vectors, which the closest-hit shader reads anyway.
 #[inline]
-fn ignore_unless_there(tables: &HoleTables, tri: &Triangle, bary: Vec2, ray: &CandidateRay) {
-    if !covers(Dynamic(0), tables, tri, bary, ray) {
+fn ignore_unless_met(
+    features: u32,
+    tables: &HoleTables,
+    tri: &Triangle,
+    bary: Vec2,
+    ray: &CandidateRay,
+    origin: Vec3,
+    dir: Vec3,
+) {
+    let (p0, edge1, edge2) = (
+        Vec3::from(tri.p0),
+        Vec3::from(tri.edge1),
+        Vec3::from(tri.edge2),
+    );
+    if ray_leaves_triangle_plane(origin, dir, p0, edge1, edge2)
+        || (Dynamic(features).opacity() && !covers(Dynamic(0), tables, tri, bary, ray))
+    {
         unsafe { spirv_std::arch::ignore_intersection() };
     }
 }

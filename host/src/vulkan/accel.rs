@@ -128,18 +128,14 @@ impl Context {
 
     /// A BLAS over `triangles` (non-indexed vertices p0, p0 + edge1, p0 + edge2 per
     /// triangle, as on the CPU); `inputs` keeps the vertex buffer until the TLAS is built.
-    /// Its geometry is OPAQUE (no any-hit shader runs for it) unless a triangle's material
-    /// has holes (`Material::opacity`, `kernel::opacity`).
+    /// Its geometry is not OPAQUE, so the any-hit shaders see every candidate (they drop the
+    /// hits a ray cannot make, `kernel::plane_side`, and holes, `kernel::opacity`).
     fn triangle_blas(
         &self,
         name: &str,
         triangles: &[kernel::scene::Triangle],
-        materials: &[kernel::scene::Material],
         inputs: &mut Vec<Buffer>,
     ) -> Result<AccelerationStructure> {
-        let holes = triangles
-            .iter()
-            .any(|t| materials[t.material as usize].has_holes());
         let mut vertices: Vec<[f32; 3]> = Vec::with_capacity(3 * triangles.len());
         for t in triangles {
             let p0 = glam::Vec3::from(t.p0);
@@ -160,11 +156,7 @@ impl Context {
         let geometry = vk::AccelerationStructureGeometryKHR::default()
             .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
             .geometry(vk::AccelerationStructureGeometryDataKHR { triangles: data })
-            .flags(if holes {
-                vk::GeometryFlagsKHR::empty()
-            } else {
-                vk::GeometryFlagsKHR::OPAQUE
-            });
+            .flags(vk::GeometryFlagsKHR::empty());
         self.build_accel(
             &format!("BLAS {name}"),
             vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL,
@@ -192,7 +184,6 @@ impl Context {
                 let blas = self.triangle_blas(
                     &group.name,
                     &scene.triangles[group.range.clone()],
-                    &scene.materials,
                     &mut inputs,
                 )?;
                 instances.push(instance(
@@ -208,7 +199,6 @@ impl Context {
                 let blas = self.triangle_blas(
                     &mesh.name,
                     &scene.triangles[mesh.range.clone()],
-                    &scene.materials,
                     &mut inputs,
                 )?;
                 mesh_blases.push(blas.address);

@@ -9,7 +9,6 @@ use crate::settings::RenderSettings;
 use anyhow::{anyhow, Context as _, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use kernel::scene::Material;
 use std::ffi::CStr;
 
 /// Entry points of the kernel module the pipeline uses (asserted by a test on the module).
@@ -44,15 +43,14 @@ pub mod binding {
 
 /// Which hit groups a pipeline has: a scene without world-space triangles (or spheres, or
 /// instances) gets no triangle (or sphere, or instance) hit group when specialized; the
-/// generic pipeline has all three. With `holes` (a material has holes, `kernel::opacity`) the
-/// triangle groups have any-hit shaders too; they run only for BLASes built without the
-/// OPAQUE flag.
+/// generic pipeline has all three. The triangle groups have any-hit shaders (which drop the
+/// hits a ray cannot make, `kernel::plane_side`, and holes, `kernel::opacity`); their BLASes
+/// are built without the OPAQUE flag.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HitGroups {
     pub triangles: bool,
     pub spheres: bool,
     pub instances: bool,
-    pub holes: bool,
 }
 
 impl HitGroups {
@@ -60,7 +58,6 @@ impl HitGroups {
         triangles: true,
         spheres: true,
         instances: true,
-        holes: true,
     };
 
     /// The groups a render of `scene` with `settings` uses: only those of the geometry it has
@@ -71,7 +68,6 @@ impl HitGroups {
                 triangles: scene.world_triangle_count() > 0,
                 spheres: !scene.spheres.is_empty(),
                 instances: !scene.instances.is_empty(),
-                holes: scene.materials.iter().any(Material::has_holes),
             }
         } else {
             HitGroups::ALL
@@ -281,23 +277,23 @@ impl CompiledPipeline {
             group(vk::RayTracingShaderGroupTypeKHR::GENERAL, 1, unused, unused),
         ];
         // A triangle hit group of closest-hit shader `name` (world-space or instanced), with
-        // any-hit shader `any` where the scene has holes.
+        // any-hit shader `any`.
         let triangle_group = |stages: &mut Vec<(vk::ShaderStageFlags, &'static CStr)>,
                               groups: &mut Vec<vk::RayTracingShaderGroupCreateInfoKHR<'_>>,
                               name: &'static CStr,
                               any: &'static CStr| {
             stages.push(stage(vk::ShaderStageFlags::CLOSEST_HIT_KHR, name));
-            let mut g = group(
-                vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP,
-                unused,
-                stages.len() as u32 - 1,
-                unused,
+            stages.push(stage(vk::ShaderStageFlags::ANY_HIT_KHR, any));
+            let closest = stages.len() as u32 - 2;
+            groups.push(
+                group(
+                    vk::RayTracingShaderGroupTypeKHR::TRIANGLES_HIT_GROUP,
+                    unused,
+                    closest,
+                    unused,
+                )
+                .any_hit_shader(closest + 1),
             );
-            if hit_groups.holes {
-                stages.push(stage(vk::ShaderStageFlags::ANY_HIT_KHR, any));
-                g = g.any_hit_shader(stages.len() as u32 - 1);
-            }
-            groups.push(g);
         };
         // Hit groups in SBT order (HitGroups::triangle_offset, sphere_offset, instance_offset).
         if hit_groups.triangles {
@@ -355,8 +351,15 @@ impl CompiledPipeline {
                     .name(name)
             })
             .collect();
-        // The ray-generation stage (first) is specialized to the scene's features.
-        stages[0] = stages[0].specialization_info(&spec);
+        // The ray-generation stage (first) and the any-hit stages are specialized to the scene's
+        // features (the any-hit shaders ask only whether a material may have holes).
+        for stage in stages.iter_mut() {
+            if stage.stage == vk::ShaderStageFlags::RAYGEN_KHR
+                || stage.stage == vk::ShaderStageFlags::ANY_HIT_KHR
+            {
+                *stage = stage.specialization_info(&spec);
+            }
+        }
         let callable_module = if compilation == Compilation::Separate {
             let callable = unsafe {
                 ctx.device.create_shader_module(

@@ -10,9 +10,7 @@
 
 use super::{use_model, v};
 use glam::Vec3;
-use kernel::plane_side::{
-    ray_leaves_triangle_plane_v3, DIRECTION_ROUNDING_EPS, SIDE_ROUNDING_EPS, VERTEX_ROUNDING_FACTOR,
-};
+use kernel::plane_side::{ray_leaves_triangle_plane_v3, INEXACT_ROUNDING_EPS, ROUNDING_EPS};
 use twinpath_tests::placements::Placements as Gen;
 use twinpath_tests::plane_side::exact;
 use twinpath_tests::vulkan_arithmetic::{seed, set_model, Model};
@@ -121,8 +119,8 @@ fn the_plane_side_test_never_rejects_a_ray_that_meets_the_plane() {
         "plane side: {tested} rays decided in f64, {leaving} of them leaving ({undecided} not \
          decided, of which the test was sure of {sure_undecided:?}); sure they leave: {sure:?} \
          (IEEE, Vulkan random, worst up, worst down); wrongly: {wrong:?}; the computed side and \
-         direction at most {worst:.3?} of their first-order counts (constants {SIDE_ROUNDING_EPS}, \
-         {DIRECTION_ROUNDING_EPS}, {VERTEX_ROUNDING_FACTOR})"
+         direction at most {worst:.3?} of their first-order counts (counts {ROUNDING_EPS} and \
+         {INEXACT_ROUNDING_EPS})"
     );
     assert!(tested > n / 2, "{tested} of {n}");
     assert_eq!((wrong, sure_undecided), ([0; 4], [0; 4]));
