@@ -126,8 +126,8 @@ fn rays_leaving_triangles_and_quads_never_hit_them_again() {
 /// What rays spawned from a random hit on each case of `case` meet again: (hits tested, then
 /// per [continuation, shadow] ray: those that hit a triangle of the case again under the CPU's
 /// test, the same under the watertight test a GPU runs, those of them left where hits on a
-/// triangle whose plane the ray certainly leaves are rejected (`kernel::plane_side`: the cure of
-/// robustness.md's "Hits a ray cannot make", which the GPU's tracer does not apply yet), and
+/// triangle whose plane the ray certainly leaves are rejected (`kernel::plane_side`, as the GPU's
+/// any-hit shaders reject them: robustness.md's "Hits a ray cannot make"), and
 /// those that the worst-case watertight test
 /// ([`worst_case_watertight_hit`]) could meet the hit triangle itself with).
 /// The triangles are the renderer's: vertices in `f32`, the kernel's edges their differences
@@ -210,16 +210,16 @@ fn rays_leaving_needles_never_hit_them_again() {
 /// A needle's well-shaped neighbour (`Placements::needle_neighbour_case`): rays leaving either
 /// triangle never meet either again under the CPU's test, nor their own triangle under the
 /// worst-case watertight test. A single-precision watertight test meets the needle behind a ray
-/// leaving its neighbour (`docs/robustness.md`, "Neighbours under a watertight test"), a known
-/// limit on such a device; the plane-side test (`kernel::plane_side`) rejects every such hit, so
-/// none is left once rejected (the cure, which the GPU's tracer does not apply yet). That the
+/// leaving its neighbour (`docs/robustness.md`, "Neighbours under a watertight test"), a hole
+/// such a device would otherwise have; the plane-side test (`kernel::plane_side`) rejects every such
+/// hit, so none is left once rejected (the cure, which the GPU's any-hit shaders apply). That the
 /// watertight test does meet them here is asserted too: else the case would not test the
 /// rejection.
 #[test]
 fn rays_leaving_a_needles_neighbour_never_hit_either_once_rejected() {
     let (tested, cpu, gpu, kept, worst) =
         leaving_triangles(7, &mut |g, _| g.needle_neighbour_case());
-    println!("needle neighbours: {tested} hits; [continuation, shadow] rays that hit either triangle again: {cpu:?} under Moller-Trumbore, {gpu:?} under a watertight test, {kept:?} of those left once rejected by the plane-side test (the cure, not yet in the GPU's tracer); {worst:?} their own triangle under the worst-case watertight test");
+    println!("needle neighbours: {tested} hits; [continuation, shadow] rays that hit either triangle again: {cpu:?} under Moller-Trumbore, {gpu:?} under a watertight test, {kept:?} of those left once rejected by the plane-side test (the cure the GPU's any-hit shaders apply); {worst:?} their own triangle under the worst-case watertight test");
     assert!(tested > cases() / 2);
     assert!(gpu[0] > 0 && gpu[1] > 0, "{gpu:?}");
     assert_eq!((cpu, kept, worst), ([0, 0], [0, 0], [0, 0]));

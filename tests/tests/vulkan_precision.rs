@@ -303,7 +303,7 @@ fn rays_leaving_needles_never_hit_them_again_under_vulkan_arithmetic() {
 /// A needle's neighbour (`Placements::needle_neighbour_case`) under [`Vk32`]: the watertight
 /// test's hits on the needle behind a ray leaving its neighbour are all rejected by the
 /// plane-side test, computed under the same arithmetic (the cure of `docs/robustness.md`,
-/// "Hits a ray cannot make", which the GPU's tracer does not apply yet; without it 105
+/// "Hits a ray cannot make", which the GPU's any-hit shaders apply; without it 105
 /// continuation and 62 shadow rays meet the needle here).
 #[test]
 fn rays_leaving_a_needles_neighbour_never_hit_either_under_vulkan_arithmetic() {
