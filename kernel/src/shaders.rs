@@ -337,9 +337,8 @@ pub fn closest_hit_instance(
 /// triangle's plane ([`plane_side`](crate::plane_side): a hit the device's triangle test made by
 /// its rounding) or where `opacity::covers` says the surface is not there, as the CPU's leaf
 /// test ignores it (`instance_custom_index` is the instance's first triangle; the instance's
-/// transform is the identity, so the world-space ray is the one the device met it with). It
-/// asks the generic path's questions, so only the ray-generation shader reads the
-/// specialization constant.
+/// transform is the identity, so the world-space ray is the one the device met it with). Of
+/// the specialization constant it reads only whether a material may have holes.
 #[spirv(any_hit)]
 pub fn any_hit_triangle(
     #[spirv(spec_constant(id = 0, default = 0))] features: u32,
@@ -413,9 +412,9 @@ pub fn any_hit_instance(
 
 /// Ignores the candidate hit of `ray` on `tri` at barycentrics `bary` where the ray as the
 /// device met the triangle (`origin`, `dir`, in the triangle's space) certainly leaves its plane,
-/// or where `opacity::covers` says the surface is not there (the generic path's questions,
-/// `Dynamic(0)`: the same answers as specialized); what both any-hit shaders do. The plane test
-/// comes first: it reads the record's three vectors, which the closest-hit shader reads anyway.
+/// or, where `features` says a material may have holes, where `opacity::covers` says the
+/// surface is not there (asked the generic path's questions, `Dynamic(0)`: the same answers as
+/// specialized); what both any-hit shaders do.
 #[inline]
 fn ignore_unless_met(
     features: u32,

@@ -126,10 +126,10 @@ fn rays_leaving_triangles_and_quads_never_hit_them_again() {
 /// What rays spawned from a random hit on each case of `case` meet again: (hits tested, then
 /// per [continuation, shadow] ray: those that hit a triangle of the case again under the CPU's
 /// test, the same under the watertight test a GPU runs, those of them left where hits on a
-/// triangle whose plane the ray certainly leaves are rejected (`kernel::plane_side`, as the GPU's
-/// any-hit shaders reject them: robustness.md's "Hits a ray cannot make"), and
-/// those that the worst-case watertight test
-/// ([`worst_case_watertight_hit`]) could meet the hit triangle itself with).
+/// triangle whose plane the ray certainly leaves are rejected (`kernel::plane_side`, as the
+/// GPU's any-hit shaders reject them: robustness.md's "Hits a ray cannot make"), and those that
+/// the worst-case watertight test ([`worst_case_watertight_hit`]) could meet the hit triangle
+/// itself with).
 /// The triangles are the renderer's: vertices in `f32`, the kernel's edges their differences
 /// ([`twinpath_tests::placements::TriangleCase::loaded`]).
 fn leaving_triangles(
@@ -211,10 +211,10 @@ fn rays_leaving_needles_never_hit_them_again() {
 /// triangle never meet either again under the CPU's test, nor their own triangle under the
 /// worst-case watertight test. A single-precision watertight test meets the needle behind a ray
 /// leaving its neighbour (`docs/robustness.md`, "Neighbours under a watertight test"), a hole
-/// such a device would otherwise have; the plane-side test (`kernel::plane_side`) rejects every such
-/// hit, so none is left once rejected (the cure, which the GPU's any-hit shaders apply). That the
-/// watertight test does meet them here is asserted too: else the case would not test the
-/// rejection.
+/// such a device would otherwise have; the plane-side test (`kernel::plane_side`) rejects every
+/// such hit, so none is left once rejected (the cure, which the GPU's any-hit shaders apply).
+/// That the watertight test does meet them here is asserted too: else the case would not test
+/// the rejection.
 #[test]
 fn rays_leaving_a_needles_neighbour_never_hit_either_once_rejected() {
     let (tested, cpu, gpu, kept, worst) =
