@@ -306,23 +306,30 @@ pub fn triangle_error_condition_v3<R: real::Real>(edge1: V3<R>, edge2: V3<R>) ->
 }
 
 /// What a triangle's hit records need that depends on its shape alone: its unit normal
-/// ([`triangle_normal`]), its [`triangle_error_condition`] and its
-/// [`triangle_watertight_scale_v3`] (four square roots and three divisions, which a renderer
-/// may compute once per triangle, as the CPU's BVH does).
+/// ([`triangle_normal`]), its [`triangle_error_condition`], its
+/// [`triangle_watertight_scale_v3`] and its [`triangle_plane_weights_v3`] (five square roots and
+/// four divisions, which a renderer may compute once per triangle, as the CPU's BVH does).
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleShape {
     pub normal: Vec3,
     pub condition: f32,
     pub watertight_scale: f32,
+    /// The plane weights P_j / |edge1 x edge2| ([`triangle_plane_weights_v3`]).
+    pub weights: Vec3,
+    /// The height that rounding to denormals may take ([`triangle_plane_weights_v3`]).
+    pub floor: f32,
 }
 
 impl TriangleShape {
     #[inline]
     pub fn of(edge1: Vec3, edge2: Vec3) -> Self {
+        let (weights, floor) = triangle_plane_weights_v3(V3::from(edge1), V3::from(edge2));
         Self {
             normal: triangle_normal(edge1, edge2),
             condition: triangle_error_condition(edge1, edge2),
             watertight_scale: triangle_watertight_scale_v3(V3::from(edge1), V3::from(edge2)),
+            weights: weights.into(),
+            floor,
         }
     }
 }
@@ -366,6 +373,140 @@ pub fn triangle_point_error_v3<R: real::Real<Bits = u32>>(
     R::splat(TRIANGLE_ERROR_EPS * f32::EPSILON)
         * (max_abs(p0) + (max_abs(edge1 * u) + max_abs(edge2 * v)) * condition)
         + triangle_watertight_error_v3(edge1, edge2, u, v, watertight_scale)
+}
+
+/// The count of the plane weights' term of [`triangle_offsets_v3`], in eps: the hit point's
+/// edge terms (3 roundings), the origin's (1), the Moller-Trumbore numerator the CPU signs
+/// (6 roundings of u <= eps / 2 under IEEE), and the plane-side test's side bound
+/// ([`crate::plane_side::INEXACT_ROUNDING_EPS`], 15, plus 7 for computing s itself), with the
+/// rest spare for the origin's own distance from the point (at most 22 eps times the weights'
+/// sum, below 4 x 10^-4 of the height on a well-conditioned triangle).
+pub const PLANE_OFFSET_EPS: f32 = 32.0;
+
+/// Largest sum of a triangle's plane weights for which [`triangle_offsets_v3`] gives the small
+/// height: above it (a sliver whose edges meet at less than about half a degree) rays leave at
+/// the bound of [`triangle_point_error`] along the normal, as they did before the weights.
+pub const WELL_CONDITIONED_WEIGHTS: f32 = 128.0;
+
+/// Largest [`TriangleShape::floor`] for which [`triangle_offsets_v3`] gives the small height
+/// (2^-24; only a triangle whose |edge1 x edge2| is below about 2^-98 exceeds it).
+pub const WELL_CONDITIONED_FLOOR: f32 = 5.960_464_5e-8;
+
+/// The cosine between a continuation ray and the leaving side's normal below which the ray
+/// starts at the grazing height too ([`continuation_origin`]). On a well-conditioned triangle
+/// the plane-side test ([`crate::plane_side`]) is sure of the direction of every ray above it:
+/// its direction bound is at most 15 eps sum_j |d_j| P_j plus denormal terms, and with
+/// sum_j P_j / |N| <= [`WELL_CONDITIONED_WEIGHTS`] the exact d . N exceeds that bound, its own
+/// rounding (7 eps) and the unit normal's (3 eps) for every cosine above
+/// 25 x 128 eps = 3.8 x 10^-4 plus at most 2^-24; 2^-10 = 9.8 x 10^-4 leaves a factor of 2.
+pub const GRAZING_COS: f32 = 1.0 / 1024.0;
+
+/// A triangle's plane weights and floor: w_j = P_j / |N| with P_j = |e1_k e2_l| + |e1_l e2_k|
+/// (the permanent of the cross product's component j) and N = edge1 x edge2, and
+/// floor = 4 tiny (16 + sum_j P_j + 3 (|edge1|_1 + |edge2|_1)) / |N| with tiny the smallest
+/// normal float. An origin o's height h above the plane sets the sign of (o - p0) . N, exactly
+/// h |N|, and both the CPU's Moller-Trumbore numerator and the plane-side test round that
+/// product by a few eps of sum_j |o_j - p0_j| P_j (plus what flushed denormals lose, which the
+/// floor bounds): so a height of a few eps of sum_j |o_j - p0_j| w_j decides its sign. w_j >=
+/// |n_j|, and w_j is 0 along an axis that both edges are normal to (a floor in z = 0 has
+/// w = (0, 0, 1)): the weights carry a sliver's 1 / sin(theta) only along the axes where the
+/// cross product can tilt. Each is capped at f32::MAX; a degenerate triangle, which no test
+/// meets, gets weights 0 and the floor f32::MAX (so it is not well-conditioned).
+#[inline]
+pub fn triangle_plane_weights_v3<R: real::Real<Bits = u32>>(
+    edge1: V3<R>,
+    edge2: V3<R>,
+) -> (V3<R>, R) {
+    let area = edge1.cross(edge2).length();
+    let (a, b) = (
+        V3::new(abs(edge1.x), abs(edge1.y), abs(edge1.z)),
+        V3::new(abs(edge2.x), abs(edge2.y), abs(edge2.z)),
+    );
+    let permanent = V3::new(
+        a.y * b.z + a.z * b.y,
+        a.z * b.x + a.x * b.z,
+        a.x * b.y + a.y * b.x,
+    );
+    let big = R::splat(f32::MAX);
+    let reach = R::splat(3.0) * (a.element_sum() + b.element_sum());
+    let numerator =
+        R::splat(4.0 * f32::MIN_POSITIVE) * (R::splat(16.0) + permanent.element_sum() + reach);
+    let degenerate = area.greater_than(R::splat(0.0)) == 0;
+    if degenerate {
+        let zero = R::splat(0.0);
+        return (V3::new(zero, zero, zero), big);
+    }
+    let weights = V3::new(
+        (permanent.x / area).min(big),
+        (permanent.y / area).min(big),
+        (permanent.z / area).min(big),
+    );
+    (weights, (numerator / area).min(big))
+}
+
+/// The heights above a triangle's plane at which rays leaving its point at barycentrics
+/// (`u`, `v`) start, as (offset, grazing offset): a ray starts `offset` along the leaving
+/// side's unit normal, and a continuation ray within [`GRAZING_COS`] of the plane and every
+/// shadow ray `offset + grazing offset` ([`continuation_origin`], [`shadow_origin`];
+/// docs/robustness.md, "The height a ray leaves at").
+///
+/// On a well-conditioned triangle (weights summing to at most [`WELL_CONDITIONED_WEIGHTS`],
+/// floor at most [`WELL_CONDITIONED_FLOOR`]) the offset is the point's rounding along the
+/// normal plus what decides the origin's side: [`TRIANGLE_ERROR_EPS`] eps of
+/// sum_j |p0_j| |n_j| over the axes along which an edge is not 0 (along the others the point's
+/// component is p0's exactly), plus [`PLANE_OFFSET_EPS`] eps of sum_j (|u e1_j| + |v e2_j|) w_j,
+/// plus the floor. There the CPU's Moller-Trumbore test cannot meet the triangle again, and a
+/// GPU's any-hit shader rejects every hit on it that the ray's direction is sure to leave
+/// (above [`GRAZING_COS`]); the grazing offset, the watertight term
+/// ([`triangle_watertight_error_v3`]), covers a device's own test for the rest. On a floor in
+/// z = 0 the offset is the floor alone, where the point's bound is 8 eps of its coordinates.
+///
+/// Elsewhere (slivers, degenerate or denormal triangles) the offset is the bound of
+/// [`triangle_point_error_v3`] times |n|_1, as for every triangle before the weights, and the
+/// grazing offset 0.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn triangle_offsets_v3<R: real::Real<Bits = u32>>(
+    p0: V3<R>,
+    edge1: V3<R>,
+    edge2: V3<R>,
+    u: R,
+    v: R,
+    normal: V3<R>,
+    condition: R,
+    watertight_scale: R,
+    weights: V3<R>,
+    floor: R,
+) -> (R, R) {
+    let well = weights
+        .element_sum()
+        .at_most(R::splat(WELL_CONDITIONED_WEIGHTS))
+        & floor.at_most(R::splat(WELL_CONDITIONED_FLOOR));
+    if well == 0 {
+        let error = triangle_point_error_v3(p0, edge1, edge2, u, v, condition, watertight_scale);
+        return (error * normal_l1(normal), R::splat(0.0));
+    }
+    let zero = R::splat(0.0);
+    let moved = |a: R, b: R| a.not_equal(zero) | b.not_equal(zero);
+    let along = |p: R, n: R, a: R, b: R| real::select(moved(a, b), abs(p) * abs(n), zero);
+    let corner = along(p0.x, normal.x, edge1.x, edge2.x)
+        + along(p0.y, normal.y, edge1.y, edge2.y)
+        + along(p0.z, normal.z, edge1.z, edge2.z);
+    let (eu, ev) = (edge1 * u, edge2 * v);
+    let edges = (abs(eu.x) + abs(ev.x)) * weights.x
+        + (abs(eu.y) + abs(ev.y)) * weights.y
+        + (abs(eu.z) + abs(ev.z)) * weights.z;
+    let offset = R::splat(TRIANGLE_ERROR_EPS * f32::EPSILON) * corner
+        + R::splat(PLANE_OFFSET_EPS * f32::EPSILON) * edges
+        + floor;
+    let grazing = triangle_watertight_error_v3(edge1, edge2, u, v, watertight_scale);
+    (offset.min(R::splat(f32::MAX)), grazing)
+}
+
+/// |n|_1, the factor that turns a per-component error bound into a height along unit `n`.
+#[inline]
+fn normal_l1<R: real::Real>(n: V3<R>) -> R {
+    abs(n.x) + abs(n.y) + abs(n.z)
 }
 
 /// The rounding of a watertight triangle test, per eps of the product of a ray origin's three
@@ -467,12 +608,94 @@ pub fn offset_ray_origin(p: Vec3, n: Vec3, error: f32) -> Vec3 {
 /// [`offset_ray_origin`] over any scalar [`real::Real`].
 #[inline]
 pub fn offset_ray_origin_v3<R: real::Real<Bits = u32>>(p: V3<R>, n: V3<R>, error: R) -> V3<R> {
-    let d = error * (abs(n.x) + abs(n.y) + abs(n.z));
-    let q = p + n * d;
+    lift_ray_origin_v3(p, n, error * normal_l1(n))
+}
+
+/// `p` moved `height` along unit normal `n`, then one ULP per component away from the surface
+/// (the step of [`offset_ray_origin`]): the origin of a ray leaving a surface point whose
+/// distance from the surface is known to within `height`. Rounding the move cannot take a
+/// component back past `p` (rounding is monotonic), and the step leaves it at least half the
+/// move's rounding beyond.
+#[inline]
+pub fn lift_ray_origin(p: Vec3, n: Vec3, height: f32) -> Vec3 {
+    lift_ray_origin_v3(V3::from(p), V3::from(n), height).into()
+}
+
+/// [`lift_ray_origin`] over any scalar [`real::Real`].
+#[inline]
+pub fn lift_ray_origin_v3<R: real::Real<Bits = u32>>(p: V3<R>, n: V3<R>, height: R) -> V3<R> {
+    let q = p + n * height;
     V3::new(
         step_away(q.x, n.x),
         step_away(q.y, n.y),
         step_away(q.z, n.z),
+    )
+}
+
+/// The origin of a continuation ray along unit `dir` leaving a surface point `p` on the side
+/// of unit normal `n_side`, whose hit gave the heights `offset` and `grazing_offset`
+/// ([`triangle_offsets_v3`]; a sphere's and an instance's grazing offset is 0): lifted by
+/// `offset` where dir . n_side >= [`GRAZING_COS`], else by both.
+#[inline]
+pub fn continuation_origin(
+    p: Vec3,
+    n_side: Vec3,
+    dir: Vec3,
+    offset: f32,
+    grazing_offset: f32,
+) -> Vec3 {
+    continuation_origin_v3(
+        V3::from(p),
+        V3::from(n_side),
+        V3::from(dir),
+        offset,
+        grazing_offset,
+    )
+    .into()
+}
+
+/// [`continuation_origin`] over any scalar [`real::Real`].
+#[inline]
+pub fn continuation_origin_v3<R: real::Real<Bits = u32>>(
+    p: V3<R>,
+    n_side: V3<R>,
+    dir: V3<R>,
+    offset: R,
+    grazing_offset: R,
+) -> V3<R> {
+    let grazing = dir.dot(n_side).at_least(R::splat(GRAZING_COS)) == 0;
+    let height = if grazing {
+        offset + grazing_offset
+    } else {
+        offset
+    };
+    lift_ray_origin_v3(p, n_side, height)
+}
+
+/// The origin of a shadow ray (or any ray whose direction is not known to be unit) leaving
+/// surface point `p` on the side of unit normal `n_side`: lifted by both heights of its hit
+/// ([`continuation_origin`]).
+#[inline]
+pub fn shadow_origin(p: Vec3, n_side: Vec3, offset: f32, grazing_offset: f32) -> Vec3 {
+    lift_ray_origin(p, n_side, offset + grazing_offset)
+}
+
+/// [`triangle_offsets_v3`] of the triangle (`p0`, `edge1`, `edge2`) at (`u`, `v`), its shape
+/// computed here ([`TriangleShape::of`]).
+#[inline]
+pub fn triangle_offsets(p0: Vec3, edge1: Vec3, edge2: Vec3, u: f32, v: f32) -> (f32, f32) {
+    let shape = TriangleShape::of(edge1, edge2);
+    triangle_offsets_v3(
+        V3::from(p0),
+        V3::from(edge1),
+        V3::from(edge2),
+        u,
+        v,
+        V3::from(shape.normal),
+        shape.condition,
+        shape.watertight_scale,
+        V3::from(shape.weights),
+        shape.floor,
     )
 }
 

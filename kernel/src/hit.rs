@@ -3,10 +3,11 @@
 //! shaders and the CPU's traversal make the same record from the same ray.
 
 use crate::geometry::{
-    reproject_to_sphere, sphere_point_error, triangle_point, triangle_point_error_conditioned,
-    TriangleShape,
+    reproject_to_sphere, sphere_point_error, triangle_offsets_v3, triangle_point,
+    triangle_point_error_conditioned, TriangleShape,
 };
 use crate::instance::{normal_to_world, point_to_world, world_point_error};
+use crate::real::V3;
 use crate::scene::{Instance, Sphere, Triangle, NONE};
 use spirv_std::glam::{Vec2, Vec3};
 
@@ -22,10 +23,15 @@ pub struct SurfaceHit {
     pub material: u32,
     /// Index into the light table if the surface is a light, else [`NONE`].
     pub light: u32,
-    /// Absolute bound on the rounding error of `position` (per component), which sizes the
-    /// offset of rays leaving it (`geometry::offset_ray_origin`); for a triangle it also holds
-    /// the rounding of a GPU's triangle test (`geometry::triangle_point_error`).
-    pub error: f32,
+    /// How far along the normal rays leaving `position` start (`geometry::lift_ray_origin`):
+    /// the position's rounding along the normal and what the tests that could meet the surface
+    /// again need to decide the ray's side (`geometry::triangle_offsets_v3`; for a sphere and
+    /// an instance, a per-component error bound times |normal|_1).
+    pub offset: f32,
+    /// What a continuation ray within `geometry::GRAZING_COS` of the surface and a shadow ray
+    /// add to `offset` (`geometry::continuation_origin`, `geometry::shadow_origin`): a GPU's
+    /// triangle test's rounding on a well-conditioned triangle, else 0.
+    pub grazing_offset: f32,
     /// Whether the ray arrived from the side `normal` points away from (a sphere's inside, a
     /// triangle's back). Decided where the record is made, and robustly for spheres: by which
     /// side of the sphere the ray's origin lies on, not by the sign of `normal . dir`, which
@@ -51,7 +57,8 @@ impl SurfaceHit {
             normal: Vec3::ZERO,
             material: NONE,
             light: NONE,
-            error: 0.0,
+            offset: 0.0,
+            grazing_offset: 0.0,
             arrived_behind: false,
             shading: NONE,
             barycentrics: Vec2::ZERO,
@@ -68,13 +75,15 @@ impl SurfaceHit {
         let (center, radius) = (Vec3::from(sphere.center), sphere.radius);
         let position = reproject_to_sphere(origin + t * dir, center, radius);
         let from_center = origin - center;
+        let normal = (position - center) / radius;
         Self {
             position,
             t,
-            normal: (position - center) / radius,
+            normal,
             material: sphere.material,
             light: sphere.light,
-            error: sphere_point_error(center, radius),
+            offset: sphere_point_error(center, radius) * normal.abs().element_sum(),
+            grazing_offset: 0.0,
             arrived_behind: from_center.dot(from_center) < radius * radius,
             shading: NONE,
             barycentrics: Vec2::ZERO,
@@ -84,8 +93,9 @@ impl SurfaceHit {
 
     /// The record of a ray along `dir` meeting triangle `tri` (of shape `shape`) at `t`, at
     /// barycentric (u, v): the point from the barycentrics (`triangle_point`: on the plane up to
-    /// a few roundings, whatever t's error), the geometric normal edge1 x edge2, the point's
-    /// error bound, and the side by the sign of `normal . dir`. Both backends build triangle
+    /// a few roundings, whatever t's error), the geometric normal edge1 x edge2, the heights
+    /// rays leave at (`geometry::triangle_offsets_v3`), and the side by the sign of
+    /// `normal . dir`. Both backends build triangle
     /// hits here.
     #[inline]
     pub fn triangle(
@@ -101,13 +111,26 @@ impl SurfaceHit {
             Vec3::from(tri.edge1),
             Vec3::from(tri.edge2),
         );
+        let (offset, grazing_offset) = triangle_offsets_v3(
+            V3::from(p0),
+            V3::from(e1),
+            V3::from(e2),
+            u,
+            v,
+            V3::from(shape.normal),
+            shape.condition,
+            shape.watertight_scale,
+            V3::from(shape.weights),
+            shape.floor,
+        );
         Self {
             position: triangle_point(p0, e1, e2, u, v),
             t,
             normal: shape.normal,
             material: tri.material,
             light: tri.light,
-            error: triangle_point_error_conditioned(p0, e1, e2, u, v, &shape),
+            offset,
+            grazing_offset,
             arrived_behind: Self::behind_plane(shape.normal, dir),
             shading: tri.shading,
             barycentrics: Vec2::new(u, v),
@@ -120,8 +143,9 @@ impl SurfaceHit {
     /// object-space record of [`SurfaceHit::triangle`] with its point mapped to world space, the
     /// geometric normal M^-T (edge1 x edge2) normalised (along the edge cross product of the
     /// same triangle flattened into world space, whose winding a mirroring transform reverses),
-    /// the world point's error bound (`instance::world_point_error`), and the side by the sign
-    /// of `normal . dir`. Barycentrics and the shading record stay the object-space triangle's
+    /// the world point's error bound (`instance::world_point_error`, of the object point's
+    /// `geometry::triangle_point_error`) times |normal|_1 as the offset (grazing offset 0), and
+    /// the side by the sign of `normal . dir`. Barycentrics and the shading record stay the object-space triangle's
     /// (an affine map keeps barycentrics). Both backends build instanced hits here.
     #[inline]
     #[allow(clippy::too_many_arguments)]
@@ -136,12 +160,20 @@ impl SurfaceHit {
         v: f32,
     ) -> Self {
         let object = Self::triangle(tri, shape, dir, t, u, v);
+        let (p0, e1, e2) = (
+            Vec3::from(tri.p0),
+            Vec3::from(tri.edge1),
+            Vec3::from(tri.edge2),
+        );
+        let object_error = triangle_point_error_conditioned(p0, e1, e2, u, v, &shape);
         let position = point_to_world(instance, object.position);
         let normal = normal_to_world(instance, shape.normal).normalize();
+        let error = world_point_error(instance, object.position, object_error, position);
         Self {
             position,
             normal,
-            error: world_point_error(instance, object.position, object.error, position),
+            offset: error * normal.abs().element_sum(),
+            grazing_offset: 0.0,
             arrived_behind: Self::behind_plane(normal, dir),
             instance: index,
             ..object

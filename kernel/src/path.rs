@@ -7,7 +7,7 @@ use crate::bsdf::{self, DELTA_PDF};
 use crate::camera::{camera_origin, camera_ray_direction, lens_radius, thin_lens_ray};
 use crate::environment;
 use crate::features::FeatureSet;
-use crate::geometry::{offset_ray_origin, shadow_ray_end};
+use crate::geometry::{continuation_origin, shadow_origin, shadow_ray_end};
 use crate::hit::SurfaceHit;
 use crate::light::{self, eval_radiance, LightKinds, LightSample};
 use crate::medium;
@@ -507,7 +507,7 @@ impl PathState {
         let (params, lights) = (scene.params, scene.lights);
         let (x, n, ng) = (query.x, query.n, query.ng);
         let albedo = Vec3::from(material.albedo);
-        let ray_origin = offset_ray_origin(x, ng, hit.error);
+        let shadow_from = shadow_origin(x, ng, hit.offset, hit.grazing_offset);
         // With a shading normal, a direction below the geometric surface carries nothing
         // (`crate::surface`): it would leave through the surface.
         let smooth = features.shading_normals() && query.smooth;
@@ -533,7 +533,7 @@ impl PathState {
                 );
                 let radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
-                self.await_shadow(query.light_kinds, lights, ray_origin, &ls, radiance);
+                self.await_shadow(query.light_kinds, lights, shadow_from, &ls, radiance);
                 if features.media() {
                     // A Lambertian surface leaves the path in its medium.
                     self.shadow_medium = self.medium;
@@ -561,7 +561,8 @@ impl PathState {
         if self.throughput.max_element() <= 0.0 {
             return;
         }
-        self.await_extension(ray_origin, wi, x, pdf_b);
+        let origin = continuation_origin(x, ng, wi, hit.offset, hit.grazing_offset);
+        self.await_extension(origin, wi, x, pdf_b);
     }
 
     /// [`PathState::vertex`] on any other material: the light sample weighed by the BSDF's
@@ -613,7 +614,8 @@ impl PathState {
                     pdf_w,
                     pdf_b,
                 );
-                let from = offset_ray_origin(x, side(ng, ng.dot(wi) > 0.0), hit.error);
+                let n_side = side(ng, ng.dot(wi) > 0.0);
+                let from = shadow_origin(x, n_side, hit.offset, hit.grazing_offset);
                 let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
                 self.await_shadow(query.light_kinds, lights, from, &ls, radiance);
                 if features.media() {
@@ -657,7 +659,8 @@ impl PathState {
         if !(self.throughput.max_element() > 0.0) {
             return;
         }
-        let origin = offset_ray_origin(x, side(ng, !s.transmitted), hit.error);
+        let n_side = side(ng, !s.transmitted);
+        let origin = continuation_origin(x, n_side, s.wi, hit.offset, hit.grazing_offset);
         self.await_extension(origin, s.wi, x, s.pdf);
     }
 
@@ -754,13 +757,15 @@ impl PathState {
 }
 
 /// The origin of a ray along `dir` that goes on through the surface at `hit`: its point,
-/// offset to the side `dir` points to (`geometry::offset_ray_origin`).
+/// lifted to the side `dir` points to by both of the hit's heights (`geometry::shadow_origin`:
+/// `dir` need not be unit, and such rays are few).
 #[inline]
 pub(crate) fn beyond_surface(hit: &SurfaceHit, dir: Vec3) -> Vec3 {
-    offset_ray_origin(
+    shadow_origin(
         hit.position,
         side(hit.normal, hit.normal.dot(dir) > 0.0),
-        hit.error,
+        hit.offset,
+        hit.grazing_offset,
     )
 }
 

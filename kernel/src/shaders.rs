@@ -48,14 +48,14 @@ use spirv_std::spirv;
 pub struct HitPayload {
     /// xyz: hit position, w: ray parameter t (negative: miss).
     pub position_t: Vec4,
-    /// xyz: unit geometric normal, w: rounding-error bound of the position.
+    /// xyz: unit geometric normal, w: the height rays leave at (`SurfaceHit::offset`).
     pub normal: Vec4,
     pub material: u32,
     pub light: u32,
-    /// 1 if the ray hit something; the miss shader clears it.
+    /// 0 if the ray hit nothing (the miss shader clears it); else 1, plus 2 if it arrived from behind the normal (`SurfaceHit::arrived_behind`).
     pub hit: u32,
-    /// 1 if the ray arrived from behind the normal (`SurfaceHit::arrived_behind`).
-    pub behind: u32,
+    /// `SurfaceHit::grazing_offset`.
+    pub grazing_offset: f32,
     /// A triangle's barycentrics and shading-table index (`SurfaceHit::shading`).
     pub barycentrics: Vec2,
     pub shading: u32,
@@ -67,11 +67,11 @@ impl HitPayload {
     /// Stores a closest-hit shader's record (and marks the ray as having hit).
     fn store(&mut self, h: &SurfaceHit) {
         self.position_t = h.position.extend(h.t);
-        self.normal = h.normal.extend(h.error);
+        self.normal = h.normal.extend(h.offset);
         self.material = h.material;
         self.light = h.light;
-        self.hit = 1;
-        self.behind = h.arrived_behind as u32;
+        self.hit = 1 | (h.arrived_behind as u32) << 1;
+        self.grazing_offset = h.grazing_offset;
         self.barycentrics = h.barycentrics;
         self.shading = h.shading;
         self.instance = h.instance;
@@ -88,8 +88,9 @@ impl HitPayload {
             normal: self.normal.truncate(),
             material: self.material,
             light: self.light,
-            error: self.normal.w,
-            arrived_behind: self.behind != 0,
+            offset: self.normal.w,
+            grazing_offset: self.grazing_offset,
+            arrived_behind: self.hit & 2 != 0,
             shading: self.shading,
             barycentrics: self.barycentrics,
             instance: self.instance,

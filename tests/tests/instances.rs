@@ -18,7 +18,7 @@
 //!    mesh on both backends.
 
 use glam::{DMat4, DVec3, Vec3};
-use kernel::geometry::{intersect_triangle, offset_ray_origin};
+use kernel::geometry::{intersect_triangle, lift_ray_origin};
 use kernel::sampling::sample_cosine_hemisphere;
 use std::path::{Path, PathBuf};
 use twinpath::cpu::Bvh;
@@ -324,12 +324,12 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
         );
         let n = (q1 - q0).cross(q2 - q0).normalize();
         let distance = n.dot(record.position.as_dvec3() - q0).abs();
-        let allowed = record.error as f64 * (n.x.abs() + n.y.abs() + n.z.abs());
+        let allowed = record.offset as f64;
         worst = worst.max(distance / allowed);
         outside += (distance > allowed) as usize;
         // Rays leaving the hit on the side it came from, as the renderer spawns them.
         let n_side = record.facing_normal();
-        let o = offset_ray_origin(record.position, n_side, record.error);
+        let o = lift_ray_origin(record.position, n_side, record.offset);
         let w = sample_cosine_hemisphere(n_side, g.unit(), g.unit());
         let (oo, wo) = kernel::instance::ray_to_object(&h_inst, o, w);
         let again = intersect_triangle(

@@ -16,8 +16,8 @@ use kernel::bsdf::lambert::{eval_scattering, pdf_brdf, sample_brdf};
 use kernel::frame::orthonormal_basis;
 use kernel::geometry::{
     area_to_solid_angle_pdf, geometry_factor, intersect_sphere, intersect_triangle,
-    intersect_triangle_uv, offset_ray_origin, shadow_ray_end, sphere_point_error, triangle_point,
-    triangle_point_error,
+    intersect_triangle_uv, offset_ray_origin, shadow_ray_end, sphere_point_error, triangle_offsets,
+    triangle_point, triangle_point_error,
 };
 use kernel::light::triangle::{pdf as pdf_triangle_light, sample as sample_triangle_light};
 use kernel::probe::probe_triangle_light;
@@ -290,6 +290,8 @@ proptest! {
             let err = triangle_point_error(p0, e1, e2, h.u, h.v);
             let p = triangle_point(p0, e1, e2, h.u, h.v);
             prop_assert!(!err.is_nan() && err >= 0.0 && !p.is_nan());
+            let (offset, grazing) = triangle_offsets(p0, e1, e2, h.u, h.v);
+            prop_assert!(offset >= 0.0 && grazing >= 0.0, "heights {offset}, {grazing}");
         }
     }
 
@@ -454,6 +456,11 @@ fn triangle_point_error_of_a_denormal_sliver_is_not_nan() {
     assert!(h.t > 0.0, "the ray hits the sliver (t = {})", h.t);
     let err = triangle_point_error(p0, e1, e2, h.u, h.v);
     let p = triangle_point(p0, e1, e2, h.u, h.v);
+    let (offset, grazing) = triangle_offsets(p0, e1, e2, h.u, h.v);
+    assert!(
+        offset >= 0.0 && grazing >= 0.0,
+        "heights {offset}, {grazing}"
+    );
     assert!(
         err >= f32::EPSILON * p0.abs().max_element() && !p.is_nan(),
         "u = {}, v = {}, error bound {err}, point {p}",

@@ -13,7 +13,7 @@ use crate::settings::RenderSettings;
 use glam::Vec3;
 use kernel::camera::{camera_origin, camera_ray_direction};
 use kernel::features::Dynamic;
-use kernel::geometry::offset_ray_origin;
+use kernel::geometry::lift_ray_origin;
 use kernel::rng::SampleRng;
 use kernel::sampling::sample_cosine_hemisphere;
 use kernel::scene::NONE;
@@ -79,7 +79,7 @@ pub fn bounce_rays(bvh: &Bvh, primary: &RaySet, seed: u32) -> RaySet {
         let mut rng = SampleRng::new(seed, i as u32, 0);
         let (u1, u2) = (rng.next_f32(), rng.next_f32());
         rays.origins
-            .push(offset_ray_origin(hit.position, n, hit.error));
+            .push(lift_ray_origin(hit.position, n, hit.offset));
         rays.dirs.push(sample_cosine_hemisphere(n, u1, u2));
         rays.t_max.push(f32::INFINITY);
     }
