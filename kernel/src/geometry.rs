@@ -446,8 +446,8 @@ pub fn triangle_plane_weights_v3<R: real::Real<Bits = u32>>(
 
 /// The heights above a triangle's plane at which rays leaving its point at barycentrics
 /// (`u`, `v`) start, as (offset, grazing offset): a ray starts `offset` along the leaving
-/// side's unit normal, and a continuation ray within [`GRAZING_COS`] of the plane and every
-/// shadow ray `offset + grazing offset` ([`continuation_origin`], [`shadow_origin`];
+/// side's unit normal, and a continuation ray or shadow segment within [`GRAZING_COS`] of the
+/// plane `offset + grazing offset` ([`continuation_origin`], [`shadow_segment`];
 /// docs/robustness.md, "The height a ray leaves at").
 ///
 /// On a well-conditioned triangle (weights summing to at most [`WELL_CONDITIONED_WEIGHTS`],
@@ -484,7 +484,11 @@ pub fn triangle_offsets_v3<R: real::Real<Bits = u32>>(
         & floor.at_most(R::splat(WELL_CONDITIONED_FLOOR));
     if well == 0 {
         let error = triangle_point_error_v3(p0, edge1, edge2, u, v, condition, watertight_scale);
-        return (error * normal_l1(normal), R::splat(0.0));
+        // |n|_1 <= sqrt(3) for a unit normal; 2 where the normal is not a number (edges whose
+        // cross product overflows, beyond the scene's domain), so that the height is one.
+        let l1 = normal_l1(normal);
+        let l1 = real::select(l1.at_most(R::splat(2.0)), l1, R::splat(2.0));
+        return (error * l1, R::splat(0.0));
     }
     let zero = R::splat(0.0);
     let moved = |a: R, b: R| a.not_equal(zero) | b.not_equal(zero);
@@ -672,12 +676,68 @@ pub fn continuation_origin_v3<R: real::Real<Bits = u32>>(
     lift_ray_origin_v3(p, n_side, height)
 }
 
-/// The origin of a shadow ray (or any ray whose direction is not known to be unit) leaving
-/// surface point `p` on the side of unit normal `n_side`: lifted by both heights of its hit
-/// ([`continuation_origin`]).
+/// The origin of a ray whose direction is not known ahead (one that passes through a surface)
+/// leaving surface point `p` on the side of unit normal `n_side`: lifted by both heights of its
+/// hit ([`continuation_origin`]).
 #[inline]
 pub fn shadow_origin(p: Vec3, n_side: Vec3, offset: f32, grazing_offset: f32) -> Vec3 {
     lift_ray_origin(p, n_side, offset + grazing_offset)
+}
+
+/// A shadow segment leaving surface point `p` on the side of unit normal `n_side` toward the
+/// light point `target` (unit normal `target_normal`, error bound `target_error`), as (from,
+/// to): from `leaving` (`p` lifted by its hit's offset, [`lift_ray_origin`]), or where the
+/// segment may graze the surface from `p` lifted by `grazing_height` (the offset plus the
+/// grazing offset), to the [`shadow_ray_end`] of that origin. The rule of
+/// [`continuation_origin`] for the segment as it is traced, decided before its end is formed:
+/// the end is the target moved by its lift (`target_error` plus 16 eps of the distance L) and
+/// shortened (which keeps the direction), so a segment whose target lies at a cosine of at
+/// least 2 [`GRAZING_COS`] from `leaving`, with `target_error` at most [`GRAZING_COS`] L / 4,
+/// leaves at a cosine of at least 1.5 / (1 + [`GRAZING_COS`] / 2) [`GRAZING_COS`] >=
+/// [`GRAZING_COS`]; every other one starts at the grazing height. A hit whose grazing offset
+/// is 0 passes `grazing_height` <= `offset` and always leaves from `leaving`.
+#[inline]
+pub fn shadow_segment(
+    p: Vec3,
+    n_side: Vec3,
+    leaving: Vec3,
+    (offset, grazing_height): (f32, f32),
+    (target, target_normal, target_error): (Vec3, Vec3, f32),
+) -> (Vec3, Vec3) {
+    let (from, to) = shadow_segment_v3(
+        V3::from(p),
+        V3::from(n_side),
+        V3::from(leaving),
+        (offset, grazing_height),
+        (V3::from(target), V3::from(target_normal), target_error),
+    );
+    (from.into(), to.into())
+}
+
+/// [`shadow_segment`] over any scalar [`real::Real`].
+#[inline]
+pub fn shadow_segment_v3<R: real::Real<Bits = u32>>(
+    p: V3<R>,
+    n_side: V3<R>,
+    leaving: V3<R>,
+    (offset, grazing_height): (R, R),
+    (target, target_normal, target_error): (V3<R>, V3<R>, R),
+) -> (V3<R>, V3<R>) {
+    let to_target = target - leaving;
+    let distance = to_target.length();
+    let steep = to_target
+        .dot(n_side)
+        .at_least(R::splat(2.0 * GRAZING_COS) * distance)
+        & target_error.at_most(R::splat(0.25 * GRAZING_COS) * distance);
+    let from = if grazing_height.greater_than(offset) != 0 && steep == 0 {
+        lift_ray_origin_v3(p, n_side, grazing_height)
+    } else {
+        leaving
+    };
+    (
+        from,
+        shadow_ray_end_v3(from, target, target_normal, target_error),
+    )
 }
 
 /// [`triangle_offsets_v3`] of the triangle (`p0`, `edge1`, `edge2`) at (`u`, `v`), its shape

@@ -29,7 +29,7 @@ pub struct SurfaceHit {
     /// an instance, a per-component error bound times |normal|_1).
     pub offset: f32,
     /// What a continuation ray within `geometry::GRAZING_COS` of the surface and a shadow ray
-    /// add to `offset` (`geometry::continuation_origin`, `geometry::shadow_origin`): a GPU's
+    /// add to `offset` (`geometry::continuation_origin`, `geometry::shadow_segment`): a GPU's
     /// triangle test's rounding on a well-conditioned triangle, else 0.
     pub grazing_offset: f32,
     /// Whether the ray arrived from the side `normal` points away from (a sphere's inside, a

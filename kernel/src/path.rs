@@ -7,7 +7,9 @@ use crate::bsdf::{self, DELTA_PDF};
 use crate::camera::{camera_origin, camera_ray_direction, lens_radius, thin_lens_ray};
 use crate::environment;
 use crate::features::FeatureSet;
-use crate::geometry::{continuation_origin, shadow_origin, shadow_ray_end};
+use crate::geometry::{
+    lift_ray_origin, shadow_origin, shadow_ray_end, shadow_segment, GRAZING_COS,
+};
 use crate::hit::SurfaceHit;
 use crate::light::{self, eval_radiance, LightKinds, LightSample};
 use crate::medium;
@@ -507,7 +509,8 @@ impl PathState {
         let (params, lights) = (scene.params, scene.lights);
         let (x, n, ng) = (query.x, query.n, query.ng);
         let albedo = Vec3::from(material.albedo);
-        let shadow_from = shadow_origin(x, ng, hit.offset, hit.grazing_offset);
+        // Rays that leave at an angle start here; grazing ones higher (`geometry::GRAZING_COS`).
+        let leaving = lift_ray_origin(x, ng, hit.offset);
         // With a shading normal, a direction below the geometric surface carries nothing
         // (`crate::surface`): it would leave through the surface.
         let smooth = features.shading_normals() && query.smooth;
@@ -533,7 +536,8 @@ impl PathState {
                 );
                 let radiance =
                     self.throughput * eval_scattering(n, wi, albedo) * emitted * (weight / pdf_w);
-                self.await_shadow(query.light_kinds, lights, shadow_from, &ls, radiance);
+                self.await_shadow_leaving(query.light_kinds, lights, (x, ng, leaving), hit, &ls);
+                self.shadow_radiance = radiance;
                 if features.media() {
                     // A Lambertian surface leaves the path in its medium.
                     self.shadow_medium = self.medium;
@@ -561,7 +565,11 @@ impl PathState {
         if self.throughput.max_element() <= 0.0 {
             return;
         }
-        let origin = continuation_origin(x, ng, wi, hit.offset, hit.grazing_offset);
+        let origin = if wi.dot(ng) >= GRAZING_COS {
+            leaving
+        } else {
+            lift_ray_origin(x, ng, hit.offset + hit.grazing_offset)
+        };
         self.await_extension(origin, wi, x, pdf_b);
     }
 
@@ -615,9 +623,16 @@ impl PathState {
                     pdf_b,
                 );
                 let n_side = side(ng, ng.dot(wi) > 0.0);
-                let from = shadow_origin(x, n_side, hit.offset, hit.grazing_offset);
+                let leaving = lift_ray_origin(x, n_side, hit.offset);
                 let radiance = self.throughput * f_cos * emitted * (weight / pdf_w);
-                self.await_shadow(query.light_kinds, lights, from, &ls, radiance);
+                self.await_shadow_leaving(
+                    query.light_kinds,
+                    lights,
+                    (x, n_side, leaving),
+                    hit,
+                    &ls,
+                );
+                self.shadow_radiance = radiance;
                 if features.media() {
                     self.shadow_medium = self.medium_beyond(scene, material, hit, wi);
                 }
@@ -660,7 +675,8 @@ impl PathState {
             return;
         }
         let n_side = side(ng, !s.transmitted);
-        let origin = continuation_origin(x, n_side, s.wi, hit.offset, hit.grazing_offset);
+        let origin =
+            crate::geometry::continuation_origin(x, n_side, s.wi, hit.offset, hit.grazing_offset);
         self.await_extension(origin, s.wi, x, s.pdf);
     }
 
@@ -717,6 +733,32 @@ impl PathState {
             light::point_error(kinds, &lights[ls.light as usize]),
         );
         self.shadow_radiance = radiance;
+    }
+
+    /// [`PathState::await_shadow`] for a segment leaving surface point `x` (its hit `hit`) on
+    /// the side of unit normal `n_side`, `leaving` being `x` lifted by the hit's offset: the
+    /// segment of `geometry::shadow_segment` (lifted higher where it grazes the surface). The
+    /// caller sets `shadow_radiance`.
+    #[inline]
+    pub(crate) fn await_shadow_leaving(
+        &mut self,
+        kinds: LightKinds,
+        lights: &[Light],
+        (x, n_side, leaving): (Vec3, Vec3, Vec3),
+        hit: &SurfaceHit,
+        ls: &LightSample,
+    ) {
+        let target_error = light::point_error(kinds, &lights[ls.light as usize]);
+        let (from, to) = shadow_segment(
+            x,
+            n_side,
+            leaving,
+            (hit.offset, hit.offset + hit.grazing_offset),
+            (ls.point.position, ls.point.normal, target_error),
+        );
+        self.shadow = true;
+        self.shadow_from = from;
+        self.shadow_to = to;
     }
 
     /// The extension ray `origin + t dir` waits to be traced, leaving vertex `x`, drawn with

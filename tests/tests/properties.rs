@@ -468,3 +468,23 @@ fn triangle_point_error_of_a_denormal_sliver_is_not_nan() {
         h.v
     );
 }
+
+/// The case `ray_triangle_returns_barycentrics_inside` found (2026-12-06): edges whose cross
+/// product overflows (beyond the scene's domain of 1e15) give a normal that is not a number,
+/// and the height of rays leaving the hit (`geometry::triangle_offsets_v3`, which multiplies a
+/// sliver's bound by |n|_1) was NaN. Both heights must be numbers, at least 0.
+#[test]
+fn triangle_offsets_of_an_overflowing_triangle_are_numbers() {
+    let o = Vec3::new(6.705678e-24, 1.0, 0.0);
+    let d = Vec3::new(0.0, 0.0, 1.0);
+    let p0 = Vec3::new(2.8628497e-22, 1.0, 1.0);
+    let e1 = Vec3::new(1.0, 9.12061e24, 1.0);
+    let e2 = Vec3::new(-1.0, 1.0, 2.3864183e22);
+    let h = intersect_triangle_uv(o, d, p0, e1, e2, 0.0, f32::INFINITY);
+    assert!(h.t > 0.0, "the ray hits the triangle (t = {})", h.t);
+    let (offset, grazing) = triangle_offsets(p0, e1, e2, h.u, h.v);
+    assert!(
+        offset >= 0.0 && grazing >= 0.0,
+        "heights {offset}, {grazing}"
+    );
+}

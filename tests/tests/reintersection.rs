@@ -8,7 +8,7 @@
 //!
 //! Hits are computed as the renderer computes them: triangle points from barycentrics with the
 //! heights of `triangle_offsets`, sphere points re-projected with `sphere_point_error` (times
-//! |n|_1 as the height), origins by `continuation_origin` and `shadow_origin`, shadow-ray ends
+//! |n|_1 as the height), origins by `continuation_origin` and `shadow_segment`, shadow-ray ends
 //! by `shadow_ray_end`.
 //!
 //! The CPU meets triangles with the kernel's Moller-Trumbore test; a GPU with its own, which
@@ -22,7 +22,7 @@
 use glam::Vec3;
 use kernel::geometry::{
     continuation_origin, intersect_sphere, intersect_triangle, intersect_triangle_uv,
-    lift_ray_origin, reproject_to_sphere, shadow_origin, shadow_ray_end, sphere_point_error,
+    lift_ray_origin, reproject_to_sphere, shadow_ray_end, shadow_segment, sphere_point_error,
     triangle_normal, triangle_offsets, triangle_point, triangle_point_error, GRAZING_COS,
 };
 use kernel::plane_side::ray_leaves_triangle_plane;
@@ -43,7 +43,7 @@ fn cases() -> usize {
 /// and `grazing` as the hit gives them, size of the surface `size`), each as (origin,
 /// direction, t_max): a continuation ray in a cosine-distributed direction (from
 /// `continuation_origin`), and a shadow ray toward a point on the leaving side, as far as 10
-/// sizes (from `shadow_origin`); `None` where the direction does not leave, or the target is
+/// sizes (from `shadow_segment`); `None` where the direction does not leave, or the target is
 /// not farther from the surface than the heights (closer, which side it is on is not defined
 /// in f32).
 fn spawned_rays(
@@ -62,7 +62,14 @@ fn spawned_rays(
         )
     });
     let target = p + (n_side * g.unit().max(1e-3) + g.dir() * 0.5) * size * g.pow10(-2.0, 1.0);
-    let o = shadow_origin(p, n_side, offset, grazing);
+    let leaving = lift_ray_origin(p, n_side, offset);
+    let (o, _) = shadow_segment(
+        p,
+        n_side,
+        leaving,
+        (offset, offset + grazing),
+        (target, Vec3::ZERO, 0.0),
+    );
     let shadow = ((target - p).dot(n_side) > offset + grazing).then_some((o, target - o, 1.0));
     [continuation, shadow]
 }
@@ -245,7 +252,8 @@ fn rays_leaving_a_needles_neighbour_never_hit_either_once_rejected() {
 /// of a direction below about 15 eps of the plane's weights, so a device's test could meet the
 /// triangle again (at its worst rounding: [`worst_case_watertight_hit`]) where the ray starts
 /// at the offset alone. Asserted: no ray at or above [`GRAZING_COS`] is met (the plane-side
-/// test rejects them all, at the small offset); below it, with the grazing offset added, no
+/// test rejects them all, at the small offset), nor a shadow segment along the same direction
+/// from `shadow_segment` whose traced direction is; below it, with the grazing offset added, no
 /// more are met than from the bound every ray left at before the plane weights
 /// (`triangle_point_error` times |n|_1); and without the grazing offset some are (so it is
 /// needed, and the test can fail). That below [`GRAZING_COS`] any are met at all is a known
@@ -255,6 +263,7 @@ fn rays_leaving_a_needles_neighbour_never_hit_either_once_rejected() {
 fn grazing_rays_leave_at_the_watertight_height() {
     let mut g = Gen(twinpath_tests::SplitMix(8));
     let (mut tested, mut above, mut with_rule, mut without, mut before) = (0, 0, 0, 0, 0);
+    let (mut shadow_above, mut shadow_below, mut shadow_within) = (0, 0, 0);
     for k in 0..cases() / 4 {
         let case = if k % 2 == 0 {
             g.triangle_case(k % 4 == 0)
@@ -287,10 +296,30 @@ fn grazing_rays_leave_at_the_watertight_height() {
         }
         tested += 1;
         let own = [q, q + f1, q + f2];
-        let met = |o: Vec3| {
-            worst_case_watertight_hit(o, w, own, n_side, f32::INFINITY)
-                && !ray_leaves_triangle_plane(o, w, q, f1, f2)
+        let met_along = |o: Vec3, d: Vec3, t_max: f32| {
+            worst_case_watertight_hit(o, d, own, n_side, t_max)
+                && !ray_leaves_triangle_plane(o, d, q, f1, f2)
         };
+        let met = |o: Vec3| met_along(o, w, f32::INFINITY);
+        // A shadow segment along w to a point 10^-2 to 10 sizes away, from `shadow_segment`.
+        let target = p + w * c.size * g.pow10(-2.0, 1.0);
+        let leaving = lift_ray_origin(p, n_side, offset);
+        let (from, _) = shadow_segment(
+            p,
+            n_side,
+            leaving,
+            (offset, offset + grazing),
+            (target, Vec3::ZERO, 0.0),
+        );
+        let d = target - from;
+        let shadow = met_along(from, d, 1.0) as usize;
+        if d.dot(n_side) >= GRAZING_COS * d.length() {
+            shadow_above += shadow;
+        } else if (target - p).dot(n_side) > offset + grazing {
+            shadow_below += shadow;
+        } else {
+            shadow_within += shadow; // a target no higher than the lift: the segment descends
+        }
         let met_by_rule = met(continuation_origin(p, n_side, w, offset, grazing));
         if w.dot(n_side) >= GRAZING_COS {
             above += met_by_rule as usize;
@@ -301,10 +330,11 @@ fn grazing_rays_leave_at_the_watertight_height() {
         let old = triangle_point_error(q, f1, f2, u, v) * n_side.abs().element_sum();
         before += met(lift_ray_origin(p, n_side, old)) as usize;
     }
-    println!("grazing continuation rays: {tested}; met again at the worst rounding and not rejected: {above} at or above GRAZING_COS; below it {with_rule} with the grazing offset, {without} without it, {before} from the bound before the plane weights");
+    println!("grazing continuation rays: {tested}; met again at the worst rounding and not rejected: {above} at or above GRAZING_COS; below it {with_rule} with the grazing offset, {without} without it, {before} from the bound before the plane weights; shadow segments along them (shadow_segment): {shadow_above} at or above GRAZING_COS, {shadow_below} below it, {shadow_within} to targets no higher than the lift");
     assert!(tested > cases() / 8);
     assert_eq!(above, 0);
     assert!(with_rule <= before, "{with_rule} against {before}");
+    assert_eq!(shadow_above, 0);
     assert!(
         without > with_rule,
         "the grazing offset is not shown to be needed"

@@ -21,9 +21,10 @@ use glam::Vec3;
 use kernel::frame::orthonormal_basis_v3;
 use kernel::geometry::{
     continuation_origin_v3, geometry_factor_v3, lift_ray_origin_v3, reproject_to_sphere_v3,
-    shadow_ray_end_v3, sphere_point_error, sphere_point_error_v3, triangle_error_condition_v3,
-    triangle_normal_v3, triangle_offsets_v3, triangle_plane_weights_v3, triangle_point_error_v3,
-    triangle_point_v3, triangle_watertight_scale_v3, TRIANGLE_ERROR_EPS,
+    shadow_ray_end_v3, shadow_segment_v3, sphere_point_error, sphere_point_error_v3,
+    triangle_error_condition_v3, triangle_normal_v3, triangle_offsets_v3,
+    triangle_plane_weights_v3, triangle_point_error_v3, triangle_point_v3,
+    triangle_watertight_scale_v3, TRIANGLE_ERROR_EPS,
 };
 use kernel::intersect;
 use kernel::plane_side::ray_leaves_triangle_plane_v3;
@@ -112,7 +113,7 @@ use twinpath_tests::placements::Placements as Gen;
 /// Whether a continuation ray and a shadow ray spawned at `p` (leaving normal `n_side`, the
 /// hit's heights `offset` and `grazing`, surface size `size`) hit their surface again (`hits`),
 /// all under [`Vk32`]: the continuation ray from `continuation_origin_v3`, the shadow ray from
-/// both heights, as the renderer spawns them.
+/// `shadow_segment_v3`, as the renderer spawns them.
 fn spawned_self_hits(
     g: &mut Gen,
     p: V,
@@ -128,9 +129,16 @@ fn spawned_self_hits(
             w,
             f(f32::INFINITY),
         );
-    let o = lift_ray_origin_v3(p, n_side, offset + grazing);
     let (pe, ne) = (back(p), back(n_side));
     let target = pe + (ne * g.unit().max(1e-3) + g.dir() * 0.5) * size * g.pow10(-2.0, 1.0);
+    let leaving = lift_ray_origin_v3(p, n_side, offset);
+    let (o, _) = shadow_segment_v3(
+        p,
+        n_side,
+        leaving,
+        (offset, offset + grazing),
+        (v(target), v(Vec3::ZERO), f(0.0)),
+    );
     let shadow = (target - pe).dot(ne) > (offset + grazing).value && hits(o, v(target) - o, f(1.0));
     (continuation, shadow)
 }
