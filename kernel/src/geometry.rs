@@ -744,7 +744,20 @@ pub fn shadow_segment_v3<R: real::Real<Bits = u32>>(
 /// computed here ([`TriangleShape::of`]).
 #[inline]
 pub fn triangle_offsets(p0: Vec3, edge1: Vec3, edge2: Vec3, u: f32, v: f32) -> (f32, f32) {
-    let shape = TriangleShape::of(edge1, edge2);
+    triangle_offsets_conditioned(p0, edge1, edge2, u, v, &TriangleShape::of(edge1, edge2))
+}
+
+/// [`triangle_offsets_v3`] with the factors of the triangle's [`TriangleShape`] given (as
+/// [`triangle_point_error_conditioned`] takes them).
+#[inline]
+pub fn triangle_offsets_conditioned(
+    p0: Vec3,
+    edge1: Vec3,
+    edge2: Vec3,
+    u: f32,
+    v: f32,
+    shape: &TriangleShape,
+) -> (f32, f32) {
     triangle_offsets_v3(
         V3::from(p0),
         V3::from(edge1),

@@ -3,11 +3,10 @@
 //! shaders and the CPU's traversal make the same record from the same ray.
 
 use crate::geometry::{
-    reproject_to_sphere, sphere_point_error, triangle_offsets_v3, triangle_point,
+    reproject_to_sphere, sphere_point_error, triangle_offsets_conditioned, triangle_point,
     triangle_point_error_conditioned, TriangleShape,
 };
 use crate::instance::{normal_to_world, point_to_world, world_point_error};
-use crate::real::V3;
 use crate::scene::{Instance, Sphere, Triangle, NONE};
 use spirv_std::glam::{Vec2, Vec3};
 
@@ -111,18 +110,7 @@ impl SurfaceHit {
             Vec3::from(tri.edge1),
             Vec3::from(tri.edge2),
         );
-        let (offset, grazing_offset) = triangle_offsets_v3(
-            V3::from(p0),
-            V3::from(e1),
-            V3::from(e2),
-            u,
-            v,
-            V3::from(shape.normal),
-            shape.condition,
-            shape.watertight_scale,
-            V3::from(shape.weights),
-            shape.floor,
-        );
+        let (offset, grazing_offset) = triangle_offsets_conditioned(p0, e1, e2, u, v, &shape);
         Self {
             position: triangle_point(p0, e1, e2, u, v),
             t,
