@@ -307,8 +307,8 @@ pub fn triangle_error_condition_v3<R: real::Real>(edge1: V3<R>, edge2: V3<R>) ->
 
 /// What a triangle's hit records need that depends on its shape alone: its unit normal
 /// ([`triangle_normal`]), its [`triangle_error_condition`], its
-/// [`triangle_watertight_scale_v3`] and its [`triangle_plane_weights_v3`] (five square roots and
-/// four divisions, which a renderer may compute once per triangle, as the CPU's BVH does).
+/// [`triangle_watertight_scale_v3`], its [`triangle_plane_weights_v3`] and its
+/// [`triangle_grazing_offset_v3`] (eight square roots and four divisions, which a renderer may compute once per triangle, as the CPU's BVH does).
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleShape {
     pub normal: Vec3,
@@ -318,18 +318,23 @@ pub struct TriangleShape {
     pub weights: Vec3,
     /// The height that rounding to denormals may take ([`triangle_plane_weights_v3`]).
     pub floor: f32,
+    /// What grazing rays add to the offset ([`triangle_grazing_offset_v3`]).
+    pub grazing: f32,
 }
 
 impl TriangleShape {
     #[inline]
     pub fn of(edge1: Vec3, edge2: Vec3) -> Self {
-        let (weights, floor) = triangle_plane_weights_v3(V3::from(edge1), V3::from(edge2));
+        let (e1, e2) = (V3::from(edge1), V3::from(edge2));
+        let (weights, floor) = triangle_plane_weights_v3(e1, e2);
+        let watertight_scale = triangle_watertight_scale_v3(e1, e2);
         Self {
             normal: triangle_normal(edge1, edge2),
             condition: triangle_error_condition(edge1, edge2),
-            watertight_scale: triangle_watertight_scale_v3(V3::from(edge1), V3::from(edge2)),
+            watertight_scale,
             weights: weights.into(),
             floor,
+            grazing: triangle_grazing_offset_v3(e1, e2, watertight_scale),
         }
     }
 }
@@ -463,7 +468,7 @@ pub fn triangle_plane_weights_v3<R: real::Real<Bits = u32>>(
 ///
 /// Elsewhere (slivers, degenerate or denormal triangles) the offset is the bound of
 /// [`triangle_point_error_v3`] times |n|_1, as for every triangle before the weights, and the
-/// grazing offset 0.
+/// grazing offset the same.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn triangle_offsets_v3<R: real::Real<Bits = u32>>(
@@ -477,6 +482,7 @@ pub fn triangle_offsets_v3<R: real::Real<Bits = u32>>(
     watertight_scale: R,
     weights: V3<R>,
     floor: R,
+    grazing: R,
 ) -> (R, R) {
     let well = weights
         .element_sum()
@@ -488,7 +494,7 @@ pub fn triangle_offsets_v3<R: real::Real<Bits = u32>>(
         // cross product overflows, beyond the scene's domain), so that the height is one.
         let l1 = normal_l1(normal);
         let l1 = real::select(l1.at_most(R::splat(2.0)), l1, R::splat(2.0));
-        return (error * l1, R::splat(0.0));
+        return (error * l1, grazing);
     }
     let zero = R::splat(0.0);
     let moved = |a: R, b: R| a.not_equal(zero) | b.not_equal(zero);
@@ -503,7 +509,6 @@ pub fn triangle_offsets_v3<R: real::Real<Bits = u32>>(
     let offset = R::splat(TRIANGLE_ERROR_EPS * f32::EPSILON) * corner
         + R::splat(PLANE_OFFSET_EPS * f32::EPSILON) * edges
         + floor;
-    let grazing = triangle_watertight_error_v3(edge1, edge2, u, v, watertight_scale);
     (offset.min(R::splat(f32::MAX)), grazing)
 }
 
@@ -556,6 +561,36 @@ pub fn triangle_watertight_scale_v3<R: real::Real<Bits = u32>>(edge1: V3<R>, edg
         (R::splat(WATERTIGHT_ERROR_EPS * f32::EPSILON) / area).min(R::splat(f32::MAX)),
         R::splat(0.0),
     )
+}
+
+/// The count of the vertex moves' term of [`triangle_grazing_offset_v3`], in eps of the
+/// longest edge: a watertight test's roundings other than its edge functions are exact tests
+/// of vertices moved by at most 13.52 eps of their distances from the origin, which move the
+/// plane under a point q by at most that times sum_i lambda_i(q) |p_i - q| <= the longest edge
+/// (docs/robustness.md, "The vertex moves, counted").
+pub const VERTEX_MOVE_EPS: f32 = 14.0;
+
+/// What a ray that grazes a triangle (within [`GRAZING_COS`]) adds to the offset of
+/// [`triangle_offsets_v3`]: [`triangle_watertight_error_bound`] (the watertight term's largest
+/// value over the triangle) plus [`VERTEX_MOVE_EPS`] eps of the longest edge. A grazing ray is
+/// met, if at all, where its backward line crosses the triangle, h / cos from the point it
+/// leaves, so the device's rounding there, not at the point, is what the height must clear:
+/// anywhere on the triangle. `watertight_scale` is [`triangle_watertight_scale_v3`]; every
+/// product is capped at f32::MAX.
+#[inline]
+pub fn triangle_grazing_offset_v3<R: real::Real<Bits = u32>>(
+    edge1: V3<R>,
+    edge2: V3<R>,
+    watertight_scale: R,
+) -> R {
+    let big = R::splat(f32::MAX);
+    let longest = edge1
+        .length()
+        .max(edge2.length())
+        .max((edge2 - edge1).length());
+    let scaled = (longest * watertight_scale).min(big);
+    let watertight = ((scaled * longest).min(big) * longest).min(big);
+    (watertight + R::splat(VERTEX_MOVE_EPS * f32::EPSILON) * longest).min(big)
 }
 
 /// A bound on [`triangle_point_error`] over every point of the triangle (a triangle light's
@@ -676,14 +711,6 @@ pub fn continuation_origin_v3<R: real::Real<Bits = u32>>(
     lift_ray_origin_v3(p, n_side, height)
 }
 
-/// The origin of a ray whose direction is not known ahead (one that passes through a surface)
-/// leaving surface point `p` on the side of unit normal `n_side`: lifted by both heights of its
-/// hit ([`continuation_origin`]).
-#[inline]
-pub fn shadow_origin(p: Vec3, n_side: Vec3, offset: f32, grazing_offset: f32) -> Vec3 {
-    lift_ray_origin(p, n_side, offset + grazing_offset)
-}
-
 /// A shadow segment leaving surface point `p` on the side of unit normal `n_side` toward the
 /// light point `target` (unit normal `target_normal`, error bound `target_error`), as (from,
 /// to): from `leaving` (`p` lifted by its hit's offset, [`lift_ray_origin`]), or where the
@@ -769,6 +796,7 @@ pub fn triangle_offsets_conditioned(
         shape.watertight_scale,
         V3::from(shape.weights),
         shape.floor,
+        shape.grazing,
     )
 }
 

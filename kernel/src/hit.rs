@@ -27,9 +27,10 @@ pub struct SurfaceHit {
     /// again need to decide the ray's side (`geometry::triangle_offsets_v3`; for a sphere and
     /// an instance, a per-component error bound times |normal|_1).
     pub offset: f32,
-    /// What a continuation ray within `geometry::GRAZING_COS` of the surface and a shadow ray
-    /// add to `offset` (`geometry::continuation_origin`, `geometry::shadow_segment`): a GPU's
-    /// triangle test's rounding on a well-conditioned triangle, else 0.
+    /// What a ray within `geometry::GRAZING_COS` of the surface adds to `offset`
+    /// (`geometry::continuation_origin`, `geometry::shadow_segment`): a GPU's triangle test's
+    /// rounding anywhere on the triangle (`geometry::triangle_grazing_offset_v3`); 0 for
+    /// spheres and instances.
     pub grazing_offset: f32,
     /// Whether the ray arrived from the side `normal` points away from (a sphere's inside, a
     /// triangle's back). Decided where the record is made, and robustly for spheres: by which

@@ -8,7 +8,7 @@ use crate::camera::{camera_origin, camera_ray_direction, lens_radius, thin_lens_
 use crate::environment;
 use crate::features::FeatureSet;
 use crate::geometry::{
-    lift_ray_origin, shadow_origin, shadow_ray_end, shadow_segment, GRAZING_COS,
+    continuation_origin, lift_ray_origin, shadow_ray_end, shadow_segment, GRAZING_COS,
 };
 use crate::hit::SurfaceHit;
 use crate::light::{self, eval_radiance, LightKinds, LightSample};
@@ -798,17 +798,33 @@ impl PathState {
     }
 }
 
-/// The origin of a ray along `dir` that goes on through the surface at `hit`: its point,
-/// lifted to the side `dir` points to by both of the hit's heights (`geometry::shadow_origin`:
-/// `dir` need not be unit, and such rays are few).
+/// The origin of a ray along unit `dir` that goes on through the surface at `hit`: its point,
+/// lifted to the side `dir` points to (`geometry::continuation_origin`).
 #[inline]
 pub(crate) fn beyond_surface(hit: &SurfaceHit, dir: Vec3) -> Vec3 {
-    shadow_origin(
+    continuation_origin(
         hit.position,
         side(hit.normal, hit.normal.dot(dir) > 0.0),
+        dir,
         hit.offset,
         hit.grazing_offset,
     )
+}
+
+/// The origin of the rest of a shadow segment along `dir` toward `to` that goes on through the
+/// surface at `hit`: its point lifted by the hit's offset to the side `dir` points to, or by
+/// both heights where the segment from there to `to` grazes the surface (the rule of
+/// `geometry::shadow_segment`, decided on the segment as traced: its end does not move).
+#[inline]
+pub(crate) fn beyond_surface_toward(hit: &SurfaceHit, dir: Vec3, to: Vec3) -> Vec3 {
+    let n_side = side(hit.normal, hit.normal.dot(dir) > 0.0);
+    let leaving = lift_ray_origin(hit.position, n_side, hit.offset);
+    let d = to - leaving;
+    if d.dot(n_side) >= GRAZING_COS * d.length() {
+        leaving
+    } else {
+        lift_ray_origin(hit.position, n_side, hit.offset + hit.grazing_offset)
+    }
 }
 
 /// `n` where `toward_n`, else `-n`: the normal of the side a ray leaves from.

@@ -14,7 +14,9 @@ use crate::free_flight;
 use crate::hit::SurfaceHit;
 use crate::light::{self, LightKinds};
 use crate::medium::{self, Medium};
-use crate::path::{beyond_surface, light_sample_weight, light_sampling_of, PathState};
+use crate::path::{
+    beyond_surface, beyond_surface_toward, light_sample_weight, light_sampling_of, PathState,
+};
 use crate::phase;
 use crate::scene::{Material, RenderParams};
 use crate::scene_view::SceneView;
@@ -262,7 +264,7 @@ impl PathState {
         let outside = scene.params.environment.medium;
         self.shadow_medium =
             medium::beyond(material, blocker.normal, dir, self.shadow_medium, outside);
-        self.shadow_from = beyond_surface(blocker, dir);
+        self.shadow_from = beyond_surface_toward(blocker, dir, self.shadow_to);
         true
     }
 
