@@ -588,9 +588,18 @@ pub fn triangle_grazing_offset_v3<R: real::Real<Bits = u32>>(
         .length()
         .max(edge2.length())
         .max((edge2 - edge1).length());
-    let scaled = (longest * watertight_scale).min(big);
-    let watertight = ((scaled * longest).min(big) * longest).min(big);
+    let watertight = watertight_bound_of(longest, watertight_scale);
     (watertight + R::splat(VERTEX_MOVE_EPS * f32::EPSILON) * longest).min(big)
+}
+
+/// `scale` E^3 for the longest edge E, each product capped at f32::MAX: the largest
+/// [`triangle_watertight_error_v3`] over a triangle of factor `scale`
+/// ([`triangle_watertight_error_bound`]).
+#[inline]
+fn watertight_bound_of<R: real::Real>(longest: R, scale: R) -> R {
+    let big = R::splat(f32::MAX);
+    let scaled = (longest * scale).min(big);
+    ((scaled * longest).min(big) * longest).min(big)
 }
 
 /// A bound on [`triangle_point_error`] over every point of the triangle (a triangle light's
@@ -612,8 +621,7 @@ pub fn triangle_watertight_error_bound(edge1: Vec3, edge2: Vec3) -> f32 {
         .max(edge2.length())
         .max((edge2 - edge1).length());
     let scale = triangle_watertight_scale_v3(V3::from(edge1), V3::from(edge2));
-    let scaled = (longest * scale).min(f32::MAX);
-    ((scaled * longest).min(f32::MAX) * longest).min(f32::MAX)
+    watertight_bound_of(longest, scale)
 }
 
 /// Absolute error bound of a point on a sphere (centre `center`, radius `radius`), re-projected
