@@ -339,6 +339,52 @@ impl TriangleShape {
     }
 }
 
+impl TriangleShape {
+    /// The shape's factors as [`triangle_offsets_v3`] reads them.
+    #[inline]
+    pub fn factors(&self) -> ShapeFactors<f32> {
+        ShapeFactors {
+            normal: V3::from(self.normal),
+            condition: self.condition,
+            watertight_scale: self.watertight_scale,
+            weights: V3::from(self.weights),
+            floor: self.floor,
+            grazing: self.grazing,
+        }
+    }
+}
+
+/// A [`TriangleShape`] over any [`real::Real`]: the factors [`triangle_offsets_v3`] reads
+/// besides the corner, the edges and the barycentrics (the tests build them under a model of
+/// Vulkan's arithmetic with [`ShapeFactors::of`]).
+#[derive(Clone, Copy)]
+pub struct ShapeFactors<R> {
+    pub normal: V3<R>,
+    pub condition: R,
+    pub watertight_scale: R,
+    pub weights: V3<R>,
+    pub floor: R,
+    pub grazing: R,
+}
+
+impl<R: real::Real<Bits = u32>> ShapeFactors<R> {
+    /// The factors of the triangle with edges `edge1`, `edge2`, computed in `R` as
+    /// [`TriangleShape::of`] computes them in `f32`.
+    #[inline]
+    pub fn of(edge1: V3<R>, edge2: V3<R>) -> Self {
+        let (weights, floor) = triangle_plane_weights_v3(edge1, edge2);
+        let watertight_scale = triangle_watertight_scale_v3(edge1, edge2);
+        Self {
+            normal: triangle_normal_v3(edge1, edge2),
+            condition: triangle_error_condition_v3(edge1, edge2),
+            watertight_scale,
+            weights,
+            floor,
+            grazing: triangle_grazing_offset_v3(edge1, edge2, watertight_scale),
+        }
+    }
+}
+
 /// [`triangle_point_error`] with the factors of the triangle's [`TriangleShape`] given.
 #[inline]
 pub fn triangle_point_error_conditioned(
@@ -470,20 +516,22 @@ pub fn triangle_plane_weights_v3<R: real::Real<Bits = u32>>(
 /// [`triangle_point_error_v3`] times |n|_1, as for every triangle before the weights, and the
 /// grazing offset the same.
 #[inline]
-#[allow(clippy::too_many_arguments)]
 pub fn triangle_offsets_v3<R: real::Real<Bits = u32>>(
     p0: V3<R>,
     edge1: V3<R>,
     edge2: V3<R>,
     u: R,
     v: R,
-    normal: V3<R>,
-    condition: R,
-    watertight_scale: R,
-    weights: V3<R>,
-    floor: R,
-    grazing: R,
+    factors: &ShapeFactors<R>,
 ) -> (R, R) {
+    let ShapeFactors {
+        normal,
+        condition,
+        watertight_scale,
+        weights,
+        floor,
+        grazing,
+    } = *factors;
     let well = weights
         .element_sum()
         .at_most(R::splat(WELL_CONDITIONED_WEIGHTS))
@@ -799,12 +847,7 @@ pub fn triangle_offsets_conditioned(
         V3::from(edge2),
         u,
         v,
-        V3::from(shape.normal),
-        shape.condition,
-        shape.watertight_scale,
-        V3::from(shape.weights),
-        shape.floor,
-        shape.grazing,
+        &shape.factors(),
     )
 }
 

@@ -22,9 +22,8 @@ use kernel::frame::orthonormal_basis_v3;
 use kernel::geometry::{
     continuation_origin_v3, geometry_factor_v3, lift_ray_origin_v3, reproject_to_sphere_v3,
     shadow_ray_end_v3, shadow_segment_v3, sphere_point_error, sphere_point_error_v3,
-    triangle_error_condition_v3, triangle_grazing_offset_v3, triangle_normal_v3,
-    triangle_offsets_v3, triangle_plane_weights_v3, triangle_point_error_v3, triangle_point_v3,
-    triangle_watertight_scale_v3, TRIANGLE_ERROR_EPS,
+    triangle_error_condition_v3, triangle_normal_v3, triangle_offsets_v3, triangle_point_error_v3,
+    triangle_point_v3, triangle_watertight_scale_v3, ShapeFactors, TRIANGLE_ERROR_EPS,
 };
 use kernel::intersect;
 use kernel::plane_side::ray_leaves_triangle_plane_v3;
@@ -279,13 +278,7 @@ fn leaving_triangles_under_vulkan(
         let p = triangle_point_v3(q, f1, f2, hu, hv);
         let nn = triangle_normal_v3(f1, f2);
         let n_side = if nn.dot(v(dir)).value < 0.0 { nn } else { -nn };
-        let condition = triangle_error_condition_v3(f1, f2);
-        let scale = triangle_watertight_scale_v3(f1, f2);
-        let (weights, floor) = triangle_plane_weights_v3(f1, f2);
-        let grazing = triangle_grazing_offset_v3(f1, f2, scale);
-        let heights = triangle_offsets_v3(
-            q, f1, f2, hu, hv, nn, condition, scale, weights, floor, grazing,
-        );
+        let heights = triangle_offsets_v3(q, f1, f2, hu, hv, &ShapeFactors::of(f1, f2));
         // Met by the CPU's test (the kernel's Moller-Trumbore) or by a GPU's (a watertight
         // test, `twinpath_tests::watertight`; with `rejecting`, not where the ray certainly
         // leaves the triangle's plane: `kernel::plane_side`), all under Vulkan's arithmetic,
