@@ -14,7 +14,8 @@
 //! Flights ([`flight`]): drawn by the path's hero channel h (`crate::free_flight`). Per
 //! channel k, with T_k the majorant transmittance exp(-M sigma_t,k s) over the distance s since
 //! the last event, the events' densities and contributions are
-//! - a real collision: p_k = (rho / M) M sigma_t,k T_k = rho sigma_t,k T_k, f_k = rho sigma_s,k T_k;
+//! - a real collision: p_k = (rho / M) M sigma_t,k T_k = rho sigma_t,k T_k,
+//!   f_k = rho sigma_s,k T_k;
 //! - a null collision: p_k = f_k = (M - rho) sigma_t,k T_k (its contribution is its density);
 //! - passing the surface: p_k = f_k = T_k.
 //!

@@ -84,8 +84,8 @@ pub fn reproject_to_sphere(p: Vec3, center: Vec3, radius: f32) -> Vec3 {
     reproject_to_sphere_v3(V3::from(p), V3::from(center), radius).into()
 }
 
-/// [`reproject_to_sphere`] over any scalar [`real::Real`] (the kernel's `f32`, or a test's model of a
-/// device's arithmetic).
+/// [`reproject_to_sphere`] over any scalar [`real::Real`] (the kernel's `f32`, or a test's model
+/// of a device's arithmetic).
 #[inline]
 pub fn reproject_to_sphere_v3<R: real::Real<Bits = u32>>(
     p: V3<R>,
@@ -308,7 +308,9 @@ pub fn triangle_error_condition_v3<R: real::Real>(edge1: V3<R>, edge2: V3<R>) ->
 /// What a triangle's hit records need that depends on its shape alone: its unit normal
 /// ([`triangle_normal`]), its [`triangle_error_condition`], its
 /// [`triangle_watertight_scale_v3`], its [`triangle_plane_weights_v3`] and its
-/// [`triangle_grazing_offset_v3`] (eight square roots and four divisions, which a renderer may compute once per triangle, as the CPU's BVH does).
+/// [`triangle_grazing_offset_v3`]. They cost eight square roots and seven divisions, which a
+/// renderer may compute once per triangle, as the CPU's BVH does. The `f32` [`ShapeFactors`]
+/// computes them, so both are the same numbers bit for bit.
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleShape {
     pub normal: Vec3,
@@ -325,21 +327,17 @@ pub struct TriangleShape {
 impl TriangleShape {
     #[inline]
     pub fn of(edge1: Vec3, edge2: Vec3) -> Self {
-        let (e1, e2) = (V3::from(edge1), V3::from(edge2));
-        let (weights, floor) = triangle_plane_weights_v3(e1, e2);
-        let watertight_scale = triangle_watertight_scale_v3(e1, e2);
+        let factors = ShapeFactors::<f32>::of(V3::from(edge1), V3::from(edge2));
         Self {
-            normal: triangle_normal(edge1, edge2),
-            condition: triangle_error_condition(edge1, edge2),
-            watertight_scale,
-            weights: weights.into(),
-            floor,
-            grazing: triangle_grazing_offset_v3(e1, e2, watertight_scale),
+            normal: factors.normal.into(),
+            condition: factors.condition,
+            watertight_scale: factors.watertight_scale,
+            weights: factors.weights.into(),
+            floor: factors.floor,
+            grazing: factors.grazing,
         }
     }
-}
 
-impl TriangleShape {
     /// The shape's factors as [`triangle_offsets_v3`] reads them.
     #[inline]
     pub fn factors(&self) -> ShapeFactors<f32> {
@@ -368,8 +366,8 @@ pub struct ShapeFactors<R> {
 }
 
 impl<R: real::Real<Bits = u32>> ShapeFactors<R> {
-    /// The factors of the triangle with edges `edge1`, `edge2`, computed in `R` as
-    /// [`TriangleShape::of`] computes them in `f32`.
+    /// The factors of the triangle with edges `edge1`, `edge2`, computed in `R`
+    /// ([`TriangleShape::of`] is the `f32` instance).
     #[inline]
     pub fn of(edge1: V3<R>, edge2: V3<R>) -> Self {
         let (weights, floor) = triangle_plane_weights_v3(edge1, edge2);
@@ -758,13 +756,62 @@ pub fn continuation_origin_v3<R: real::Real<Bits = u32>>(
     offset: R,
     grazing_offset: R,
 ) -> V3<R> {
-    let grazing = dir.dot(n_side).at_least(R::splat(GRAZING_COS)) == 0;
-    let height = if grazing {
+    let height = if grazes(dir.dot(n_side), R::splat(1.0)) {
         offset + grazing_offset
     } else {
         offset
     };
     lift_ray_origin_v3(p, n_side, height)
+}
+
+/// Whether a ray whose direction has component `along` along the leaving side's unit normal
+/// and length `length` leaves within [`GRAZING_COS`] of the plane (or is not a number), where
+/// rays start higher by the grazing offset: the one test of [`continuation_origin_v3`] and
+/// [`origin_by_angle_v3`].
+#[inline]
+fn grazes<R: real::Real<Bits = u32>>(along: R, length: R) -> bool {
+    along.at_least(R::splat(GRAZING_COS) * length) == 0
+}
+
+/// The one rule for where a ray leaving surface point `p` on the side of unit normal `n_side`
+/// starts, given `leaving` (`p` lifted by its hit's offset, [`lift_ray_origin`]) and the
+/// direction's component `along` `n_side` and its `length` (as a pair): `leaving` where
+/// along >= [`GRAZING_COS`] length, else `p` lifted by `grazing_height` (the offset plus the
+/// grazing offset, [`triangle_offsets_v3`]). Taking `leaving` made lets a vertex that sends a
+/// light sample too lift once ([`continuation_origin_v3`] lifts once by the height it picks). [`shadow_segment`] applies the rule to a segment whose end is
+/// formed after its origin.
+#[inline]
+pub fn origin_by_angle_v3<R: real::Real<Bits = u32>>(
+    p: V3<R>,
+    n_side: V3<R>,
+    leaving: V3<R>,
+    (along, length): (R, R),
+    grazing_height: R,
+) -> V3<R> {
+    if grazes(along, length) {
+        lift_ray_origin_v3(p, n_side, grazing_height)
+    } else {
+        leaving
+    }
+}
+
+/// [`origin_by_angle_v3`] in `f32`.
+#[inline]
+pub fn origin_by_angle(
+    p: Vec3,
+    n_side: Vec3,
+    leaving: Vec3,
+    along_length: (f32, f32),
+    grazing_height: f32,
+) -> Vec3 {
+    origin_by_angle_v3(
+        V3::from(p),
+        V3::from(n_side),
+        V3::from(leaving),
+        along_length,
+        grazing_height,
+    )
+    .into()
 }
 
 /// A shadow segment leaving surface point `p` on the side of unit normal `n_side` toward the

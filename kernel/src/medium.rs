@@ -119,8 +119,8 @@ pub fn transmittance_v3<R: Exponential>(sigma_t: V3<R>, distance: R) -> V3<R> {
 }
 
 /// The transmittance of the segment from `from` to `to` in homogeneous medium `medium` of
-/// `media` (a segment between surfaces lies in one medium): 1 in vacuum. Exact for a homogeneous medium,
-/// so a shadow segment needs no estimate of it (ratio tracking estimates what has no closed
+/// `media` (a segment between surfaces lies in one medium): 1 in vacuum. Exact for a homogeneous
+/// medium, so a shadow segment needs no estimate of it (ratio tracking estimates what has no closed
 /// form). Out of line on the CPU: only scenes with media call it.
 #[cfg_attr(not(target_arch = "spirv"), inline(never))]
 pub fn along(media: &[Medium], medium: u32, from: Vec3, to: Vec3) -> Vec3 {

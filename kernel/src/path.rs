@@ -8,7 +8,7 @@ use crate::camera::{camera_origin, camera_ray_direction, lens_radius, thin_lens_
 use crate::environment;
 use crate::features::FeatureSet;
 use crate::geometry::{
-    continuation_origin, lift_ray_origin, shadow_ray_end, shadow_segment, GRAZING_COS,
+    continuation_origin, lift_ray_origin, origin_by_angle, shadow_ray_end, shadow_segment,
 };
 use crate::hit::SurfaceHit;
 use crate::light::{self, eval_radiance, LightKinds, LightSample};
@@ -82,8 +82,8 @@ pub trait Tracer {
 ///    a vertex always happens, and the roulette decision follows it.
 /// 5. A path also ends where its throughput is exactly zero (nothing after can add light) and,
 ///    as a guard only, after `max_depth` vertices (`u32::MAX` by default: no bias). Every place
-///    a path ends without escaping is listed in `docs/correctness.md` ("Where a path ends"). No shadow
-///    ray is traced from a black surface (its light sample would add exactly zero).
+///    a path ends without escaping is listed in `docs/correctness.md` ("Where a path ends").
+///    No shadow ray is traced from a black surface (its light sample would add exactly zero).
 ///
 /// `features` answers which of these steps the scene needs (`crate::features`): a
 /// [`crate::features::Static`] set compiles the others away, a dynamic one asks `params`.
@@ -565,11 +565,8 @@ impl PathState {
         if self.throughput.max_element() <= 0.0 {
             return;
         }
-        let origin = if wi.dot(ng) >= GRAZING_COS {
-            leaving
-        } else {
-            lift_ray_origin(x, ng, hit.offset + hit.grazing_offset)
-        };
+        let grazing_height = hit.offset + hit.grazing_offset;
+        let origin = origin_by_angle(x, ng, leaving, (wi.dot(ng), 1.0), grazing_height);
         self.await_extension(origin, wi, x, pdf_b);
     }
 
@@ -813,18 +810,21 @@ pub(crate) fn beyond_surface(hit: &SurfaceHit, dir: Vec3) -> Vec3 {
 
 /// The origin of the rest of a shadow segment along `dir` toward `to` that goes on through the
 /// surface at `hit`: its point lifted by the hit's offset to the side `dir` points to, or by
-/// both heights where the segment from there to `to` grazes the surface (the rule of
-/// `geometry::shadow_segment`, decided on the segment as traced: its end does not move).
+/// both heights where the segment from there to `to` grazes the surface
+/// (`geometry::origin_by_angle_v3`, decided on the segment as traced: its end does not move).
 #[inline]
 pub(crate) fn beyond_surface_toward(hit: &SurfaceHit, dir: Vec3, to: Vec3) -> Vec3 {
     let n_side = side(hit.normal, hit.normal.dot(dir) > 0.0);
     let leaving = lift_ray_origin(hit.position, n_side, hit.offset);
     let d = to - leaving;
-    if d.dot(n_side) >= GRAZING_COS * d.length() {
-        leaving
-    } else {
-        lift_ray_origin(hit.position, n_side, hit.offset + hit.grazing_offset)
-    }
+    let grazing_height = hit.offset + hit.grazing_offset;
+    origin_by_angle(
+        hit.position,
+        n_side,
+        leaving,
+        (d.dot(n_side), d.length()),
+        grazing_height,
+    )
 }
 
 /// `n` where `toward_n`, else `-n`: the normal of the side a ray leaves from.

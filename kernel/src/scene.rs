@@ -47,8 +47,8 @@ pub struct Triangle {
 /// colours (`shading_flags::VERTEX_COLOURS`, glTF's `COLOR_0`) has one more record after those,
 /// [`ShadingTriangle::vertex_colours`]: the three linear RGB colours in `normal0..2`,
 /// interpolated like the normals, multiplying the base colour; one with a second set of texture
-/// coordinates (`shading_flags::SECOND_UVS`) one more, with them in `uv0..2`. Keeping them in the same table
-/// costs nothing to scenes without them and needs no further GPU binding.
+/// coordinates (`shading_flags::SECOND_UVS`) one more, with them in `uv0..2`. Keeping them in the
+/// same table costs nothing to scenes without them and needs no further GPU binding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
@@ -521,8 +521,9 @@ pub mod sampler {
 
 /// Everything a launch of the kernel needs besides the scene's tables, one part per concern:
 /// the camera, which samples of which image, how a path is estimated, adaptive sampling, and
-/// what rays that leave the scene see, and where paths split. 192 bytes; every part is 4-byte words, so the host's
-/// `repr(C)` layout is the std430 layout the GPU reads (checked by `tests/tests/spirv_module.rs`).
+/// what rays that leave the scene see, and where paths split. 192 bytes; every part is 4-byte
+/// words, so the host's `repr(C)` layout is the std430 layout the GPU reads (checked by
+/// `tests/tests/spirv_module.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]

@@ -52,7 +52,8 @@ pub struct HitPayload {
     pub normal: Vec4,
     pub material: u32,
     pub light: u32,
-    /// 0 if the ray hit nothing (the miss shader clears it); else 1, plus 2 if it arrived from behind the normal (`SurfaceHit::arrived_behind`).
+    /// 0 if the ray hit nothing (the miss shader clears it); else 1, plus 2 if it arrived from
+    /// behind the normal (`SurfaceHit::arrived_behind`).
     pub hit: u32,
     /// `SurfaceHit::grazing_offset`.
     pub grazing_offset: f32,
@@ -164,7 +165,8 @@ impl Tracer for RayTracer<'_> {
 /// launch, Chan, Golub and LeVeque's pairwise combination with the earlier launches. Both stay
 /// accurate in f32 where a sum of squares minus n mean^2 would cancel. Samples the film does not
 /// sum (`film_sample::classify`: non-finite or huge) are not merged; they are counted in
-/// `accum_m2.a`. With adaptive sampling, a converged pixel takes no samples, and pilot samples go to the pilot image instead (`crate::adaptive`).
+/// `accum_m2.a`. With adaptive sampling, a converged pixel takes no samples, and pilot samples
+/// go to the pilot image instead (`crate::adaptive`).
 /// The earlier launches' mean and M2 are read after the sample loop, where they are merged: a
 /// value read before it would be live across every trace call, which GPUs that traverse in
 /// hardware save and restore around each ray (`docs/gpu.md`).

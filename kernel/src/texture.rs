@@ -25,8 +25,6 @@ use crate::bsdf;
 use crate::features::{Dynamic, FeatureSet};
 use crate::real::{Real, V3};
 use crate::scene::{texture_slot, Material, NONE};
-#[cfg(target_arch = "spirv")]
-use crate::Float;
 use spirv_std::glam::{Vec2, Vec3};
 
 /// Word holding the record of the GGX albedo table, or `NONE`.

@@ -31,10 +31,11 @@ pub const CAMERA_DIMENSIONS: u32 = 2;
 // Split paths' continuations read their own sequence index from the first vertex's roulette
 // number on (`crate::split`).
 const _: () = assert!(crate::rng::CONTINUED_FROM == CAMERA_DIMENSIONS + ROULETTE_DIMENSION);
-/// The lobe choice of the vertex at depth d (a BSDF that mixes lobes, `bsdf::BsdfFlags::chooses_lobe`) is
-/// dimension `LOBE_DIMENSION + d`: outside every vertex's block, so scenes without such a
-/// material draw exactly the numbers they drew before it existed. (Both samplers hash the
-/// dimension into an independent stream: any dimension is as good as the next.)
+/// The lobe choice of the vertex at depth d (a BSDF that mixes lobes,
+/// `bsdf::BsdfFlags::chooses_lobe`) is dimension `LOBE_DIMENSION + d`: outside every vertex's
+/// block, so scenes without such a material draw exactly the numbers they drew before it
+/// existed. (Both samplers hash the dimension into an independent stream: any dimension is as
+/// good as the next.)
 pub const LOBE_DIMENSION: u32 = 1 << 31;
 /// The thin lens's pair (the point on the lens), drawn only by cameras with a lens: outside every
 /// vertex's block and below the lobe choices, so pinhole renders draw exactly what they drew

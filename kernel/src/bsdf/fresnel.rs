@@ -53,7 +53,8 @@ fn unit_clamp<R: Real>(x: R) -> R {
 /// With a^2 + b^2 = sqrt((eta^2 - k^2 - sin^2)^2 + 4 eta^2 k^2) and
 /// a^2 = (a^2 + b^2 + eta^2 - k^2 - sin^2) / 2, the s and p reflectances are
 /// Rs = (a^2 + b^2 - 2 a cos + cos^2) / (a^2 + b^2 + 2 a cos + cos^2) and
-/// Rp = Rs (cos^2 (a^2 + b^2) - 2 a cos sin^2 + sin^4) / (cos^2 (a^2 + b^2) + 2 a cos sin^2 + sin^4)
+/// Rp = Rs (cos^2 (a^2 + b^2) - 2 a cos sin^2 + sin^4)
+///    / (cos^2 (a^2 + b^2) + 2 a cos sin^2 + sin^4)
 /// (Born and Wolf, Principles of Optics, 14.2; the tan-free form multiplies the usual
 /// a sin tan terms by cos^2). Equal to the complex-arithmetic Fresnel equations (tested in f64).
 /// Generic over the scalar [`Real`] so that its error under a Vulkan device's arithmetic can be
@@ -110,7 +111,8 @@ pub fn dielectric<R: Real<Bits = u32>>(cos: R, eta: R) -> (R, R) {
 
 /// 1 - [`dielectric`]'s reflectance, the transmitted fraction, computed without that
 /// cancellation (it loses every digit near total internal reflection, where F -> 1):
-/// 1 - rs^2 = 4 eta cos cos_t / (cos + eta cos_t)^2, 1 - rp^2 = 4 eta cos cos_t / (eta cos + cos_t)^2.
+/// 1 - rs^2 = 4 eta cos cos_t / (cos + eta cos_t)^2,
+/// 1 - rp^2 = 4 eta cos cos_t / (eta cos + cos_t)^2.
 /// `cos_t` is [`dielectric`]'s; 0 under total internal reflection.
 /// Generic over the scalar [`Real`] as [`conductor`] is.
 #[inline(always)]
