@@ -616,10 +616,22 @@ pub fn triangle_watertight_scale_v3<R: real::Real<Bits = u32>>(edge1: V3<R>, edg
 /// (docs/robustness.md, "The vertex moves, counted").
 pub const VERTEX_MOVE_EPS: f32 = 14.0;
 
+/// The heights, in units of a triangle's longest edge E, within which its grazing offset
+/// ([`triangle_grazing_offset_v3`]) is derived. A watertight test's rounding grows with the
+/// product of the distances from the ray's origin to the vertices, and an origin h above a
+/// point of the triangle is up to E + h from them: the offset counts them as (1 +
+/// `GRAZING_DOMAIN`) E, which holds while the height the ray leaves at (the offset plus the
+/// grazing offset) is at most `GRAZING_DOMAIN` E. Beyond it (a triangle tiny against the
+/// rounding of its coordinates, or a needle narrower than about 10^-5 of its length) no height
+/// is proven for grazing rays, and a larger one is worse: the height h must exceed the term at
+/// distance E + h, which grows as its cube (docs/robustness.md, "Known limits").
+pub const GRAZING_DOMAIN: f32 = 0.125;
+
 /// What a ray that grazes a triangle (within [`GRAZING_COS`]) adds to the offset of
-/// [`triangle_offsets_v3`]: [`triangle_watertight_error_bound`] (the watertight term's largest
-/// value over the triangle) plus [`VERTEX_MOVE_EPS`] eps of the longest edge. A grazing ray is
-/// met, if at all, where its backward line crosses the triangle, h / cos from the point it
+/// [`triangle_offsets_v3`]: the watertight term's largest value over the triangle
+/// ([`triangle_watertight_error_bound`]) plus [`VERTEX_MOVE_EPS`] eps of the longest edge E,
+/// both with the distances from the origin counted as (1 + [`GRAZING_DOMAIN`]) E. A grazing ray
+/// is met, if at all, where its backward line crosses the triangle, h / cos from the point it
 /// leaves, so the device's rounding there, not at the point, is what the height must clear:
 /// anywhere on the triangle. `watertight_scale` is [`triangle_watertight_scale_v3`]; every
 /// product is capped at f32::MAX.
@@ -634,8 +646,9 @@ pub fn triangle_grazing_offset_v3<R: real::Real<Bits = u32>>(
         .length()
         .max(edge2.length())
         .max((edge2 - edge1).length());
-    let watertight = watertight_bound_of(longest, watertight_scale);
-    (watertight + R::splat(VERTEX_MOVE_EPS * f32::EPSILON) * longest).min(big)
+    let reach = longest * R::splat(1.0 + GRAZING_DOMAIN);
+    let watertight = watertight_bound_of(reach, watertight_scale);
+    (watertight + R::splat(VERTEX_MOVE_EPS * f32::EPSILON) * reach).min(big)
 }
 
 /// `scale` E^3 for the longest edge E, each product capped at f32::MAX: the largest

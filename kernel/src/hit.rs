@@ -6,7 +6,8 @@ use crate::geometry::{
     reproject_to_sphere, sphere_point_error, triangle_offsets_conditioned, triangle_point,
     triangle_point_error_conditioned, TriangleShape,
 };
-use crate::instance::{normal_to_world, point_to_world, world_point_error};
+use crate::instance::{instanced_offset_v3, normal_to_world, point_to_world};
+use crate::real::V3;
 use crate::scene::{Instance, Sphere, Triangle, NONE};
 use spirv_std::glam::{Vec2, Vec3};
 
@@ -24,13 +25,14 @@ pub struct SurfaceHit {
     pub light: u32,
     /// How far along the normal rays leaving `position` start (`geometry::lift_ray_origin`):
     /// the position's rounding along the normal and what the tests that could meet the surface
-    /// again need to decide the ray's side (`geometry::triangle_offsets_v3`; for a sphere and
-    /// an instance, a per-component error bound times |normal|_1).
+    /// again need to decide the ray's side (`geometry::triangle_offsets_v3`; for a sphere, a
+    /// per-component error bound times |normal|_1; for an instance, that and its grazing offset,
+    /// `instance::instanced_offset_v3`).
     pub offset: f32,
     /// What a ray within `geometry::GRAZING_COS` of the surface adds to `offset`
     /// (`geometry::continuation_origin`, `geometry::shadow_segment`): a GPU's triangle test's
     /// rounding anywhere on the triangle (`geometry::triangle_grazing_offset_v3`); 0 for
-    /// spheres and instances.
+    /// spheres, and for instances, whose `offset` holds it.
     pub grazing_offset: f32,
     /// Whether the ray arrived from the side `normal` points away from (a sphere's inside, a
     /// triangle's back). Decided where the record is made, and robustly for spheres: by which
@@ -129,13 +131,13 @@ impl SurfaceHit {
 
     /// The record of a ray along world direction `dir` meeting triangle `tri` (object space, of
     /// shape `shape`) of instance `instance` (number `index`) at `t`, barycentric (u, v): the
-    /// object-space record of [`SurfaceHit::triangle`] with its point mapped to world space, the
-    /// geometric normal M^-T (edge1 x edge2) normalised (along the edge cross product of the
-    /// same triangle flattened into world space, whose winding a mirroring transform reverses),
-    /// the world point's error bound (`instance::world_point_error`, of the object point's
-    /// `geometry::triangle_point_error`) times |normal|_1 as the offset (grazing offset 0), and
-    /// the side by the sign of `normal . dir`. Barycentrics and the shading record stay the object-space triangle's
-    /// (an affine map keeps barycentrics). Both backends build instanced hits here.
+    /// object point (`triangle_point`) mapped to world space, the geometric normal
+    /// M^-T (edge1 x edge2) normalised (along the edge cross product of the same triangle
+    /// flattened into world space, whose winding a mirroring transform reverses), the offset of
+    /// `instance::instanced_offset_v3` (the object point's `triangle_point_error` carried to
+    /// world space, and the grazing offset for every ray; grazing offset 0), and the side by
+    /// the sign of `normal . dir`. Barycentrics and the shading record stay the object-space
+    /// triangle's (an affine map keeps barycentrics). Both backends build instanced hits here.
     #[inline]
     #[allow(clippy::too_many_arguments)]
     pub fn instanced_triangle(
@@ -148,24 +150,34 @@ impl SurfaceHit {
         u: f32,
         v: f32,
     ) -> Self {
-        let object = Self::triangle(tri, shape, dir, t, u, v);
         let (p0, e1, e2) = (
             Vec3::from(tri.p0),
             Vec3::from(tri.edge1),
             Vec3::from(tri.edge2),
         );
+        let object_position = triangle_point(p0, e1, e2, u, v);
         let object_error = triangle_point_error_conditioned(p0, e1, e2, u, v, &shape);
-        let position = point_to_world(instance, object.position);
-        let normal = normal_to_world(instance, shape.normal).normalize();
-        let error = world_point_error(instance, object.position, object_error, position);
+        let position = point_to_world(instance, object_position);
+        let world_normal = normal_to_world(instance, shape.normal);
+        let normal = world_normal.normalize();
+        let offset = instanced_offset_v3(
+            instance,
+            (V3::from(object_position), object_error),
+            (V3::from(position), V3::from(normal), world_normal.length()),
+            shape.grazing,
+        );
         Self {
             position,
+            t,
             normal,
-            offset: error * normal.abs().element_sum(),
+            material: tri.material,
+            light: tri.light,
+            offset,
             grazing_offset: 0.0,
             arrived_behind: Self::behind_plane(normal, dir),
+            shading: tri.shading,
+            barycentrics: Vec2::new(u, v),
             instance: index,
-            ..object
         }
     }
 

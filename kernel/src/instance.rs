@@ -159,3 +159,49 @@ pub fn world_point_error_v3<R: real::Real>(
         m * (w * max_abs(p_world) + R::splat(translation_norm(&instance.world_to_object)));
     carried + eps * (forward + round_trip)
 }
+
+/// The world height along an instance's unit world normal that is at least `object_height`
+/// along its object triangle's normal n_o, where `normal_length` is the computed length of
+/// [`normal_to_world_v3`]`(n_o)`, which the world normal is normalised from. A world move H n_w
+/// maps back to H |M^-T n_o| along n_o (n_w is M^-T n_o normalised; a computed n_w a small angle
+/// off loses only the square of it), so H = `object_height` / |M^-T n_o| serves. The computed
+/// length is within about 3.5 sqrt(3) eps ||M^-1|| of |M^-T n_o| (the stored inverse's entries
+/// within eps / 2 of the exact ones, three roundings per component) and a few eps of itself
+/// (the norm's roundings), so |M^-T n_o| >= L (1 - 8 eps) - 8 eps ||M^-1||. Where that is not
+/// positive, or larger than the bound it improves on, |M^-T n_o| >= 1 / ||M||_2 >=
+/// 1 / (sqrt(3) ||M||_inf) serves instead. Spares of 4 eps for the division and 16 eps for the
+/// product's rounding.
+#[inline]
+pub fn world_height_v3<R: real::Real>(
+    instance: &Instance,
+    normal_length: R,
+    object_height: R,
+) -> R {
+    let eps = f32::EPSILON;
+    let loose = R::splat(instance.forward_norm * (1.732_051 * (1.0 + 16.0 * eps)));
+    let shrunk =
+        normal_length * R::splat(1.0 - 8.0 * eps) - R::splat(8.0 * eps * instance.inverse_norm);
+    let tight = R::splat(1.0 + 4.0 * eps) / shrunk;
+    let factor = real::select(shrunk.greater_than(R::splat(0.0)), tight.min(loose), loose);
+    factor * object_height
+}
+
+/// The height rays leaving an instanced triangle start at, along world normal `n_world`
+/// (normalised from a vector of length `normal_length`, [`world_height_v3`]): the world point's
+/// bound ([`world_point_error_v3`] of `p_object`, known to within `object_error`, mapped to
+/// `p_world`) times |n_world|_1, plus the object triangle's grazing offset `object_grazing`
+/// (`geometry::triangle_grazing_offset_v3`) carried to world space ([`world_height_v3`]). Every
+/// ray lifts by the grazing offset, not only the grazing ones: a map turns directions by up to
+/// its condition number ||M|| ||M^-1||, so a world direction at `geometry::GRAZING_COS` or more
+/// from the world plane may graze the object triangle, where the device tests it.
+#[inline]
+pub fn instanced_offset_v3<R: real::Real>(
+    instance: &Instance,
+    (p_object, object_error): (V3<R>, R),
+    (p_world, n_world, normal_length): (V3<R>, V3<R>, R),
+    object_grazing: R,
+) -> R {
+    let error = world_point_error_v3(instance, p_object, object_error, p_world);
+    let l1 = real::abs(n_world.x) + real::abs(n_world.y) + real::abs(n_world.z);
+    error * l1 + world_height_v3(instance, normal_length, object_grazing)
+}

@@ -345,6 +345,149 @@ fn grazing_rays_leave_at_the_watertight_height() {
     );
 }
 
+/// The grazing rays of `grazing_rays_leave_at_the_watertight_height`, leaving a triangle of an
+/// instance: the kernel's instanced hit (`hit::SurfaceHit::instanced_triangle`) at a point near
+/// a corner, a world ray within 10^-10 to 10^-2.5 of the world plane from
+/// `continuation_origin`, mapped into object space as the CPU maps it
+/// (`instance::ray_to_object`), against the worst-case watertight test there, kept where the
+/// plane-side test does not reject it. Transforms as `instances.rs` draws them: scale
+/// 10^U(-3, 3), anisotropy up to 100, any rotation, mirrored in half, translated. Every ray lifts
+/// by the object triangle's grazing offset carried to world space
+/// (`instance::instanced_offset_v3`). Held to none met where the origin lies within
+/// `GRAZING_DOMAIN` of the longest edge above the object triangle, where the offset is derived;
+/// the rays that leave higher (the world bound's round trip, large against a small object
+/// triangle) are counted and printed. The count without the grazing offset must not be 0; the
+/// count with it for world-grazing rays only (the rule of plain triangles, which an
+/// anisotropic map may defeat by turning a direction's angle to the plane) is printed.
+#[test]
+fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
+    use glam::{DMat4, DVec3};
+    use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
+    use kernel::hit::SurfaceHit;
+    use kernel::instance::{normal_to_world, point_to_world, ray_to_object, world_height_v3};
+    use kernel::scene::{Triangle, NONE};
+    use twinpath::scene::instancing::instance_record;
+    use twinpath::scene::transform::Transform;
+    let mut g = Gen(twinpath_tests::SplitMix(9));
+    let (mut tested, mut met, mut without, mut world_rule) = (0, 0, 0, 0);
+    let (mut beyond, mut beyond_met) = (0, 0);
+    let (mut shadow_met, mut shadow_within) = (0, 0);
+    for k in 0..cases() / 4 {
+        let unit = |g: &mut Gen| g.unit() as f64;
+        let scale = 10f64.powf(-3.0 + 6.0 * unit(&mut g));
+        let aniso = DVec3::new(
+            10f64.powf(2.0 * unit(&mut g) - 1.0),
+            10f64.powf(2.0 * unit(&mut g) - 1.0),
+            1.0,
+        );
+        let mirror = if g.unit() < 0.5 { -1.0 } else { 1.0 };
+        let (axis, angle) = (g.dir().as_dvec3(), unit(&mut g) * std::f64::consts::TAU);
+        let shift = g.dir().as_dvec3() * (scale * 10f64.powf(3.0 * unit(&mut g)));
+        let m = DMat4::from_translation(shift)
+            * DMat4::from_axis_angle(axis, angle)
+            * DMat4::from_scale(scale * aniso * DVec3::new(mirror, 1.0, 1.0));
+        let Ok(Some(transform)) = Transform::affine(m) else {
+            continue;
+        };
+        let inst = instance_record(&transform, 0);
+        let case = if k % 2 == 0 {
+            g.triangle_case(k % 4 == 0)
+        } else {
+            g.needle_case()
+        };
+        let Some(c) = case else {
+            continue;
+        };
+        let (_, (q, f1, f2)) = c.loaded()[0];
+        let q = if k % 3 == 0 { q } else { Vec3::ZERO };
+        let (u, v) = (g.pow10(-4.0, 0.0), g.pow10(-4.0, 0.0));
+        if u + v > 1.0 {
+            continue;
+        }
+        let tri = Triangle {
+            p0: q.into(),
+            material: 0,
+            edge1: f1.into(),
+            light: NONE,
+            edge2: f2.into(),
+            shading: NONE,
+        };
+        let shape = TriangleShape::of(f1, f2);
+        let hit = SurfaceHit::instanced_triangle(&tri, shape, &inst, 0, g.dir(), 1.0, u, v);
+        let (p, n) = (hit.position, hit.normal);
+        let toward_n = g.unit() < 0.5;
+        let (n_side, n_object) = if toward_n {
+            (n, shape.normal)
+        } else {
+            (-n, -shape.normal)
+        };
+        let a = if k % 5 < 2 {
+            g.dir()
+        } else {
+            (p - point_to_world(&inst, q)) * (g.unit() - 0.5)
+        };
+        let tangent = (a - n_side * a.dot(n_side)).normalize();
+        let cos = g.pow10(-10.0, -2.5);
+        let w = (n_side * cos + tangent * (1.0 - cos * cos).sqrt()).normalize();
+        if !(w.dot(n_side) > 0.0 && tangent.is_finite() && n.is_finite() && hit.offset.is_finite())
+        {
+            continue;
+        }
+        let own = [q, q + f1, q + f2];
+        let met_along = |o: Vec3, d: Vec3, t_max: f32| {
+            let (oo, od) = ray_to_object(&inst, o, d);
+            worst_case_watertight_hit(oo, od, own, n_object, t_max)
+                && !ray_leaves_triangle_plane(oo, od, q, f1, f2)
+        };
+        let met_from = |o: Vec3| met_along(o, w, f32::INFINITY) as usize;
+        let origin = continuation_origin(p, n_side, w, hit.offset, hit.grazing_offset);
+        let m = met_from(origin);
+        // How far above the object triangle's plane the origin lies, in object space.
+        let height = (ray_to_object(&inst, origin, w).0 - q).dot(n_object);
+        let longest = f1.length().max(f2.length()).max((f2 - f1).length());
+        if height > GRAZING_DOMAIN * longest {
+            beyond += 1;
+            beyond_met += m;
+            continue;
+        }
+        tested += 1;
+        met += m;
+        let carried = world_height_v3(
+            &inst,
+            normal_to_world(&inst, shape.normal).length(),
+            shape.grazing,
+        );
+        let bare = hit.offset - carried;
+        without += met_from(continuation_origin(p, n_side, w, bare, 0.0));
+        world_rule += met_from(continuation_origin(p, n_side, w, bare, carried));
+        // A shadow segment along w to a point 10^-2 to 10 sizes away, from `shadow_segment`.
+        let size = c.size * (scale * aniso.max_element()) as f32;
+        let target = p + w * size * g.pow10(-2.0, 1.0);
+        let leaving = lift_ray_origin(p, n_side, hit.offset);
+        let grazing_height = hit.offset + hit.grazing_offset;
+        let (from, _) = shadow_segment(
+            p,
+            n_side,
+            leaving,
+            (hit.offset, grazing_height),
+            (target, Vec3::ZERO, 0.0),
+        );
+        let shadow = met_along(from, target - from, 1.0) as usize;
+        if (target - p).dot(n_side) > grazing_height {
+            shadow_met += shadow;
+        } else {
+            shadow_within += shadow; // a target no higher than the lift: the segment descends
+        }
+    }
+    println!("grazing rays leaving instanced triangles: {tested} within GRAZING_DOMAIN; met again at the worst rounding and not rejected: {met} (shadow segments along them: {shadow_met}, and {shadow_within} to targets no higher than the lift); without the grazing offset {without}, with it for world-grazing rays only {world_rule}; beyond GRAZING_DOMAIN {beyond}, of which {beyond_met} met");
+    assert!(tested > cases() / 8, "{tested}");
+    assert_eq!((met, shadow_met), (0, 0));
+    assert!(
+        without > 0,
+        "the grazing offset is not shown to be needed on instances"
+    );
+}
+
 #[test]
 fn rays_leaving_spheres_never_hit_them_again() {
     let mut g = Gen(twinpath_tests::SplitMix(2));

@@ -143,7 +143,7 @@ fn spawned_self_hits(
 }
 
 /// A per-component error bound `err` as the height along unit `n` it gives (times |n|_1), as
-/// the kernel's sphere and instance hits give it.
+/// the kernel's sphere hits give it.
 fn height_of(err: Vk32, n: V) -> (Vk32, Vk32) {
     (err * (n.x.abs() + n.y.abs() + n.z.abs()), f(0.0))
 }
@@ -338,17 +338,18 @@ fn rays_leaving_a_needles_neighbour_never_hit_either_under_vulkan_arithmetic() {
 /// instanced hit (`hit::SurfaceHit::instanced_triangle`) under [`Vk32`]: the world ray mapped
 /// into object space (`instance::ray_to_object_v3`, as the CPU maps it; a device maps by its
 /// own inverse, which `INSTANCE_ERROR_EPS`'s spare covers), Moller-Trumbore there, the object
-/// point and its bound, the world point (`point_to_world_v3`) and its bound
-/// (`world_point_error_v3`), the world normal M^-T n normalised; the leaving rays mapped back
+/// point and its bound, the world point (`point_to_world_v3`), the world normal M^-T n
+/// normalised, the offset (`instanced_offset_v3`); the leaving rays mapped back
 /// and tested against the object triangle. Placements as `instances.rs` draws them: scale
 /// 10^U(-3, 3), anisotropy up to 100, any rotation, mirrored in half, translated up to 10^4
 /// scales (capped at 10^4).
 #[test]
 fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic() {
     use glam::{DMat4, DVec3};
+    use kernel::geometry::triangle_grazing_offset_v3;
     use kernel::instance::{
-        normal_to_world_v3, point_to_world, point_to_world_v3, ray_to_object_v3,
-        world_point_error_v3,
+        instanced_offset_v3, normal_to_world_v3, point_to_world, point_to_world_v3,
+        ray_to_object_v3,
     };
     use twinpath::scene::instancing::instance_record;
     use twinpath::scene::transform::Transform;
@@ -414,11 +415,13 @@ fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic
         );
         let object_error = triangle_point_error_v3(qv, e1, e2, hu, hv, condition, scale);
         let p = point_to_world_v3(&inst, p_object);
-        let err = world_point_error_v3(&inst, p_object, object_error, p);
         let n = normal_to_world_v3(&inst, triangle_normal_v3(e1, e2));
-        let n = n * (f(1.0) / n.dot(n).sqrt());
+        let length = n.dot(n).sqrt();
+        let n = n * (f(1.0) / length);
+        let grazing = triangle_grazing_offset_v3(e1, e2, scale);
+        let offset = instanced_offset_v3(&inst, (p_object, object_error), (p, n, length), grazing);
         let n_side = if n.dot(v(dir)).value < 0.0 { n } else { -n };
-        let (c, sh) = spawned_self_hits(&mut g, p, n_side, height_of(err, n_side), size, &hit);
+        let (c, sh) = spawned_self_hits(&mut g, p, n_side, (offset, f(0.0)), size, &hit);
         cont_fail += c as usize;
         shadow_fail += sh as usize;
     }
