@@ -27,6 +27,25 @@ impl Placements {
         (s, t)
     }
 
+    /// An instance's object-to-world map as `instances.rs` draws them, and its largest stretch:
+    /// scale 10^U(-3, 3), anisotropy 10^U(-1, 1) along two axes, a rotation about a random axis,
+    /// mirrored in half, translated by up to 10^U(0, 4) scales (at most 10^4).
+    pub fn instance_map(&mut self) -> (glam::DMat4, f64) {
+        use glam::{DMat4, DVec3};
+        let scale = 10f64.powf(-3.0 + 6.0 * self.unit() as f64);
+        let ax = 10f64.powf(2.0 * self.unit() as f64 - 1.0);
+        let aniso = DVec3::new(ax, 10f64.powf(2.0 * self.unit() as f64 - 1.0), 1.0);
+        let mirror = if self.unit() < 0.5 { -1.0 } else { 1.0 };
+        let axis = self.dir().as_dvec3();
+        let angle = self.unit() as f64 * std::f64::consts::TAU;
+        let (direction, length) = (self.dir().as_dvec3(), self.unit() as f64);
+        let shift = direction * length * (scale * 10f64.powf(4.0 * self.unit() as f64)).min(1e4);
+        let m = DMat4::from_translation(shift)
+            * DMat4::from_axis_angle(axis, angle)
+            * DMat4::from_scale(scale * aniso * DVec3::new(mirror, 1.0, 1.0));
+        (m, scale * aniso.max_element())
+    }
+
     /// A triangle (or, for a quad, the loader's two triangles sharing the diagonal) placed at
     /// random, and a ray from 0.1 to 100 sizes away toward a random point of it: (size, origin,
     /// unit direction, the triangles as (p0, edge1, edge2)). None for a degenerate shape.

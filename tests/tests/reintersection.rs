@@ -244,6 +244,35 @@ fn rays_leaving_a_needles_neighbour_never_hit_either_once_rejected() {
     assert_eq!((cpu, kept, worst), ([0, 0], [0, 0], [0, 0]));
 }
 
+/// A triangle of the grazing tests and a point near its corner.
+struct CornerCase {
+    /// (p0, edge1, edge2).
+    triangle: (Vec3, Vec3, Vec3),
+    /// The point's barycentrics.
+    uv: (f32, f32),
+    /// The size of the placement it was drawn at.
+    size: f32,
+}
+
+/// The [`CornerCase`] of case `k`: a triangle or quad (`k` even, a quad every fourth) or a
+/// needle, its first triangle, with p0 moved to the origin but for every third case, and
+/// barycentrics of 10^U(-4, 0) each. None where the shape is degenerate or u + v > 1.
+fn corner_case(g: &mut Gen, k: usize) -> Option<CornerCase> {
+    let case = if k.is_multiple_of(2) {
+        g.triangle_case(k.is_multiple_of(4))
+    } else {
+        g.needle_case()
+    }?;
+    let (_, (q, f1, f2)) = case.loaded()[0];
+    let q = if k.is_multiple_of(3) { q } else { Vec3::ZERO };
+    let (u, v) = (g.pow10(-4.0, 0.0), g.pow10(-4.0, 0.0));
+    (u + v <= 1.0).then_some(CornerCase {
+        triangle: (q, f1, f2),
+        uv: (u, v),
+        size: case.size,
+    })
+}
+
 /// Continuation rays that graze the triangle they leave (cosines 10^-10 to 10^-2.5 with the
 /// leaving side's normal, across [`GRAZING_COS`]), on the shapes of triangles, quads and
 /// needles, from points near the corner p0 (barycentrics 10^-4 to 1) of triangles placed as
@@ -264,20 +293,14 @@ fn grazing_rays_leave_at_the_watertight_height() {
     let (mut tested, mut above, mut with_rule, mut without, mut before) = (0, 0, 0, 0, 0);
     let (mut shadow_above, mut shadow_below, mut shadow_within) = (0, 0, 0);
     for k in 0..cases() / 4 {
-        let case = if k % 2 == 0 {
-            g.triangle_case(k % 4 == 0)
-        } else {
-            g.needle_case()
-        };
-        let Some(c) = case else {
+        let Some(CornerCase {
+            triangle: (q, f1, f2),
+            uv: (u, v),
+            size,
+        }) = corner_case(&mut g, k)
+        else {
             continue;
         };
-        let (_, (q, f1, f2)) = c.loaded()[0];
-        let q = if k % 3 == 0 { q } else { Vec3::ZERO };
-        let (u, v) = (g.pow10(-4.0, 0.0), g.pow10(-4.0, 0.0));
-        if u + v > 1.0 {
-            continue;
-        }
         let p = triangle_point(q, f1, f2, u, v);
         let nn = triangle_normal(f1, f2);
         let n_side = if g.unit() < 0.5 { nn } else { -nn };
@@ -301,7 +324,7 @@ fn grazing_rays_leave_at_the_watertight_height() {
         };
         let met = |o: Vec3| met_along(o, w, f32::INFINITY);
         // A shadow segment along w to a point 10^-2 to 10 sizes away, from `shadow_segment`.
-        let target = p + w * c.size * g.pow10(-2.0, 1.0);
+        let target = p + w * size * g.pow10(-2.0, 1.0);
         let leaving = lift_ray_origin(p, n_side, offset);
         let (from, _) = shadow_segment(
             p,
@@ -361,7 +384,6 @@ fn grazing_rays_leave_at_the_watertight_height() {
 /// anisotropic map may defeat by turning a direction's angle to the plane) is printed.
 #[test]
 fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
-    use glam::{DMat4, DVec3};
     use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
     use kernel::hit::SurfaceHit;
     use kernel::instance::{normal_to_world, point_to_world, ray_to_object, world_height_v3};
@@ -373,37 +395,19 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
     let (mut beyond, mut beyond_met) = (0, 0);
     let (mut shadow_met, mut shadow_within) = (0, 0);
     for k in 0..cases() / 4 {
-        let unit = |g: &mut Gen| g.unit() as f64;
-        let scale = 10f64.powf(-3.0 + 6.0 * unit(&mut g));
-        let aniso = DVec3::new(
-            10f64.powf(2.0 * unit(&mut g) - 1.0),
-            10f64.powf(2.0 * unit(&mut g) - 1.0),
-            1.0,
-        );
-        let mirror = if g.unit() < 0.5 { -1.0 } else { 1.0 };
-        let (axis, angle) = (g.dir().as_dvec3(), unit(&mut g) * std::f64::consts::TAU);
-        let shift = g.dir().as_dvec3() * (scale * 10f64.powf(3.0 * unit(&mut g)));
-        let m = DMat4::from_translation(shift)
-            * DMat4::from_axis_angle(axis, angle)
-            * DMat4::from_scale(scale * aniso * DVec3::new(mirror, 1.0, 1.0));
+        let (m, stretch) = g.instance_map();
         let Ok(Some(transform)) = Transform::affine(m) else {
             continue;
         };
         let inst = instance_record(&transform, 0);
-        let case = if k % 2 == 0 {
-            g.triangle_case(k % 4 == 0)
-        } else {
-            g.needle_case()
-        };
-        let Some(c) = case else {
+        let Some(CornerCase {
+            triangle: (q, f1, f2),
+            uv: (u, v),
+            size,
+        }) = corner_case(&mut g, k)
+        else {
             continue;
         };
-        let (_, (q, f1, f2)) = c.loaded()[0];
-        let q = if k % 3 == 0 { q } else { Vec3::ZERO };
-        let (u, v) = (g.pow10(-4.0, 0.0), g.pow10(-4.0, 0.0));
-        if u + v > 1.0 {
-            continue;
-        }
         let tri = Triangle {
             p0: q.into(),
             material: 0,
@@ -461,7 +465,7 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         without += met_from(continuation_origin(p, n_side, w, bare, 0.0));
         world_rule += met_from(continuation_origin(p, n_side, w, bare, carried));
         // A shadow segment along w to a point 10^-2 to 10 sizes away, from `shadow_segment`.
-        let size = c.size * (scale * aniso.max_element()) as f32;
+        let size = size * stretch as f32;
         let target = p + w * size * g.pow10(-2.0, 1.0);
         let leaving = lift_ray_origin(p, n_side, hit.offset);
         let grazing_height = hit.offset + hit.grazing_offset;

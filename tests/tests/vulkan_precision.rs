@@ -345,7 +345,6 @@ fn rays_leaving_a_needles_neighbour_never_hit_either_under_vulkan_arithmetic() {
 /// scales (capped at 10^4).
 #[test]
 fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic() {
-    use glam::{DMat4, DVec3};
     use kernel::geometry::triangle_grazing_offset_v3;
     use kernel::instance::{
         instanced_offset_v3, normal_to_world_v3, point_to_world, point_to_world_v3,
@@ -359,21 +358,7 @@ fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic
     let (mut tested, mut cont_fail, mut shadow_fail) = (0, 0, 0);
     for case in 0..cases() / 2 {
         any_device(case);
-        let unit = |g: &mut Gen| g.unit() as f64;
-        let scale = 10f64.powf(-3.0 + 6.0 * unit(&mut g));
-        let aniso = DVec3::new(
-            10f64.powf(2.0 * unit(&mut g) - 1.0),
-            10f64.powf(2.0 * unit(&mut g) - 1.0),
-            1.0,
-        );
-        let mirror = if g.unit() < 0.5 { -1.0 } else { 1.0 };
-        let axis = g.dir().as_dvec3();
-        let angle = unit(&mut g) * std::f64::consts::TAU;
-        let shift =
-            (g.dir().as_dvec3() * unit(&mut g)) * (scale * 10f64.powf(4.0 * unit(&mut g))).min(1e4);
-        let m = DMat4::from_translation(shift)
-            * DMat4::from_axis_angle(axis, angle)
-            * DMat4::from_scale(scale * aniso * DVec3::new(mirror, 1.0, 1.0));
+        let (m, stretch) = g.instance_map();
         let Ok(Some(transform)) = Transform::affine(m) else {
             continue;
         };
@@ -390,7 +375,7 @@ fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic
             (a, b)
         };
         let target = point_to_world(&inst, q + a * f1 + b * f2);
-        let size = scale as f32 * aniso.max_element() as f32;
+        let size = stretch as f32;
         let origin = target + g.dir() * size * 3.0;
         let dir = (target - origin).normalize();
         if !dir.is_finite() {
