@@ -244,6 +244,18 @@ fn rays_leaving_a_needles_neighbour_never_hit_either_once_rejected() {
     assert_eq!((cpu, kept, worst), ([0, 0], [0, 0], [0, 0]));
 }
 
+/// The scene record of triangle (`p0`, `edge1`, `edge2`): material 0, no light, no shading.
+fn plain_triangle(p0: Vec3, edge1: Vec3, edge2: Vec3) -> kernel::scene::Triangle {
+    kernel::scene::Triangle {
+        p0: p0.into(),
+        material: 0,
+        edge1: edge1.into(),
+        light: kernel::scene::NONE,
+        edge2: edge2.into(),
+        shading: kernel::scene::NONE,
+    }
+}
+
 /// A triangle of the grazing tests and a point near its corner.
 struct CornerCase {
     /// (p0, edge1, edge2).
@@ -387,7 +399,6 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
     use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
     use kernel::hit::SurfaceHit;
     use kernel::instance::{normal_to_world, point_to_world, ray_to_object, world_height_v3};
-    use kernel::scene::{Triangle, NONE};
     use twinpath::scene::instancing::instance_record;
     use twinpath::scene::transform::Transform;
     let mut g = Gen(twinpath_tests::SplitMix(9));
@@ -408,14 +419,7 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         else {
             continue;
         };
-        let tri = Triangle {
-            p0: q.into(),
-            material: 0,
-            edge1: f1.into(),
-            light: NONE,
-            edge2: f2.into(),
-            shading: NONE,
-        };
+        let tri = plain_triangle(q, f1, f2);
         let shape = TriangleShape::of(f1, f2);
         let hit = SurfaceHit::instanced_triangle(&tri, shape, &inst, 0, g.dir(), 1.0, u, v);
         let (p, n) = (hit.position, hit.normal);
@@ -568,7 +572,7 @@ fn shadow_rays_never_hit_the_light_they_sample() {
 #[test]
 fn shadow_rays_never_hit_the_triangle_light_they_sample() {
     use kernel::light::triangle::sample as sample_triangle_light;
-    use kernel::scene::{light_sampling, Triangle, NONE};
+    use kernel::scene::light_sampling;
     let mut g = Gen(twinpath_tests::SplitMix(4));
     let (mut fails, mut tested) = (0, 0);
     for k in 0..cases() {
@@ -577,14 +581,7 @@ fn shadow_rays_never_hit_the_triangle_light_they_sample() {
         if e1.cross(e2).length() < 1e-3 * s * s {
             continue;
         }
-        let tri = Triangle {
-            p0: p0.to_array(),
-            material: 0,
-            edge1: e1.to_array(),
-            light: NONE,
-            edge2: e2.to_array(),
-            shading: kernel::scene::NONE,
-        };
+        let tri = plain_triangle(p0, e1, e2);
         let mut l = twinpath::scene::light_table::triangle_light(&tri, [1.0; 3], k % 2 == 0);
         l.select_pmf = 1.0;
         let centroid = p0 + (e1 + e2) / 3.0;
