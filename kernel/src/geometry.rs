@@ -560,7 +560,7 @@ pub fn triangle_offsets_v3<R: real::Real<Bits = u32>>(
 
 /// |n|_1, the factor that turns a per-component error bound into a height along unit `n`.
 #[inline]
-fn normal_l1<R: real::Real>(n: V3<R>) -> R {
+pub(crate) fn normal_l1<R: real::Real>(n: V3<R>) -> R {
     abs(n.x) + abs(n.y) + abs(n.z)
 }
 
@@ -791,8 +791,8 @@ fn grazes<R: real::Real<Bits = u32>>(along: R, length: R) -> bool {
 /// direction's component `along` `n_side` and its `length` (as a pair): `leaving` where
 /// along >= [`GRAZING_COS`] length, else `p` lifted by `grazing_height` (the offset plus the
 /// grazing offset, [`triangle_offsets_v3`]). Taking `leaving` made lets a vertex that sends a
-/// light sample too lift once ([`continuation_origin_v3`] lifts once by the height it picks). [`shadow_segment`] applies the rule to a segment whose end is
-/// formed after its origin.
+/// light sample too lift once ([`continuation_origin_v3`] lifts once by the height it picks).
+/// [`shadow_segment`] applies the rule to a segment whose end is formed after its origin.
 #[inline]
 pub fn origin_by_angle_v3<R: real::Real<Bits = u32>>(
     p: V3<R>,

@@ -6,6 +6,7 @@
 //! Every map is written out component by component in a fixed order (three products summed left
 //! to right, then the translation), so both backends compute the same `f32`s.
 
+use crate::geometry::normal_l1;
 use crate::real::{self, V3};
 use crate::scene::Instance;
 use spirv_std::glam::Vec3;
@@ -202,6 +203,5 @@ pub fn instanced_offset_v3<R: real::Real>(
     object_grazing: R,
 ) -> R {
     let error = world_point_error_v3(instance, p_object, object_error, p_world);
-    let l1 = real::abs(n_world.x) + real::abs(n_world.y) + real::abs(n_world.z);
-    error * l1 + world_height_v3(instance, normal_length, object_grazing)
+    error * normal_l1(n_world) + world_height_v3(instance, normal_length, object_grazing)
 }
