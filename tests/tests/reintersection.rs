@@ -391,7 +391,8 @@ fn grazing_rays_leave_at_the_watertight_height() {
 /// (`instance::instanced_offset_v3`). Held to none met where the origin lies within
 /// `GRAZING_DOMAIN` of the longest edge above the object triangle, where the offset is derived;
 /// the rays that leave higher (the world bound's round trip, large against a small object
-/// triangle) are counted and printed. The count without the grazing offset must not be 0; the
+/// triangle) are counted and printed, and the loader's check
+/// (`twinpath::scene::grazing_domain`) must flag the triangle under that instance for each. The count without the grazing offset must not be 0; the
 /// count with it for world-grazing rays only (the rule of plain triangles, which an
 /// anisotropic map may defeat by turning a direction's angle to the plane) is printed.
 #[test]
@@ -399,11 +400,12 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
     use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
     use kernel::hit::SurfaceHit;
     use kernel::instance::{normal_to_world, point_to_world, ray_to_object, world_height_v3};
+    use twinpath::scene::grazing_domain::LeavingHeight;
     use twinpath::scene::instancing::instance_record;
     use twinpath::scene::transform::Transform;
     let mut g = Gen(twinpath_tests::SplitMix(9));
     let (mut tested, mut met, mut without, mut world_rule) = (0, 0, 0, 0);
-    let (mut beyond, mut beyond_met) = (0, 0);
+    let (mut beyond, mut beyond_met, mut beyond_unflagged, mut within_flagged) = (0, 0, 0, 0);
     let (mut shadow_met, mut shadow_within) = (0, 0);
     for k in 0..cases() / 4 {
         let (m, stretch) = g.instance_map();
@@ -456,10 +458,12 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         if height > GRAZING_DOMAIN * longest {
             beyond += 1;
             beyond_met += m;
+            beyond_unflagged += !LeavingHeight::of_instanced(&tri, &inst).beyond_domain() as usize;
             continue;
         }
         tested += 1;
         met += m;
+        within_flagged += LeavingHeight::of_instanced(&tri, &inst).beyond_domain() as usize;
         let carried = world_height_v3(
             &inst,
             normal_to_world(&inst, shape.normal).length(),
@@ -487,9 +491,10 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
             shadow_within += shadow; // a target no higher than the lift: the segment descends
         }
     }
-    println!("grazing rays leaving instanced triangles: {tested} within GRAZING_DOMAIN; met again at the worst rounding and not rejected: {met} (shadow segments along them: {shadow_met}, and {shadow_within} to targets no higher than the lift); without the grazing offset {without}, with it for world-grazing rays only {world_rule}; beyond GRAZING_DOMAIN {beyond}, of which {beyond_met} met");
+    println!("grazing rays leaving instanced triangles: {tested} within GRAZING_DOMAIN; met again at the worst rounding and not rejected: {met} (shadow segments along them: {shadow_met}, and {shadow_within} to targets no higher than the lift); without the grazing offset {without}, with it for world-grazing rays only {world_rule}; beyond GRAZING_DOMAIN {beyond}, of which {beyond_met} met and {beyond_unflagged} not flagged by the loader's check ({within_flagged} flagged within)");
     assert!(tested > cases() / 8, "{tested}");
-    assert_eq!((met, shadow_met), (0, 0));
+    assert_eq!((met, shadow_met, beyond_unflagged), (0, 0, 0));
+    assert!(beyond > 0);
     assert!(
         without > 0,
         "the grazing offset is not shown to be needed on instances"
@@ -613,4 +618,104 @@ fn shadow_rays_never_hit_the_triangle_light_they_sample() {
     println!("triangle light samples: {fails} of {tested} shadow rays hit their own light");
     assert!(tested > cases() / 3);
     assert_eq!(fails, 0);
+}
+
+/// The loader's check of the grazing domain (`twinpath::scene::grazing_domain`) flags every
+/// triangle that a grazing ray leaves higher than `GRAZING_DOMAIN` times its longest edge above
+/// (the height measured in f64 from the plane of its f32 vertices): needles whose short leg is
+/// 10^U(-7, -2) of the long one, placed as `placement` places shapes, and the shapes of
+/// `triangle_case` moved 10^U(2, 6) of their size from the origin, at uniform and near-corner
+/// points, on either side, along directions within 10^-10 to [`GRAZING_COS`] of the plane,
+/// from `continuation_origin`. Shapes of both kinds must be found beyond the domain, and the
+/// share of triangles flagged whose sampled rays stayed within is printed (the check's bound
+/// over the whole triangle is not tight). Halved, the check's rounding term (the offset, the
+/// origin's own distance from it, and the grid the origin is rounded to) must miss some.
+#[test]
+fn the_grazing_domain_check_flags_every_triangle_rays_leave_too_high() {
+    use kernel::geometry::GRAZING_DOMAIN;
+    use twinpath::scene::grazing_domain::LeavingHeight;
+    let mut g = Gen(twinpath_tests::SplitMix(10));
+    let (mut beyond, mut beyond_kinds, mut missed) = (0, [0, 0], 0);
+    let (mut within_flagged, mut within, mut halved_missed) = (0, 0, 0);
+    for k in 0..cases() / 40 {
+        let needle = k.is_multiple_of(2);
+        let (q, f1, f2) = if needle {
+            let (s, t) = g.placement();
+            let long = g.dir() * s;
+            let other = g.dir();
+            let across = (other - long * other.dot(long) / long.length_squared()).normalize();
+            let short = across * s * g.pow10(-7.0, -2.0);
+            (t + g.dir() * s, long, short)
+        } else {
+            let Some(case) = g.triangle_case(false) else {
+                continue;
+            };
+            let (_, (q, f1, f2)) = case.loaded()[0];
+            (q + g.dir() * case.size * g.pow10(2.0, 6.0), f1, f2)
+        };
+        let tri = plain_triangle(q, f1, f2);
+        let n = triangle_normal(f1, f2);
+        if !n.is_finite() || f1.cross(f2).length() == 0.0 {
+            continue;
+        }
+        let (d1, d2) = (f1.as_dvec3(), f2.as_dvec3());
+        let n64 = d1.cross(d2).normalize();
+        let longest = d1.length().max(d2.length()).max((d2 - d1).length());
+        let check = LeavingHeight::of_world(&tri);
+        let mut highest = 0.0f64;
+        for j in 0..8 {
+            let (u, v) = if j < 4 {
+                let (a, b) = (g.unit(), g.unit());
+                if a + b > 1.0 {
+                    (1.0 - a, 1.0 - b)
+                } else {
+                    (a, b)
+                }
+            } else {
+                // A corner or the long edge's midpoint, moved toward the centroid by up to 10^-4.
+                let corner: (f32, f32) = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.5, 0.5)][j - 4];
+                let d = 1e-4 * g.unit();
+                (
+                    corner.0 + (1.0 / 3.0 - corner.0) * d,
+                    corner.1 + (1.0 / 3.0 - corner.1) * d,
+                )
+            };
+            let p = triangle_point(q, f1, f2, u, v);
+            let (offset, grazing) = triangle_offsets(q, f1, f2, u, v);
+            let n_side = if g.unit() < 0.5 { n } else { -n };
+            let a = g.dir();
+            let tangent = (a - n_side * a.dot(n_side)).normalize();
+            let cos = g.pow10(-10.0, GRAZING_COS.log10());
+            let w = (n_side * cos + tangent * (1.0 - cos * cos).sqrt()).normalize();
+            if !(w.dot(n_side) > 0.0 && tangent.is_finite()) {
+                continue;
+            }
+            let origin = continuation_origin(p, n_side, w, offset, grazing);
+            let height = (origin.as_dvec3() - q.as_dvec3()).dot(n64).abs();
+            highest = highest.max(height);
+        }
+        if highest > GRAZING_DOMAIN as f64 * longest {
+            beyond += 1;
+            beyond_kinds[needle as usize] += 1;
+            missed += !check.beyond_domain() as usize;
+            let halved = LeavingHeight {
+                rounding: 0.5 * check.rounding,
+                ..check
+            };
+            halved_missed += !halved.beyond_domain() as usize;
+        } else {
+            within += 1;
+            within_flagged += check.beyond_domain() as usize;
+        }
+    }
+    println!("grazing domain check: {beyond} triangles left beyond GRAZING_DOMAIN ({} needles, {} far from the origin), {missed} not flagged (with the rounding term halved: {halved_missed}); {within_flagged} of {within} flagged whose sampled rays stayed within", beyond_kinds[1], beyond_kinds[0]);
+    assert!(
+        beyond_kinds[0] > 100 && beyond_kinds[1] > 100,
+        "{beyond_kinds:?}"
+    );
+    assert_eq!(missed, 0);
+    assert!(
+        halved_missed > 0,
+        "the rounding term is not shown to be needed"
+    );
 }

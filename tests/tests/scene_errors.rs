@@ -749,3 +749,87 @@ fn environment_map_settings() {
         "{e}"
     );
 }
+
+/// Meshes with triangles that rays may leave higher than the grazing offset is derived for
+/// (`scene::grazing_domain`) load with a note naming the mesh, and meshes without load without:
+/// a needle 10^-6 as wide as it is long, 1 mm triangles 3 km from the origin in a plane tilted
+/// against the axes (world-space, and instanced by two translations of 3 km), beside a needle 10^-3 wide and a 1 mm triangle at
+/// the origin, which are within. No shipped scene has such a triangle.
+#[test]
+fn triangles_beyond_the_grazing_domain_are_noted() {
+    let dir = temp_dir("grazing");
+    let write = |name: &str, triangles: &[[[f64; 3]; 3]]| {
+        let mut obj = String::new();
+        for (k, t) in triangles.iter().enumerate() {
+            for v in t {
+                obj += &format!("v {} {} {}\n", v[0], v[1], v[2]);
+            }
+            obj += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+        }
+        std::fs::write(dir.join(name), obj).unwrap();
+    };
+    let fine = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let needle = |w: f64| [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, w, 0.0]];
+    let mm = |x: f64, k: usize| {
+        let z = k as f64 * 0.01;
+        [[x, 0.0, z], [x + 1e-3, 1e-3, z], [x, 0.0, z + 1e-3]]
+    };
+    write("needle.obj", &[needle(1e-6), fine]);
+    write("thin.obj", &[needle(1e-3), fine]);
+    write("far.obj", &[mm(3000.0, 0), fine]);
+    write("near.obj", &[mm(0.0, 0), fine]);
+    let mm_mesh: Vec<_> = (0..16).map(|k| mm(0.0, k)).collect();
+    write("mm16.obj", &mm_mesh);
+    let mut scene = GOOD.to_string();
+    for file in ["needle.obj", "thin.obj", "far.obj", "near.obj"] {
+        scene += &format!("[[mesh]]\nfile = \"{file}\"\nmaterial = \"white\"\n");
+    }
+    for x in [3000, -3000] {
+        scene += &format!(
+            "[[mesh]]\nfile = \"mm16.obj\"\nmaterial = \"white\"\ntranslate = [{x}, 0, 0]\n"
+        );
+    }
+    std::fs::write(dir.join("s.toml"), &scene).unwrap();
+    let loaded = SceneFile::load(&dir.join("s.toml")).unwrap();
+    assert_eq!(loaded.scene.instances.len(), 2, "mm16.obj is instanced");
+    let notes = &loaded.scene.notes;
+    for n in notes {
+        println!("note: {n}");
+    }
+    let about = |file: &str| {
+        notes
+            .iter()
+            .filter(|n| n.contains(file))
+            .collect::<Vec<_>>()
+    };
+    let needle_notes = about("needle.obj");
+    assert_eq!(needle_notes.len(), 1, "{notes:?}");
+    assert!(needle_notes[0].contains("1 of 2 triangles") && needle_notes[0].contains("a needle"));
+    let far_notes = about("far.obj");
+    assert_eq!(far_notes.len(), 1, "{notes:?}");
+    assert!(far_notes[0].contains("1 of 2 triangles") && far_notes[0].contains("(3000, 0, 0)"));
+    assert!(far_notes[0].contains("small against the rounding"));
+    let instanced = about("mm16.obj");
+    assert_eq!(instanced.len(), 1, "{notes:?}");
+    assert!(instanced[0].contains("16 of 16 triangles (object space, under 2 instances)"));
+    assert!(about("thin.obj").is_empty() && about("near.obj").is_empty());
+    assert_eq!(notes.len(), 3, "{notes:?}");
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    let gltf = std::fs::read_dir(scenes.join("gltf")).unwrap();
+    for entry in std::fs::read_dir(&scenes).unwrap().chain(gltf) {
+        let path = entry.unwrap().path();
+        if path
+            .extension()
+            .is_some_and(|e| e == "toml" || e == "glb" || e == "gltf")
+        {
+            let s = SceneFile::load(&path).unwrap();
+            let beyond: Vec<_> = s
+                .scene
+                .notes
+                .iter()
+                .filter(|n| n.contains("GRAZING"))
+                .collect();
+            assert!(beyond.is_empty(), "{}: {beyond:?}", path.display());
+        }
+    }
+}

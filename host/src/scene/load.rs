@@ -4,7 +4,7 @@
 use super::error::{self, SceneError};
 use super::flat_scene::SceneFile;
 use super::toml::{parse_scene, parse_scene_with_camera, DEFAULT_SCENE_NAME, DEFAULT_SCENE_TOML};
-use super::{gltf, inputs};
+use super::{gltf, grazing_domain, inputs};
 use crate::settings::RenderSettings;
 use kernel::scene::RenderParams;
 use std::path::Path;
@@ -17,11 +17,14 @@ impl SceneFile {
     }
 
     /// [`SceneFile::load`] seen through the perspective camera named `camera`: of the glTF
-    /// file, or of a TOML scene's `[[gltf]]` files (instead of its `[camera]` table).
+    /// file, or of a TOML scene's `[[gltf]]` files (instead of its `[camera]` table). The
+    /// scene's notes end with those of `grazing_domain`.
     pub fn load_with_camera(path: &Path, camera: Option<&str>) -> Result<SceneFile, SceneError> {
         let (file, files) = inputs::recording(|| Self::read(path, camera));
         let mut file = file?;
         file.scene.inputs = files;
+        let beyond = grazing_domain::notes(&file.scene);
+        file.scene.notes.extend(beyond);
         Ok(file)
     }
 

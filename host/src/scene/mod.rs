@@ -13,6 +13,7 @@ mod flat_scene;
 pub mod ggx_albedo;
 mod ggx_albedo_table;
 pub mod gltf;
+pub mod grazing_domain;
 pub mod inputs;
 pub mod instancing;
 pub mod light_table;

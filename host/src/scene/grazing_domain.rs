@@ -1,0 +1,225 @@
+//! Triangles that rays may leave higher than the kernel's offsets are derived for: a note for
+//! the user, naming the mesh and where one such triangle lies.
+//!
+//! A ray leaving a triangle within `kernel::geometry::GRAZING_COS` of its plane clears a
+//! device's own triangle test only while it starts within `GRAZING_DOMAIN` E of the plane (E the
+//! longest edge; `kernel::geometry::triangle_grazing_offset_v3`, docs/robustness.md, "Known
+//! limits"). Two kinds of triangle let it start higher: needles, whose grazing offset grows with
+//! the ratio of their length to their width, and triangles small against the rounding of their
+//! coordinates (or, instanced, against their instance's round trip). A ray grazing one of them
+//! may meet it again; nothing else changes, so the scene renders, and the note says where.
+//!
+//! The height checked is what the kernel computes, with its own functions, at the triangle's
+//! corners (where the offsets' rounding terms are largest; they are linear in the barycentrics),
+//! plus the watertight term's largest value over the triangle, the point's rounding bound
+//! counted twice (the origin lies up to that far off the offset it is given) and the grid the
+//! origin is rounded to. A triangle is flagged when that exceeds `GRAZING_DOMAIN` E. The check
+//! is meant to flag more than it must, never less: `tests/tests/reintersection.rs` finds no
+//! ray beyond the domain from a triangle it passes, plain or instanced.
+
+use super::flat_scene::{Scene, TriangleGroup};
+use glam::Vec3;
+use kernel::geometry::{
+    triangle_offsets_v3, triangle_point, triangle_point_error_conditioned,
+    triangle_watertight_error_bound, ShapeFactors, TriangleShape, GRAZING_DOMAIN,
+};
+use kernel::instance::{instanced_offset_v3, normal_to_world, point_to_world};
+use kernel::real::V3;
+use kernel::scene::{Instance, Triangle};
+use rayon::prelude::*;
+
+/// The barycentrics of a triangle's corners, where the offsets' rounding terms peak.
+const CORNERS: [(f32, f32); 3] = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)];
+
+/// The largest height above a triangle's plane, in the triangle's own space, at which a ray
+/// leaving it may start, split into the part the point's rounding gives (the offset and the
+/// origin's own distance from it, up to the offset again) and the grazing offset, with the
+/// triangle's longest edge E.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LeavingHeight {
+    pub rounding: f32,
+    pub grazing: f32,
+    pub longest: f32,
+}
+
+impl LeavingHeight {
+    /// Whether a ray may leave higher than `GRAZING_DOMAIN` E, or the height is not a number.
+    pub fn beyond_domain(&self) -> bool {
+        !(self.rounding + self.grazing <= GRAZING_DOMAIN * self.longest)
+    }
+
+    /// The height of world-space triangle `tri`, from `kernel::geometry::triangle_offsets_v3`
+    /// and the grid the origin is rounded to: `kernel::geometry::lift_ray_origin` rounds the
+    /// lifted point and then steps each component one ULP away from the surface, at most 1.5 ULP
+    /// <= 1.5 eps of the component's magnitude, which is what a ray leaving a floor far from the
+    /// origin rises by whatever its offset (counted as 2 eps).
+    pub fn of_world(tri: &Triangle) -> Self {
+        let (p0, e1, e2) = corners(tri);
+        let factors = ShapeFactors::<f32>::of(V3::from(e1), V3::from(e2));
+        let normal = Vec3::from(factors.normal).abs();
+        let mut offset = 0.0f32;
+        let mut grazing = 0.0f32;
+        let mut coordinates = 0.0f32;
+        for (u, v) in CORNERS {
+            let (o, g) = triangle_offsets_v3(p0.into(), e1.into(), e2.into(), u, v, &factors);
+            offset = offset.max(o);
+            grazing = g;
+            let corner = triangle_point(p0, e1, e2, u, v);
+            coordinates = coordinates.max(corner.abs().dot(normal));
+        }
+        // Where the offset is the point's bound (slivers), its watertight part peaks inside.
+        let watertight = triangle_watertight_error_bound(e1, e2) * normal.element_sum();
+        let lift = 2.0 * (offset + watertight);
+        let grid = 2.0 * f32::EPSILON * (coordinates + (lift + grazing) * normal.element_sum());
+        Self {
+            rounding: lift + grid,
+            grazing,
+            longest: longest_edge(e1, e2),
+        }
+    }
+
+    /// The height of object-space triangle `tri` placed by `instance`, in object units: the
+    /// world height of `kernel::instance::instanced_offset_v3` times the length of the world
+    /// normal before normalising (a world move H along it maps back to H |M^-T n_o| along the
+    /// object normal).
+    pub fn of_instanced(tri: &Triangle, instance: &Instance) -> Self {
+        let (p0, e1, e2) = corners(tri);
+        let shape = TriangleShape::of(e1, e2);
+        let world_normal = normal_to_world(instance, shape.normal);
+        let length = world_normal.length();
+        let normal = world_normal / length;
+        let watertight = triangle_watertight_error_bound(e1, e2);
+        let mut rounding = 0.0f32;
+        let mut lifted = 0.0f32;
+        for (u, v) in CORNERS {
+            let p_object = triangle_point(p0, e1, e2, u, v);
+            let error = triangle_point_error_conditioned(p0, e1, e2, u, v, &shape) + watertight;
+            let p_world = point_to_world(instance, p_object);
+            let at = |grazing: f32| {
+                instanced_offset_v3(
+                    instance,
+                    (V3::from(p_object), error),
+                    (V3::from(p_world), V3::from(normal), length),
+                    grazing,
+                )
+            };
+            let bare = at(0.0);
+            rounding = rounding.max(bare);
+            lifted = lifted.max(at(shape.grazing) - bare);
+        }
+        Self {
+            rounding: 2.0 * rounding * length,
+            grazing: lifted * length,
+            longest: longest_edge(e1, e2),
+        }
+    }
+}
+
+/// A triangle's p0 and edges.
+fn corners(tri: &Triangle) -> (Vec3, Vec3, Vec3) {
+    (
+        Vec3::from(tri.p0),
+        Vec3::from(tri.edge1),
+        Vec3::from(tri.edge2),
+    )
+}
+
+/// The longest of a triangle's edges, as the kernel's grazing offset measures it.
+fn longest_edge(e1: Vec3, e2: Vec3) -> f32 {
+    e1.length().max(e2.length()).max((e2 - e1).length())
+}
+
+/// What the check found in one group of triangles: how many it flagged, and the first.
+struct Flagged {
+    count: usize,
+    first: Option<(Triangle, LeavingHeight)>,
+}
+
+impl Flagged {
+    /// The note for group `name` of `total` triangles, `placed` saying how they are placed,
+    /// or None where none is flagged.
+    fn note(&self, name: &str, total: usize, placed: &str) -> Option<String> {
+        let (triangle, height) = self.first?;
+        let corner = Vec3::from(triangle.p0);
+        Some(format!(
+            "{name}: {} of {total} triangles{placed} may be left by grazing rays higher than \
+             the offsets are derived for (GRAZING_DOMAIN, docs/robustness.md \"Known limits\"), \
+             e.g. the one at ({}, {}, {}), longest edge {:.3e}, {}: a ray within 1/1024 of \
+             its plane may meet it again",
+            self.count,
+            corner.x,
+            corner.y,
+            corner.z,
+            height.longest,
+            reason(&triangle)
+        ))
+    }
+
+    /// The triangles of `group` that `flag` flags (giving the height it found too high).
+    fn among(
+        scene: &Scene,
+        group: &TriangleGroup,
+        flag: impl Fn(&Triangle) -> Option<LeavingHeight> + Sync,
+    ) -> Self {
+        let flagged: Vec<(usize, LeavingHeight)> = scene.triangles[group.range.clone()]
+            .par_iter()
+            .enumerate()
+            .filter_map(|(k, tri)| flag(tri).map(|h| (k, h)))
+            .collect();
+        Self {
+            count: flagged.len(),
+            first: flagged
+                .first()
+                .map(|&(k, h)| (scene.triangles[group.range.start + k], h)),
+        }
+    }
+}
+
+/// Which kind of triangle `tri` is, for the note: a needle where it is beyond the domain even
+/// with its first corner at the origin (its shape alone), else one small against the rounding
+/// of its coordinates (or, instanced, of its placement).
+fn reason(tri: &Triangle) -> &'static str {
+    let at_origin = Triangle {
+        p0: [0.0; 3],
+        ..*tri
+    };
+    if LeavingHeight::of_world(&at_origin).beyond_domain() {
+        "a needle, narrow against its length"
+    } else {
+        "small against the rounding of its coordinates or its placement"
+    }
+}
+
+/// The notes for every mesh with triangles beyond the grazing domain: world-space triangles by
+/// [`LeavingHeight::of_world`], instanced ones by [`LeavingHeight::of_instanced`] under each
+/// instance that places them (their first vertex given in object space).
+pub fn notes(scene: &Scene) -> Vec<String> {
+    let world = scene.world_triangle_count();
+    let mut notes = Vec::new();
+    for group in &scene.triangle_groups {
+        if group.range.end <= world {
+            let found = Flagged::among(scene, group, |tri| {
+                Some(LeavingHeight::of_world(tri)).filter(LeavingHeight::beyond_domain)
+            });
+            notes.extend(found.note(&group.name, group.range.len(), ""));
+        }
+    }
+    for (m, mesh) in scene.meshes.iter().enumerate() {
+        let instances: Vec<&Instance> = scene
+            .instances
+            .iter()
+            .zip(&scene.instance_meshes)
+            .filter(|&(_, &of)| of as usize == m)
+            .map(|(inst, _)| inst)
+            .collect();
+        let found = Flagged::among(scene, mesh, |tri| {
+            instances
+                .iter()
+                .map(|inst| LeavingHeight::of_instanced(tri, inst))
+                .find(LeavingHeight::beyond_domain)
+        });
+        let placed = format!(" (object space, under {} instances)", instances.len());
+        notes.extend(found.note(&mesh.name, mesh.range.len(), &placed));
+    }
+    notes
+}
