@@ -392,7 +392,8 @@ fn grazing_rays_leave_at_the_watertight_height() {
 /// `GRAZING_DOMAIN` of the longest edge above the object triangle, where the offset is derived;
 /// the rays that leave higher (the world bound's round trip, large against a small object
 /// triangle) are counted and printed, and the loader's check
-/// (`twinpath::scene::grazing_domain`) must flag the triangle under that instance for each. The count without the grazing offset must not be 0; the
+/// (`twinpath::scene::grazing_domain`) must flag the triangle under that instance for each; the
+/// cheap bound it checks first must not pass a triangle its exact check flags. The count without the grazing offset must not be 0; the
 /// count with it for world-grazing rays only (the rule of plain triangles, which an
 /// anisotropic map may defeat by turning a direction's angle to the plane) is printed.
 #[test]
@@ -400,12 +401,13 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
     use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
     use kernel::hit::SurfaceHit;
     use kernel::instance::{normal_to_world, point_to_world, ray_to_object, world_height_v3};
-    use twinpath::scene::grazing_domain::LeavingHeight;
+    use twinpath::scene::grazing_domain::{InstancedBound, LeavingHeight};
     use twinpath::scene::instancing::instance_record;
     use twinpath::scene::transform::Transform;
     let mut g = Gen(twinpath_tests::SplitMix(9));
     let (mut tested, mut met, mut without, mut world_rule) = (0, 0, 0, 0);
     let (mut beyond, mut beyond_met, mut beyond_unflagged, mut within_flagged) = (0, 0, 0, 0);
+    let (mut bound_missed, mut bound_flagged) = (0, 0);
     let (mut shadow_met, mut shadow_within) = (0, 0);
     for k in 0..cases() / 4 {
         let (m, stretch) = g.instance_map();
@@ -458,12 +460,16 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         if height > GRAZING_DOMAIN * longest {
             beyond += 1;
             beyond_met += m;
-            beyond_unflagged += !LeavingHeight::of_instanced(&tri, &inst).beyond_domain() as usize;
+            beyond_unflagged += InstancedBound::of(&tri).beyond(&tri, &inst).is_none() as usize;
             continue;
         }
         tested += 1;
         met += m;
-        within_flagged += LeavingHeight::of_instanced(&tri, &inst).beyond_domain() as usize;
+        let exact = LeavingHeight::of_instanced(&tri, &inst).beyond_domain();
+        within_flagged += exact as usize;
+        // The cheap bound must pass no triangle that the exact check flags.
+        bound_missed += (exact && !InstancedBound::of(&tri).may_be_beyond(&inst)) as usize;
+        bound_flagged += InstancedBound::of(&tri).may_be_beyond(&inst) as usize;
         let carried = world_height_v3(
             &inst,
             normal_to_world(&inst, shape.normal).length(),
@@ -491,9 +497,12 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
             shadow_within += shadow; // a target no higher than the lift: the segment descends
         }
     }
-    println!("grazing rays leaving instanced triangles: {tested} within GRAZING_DOMAIN; met again at the worst rounding and not rejected: {met} (shadow segments along them: {shadow_met}, and {shadow_within} to targets no higher than the lift); without the grazing offset {without}, with it for world-grazing rays only {world_rule}; beyond GRAZING_DOMAIN {beyond}, of which {beyond_met} met and {beyond_unflagged} not flagged by the loader's check ({within_flagged} flagged within)");
+    println!("grazing rays leaving instanced triangles: {tested} within GRAZING_DOMAIN; met again at the worst rounding and not rejected: {met} (shadow segments along them: {shadow_met}, and {shadow_within} to targets no higher than the lift); without the grazing offset {without}, with it for world-grazing rays only {world_rule}; beyond GRAZING_DOMAIN {beyond}, of which {beyond_met} met and {beyond_unflagged} not flagged by the loader's check ({within_flagged} flagged within; its cheap bound passes {bound_missed} that the exact check flags, and flags {bound_flagged} within)");
     assert!(tested > cases() / 8, "{tested}");
-    assert_eq!((met, shadow_met, beyond_unflagged), (0, 0, 0));
+    assert_eq!(
+        (met, shadow_met, beyond_unflagged, bound_missed),
+        (0, 0, 0, 0)
+    );
     assert!(beyond > 0);
     assert!(
         without > 0,
