@@ -17,7 +17,7 @@
 //!    emissive and small meshes are flattened; memory of 1000 instances of a 100k-triangle
 //!    mesh on both backends.
 
-use glam::{DMat4, DVec3, Vec3};
+use glam::{DVec3, Vec3};
 use kernel::geometry::{intersect_triangle, lift_ray_origin};
 use kernel::sampling::sample_cosine_hemisphere;
 use std::path::{Path, PathBuf};
@@ -27,6 +27,7 @@ use twinpath::scene::instancing::instance_record;
 use twinpath::scene::transform::Transform;
 use twinpath::scene::{parse_scene, SceneFile};
 use twinpath_tests::gpu::assert_validation_clean;
+use twinpath_tests::placements::Placements;
 use twinpath_tests::{
     assert_noiseless_pixels, pixel_quadrature, render_film, with_independent_samples, z_critical,
     SplitMix,
@@ -222,33 +223,16 @@ fn an_instanced_mesh_renders_as_its_flattened_copies_on_both_backends() {
     assert_validation_clean();
 }
 
-/// A random affine placement for test 2: scale 10^U(-3, 3), anisotropy up to 100, a random
-/// rotation, a mirror in half the cases, translation up to 10^4 x the scale (capped at 10^4).
-fn random_transform(g: &mut SplitMix) -> (Transform, f64) {
-    let s = 10f64.powf(-3.0 + 6.0 * g.unit() as f64);
-    let aniso = DVec3::new(
-        10f64.powf(2.0 * g.unit() as f64 - 1.0),
-        10f64.powf(2.0 * g.unit() as f64 - 1.0),
-        1.0,
-    );
-    let mirror = if g.unit() < 0.5 { -1.0 } else { 1.0 };
-    let axis = DVec3::new(
-        g.unit() as f64 - 0.5,
-        g.unit() as f64 - 0.5,
-        g.unit() as f64 - 0.5,
-    )
-    .normalize();
-    let angle = g.unit() as f64 * std::f64::consts::TAU;
-    let t = DVec3::new(
-        g.unit() as f64 - 0.5,
-        g.unit() as f64 - 0.5,
-        g.unit() as f64 - 0.5,
-    ) * (s * 10f64.powf(4.0 * g.unit() as f64)).min(1e4);
-    let m = DMat4::from_translation(t)
-        * DMat4::from_axis_angle(axis, angle)
-        * DMat4::from_scale(s * aniso * DVec3::new(mirror, 1.0, 1.0));
-    let transform = Transform::affine(m).unwrap().unwrap();
-    (transform, s)
+/// A random affine placement for test 2 (`Placements::instance_map`, as the robustness tests
+/// draw them: scale 10^U(-3, 3), anisotropy up to 100, a random rotation, a mirror in half the
+/// cases, translation up to 10^4 x the scale, capped at 10^4), and its largest stretch.
+fn random_transform(g: &mut Placements) -> (Transform, f64) {
+    loop {
+        let (m, stretch) = g.instance_map();
+        if let Ok(Some(transform)) = Transform::affine(m) {
+            return (transform, stretch);
+        }
+    }
 }
 
 #[test]
@@ -271,7 +255,7 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
         name: "torus".into(),
         range: 0..mesh.len(),
     }];
-    let mut g = SplitMix(7);
+    let mut g = Placements(SplitMix(7));
     let mut scales = Vec::new();
     for _ in 0..400 {
         let (t, s) = random_transform(&mut g);
@@ -356,30 +340,42 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
 /// inverse (f64): H |M^-T n| >= 1, for 400 maps of test 2 (scales 10^-3..10^3, anisotropy to
 /// 100, mirrors, translations) and 250 unit normals each. And at most 1 + 10^-4: a height
 /// carried loosely is not safer (a needle's grazing rays are met again from too high,
-/// docs/robustness.md, "Known limits"); sqrt(3) ||M|| alone, the first version, gives 1.42 to
-/// 103 here. (The rounding spares are derived, not shown needed: without them the lowest is
-/// still 1.0000007.)
+/// docs/robustness.md, "Known limits"). Both mutations must fail: sqrt(3) ||M|| alone, the
+/// first version, exceeds 1 + 10^-4, and the height without its rounding spares (1 / length)
+/// falls below 1 for some map and normal.
 #[test]
 fn world_heights_carry_object_heights_tightly_under_every_map() {
     use kernel::instance::{normal_to_world, world_height_v3};
-    let mut g = SplitMix(77);
+    let mut g = Placements(SplitMix(77));
     let (mut lowest, mut highest) = (f64::INFINITY, 0f64);
+    // The two mutations: no rounding spares (1 / length), and sqrt(3) ||M|| alone.
+    let (mut bare_lowest, mut loose_highest) = (f64::INFINITY, 0f64);
     for _ in 0..400 {
         let (transform, _) = random_transform(&mut g);
         let inst = instance_record(&transform, 0);
         let inverse_transpose = transform.matrix().inverse().transpose();
         for _ in 0..250 {
-            let n = g.direction();
+            let n = g.dir();
             let length = normal_to_world(&inst, n).length();
             let height = world_height_v3(&inst, length, 1.0f32) as f64;
             let along = inverse_transpose.transform_vector3(n.as_dvec3()).length();
             lowest = lowest.min(height * along);
+            bare_lowest = bare_lowest.min(along / length as f64);
+            loose_highest = loose_highest.max(1.732_051 * inst.forward_norm as f64 * along);
             highest = highest.max(height * along);
         }
     }
-    println!("world heights of an object height of 1, mapped back: {lowest:.9} to {highest:.9}");
+    println!("world heights of an object height of 1, mapped back: {lowest:.9} to {highest:.9}; without the rounding spares from {bare_lowest:.9}, by sqrt(3) ||M|| alone up to {loose_highest:.3}");
     assert!(lowest >= 1.0, "{lowest}");
     assert!(highest <= 1.0 + 1e-4, "{highest}");
+    assert!(
+        bare_lowest < 1.0,
+        "the rounding spares are not shown to be needed"
+    );
+    assert!(
+        loose_highest > 1.0 + 1e-4,
+        "the loose factor is not shown to fail"
+    );
 }
 
 #[test]
