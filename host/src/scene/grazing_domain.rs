@@ -221,10 +221,10 @@ impl Flagged {
         let (triangle, height) = self.first?;
         let corner = Vec3::from(triangle.p0);
         Some(format!(
-            "{name}: {} of {total} triangles{placed} may be left by grazing rays higher than \
-             the offsets are derived for (GRAZING_DOMAIN, docs/robustness.md \"Known limits\"), \
-             e.g. the one at ({}, {}, {}), longest edge {:.3e}, {}: a ray within 1/1024 of \
-             its plane may meet it again",
+            "{name}: {} of {total} triangles{placed} lie beyond the domain where rays leaving \
+             them are proven not to meet them again (docs/robustness.md, \"Known limits\"): a \
+             ray leaving one within 1/1024 of its plane may. E.g. the one at ({}, {}, {}), \
+             longest edge {:.3e}: {}",
             self.count,
             corner.x,
             corner.y,
