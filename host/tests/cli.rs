@@ -205,3 +205,67 @@ fn ctrl_c_writes_the_image_so_far_cpu() {
 fn ctrl_c_writes_the_image_so_far_gpu() {
     interrupt("gpu");
 }
+
+/// Every command that reads a scene shows its notes first, as `render` does: here the note on
+/// a needle too thin for the proven grazing offsets (`scene::grazing_domain`).
+#[test]
+fn commands_that_read_a_scene_show_its_notes() {
+    let dir = temp_dir("notes");
+    std::fs::write(
+        dir.join("needle.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0.5 0.000001 0\nf 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 4 5 6\n",
+    )
+    .unwrap();
+    let scene = dir.join("needle.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\neye = [0.3, 0.3, 2]\nlook_at = [0.3, 0.3, 0]\nup = [0, 1, 0]\nvfov = 40\n\
+         width = 8\nheight = 8\n[background]\nradiance = [1, 1, 1]\n[materials]\nwhite = { kd = [0.5, 0.5, 0.5] }\n\
+         [[mesh]]\nfile = \"needle.obj\"\nmaterial = \"white\"\n",
+    )
+    .unwrap();
+    let exr = dir.join("out.exr");
+    let reference = dir.join("reference.exr");
+    let runs: [Vec<std::ffi::OsString>; 4] = [
+        vec![
+            "render".into(),
+            "--backend".into(),
+            "cpu".into(),
+            "--spp".into(),
+            "2".into(),
+            "--quiet".into(),
+            "-o".into(),
+            exr.clone().into(),
+        ],
+        vec![
+            "reference".into(),
+            "--backend".into(),
+            "cpu".into(),
+            "--spp".into(),
+            "2".into(),
+            "-o".into(),
+            reference.clone().into(),
+        ],
+        vec!["rays".into(), "--width".into(), "4".into()],
+        vec![
+            "bench".into(),
+            "--backend".into(),
+            "cpu".into(),
+            "--max-spp".into(),
+            "1".into(),
+            "--reference".into(),
+            reference.clone().into(),
+            "--out-dir".into(),
+            dir.clone().into(),
+        ],
+    ];
+    for args in runs {
+        let out = Command::new(BIN).args(&args).arg(&scene).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {err}");
+        assert!(
+            err.contains("twinpath: note: needle.obj: 1 of 2 triangles"),
+            "{args:?}: {err}"
+        );
+    }
+}

@@ -1,6 +1,6 @@
 //! `twinpath bench`: time against error for variants of the settings, as CSV and a plot.
 
-use super::load_scene;
+use super::{load_scene, show_notes};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
@@ -48,6 +48,7 @@ pub struct BenchArgs {
 pub fn run(a: BenchArgs) -> Result<()> {
     install_interrupt_handler();
     let SceneFile { scene, settings } = load_scene(a.scene.as_deref())?;
+    show_notes(&scene);
     let reference_image = RgbImage::read(&a.reference)?;
     let variants = if a.variants.is_empty() {
         vec![Variant {

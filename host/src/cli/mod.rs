@@ -164,6 +164,14 @@ pub fn load_scene(path: Option<&Path>) -> Result<SceneFile> {
     })
 }
 
+/// Shows what the loader approximated, ignored or cannot prove about the scene (its notes), as
+/// `render` does before it renders.
+pub fn show_notes(scene: &twinpath::scene::Scene) {
+    for note in &scene.notes {
+        eprintln!("twinpath: note: {note}");
+    }
+}
+
 /// `scenes/cornell.toml` -> `cornell`; the built-in scene -> `cornell`.
 pub fn scene_stem(name: &str) -> String {
     let name = if name.is_empty() {

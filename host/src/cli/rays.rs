@@ -1,6 +1,6 @@
 //! `twinpath rays`: rays per second of the CPU traversal, and the BVH's build time and memory.
 
-use super::{load_scene, mib, scene_stem};
+use super::{load_scene, mib, scene_stem, show_notes};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::io::Write;
@@ -37,6 +37,7 @@ pub fn run(a: RaysArgs) -> Result<()> {
         mut scene,
         settings,
     } = load_scene(a.scene.as_deref())?;
+    show_notes(&scene);
     if let Some(n) = a.mesh_triangles {
         twinpath::bench::rays::add_knot_mesh(&mut scene, n);
     }

@@ -1,7 +1,7 @@
 //! `twinpath reference`: a converged image as the mean of two independent halves, with its own
 //! noise estimate.
 
-use super::load_scene;
+use super::{load_scene, show_notes};
 use anyhow::{bail, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -32,6 +32,7 @@ pub fn run(a: ReferenceArgs) -> Result<()> {
         scene,
         mut settings,
     } = load_scene(a.scene.as_deref())?;
+    show_notes(&scene);
     settings.spp = a.spp / 2;
     let opts = RenderOptions {
         backend: a.backend,

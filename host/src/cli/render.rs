@@ -1,6 +1,6 @@
 //! `twinpath render`: a scene to EXR and/or PNG, with progress, Ctrl-C and an honest log.
 
-use super::{check_writable, extension, load_scene, mib, scene_stem, SettingFlags};
+use super::{check_writable, extension, load_scene, mib, scene_stem, show_notes, SettingFlags};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -152,9 +152,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         settings.seed
     );
     eprintln!("twinpath: scene memory: {}", scene.memory_report());
-    for note in &scene.notes {
-        eprintln!("twinpath: note: {note}");
-    }
+    show_notes(&scene);
     let opts = RenderOptions {
         backend: a.backend,
         device: a.device,
