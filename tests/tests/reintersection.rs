@@ -393,9 +393,12 @@ fn grazing_rays_leave_at_the_watertight_height() {
 /// the rays that leave higher (the world bound's round trip, large against a small object
 /// triangle) are counted and printed, and the loader's check
 /// (`twinpath::scene::grazing_domain`) must flag the triangle under that instance for each; the
-/// cheap bound it checks first must not pass a triangle its exact check flags. The count without the grazing offset must not be 0; the
-/// count with it for world-grazing rays only (the rule of plain triangles, which an
-/// anisotropic map may defeat by turning a direction's angle to the plane) is printed.
+/// cheap bound it checks first must not pass a triangle its exact check flags. The count without
+/// the grazing offset must not be 0; the count with it for world-grazing rays only (the rule of
+/// plain triangles, which an anisotropic map may defeat by turning a direction's angle to the
+/// plane) is printed. From each point within the domain a steeper ray too (world cosine 10^-2.5
+/// to 1), held to none met; the count without the grazing offset is printed (a map that turns
+/// a direction toward a sliver's plane makes one need it).
 #[test]
 fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
     use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
@@ -408,6 +411,8 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
     let (mut tested, mut met, mut without, mut world_rule) = (0, 0, 0, 0);
     let (mut beyond, mut beyond_met, mut beyond_unflagged, mut within_flagged) = (0, 0, 0, 0);
     let (mut bound_missed, mut bound_flagged) = (0, 0);
+    let mut g_steep = Gen(twinpath_tests::SplitMix(90));
+    let (mut steep_tested, mut steep_met, mut steep_without) = (0, 0, 0);
     let (mut shadow_met, mut shadow_within) = (0, 0);
     for k in 0..cases() / 4 {
         let (m, stretch) = g.instance_map();
@@ -478,6 +483,23 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         let bare = hit.offset - carried;
         without += met_from(continuation_origin(p, n_side, w, bare, 0.0));
         world_rule += met_from(continuation_origin(p, n_side, w, bare, carried));
+        // A steeper ray from the same point, cosine 10^-2.5 to 1 (drawn from a stream of its
+        // own, so that the grazing rays' draws stay as they were): not met either.
+        let steep_cos = g_steep.pow10(-2.5, 0.0);
+        let steep =
+            (n_side * steep_cos + tangent * (1.0 - steep_cos * steep_cos).sqrt()).normalize();
+        if steep.dot(n_side) > 0.0 {
+            let from = |offset: f32, grazing: f32| {
+                met_along(
+                    continuation_origin(p, n_side, steep, offset, grazing),
+                    steep,
+                    f32::INFINITY,
+                ) as usize
+            };
+            steep_tested += 1;
+            steep_met += from(hit.offset, hit.grazing_offset);
+            steep_without += from(bare, 0.0);
+        }
         // A shadow segment along w to a point 10^-2 to 10 sizes away, from `shadow_segment`.
         let size = size * stretch as f32;
         let target = p + w * size * g.pow10(-2.0, 1.0);
@@ -497,13 +519,15 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
             shadow_within += shadow; // a target no higher than the lift: the segment descends
         }
     }
-    println!("grazing rays leaving instanced triangles: {tested} within GRAZING_DOMAIN; met again at the worst rounding and not rejected: {met} (shadow segments along them: {shadow_met}, and {shadow_within} to targets no higher than the lift); without the grazing offset {without}, with it for world-grazing rays only {world_rule}; beyond GRAZING_DOMAIN {beyond}, of which {beyond_met} met and {beyond_unflagged} not flagged by the loader's check ({within_flagged} flagged within; its cheap bound passes {bound_missed} that the exact check flags, and flags {bound_flagged} within)");
+    println!("grazing rays leaving instanced triangles: {tested} within GRAZING_DOMAIN; met again at the worst rounding and not rejected: {met} (shadow segments along them: {shadow_met}, and {shadow_within} to targets no higher than the lift); without the grazing offset {without}, with it for world-grazing rays only {world_rule}; beyond GRAZING_DOMAIN {beyond}, of which {beyond_met} met and {beyond_unflagged} not flagged by the loader's check ({within_flagged} flagged within; its cheap bound passes {bound_missed} that the exact check flags, and flags {bound_flagged} within); steeper rays (cosines 10^-2.5 to 1) from the same points: {steep_tested}, met {steep_met}, without the grazing offset {steep_without}");
     assert!(tested > cases() / 8, "{tested}");
     assert_eq!(
         (met, shadow_met, beyond_unflagged, bound_missed),
         (0, 0, 0, 0)
     );
     assert!(beyond > 0);
+    assert!(steep_tested > tested / 2, "{steep_tested}");
+    assert_eq!(steep_met, 0);
     assert!(
         without > 0,
         "the grazing offset is not shown to be needed on instances"
