@@ -404,7 +404,7 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
     use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
     use kernel::hit::SurfaceHit;
     use kernel::instance::{normal_to_world, point_to_world, ray_to_object, world_height_v3};
-    use twinpath::scene::grazing_domain::{InstancedBound, LeavingHeight};
+    use twinpath::scene::grazing_domain::InstancedBound;
     use twinpath::scene::instancing::instance_record;
     use twinpath::scene::transform::Transform;
     let mut g = Gen(twinpath_tests::SplitMix(9));
@@ -465,16 +465,18 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         if height > GRAZING_DOMAIN * longest {
             beyond += 1;
             beyond_met += m;
-            beyond_unflagged += InstancedBound::of(&tri).beyond(&tri, &inst).is_none() as usize;
+            beyond_unflagged += InstancedBound::of(&tri).beyond(&inst).is_none() as usize;
             continue;
         }
         tested += 1;
         met += m;
-        let exact = LeavingHeight::of_instanced(&tri, &inst).beyond_domain();
+        let checks = InstancedBound::of(&tri);
+        let exact = checks.exact(&inst).beyond_domain();
         within_flagged += exact as usize;
         // The cheap bound must pass no triangle that the exact check flags.
-        bound_missed += (exact && !InstancedBound::of(&tri).may_be_beyond(&inst)) as usize;
-        bound_flagged += InstancedBound::of(&tri).may_be_beyond(&inst) as usize;
+        let bound = checks.may_be_beyond(&inst);
+        bound_missed += (exact && !bound) as usize;
+        bound_flagged += bound as usize;
         let carried = world_height_v3(
             &inst,
             normal_to_world(&inst, shape.normal).length(),

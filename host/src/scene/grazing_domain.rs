@@ -59,13 +59,11 @@ impl LeavingHeight {
         let (p0, e1, e2) = corners(tri);
         let factors = ShapeFactors::<f32>::of(V3::from(e1), V3::from(e2));
         let normal = Vec3::from(factors.normal).abs();
-        let mut offset = 0.0f32;
-        let mut grazing = 0.0f32;
-        let mut coordinates = 0.0f32;
+        let grazing = factors.grazing;
+        let (mut offset, mut coordinates) = (0.0f32, 0.0f32);
         for (u, v) in CORNERS {
-            let (o, g) = triangle_offsets_v3(p0.into(), e1.into(), e2.into(), u, v, &factors);
+            let (o, _) = triangle_offsets_v3(p0.into(), e1.into(), e2.into(), u, v, &factors);
             offset = offset.max(o);
-            grazing = g;
             let corner = triangle_point(p0, e1, e2, u, v);
             coordinates = coordinates.max(corner.abs().dot(normal));
         }
@@ -79,23 +77,57 @@ impl LeavingHeight {
             longest: longest_edge(e1, e2),
         }
     }
+}
 
-    /// The height of object-space triangle `tri` placed by `instance`, in object units: the
-    /// world height of `kernel::instance::instanced_offset_v3` times the length of the world
-    /// normal before normalising (a world move H along it maps back to H |M^-T n_o| along the
-    /// object normal).
-    pub fn of_instanced(tri: &Triangle, instance: &Instance) -> Self {
+/// What the checks of an instanced triangle need of the object triangle alone, computed once
+/// per triangle and used under each of its instances: the exact height
+/// ([`InstancedBound::exact`]) and a bound on it that is cheap per instance
+/// ([`InstancedBound::may_be_beyond`]); a scene placing a mesh 10^3 times would otherwise spend
+/// seconds in the exact check.
+pub struct InstancedBound {
+    /// The corners, each with the object point's error bound there plus the watertight term at
+    /// its largest.
+    corners: [(Vec3, f32); 3],
+    /// The largest of the corners' error bounds.
+    error: f32,
+    /// The largest absolute coordinate of the corners.
+    coordinates: f32,
+    normal: Vec3,
+    grazing: f32,
+    longest: f32,
+}
+
+impl InstancedBound {
+    pub fn of(tri: &Triangle) -> Self {
         let (p0, e1, e2) = corners(tri);
         let shape = TriangleShape::of(e1, e2);
-        let world_normal = normal_to_world(instance, shape.normal);
+        let watertight = triangle_watertight_error_bound(e1, e2);
+        let corners = CORNERS.map(|(u, v)| {
+            let error = triangle_point_error_conditioned(p0, e1, e2, u, v, &shape) + watertight;
+            (triangle_point(p0, e1, e2, u, v), error)
+        });
+        Self {
+            corners,
+            error: corners.iter().fold(0.0, |m, c| c.1.max(m)),
+            coordinates: corners
+                .iter()
+                .fold(0.0, |m, c| c.0.abs().max_element().max(m)),
+            normal: shape.normal,
+            grazing: shape.grazing,
+            longest: longest_edge(e1, e2),
+        }
+    }
+
+    /// The height under `instance`, in object units: the world height of
+    /// `kernel::instance::instanced_offset_v3` at the corners times the length of the world
+    /// normal before normalising (a world move H along it maps back to H |M^-T n_o| along the
+    /// object normal).
+    pub fn exact(&self, instance: &Instance) -> LeavingHeight {
+        let world_normal = normal_to_world(instance, self.normal);
         let length = world_normal.length();
         let normal = world_normal / length;
-        let watertight = triangle_watertight_error_bound(e1, e2);
-        let mut rounding = 0.0f32;
-        let mut lifted = 0.0f32;
-        for (u, v) in CORNERS {
-            let p_object = triangle_point(p0, e1, e2, u, v);
-            let error = triangle_point_error_conditioned(p0, e1, e2, u, v, &shape) + watertight;
+        let (mut rounding, mut lifted) = (0.0f32, 0.0f32);
+        for (p_object, error) in self.corners {
             let p_world = point_to_world(instance, p_object);
             let at = |grazing: f32| {
                 instanced_offset_v3(
@@ -107,49 +139,17 @@ impl LeavingHeight {
             };
             let bare = at(0.0);
             rounding = rounding.max(bare);
-            lifted = lifted.max(at(shape.grazing) - bare);
+            lifted = lifted.max(at(self.grazing) - bare);
         }
-        Self {
+        LeavingHeight {
             rounding: 2.0 * rounding * length,
             grazing: lifted * length,
-            longest: longest_edge(e1, e2),
-        }
-    }
-}
-
-/// What [`LeavingHeight::of_instanced`] needs of an object triangle alone, for a bound on it
-/// under any instance that is cheap per instance: a scene placing a mesh 10^3 times would
-/// otherwise spend seconds in the exact check.
-pub struct InstancedBound {
-    /// The object point's error bound at its corners, the watertight term at its largest.
-    error: f32,
-    /// The largest absolute coordinate of its corners.
-    coordinates: f32,
-    grazing: f32,
-    longest: f32,
-}
-
-impl InstancedBound {
-    pub fn of(tri: &Triangle) -> Self {
-        let (p0, e1, e2) = corners(tri);
-        let shape = TriangleShape::of(e1, e2);
-        let watertight = triangle_watertight_error_bound(e1, e2);
-        let (mut error, mut coordinates) = (0.0f32, 0.0f32);
-        for (u, v) in CORNERS {
-            let e = triangle_point_error_conditioned(p0, e1, e2, u, v, &shape) + watertight;
-            error = error.max(e);
-            coordinates = coordinates.max(triangle_point(p0, e1, e2, u, v).abs().max_element());
-        }
-        Self {
-            error,
-            coordinates,
-            grazing: shape.grazing,
-            longest: longest_edge(e1, e2),
+            longest: self.longest,
         }
     }
 
     /// Whether the triangle may be beyond the domain under `instance`: false only where
-    /// [`LeavingHeight::of_instanced`] is within it. The bound takes each of its terms at its
+    /// [`InstancedBound::exact`] is within it. The bound takes each of its terms at its
     /// largest over the triangle and the object normal's direction, by the instance's infinity
     /// norms m = ||M||, w = ||M^-1||:
     /// - the world point, |p_w| <= m |p_o| + |T| (`kernel::instance::world_point_error_v3`
@@ -184,13 +184,13 @@ impl InstancedBound {
         !(height <= GRAZING_DOMAIN * self.longest)
     }
 
-    /// The triangle's [`LeavingHeight::of_instanced`] where it is beyond the domain under
+    /// The triangle's [`InstancedBound::exact`] height where it is beyond the domain under
     /// `instance`, checked exactly only where [`InstancedBound::may_be_beyond`] says it may be.
-    pub fn beyond(&self, tri: &Triangle, instance: &Instance) -> Option<LeavingHeight> {
+    pub fn beyond(&self, instance: &Instance) -> Option<LeavingHeight> {
         if !self.may_be_beyond(instance) {
             return None;
         }
-        Some(LeavingHeight::of_instanced(tri, instance)).filter(LeavingHeight::beyond_domain)
+        Some(self.exact(instance)).filter(LeavingHeight::beyond_domain)
     }
 }
 
@@ -293,7 +293,7 @@ pub fn notes(scene: &Scene) -> Vec<String> {
             .collect();
         let found = Flagged::among(scene, mesh, |tri| {
             let bound = InstancedBound::of(tri);
-            instances.iter().find_map(|inst| bound.beyond(tri, inst))
+            instances.iter().find_map(|inst| bound.beyond(inst))
         });
         let placed = format!(" (object space, under {} instances)", instances.len());
         notes.extend(found.note(&mesh.name, mesh.range.len(), &placed));
