@@ -224,39 +224,41 @@ fn commands_that_read_a_scene_show_its_notes() {
          [[mesh]]\nfile = \"needle.obj\"\nmaterial = \"white\"\n",
     )
     .unwrap();
-    let exr = dir.join("out.exr");
-    let reference = dir.join("reference.exr");
-    let runs: [Vec<std::ffi::OsString>; 4] = [
+    let path = |p: PathBuf| p.to_str().unwrap().to_string();
+    let exr = path(dir.join("out.exr"));
+    let reference = path(dir.join("reference.exr"));
+    let out_dir = path(dir.clone());
+    let runs: [Vec<&str>; 4] = [
         vec![
-            "render".into(),
-            "--backend".into(),
-            "cpu".into(),
-            "--spp".into(),
-            "2".into(),
-            "--quiet".into(),
-            "-o".into(),
-            exr.clone().into(),
+            "render",
+            "--backend",
+            "cpu",
+            "--spp",
+            "2",
+            "--quiet",
+            "-o",
+            &exr,
         ],
         vec![
-            "reference".into(),
-            "--backend".into(),
-            "cpu".into(),
-            "--spp".into(),
-            "2".into(),
-            "-o".into(),
-            reference.clone().into(),
+            "reference",
+            "--backend",
+            "cpu",
+            "--spp",
+            "2",
+            "-o",
+            &reference,
         ],
-        vec!["rays".into(), "--width".into(), "4".into()],
+        vec!["rays", "--width", "4"],
         vec![
-            "bench".into(),
-            "--backend".into(),
-            "cpu".into(),
-            "--max-spp".into(),
-            "1".into(),
-            "--reference".into(),
-            reference.clone().into(),
-            "--out-dir".into(),
-            dir.clone().into(),
+            "bench",
+            "--backend",
+            "cpu",
+            "--max-spp",
+            "1",
+            "--reference",
+            &reference,
+            "--out-dir",
+            &out_dir,
         ],
     ];
     for args in runs {
