@@ -6,7 +6,7 @@ use crate::geometry::{
     reproject_to_sphere, sphere_point_error, triangle_offsets_conditioned, triangle_point,
     triangle_point_error_conditioned, TriangleShape,
 };
-use crate::instance::{instanced_offset_v3, normal_to_world, point_to_world};
+use crate::instance::{instanced_offsets_v3, normal_to_world, point_to_world, ObjectLeaving};
 use crate::real::V3;
 use crate::scene::{Instance, Sphere, Triangle, NONE};
 use spirv_std::glam::{Vec2, Vec3};
@@ -26,13 +26,14 @@ pub struct SurfaceHit {
     /// How far along the normal rays leaving `position` start (`geometry::lift_ray_origin`):
     /// the position's rounding along the normal and what the tests that could meet the surface
     /// again need to decide the ray's side (`geometry::triangle_offsets_v3`; for a sphere, a
-    /// per-component error bound times |normal|_1; for an instance, that and its grazing offset,
-    /// `instance::instanced_offset_v3`).
+    /// per-component error bound times |normal|_1; for an instance,
+    /// `instance::instanced_offsets_v3`).
     pub offset: f32,
     /// What a ray within `geometry::GRAZING_COS` of the surface adds to `offset`
     /// (`geometry::continuation_origin`, `geometry::shadow_segment`): a GPU's triangle test's
-    /// rounding anywhere on the triangle (`geometry::triangle_grazing_offset_v3`); 0 for
-    /// spheres, and for instances, whose `offset` holds it.
+    /// rounding anywhere on the triangle (`geometry::triangle_grazing_offset_v3`; for an
+    /// instance, what lifts such a ray to `instance::instanced_offset_v3`'s height, or 0 where
+    /// `offset` is that height); 0 for spheres.
     pub grazing_offset: f32,
     /// Whether the ray arrived from the side `normal` points away from (a sphere's inside, a
     /// triangle's back). Decided where the record is made, and robustly for spheres: by which
@@ -133,10 +134,10 @@ impl SurfaceHit {
     /// shape `shape`) of instance `instance` (number `index`) at `t`, barycentric (u, v): the
     /// object point (`triangle_point`) mapped to world space, the geometric normal
     /// M^-T (edge1 x edge2) normalised (along the edge cross product of the same triangle
-    /// flattened into world space, whose winding a mirroring transform reverses), the offset of
-    /// `instance::instanced_offset_v3` (the object point's `triangle_point_error` carried to
-    /// world space, and the grazing offset for every ray; grazing offset 0), and the side by
-    /// the sign of `normal . dir`. Barycentrics and the shading record stay the object-space
+    /// flattened into world space, whose winding a mirroring transform reverses), the heights
+    /// of `instance::instanced_offsets_v3` (the object triangle's own offset carried to world
+    /// space where the map turns directions little, else the object point's bound and its
+    /// grazing offset for every ray), and the side by the sign of `normal . dir`. Barycentrics and the shading record stay the object-space
     /// triangle's (an affine map keeps barycentrics). Both backends build instanced hits here.
     #[inline]
     #[allow(clippy::too_many_arguments)]
@@ -156,15 +157,24 @@ impl SurfaceHit {
             Vec3::from(tri.edge2),
         );
         let object_position = triangle_point(p0, e1, e2, u, v);
-        let object_error = triangle_point_error_conditioned(p0, e1, e2, u, v, &shape);
+        let (object_offset, object_grazing) =
+            triangle_offsets_conditioned(p0, e1, e2, u, v, &shape);
+        let object = ObjectLeaving {
+            point: V3::from(object_position),
+            error: triangle_point_error_conditioned(p0, e1, e2, u, v, &shape),
+            offset: object_offset,
+            grazing: object_grazing,
+            normal: V3::from(shape.normal),
+            weight_sum: shape.weights.element_sum(),
+            floor: shape.floor,
+        };
         let position = point_to_world(instance, object_position);
         let world_normal = normal_to_world(instance, shape.normal);
         let normal = world_normal.normalize();
-        let offset = instanced_offset_v3(
+        let (offset, grazing_offset) = instanced_offsets_v3(
             instance,
-            (V3::from(object_position), object_error),
+            &object,
             (V3::from(position), V3::from(normal), world_normal.length()),
-            shape.grazing,
         );
         Self {
             position,
@@ -173,7 +183,7 @@ impl SurfaceHit {
             material: tri.material,
             light: tri.light,
             offset,
-            grazing_offset: 0.0,
+            grazing_offset,
             arrived_behind: Self::behind_plane(normal, dir),
             shading: tri.shading,
             barycentrics: Vec2::new(u, v),

@@ -6,7 +6,7 @@
 //! Every map is written out component by component in a fixed order (three products summed left
 //! to right, then the translation), so both backends compute the same `f32`s.
 
-use crate::geometry::normal_l1;
+use crate::geometry::{normal_l1, GRAZING_COS, WELL_CONDITIONED_FLOOR, WELL_CONDITIONED_WEIGHTS};
 use crate::real::{self, V3};
 use crate::scene::Instance;
 use spirv_std::glam::Vec3;
@@ -204,4 +204,161 @@ pub fn instanced_offset_v3<R: real::Real>(
 ) -> R {
     let error = world_point_error_v3(instance, p_object, object_error, p_world);
     error * normal_l1(n_world) + world_height_v3(instance, normal_length, object_grazing)
+}
+
+/// What the offsets of a ray leaving an instanced triangle read of the object triangle: the
+/// object point and its per-component bound (`geometry::triangle_point_error_v3`, which
+/// [`instanced_offset_v3`] carries), the object triangle's own offset and grazing offset at the
+/// point (`geometry::triangle_offsets_v3`), its unit normal, and the sum of its plane weights
+/// and its floor (`geometry::triangle_plane_weights_v3`).
+#[derive(Clone, Copy)]
+pub struct ObjectLeaving<R> {
+    pub point: V3<R>,
+    pub error: R,
+    pub offset: R,
+    pub grazing: R,
+    pub normal: V3<R>,
+    pub weight_sum: R,
+    pub floor: R,
+}
+
+/// A lower bound on |X^T n_o|, the length of the exact world normal of the object triangle's
+/// exact unit normal n_o under X, the exact inverse of the stored `object_to_world` M (the map
+/// the device places the mesh by), from `normal_length`, the computed length of
+/// [`normal_to_world_v3`] of the computed normal; and the bound `deviation` on the Euclidean
+/// distance between that computed vector and X^T n_o. The stored inverse W is the rounding of
+/// the inverse of the `f64` matrix M rounds from, so W - X is at most eps / 2 (|W| + |W| |M| |W|)
+/// per entry (first order), sqrt(3) eps / 2 w (1 + m w) in the 2-norm (m, w the infinity norms
+/// of M and W); the computed normal is within 4 eps of n_o, which X^T carries by at most
+/// sqrt(3) w; the three products and two sums per component round by at most 3 eps of
+/// sum_j |W_ji| |n_j| <= 3 w' with w' <= 3 w the largest column sum, 9 sqrt(3) eps w in the
+/// 2-norm. So `deviation` = eps w (m w + 24) holds them, and the length's own rounding (the
+/// dot product and the square root) is within 4 eps of it.
+#[inline]
+fn normal_length_bounds<R: real::Real>(instance: &Instance, normal_length: R) -> (R, R) {
+    let (m, w) = (instance.forward_norm, instance.inverse_norm);
+    let deviation = R::splat(f32::EPSILON * w * (m * w + 24.0));
+    let low = normal_length * R::splat(1.0 - 4.0 * f32::EPSILON) - deviation;
+    (low, deviation)
+}
+
+/// Whether a ray leaving an instanced triangle at a world cosine of at least
+/// `geometry::GRAZING_COS` (against the computed world normal, whose length was
+/// `normal_length`) leaves the object triangle at a direction the plane-side test
+/// (`plane_side`) is sure of, as a lane mask: then such a ray needs no grazing offset
+/// ([`instanced_offsets_v3`]). Four conditions:
+/// 1. The object triangle is well-conditioned (its weights sum to at most
+///    `geometry::WELL_CONDITIONED_WEIGHTS`, its floor at most `WELL_CONDITIONED_FLOOR`), so that
+///    its offset is the plane height of `geometry::triangle_offsets_v3`.
+/// 2. The lower bound L of |X^T n_o| ([`normal_length_bounds`]) is positive.
+/// 3. The computed world normal is within 2^-12 of the exact one in angle: 2 `deviation`
+///    <= 2^-12 L. So a computed cosine of `GRAZING_COS` is an exact one of at least
+///    3/4 `GRAZING_COS`, and the world normal's components are within 2^-12 of the exact ones.
+/// 4. The object direction the device tests, X d (each component within
+///    [`INSTANCE_ERROR_EPS`] eps w of it, as the round trip's model allows), has
+///    X d . n_o >= c |X^T n_o| for a world cosine c, less sqrt(3) 16 eps w; the plane-side test
+///    is sure of a direction d_o with d_o . n_o >= 25 eps |w_o|_1 |d_o|_inf plus its denormal
+///    terms (`geometry::GRAZING_COS`'s derivation), with |d_o|_inf <= w (1 + 2^-12); those
+///    terms are at most floor (1 + w) over |N|'s share. So 3/4 `GRAZING_COS` L >=
+///    eps w (32 + 26 |w_o|_1) + floor (1 + w) suffices. On an unscaled instance of a
+///    well-shaped triangle the right side is below 10^-5 and the left 7 x 10^-4.
+#[inline]
+pub fn turns_directions_little<R: real::Real<Bits = u32>>(
+    instance: &Instance,
+    object: &ObjectLeaving<R>,
+    normal_length: R,
+) -> u32 {
+    let w = instance.inverse_norm;
+    let (low, deviation) = normal_length_bounds(instance, normal_length);
+    let well = object
+        .weight_sum
+        .at_most(R::splat(WELL_CONDITIONED_WEIGHTS))
+        & object.floor.at_most(R::splat(WELL_CONDITIONED_FLOOR));
+    let straight = (R::splat(2.0) * deviation).at_most(R::splat(1.0 / 4096.0) * low);
+    let needed = R::splat(f32::EPSILON * w) * (R::splat(32.0) + R::splat(26.0) * object.weight_sum)
+        + object.floor * R::splat(1.0 + w);
+    let sure = needed.at_most(R::splat(0.75 * GRAZING_COS) * low);
+    well & low.greater_than(R::splat(0.0)) & straight & sure
+}
+
+/// The height rays leaving an instanced triangle start at where the map turns directions
+/// little ([`turns_directions_little`]) and the ray does not graze the world plane: the object
+/// triangle's own offset h_o (`geometry::triangle_offsets_v3`, which decides the origin's side
+/// for the CPU's test and the plane-side test) and the round trip's rounding along n_o, carried
+/// to world space by the lower bound L of |X^T n_o|, plus the world point's rounding along the
+/// world normal:
+/// H = (1 + 2^-8) ((h_o + r) / L + sum_i (|n_i| + 2^-10) 8 eps a_i), where
+/// - r = [`INSTANCE_ERROR_EPS`] eps (w |p_w|_inf + |T_w|_inf) |n_o|_1: the origin mapped back
+///   into object space (by the stored inverse or the device's) is within the round trip's bound
+///   per component, of which n_o takes |n_o|_1;
+/// - a_i = sum_j |M_ij| |p_o_j| + |T_i|: the world point is M p_o + T rounded by at most 4 eps
+///   of a_i per component, and the stored inverse pairs with M up to eps / 2 of M's entries and
+///   T's, which a move along n_o sees as a world move along the exact world normal (a world
+///   vector f moves the object point by X f, whose component along n_o is |X^T n_o| times f's
+///   along the exact world normal), and the world normal's components are within 2^-10 of the
+///   computed ones (condition 3, with room for the lift's step, 2 eps of a_i along an axis
+///   whose sign it may take wrong);
+/// - (1 + 2^-8): what the origin's own distance from the point adds to the round trip's and the
+///   plane-side test's rounding, at most 10^-3 of the height under conditions 3 and 4.
+///
+/// On the identity instance of a floor in y = 0 every a_i along y is 0 and h_o is its floor:
+/// H is the round trip's 16 eps of the point's coordinates (docs/robustness.md, "Instanced
+/// large triangles").
+#[inline]
+pub fn instanced_plane_height_v3<R: real::Real<Bits = u32>>(
+    instance: &Instance,
+    object: &ObjectLeaving<R>,
+    (p_world, n_world, normal_length): (V3<R>, V3<R>, R),
+) -> R {
+    let (low, _) = normal_length_bounds(instance, normal_length);
+    let eps = f32::EPSILON;
+    let round_trip = R::splat(INSTANCE_ERROR_EPS * eps)
+        * (R::splat(instance.inverse_norm) * max_abs(p_world)
+            + R::splat(translation_norm(&instance.world_to_object)))
+        * normal_l1(object.normal);
+    let m = &instance.object_to_world;
+    let p = object.point;
+    let p = V3::new(real::abs(p.x), real::abs(p.y), real::abs(p.z));
+    let row = |i: usize| {
+        R::splat(m[i].abs()) * p.x
+            + R::splat(m[i + 1].abs()) * p.y
+            + R::splat(m[i + 2].abs()) * p.z
+            + R::splat(m[i + 3].abs())
+    };
+    let turn = R::splat(1.0 / 1024.0);
+    let point = (real::abs(n_world.x) + turn) * row(0)
+        + (real::abs(n_world.y) + turn) * row(4)
+        + (real::abs(n_world.z) + turn) * row(8);
+    R::splat(1.0 + 1.0 / 256.0) * ((object.offset + round_trip) / low + R::splat(8.0 * eps) * point)
+}
+
+/// The heights rays leaving an instanced triangle start at, as (offset, grazing offset) like
+/// `geometry::triangle_offsets_v3`'s: where the map turns directions little
+/// ([`turns_directions_little`]), the offset is [`instanced_plane_height_v3`] (or the height of
+/// [`instanced_offset_v3`] where that is lower) and the offset plus the grazing offset is at
+/// least [`instanced_offset_v3`]'s height, which rays grazing the world plane need (the
+/// device's own triangle test decides them); elsewhere every ray starts at
+/// [`instanced_offset_v3`]'s height and the grazing offset is 0. The grazing offset carries
+/// 4 eps of that height more, so that the sum's rounding cannot fall short of it.
+#[inline]
+pub fn instanced_offsets_v3<R: real::Real<Bits = u32>>(
+    instance: &Instance,
+    object: &ObjectLeaving<R>,
+    world: (V3<R>, V3<R>, R),
+) -> (R, R) {
+    let every = instanced_offset_v3(
+        instance,
+        (object.point, object.error),
+        world,
+        object.grazing,
+    );
+    let plane = instanced_plane_height_v3(instance, object, world);
+    let steady = turns_directions_little(instance, object, world.2) & plane.at_most(every);
+    let offset = real::select(steady, plane, every);
+    let grazing = real::select(
+        steady,
+        every - offset + R::splat(4.0 * f32::EPSILON) * every,
+        R::splat(0.0),
+    );
+    (offset, grazing)
 }

@@ -386,24 +386,30 @@ fn grazing_rays_leave_at_the_watertight_height() {
 /// `continuation_origin`, mapped into object space as the CPU maps it
 /// (`instance::ray_to_object`), against the worst-case watertight test there, kept where the
 /// plane-side test does not reject it. Transforms as `instances.rs` draws them: scale
-/// 10^U(-3, 3), anisotropy up to 100, any rotation, mirrored in half, translated. Every ray lifts
-/// by the object triangle's grazing offset carried to world space
-/// (`instance::instanced_offset_v3`). Held to none met where the origin lies within
+/// 10^U(-3, 3), anisotropy up to 100, any rotation, mirrored in half, translated. Rays start at
+/// the kernel's heights (`instance::instanced_offsets_v3`: the plane height where the map turns
+/// directions little and the ray does not graze the world plane, else the height that lifts by
+/// the object triangle's grazing offset, `instanced_offset_v3`). Held to none met where the origin lies within
 /// `GRAZING_DOMAIN` of the longest edge above the object triangle, where the offset is derived;
 /// the rays that leave higher (the world bound's round trip, large against a small object
 /// triangle) are counted and printed, and the loader's check
 /// (`twinpath::scene::grazing_domain`) must flag the triangle under that instance for each; the
 /// cheap bound it checks first must not pass a triangle its exact check flags. The count without
-/// the grazing offset must not be 0; the count with it for world-grazing rays only (the rule of
-/// plain triangles, which an anisotropic map may defeat by turning a direction's angle to the
-/// plane) is printed. From each point within the domain a steeper ray too (world cosine 10^-2.5
-/// to 1), held to none met; the count without the grazing offset is printed (a map that turns
-/// a direction toward a sliver's plane makes one need it).
+/// the grazing offset (from `instanced_offset_v3`'s height) must not be 0; the count with it for
+/// world-grazing rays only is printed. From each point within the domain a steeper ray too
+/// (world cosine 10^-2.5 to 1), held to none met; the counts without the grazing offset and at
+/// the plane height whatever the map are printed (the maps that need the gate are rare here:
+/// `rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height` draws them).
 #[test]
 fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
+    use kernel::geometry::{triangle_offsets_conditioned, triangle_point_error_conditioned};
     use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
     use kernel::hit::SurfaceHit;
-    use kernel::instance::{normal_to_world, point_to_world, ray_to_object, world_height_v3};
+    use kernel::instance::{
+        instanced_offset_v3, instanced_plane_height_v3, normal_to_world, point_to_world,
+        ray_to_object, world_height_v3, ObjectLeaving,
+    };
+    use kernel::real::V3;
     use twinpath::scene::grazing_domain::InstancedBound;
     use twinpath::scene::instancing::instance_record;
     use twinpath::scene::transform::Transform;
@@ -412,7 +418,8 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
     let (mut beyond, mut beyond_met, mut beyond_unflagged, mut within_flagged) = (0, 0, 0, 0);
     let (mut bound_missed, mut bound_flagged) = (0, 0);
     let mut g_steep = Gen(twinpath_tests::SplitMix(90));
-    let (mut steep_tested, mut steep_met, mut steep_without) = (0, 0, 0);
+    let (mut steep_tested, mut steep_met, mut steep_without, mut steep_ungated) = (0, 0, 0, 0);
+    let mut steady = 0;
     let (mut shadow_met, mut shadow_within) = (0, 0);
     for k in 0..cases() / 4 {
         let (m, stretch) = g.instance_map();
@@ -477,12 +484,26 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         let bound = checks.may_be_beyond(&inst);
         bound_missed += (exact && !bound) as usize;
         bound_flagged += bound as usize;
-        let carried = world_height_v3(
-            &inst,
-            normal_to_world(&inst, shape.normal).length(),
-            shape.grazing,
-        );
-        let bare = hit.offset - carried;
+        // The height every ray took before the plane height (`instanced_offset_v3`, the
+        // grazing offset folded in), and that height without the fold.
+        let world_normal = normal_to_world(&inst, shape.normal);
+        let (object_offset, object_grazing) = triangle_offsets_conditioned(q, f1, f2, u, v, &shape);
+        let object = ObjectLeaving {
+            point: V3::from(triangle_point(q, f1, f2, u, v)),
+            error: triangle_point_error_conditioned(q, f1, f2, u, v, &shape),
+            offset: object_offset,
+            grazing: object_grazing,
+            normal: V3::from(shape.normal),
+            weight_sum: shape.weights.element_sum(),
+            floor: shape.floor,
+        };
+        let world = (V3::from(p), V3::from(n), world_normal.length());
+        let every = instanced_offset_v3(&inst, (object.point, object.error), world, object.grazing);
+        // The plane height for every ray, whatever the map (the gate forced open).
+        let ungated = instanced_plane_height_v3(&inst, &object, world);
+        let carried = world_height_v3(&inst, world_normal.length(), shape.grazing);
+        let bare = every - carried;
+        steady += (hit.offset < every) as usize;
         without += met_from(continuation_origin(p, n_side, w, bare, 0.0));
         world_rule += met_from(continuation_origin(p, n_side, w, bare, carried));
         // A steeper ray from the same point, cosine 10^-2.5 to 1 (drawn from a stream of its
@@ -501,6 +522,7 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
             steep_tested += 1;
             steep_met += from(hit.offset, hit.grazing_offset);
             steep_without += from(bare, 0.0);
+            steep_ungated += from(ungated, every - ungated);
         }
         // A shadow segment along w to a point 10^-2 to 10 sizes away, from `shadow_segment`.
         let size = size * stretch as f32;
@@ -521,7 +543,7 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
             shadow_within += shadow; // a target no higher than the lift: the segment descends
         }
     }
-    println!("grazing rays leaving instanced triangles: {tested} within GRAZING_DOMAIN; met again at the worst rounding and not rejected: {met} (shadow segments along them: {shadow_met}, and {shadow_within} to targets no higher than the lift); without the grazing offset {without}, with it for world-grazing rays only {world_rule}; beyond GRAZING_DOMAIN {beyond}, of which {beyond_met} met and {beyond_unflagged} not flagged by the loader's check ({within_flagged} flagged within; its cheap bound passes {bound_missed} that the exact check flags, and flags {bound_flagged} within); steeper rays (cosines 10^-2.5 to 1) from the same points: {steep_tested}, met {steep_met}, without the grazing offset {steep_without}");
+    println!("grazing rays leaving instanced triangles: {tested} within GRAZING_DOMAIN; met again at the worst rounding and not rejected: {met} (shadow segments along them: {shadow_met}, and {shadow_within} to targets no higher than the lift); without the grazing offset {without}, with it for world-grazing rays only {world_rule}; beyond GRAZING_DOMAIN {beyond}, of which {beyond_met} met and {beyond_unflagged} not flagged by the loader's check ({within_flagged} flagged within; its cheap bound passes {bound_missed} that the exact check flags, and flags {bound_flagged} within); steeper rays (cosines 10^-2.5 to 1) from the same points: {steep_tested}, met {steep_met}, without the grazing offset {steep_without}, at the plane height whatever the map {steep_ungated}; rays leaving at the plane height: {steady} of {tested}");
     assert!(tested > cases() / 8, "{tested}");
     assert_eq!(
         (met, shadow_met, beyond_unflagged, bound_missed),
@@ -534,6 +556,111 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         without > 0,
         "the grazing offset is not shown to be needed on instances"
     );
+}
+
+/// Rays leaving an instanced triangle under a map that stretches it along its normal by
+/// 10^U(0, 4): a world cosine just above [`GRAZING_COS`] (1 to 4 times it) becomes an object
+/// cosine up to 10^4 times smaller, where the plane-side test cannot be sure of the direction
+/// and the device's own test decides. Well-shaped triangles of unit size, rotated and
+/// translated, points anywhere on them, world rays in a random tangent direction or back along
+/// the direction from the corner p0 (where the backward line crosses the triangle). Asserted, at
+/// the worst rounding ([`worst_case_watertight_hit`]) where the plane-side test does not reject
+/// the hit: none is met at the kernel's heights (`instance::instanced_offsets_v3`, whose gate
+/// `turns_directions_little` sends such rays to the height every instanced ray took before),
+/// and some are met at the plane height given to every ray whatever the map (the gate open:
+/// `instance::instanced_plane_height_v3`), so the gate is shown to be needed.
+#[test]
+fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
+    use glam::{DMat3, DMat4};
+    use kernel::geometry::{
+        triangle_offsets_conditioned, triangle_point_error_conditioned, TriangleShape,
+    };
+    use kernel::hit::SurfaceHit;
+    use kernel::instance::{
+        instanced_offset_v3, instanced_plane_height_v3, normal_to_world, point_to_world,
+        ray_to_object, ObjectLeaving,
+    };
+    use kernel::real::V3;
+    use twinpath::scene::instancing::instance_record;
+    use twinpath::scene::transform::Transform;
+    let mut g = Gen(twinpath_tests::SplitMix(12));
+    let (mut tested, mut met, mut open, mut plane_height) = (0, 0, 0, 0);
+    for k in 0..cases() / 4 {
+        let (q, f1, f2) = (g.dir() * 0.3, g.dir(), g.dir());
+        let q = if k % 3 == 0 { q } else { Vec3::ZERO };
+        if f1.cross(f2).length() < 0.3 {
+            continue;
+        }
+        let shape = TriangleShape::of(f1, f2);
+        let n_o = shape.normal.as_dvec3();
+        let stretch = 10f64.powf(4.0 * g.unit() as f64);
+        let linear = DMat3::IDENTITY
+            + DMat3::from_cols(n_o * n_o.x, n_o * n_o.y, n_o * n_o.z) * (stretch - 1.0);
+        let shift = if k % 4 == 0 { 10.0 } else { 0.0 };
+        let m = DMat4::from_translation(g.dir().as_dvec3() * shift)
+            * DMat4::from_axis_angle(g.dir().as_dvec3(), g.unit() as f64 * std::f64::consts::TAU)
+            * DMat4::from_mat3(linear);
+        let Ok(Some(transform)) = Transform::affine(m) else {
+            continue;
+        };
+        let inst = instance_record(&transform, 0);
+        let (u, v) = (g.pow10(-4.0, 0.0), g.pow10(-4.0, 0.0));
+        if u + v > 1.0 {
+            continue;
+        }
+        let tri = plain_triangle(q, f1, f2);
+        let hit = SurfaceHit::instanced_triangle(&tri, shape, &inst, 0, g.dir(), 1.0, u, v);
+        let (p, n) = (hit.position, hit.normal);
+        let (n_side, n_object) = if g.unit() < 0.5 {
+            (n, shape.normal)
+        } else {
+            (-n, -shape.normal)
+        };
+        let a = if k % 2 == 0 {
+            g.dir()
+        } else {
+            (p - point_to_world(&inst, q)) * (g.unit() - 0.5)
+        };
+        let tangent = (a - n_side * a.dot(n_side)).normalize();
+        let cos = GRAZING_COS * g.pow10(0.0, 0.6);
+        let w = (n_side * cos + tangent * (1.0 - cos * cos).sqrt()).normalize();
+        if !(w.dot(n_side) >= GRAZING_COS && tangent.is_finite() && hit.offset.is_finite()) {
+            continue;
+        }
+        let own = [q, q + f1, q + f2];
+        let met_from = |offset: f32, grazing: f32| {
+            let o = continuation_origin(p, n_side, w, offset, grazing);
+            let (oo, od) = ray_to_object(&inst, o, w);
+            (worst_case_watertight_hit(oo, od, own, n_object, f32::INFINITY)
+                && !ray_leaves_triangle_plane(oo, od, q, f1, f2)) as usize
+        };
+        let (object_offset, object_grazing) = triangle_offsets_conditioned(q, f1, f2, u, v, &shape);
+        let object = ObjectLeaving {
+            point: V3::from(triangle_point(q, f1, f2, u, v)),
+            error: triangle_point_error_conditioned(q, f1, f2, u, v, &shape),
+            offset: object_offset,
+            grazing: object_grazing,
+            normal: V3::from(shape.normal),
+            weight_sum: shape.weights.element_sum(),
+            floor: shape.floor,
+        };
+        let world = (
+            V3::from(p),
+            V3::from(n),
+            normal_to_world(&inst, shape.normal).length(),
+        );
+        let every = instanced_offset_v3(&inst, (object.point, object.error), world, object.grazing);
+        let ungated = instanced_plane_height_v3(&inst, &object, world);
+        tested += 1;
+        plane_height += (hit.offset < every) as usize;
+        met += met_from(hit.offset, hit.grazing_offset);
+        open += met_from(ungated, every - ungated);
+    }
+    println!("rays a map turns toward the object plane (stretched 10^0 to 10^4 along its normal, world cosines 1 to 4 GRAZING_COS): {tested}, of which {plane_height} leave at the plane height; met at the worst rounding and not rejected: {met}; at the plane height whatever the map: {open}");
+    assert!(tested > cases() / 16, "{tested}");
+    assert!(plane_height > 0 && plane_height < tested, "{plane_height}");
+    assert_eq!(met, 0);
+    assert!(open > 0, "the gate is not shown to be needed");
 }
 
 #[test]
