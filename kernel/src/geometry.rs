@@ -513,7 +513,11 @@ pub fn triangle_plane_weights_v3<R: real::Real<Bits = u32>>(
 /// Elsewhere (slivers, degenerate or denormal triangles) the offset is the bound of
 /// [`triangle_point_error_v3`] times |n|_1, as for every triangle before the weights, and the
 /// grazing offset the same.
-#[inline]
+///
+/// Always inlined, as [`triangle_offsets_conditioned`] is: both hit records (plain and
+/// instanced) call it, and the plain triangle's hit must not pay for a call the instanced one
+/// adds (docs/instancing.md, "The plane height").
+#[inline(always)]
 pub fn triangle_offsets_v3<R: real::Real<Bits = u32>>(
     p0: V3<R>,
     edge1: V3<R>,
@@ -891,8 +895,9 @@ pub fn triangle_offsets(p0: Vec3, edge1: Vec3, edge2: Vec3, u: f32, v: f32) -> (
 }
 
 /// [`triangle_offsets_v3`] with the factors of the triangle's [`TriangleShape`] given (as
-/// [`triangle_point_error_conditioned`] takes them).
-#[inline]
+/// [`triangle_point_error_conditioned`] takes them). Always inlined, for the reason
+/// [`triangle_offsets_v3`] gives.
+#[inline(always)]
 pub fn triangle_offsets_conditioned(
     p0: Vec3,
     edge1: Vec3,
