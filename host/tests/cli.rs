@@ -271,3 +271,23 @@ fn commands_that_read_a_scene_show_its_notes() {
         );
     }
 }
+
+/// `twinpath info | head -1`: output into a pipe whose reader has gone ends the process by
+/// SIGPIPE, quietly, as other command-line tools end, not with a panic and its backtrace. The
+/// reader is closed before the process starts, so its first write meets the closed pipe.
+#[cfg(unix)]
+#[test]
+fn a_closed_pipe_ends_the_process_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(BIN)
+        .arg("info")
+        .stdout(writer)
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.signal(), Some(13), "{:?}: {err}", out.status);
+    assert!(!err.contains("panicked"), "{err}");
+}
