@@ -86,9 +86,21 @@ fn bench_sweeps_writes_csv_and_plot() {
     let csv = std::fs::read_to_string(dir.join("bench.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + rows.len());
     assert!(csv.starts_with("variant,backend,spp,seed,setup_s,render_s,relmse,rmse,efficiency\n"));
-    write_plot(&rows, "test", &dir.join("bench.png")).unwrap();
+    assert!(write_plot(&rows, "test", &dir.join("bench.png")).unwrap());
     let png = image::open(dir.join("bench.png")).unwrap();
     assert_eq!((png.width(), png.height()), (900, 600));
+    // Rows whose renders equal the reference (relMSE 0) have no place on a log scale: no plot,
+    // and no error.
+    let exact: Vec<_> = rows
+        .iter()
+        .map(|r| twinpath::bench::BenchRow {
+            relmse: 0.0,
+            ..r.clone()
+        })
+        .collect();
+    let none = dir.join("none.png");
+    assert!(!write_plot(&exact, "test", &none).unwrap());
+    assert!(!none.exists());
 }
 
 /// `twinpath diff`'s z of the mean difference: the mean of the pixels' channel means over its

@@ -85,11 +85,14 @@ pub fn run(a: BenchArgs) -> Result<()> {
     write_csv(&rows, &csv)?;
     eprintln!("bench: wrote {}", csv.display());
     let png = a.out_dir.join("bench.png");
-    write_plot(
-        &rows,
-        &format!("{}: relMSE against render time", scene.name),
-        &png,
-    )?;
-    eprintln!("bench: wrote {}", png.display());
+    let title = format!("{}: relMSE against render time", scene.name);
+    if write_plot(&rows, &title, &png)? {
+        eprintln!("bench: wrote {}", png.display());
+    } else {
+        eprintln!(
+            "bench: no plot: no render has both a positive time and a positive relMSE (every one \
+             equals the reference, which a log-log plot has no place for); the CSV holds them"
+        );
+    }
     Ok(())
 }
