@@ -225,20 +225,38 @@ pub struct ObjectLeaving<R> {
 /// A lower bound on |X^T n_o|, the length of the exact world normal of the object triangle's
 /// exact unit normal n_o under X, the exact inverse of the stored `object_to_world` M (the map
 /// the device places the mesh by), from `normal_length`, the computed length of
-/// [`normal_to_world_v3`] of the computed normal; and the bound `deviation` on the Euclidean
-/// distance between that computed vector and X^T n_o. The stored inverse W is the rounding of
-/// the inverse of the `f64` matrix M rounds from, so W - X is at most eps / 2 (|W| + |W| |M| |W|)
-/// per entry (first order), sqrt(3) eps / 2 w (1 + m w) in the 2-norm (m, w the infinity norms
-/// of M and W); the computed normal is within 4 eps of n_o, which X^T carries by at most
-/// sqrt(3) w; the three products and two sums per component round by at most 3 eps of
-/// sum_j |W_ji| |n_j| <= 3 w' with w' <= 3 w the largest column sum, 9 sqrt(3) eps w in the
-/// 2-norm. So `deviation` = eps w (m w + 24) holds them, and the length's own rounding (the
-/// dot product and the square root) is within 4 eps of it.
+/// [`normal_to_world_v3`] of the computed normal of a triangle whose plane weights sum to
+/// `weight_sum`; and the bound `deviation` on the Euclidean distance between that computed
+/// vector and X^T n_o (m, w the infinity norms of M and W, the stored inverse; 2-norms are at
+/// most sqrt(3) times them):
+/// - W is the rounding of the inverse of the `f64` matrix M rounds from (whose own error, of
+///   order 10^-16 m w, the spares hold): its rounding is eps / 2 |W| per entry, at most
+///   sqrt(3) eps / 2 w on n_o; and that inverse differs from X by W dM W to first order, with
+///   |dM| <= eps / 2 |M| per entry, which applied to n_o is W^T dM^T (X^T n_o): at most
+///   1.5 eps m w |X^T n_o|, relative to the length itself;
+/// - the computed normal: each component of edge1 x edge2 rounds by at most 2 eps of its
+///   permanent P_j, so the cross product is within 2 eps |w_o|_1 of its length, and its
+///   direction, normalised (3 eps more), within eps (4 |w_o|_1 + 3) of n_o, which W^T carries by
+///   at most sqrt(3) w;
+/// - the three products and two sums per component round by at most 3 eps of
+///   sum_j |W_ji| |n_j|, whose vector is at most the Frobenius norm of W, 3 w: 9 eps w.
+///
+/// So `deviation` = eps w (16 + 7 |w_o|_1 + 2 m `normal_length`) holds them (the length for
+/// |X^T n_o|, first order), and the length's own rounding (the dot product and the square
+/// root) is within 4 eps of it. (`world_height_v3`, older, counts neither the pairing of W with
+/// M nor the normal's rounding: docs/instancing.md.)
 #[inline]
-fn normal_length_bounds<R: real::Real>(instance: &Instance, normal_length: R) -> (R, R) {
+fn normal_length_bounds<R: real::Real>(
+    instance: &Instance,
+    normal_length: R,
+    weight_sum: R,
+) -> (R, R) {
     let (m, w) = (instance.forward_norm, instance.inverse_norm);
-    let deviation = R::splat(f32::EPSILON * w * (m * w + 24.0));
-    let low = normal_length * R::splat(1.0 - 4.0 * f32::EPSILON) - deviation;
+    let eps = f32::EPSILON;
+    let deviation = R::splat(16.0 * eps * w)
+        + R::splat(7.0 * eps * w) * weight_sum
+        + R::splat(2.0 * eps * w * m) * normal_length;
+    let low = normal_length * R::splat(1.0 - 4.0 * eps) - deviation;
     (low, deviation)
 }
 
@@ -269,7 +287,7 @@ pub fn turns_directions_little<R: real::Real<Bits = u32>>(
     normal_length: R,
 ) -> u32 {
     let w = instance.inverse_norm;
-    let (low, deviation) = normal_length_bounds(instance, normal_length);
+    let (low, deviation) = normal_length_bounds(instance, normal_length, object.weight_sum);
     let well = object
         .weight_sum
         .at_most(R::splat(WELL_CONDITIONED_WEIGHTS))
@@ -310,7 +328,7 @@ pub fn instanced_plane_height_v3<R: real::Real<Bits = u32>>(
     object: &ObjectLeaving<R>,
     (p_world, n_world, normal_length): (V3<R>, V3<R>, R),
 ) -> R {
-    let (low, _) = normal_length_bounds(instance, normal_length);
+    let (low, _) = normal_length_bounds(instance, normal_length, object.weight_sum);
     let eps = f32::EPSILON;
     let round_trip = R::splat(INSTANCE_ERROR_EPS * eps)
         * (R::splat(instance.inverse_norm) * max_abs(p_world)
