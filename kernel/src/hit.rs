@@ -4,7 +4,7 @@
 
 use crate::geometry::{
     reproject_to_sphere, sphere_point_error, triangle_offsets_conditioned, triangle_point,
-    triangle_point_error_conditioned, TriangleShape,
+    TriangleShape,
 };
 use crate::instance::{instanced_offsets_v3, normal_to_world, point_to_world, ObjectLeaving};
 use crate::real::V3;
@@ -156,19 +156,8 @@ impl SurfaceHit {
             Vec3::from(tri.edge1),
             Vec3::from(tri.edge2),
         );
-        let object_position = triangle_point(p0, e1, e2, u, v);
-        let (object_offset, object_grazing) =
-            triangle_offsets_conditioned(p0, e1, e2, u, v, &shape);
-        let object = ObjectLeaving {
-            point: V3::from(object_position),
-            error: triangle_point_error_conditioned(p0, e1, e2, u, v, &shape),
-            offset: object_offset,
-            grazing: object_grazing,
-            normal: V3::from(shape.normal),
-            weight_sum: shape.weights.element_sum(),
-            floor: shape.floor,
-        };
-        let position = point_to_world(instance, object_position);
+        let object = ObjectLeaving::of_triangle((p0, e1, e2), (u, v), &shape);
+        let position = point_to_world(instance, object.point.into());
         let world_normal = normal_to_world(instance, shape.normal);
         let normal = world_normal.normalize();
         let (offset, grazing_offset) = instanced_offsets_v3(

@@ -6,7 +6,10 @@
 //! Every map is written out component by component in a fixed order (three products summed left
 //! to right, then the translation), so both backends compute the same `f32`s.
 
-use crate::geometry::{normal_l1, GRAZING_COS, WELL_CONDITIONED_FLOOR, WELL_CONDITIONED_WEIGHTS};
+use crate::geometry::{
+    normal_l1, triangle_offsets_conditioned, triangle_point, triangle_point_error_conditioned,
+    TriangleShape, GRAZING_COS, WELL_CONDITIONED_FLOOR, WELL_CONDITIONED_WEIGHTS,
+};
 use crate::real::{self, V3};
 use crate::scene::Instance;
 use spirv_std::glam::Vec3;
@@ -220,6 +223,29 @@ pub struct ObjectLeaving<R> {
     pub normal: V3<R>,
     pub weight_sum: R,
     pub floor: R,
+}
+
+impl ObjectLeaving<f32> {
+    /// What the offsets read of the triangle (`p0`, `edge1`, `edge2`, of shape `shape`) at
+    /// barycentrics (`u`, `v`): the point, its bound and its heights as the hit record forms
+    /// them (`hit::SurfaceHit::instanced_triangle`).
+    #[inline]
+    pub fn of_triangle(
+        (p0, edge1, edge2): (Vec3, Vec3, Vec3),
+        (u, v): (f32, f32),
+        shape: &TriangleShape,
+    ) -> Self {
+        let (offset, grazing) = triangle_offsets_conditioned(p0, edge1, edge2, u, v, shape);
+        Self {
+            point: V3::from(triangle_point(p0, edge1, edge2, u, v)),
+            error: triangle_point_error_conditioned(p0, edge1, edge2, u, v, shape),
+            offset,
+            grazing,
+            normal: V3::from(shape.normal),
+            weight_sum: shape.weights.element_sum(),
+            floor: shape.floor,
+        }
+    }
 }
 
 /// A lower bound on |X^T n_o|, the length of the exact world normal of the object triangle's

@@ -402,7 +402,6 @@ fn grazing_rays_leave_at_the_watertight_height() {
 /// `rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height` draws them).
 #[test]
 fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
-    use kernel::geometry::{triangle_offsets_conditioned, triangle_point_error_conditioned};
     use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
     use kernel::hit::SurfaceHit;
     use kernel::instance::{
@@ -487,16 +486,7 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         // The height every ray took before the plane height (`instanced_offset_v3`, the
         // grazing offset folded in), and that height without the fold.
         let world_normal = normal_to_world(&inst, shape.normal);
-        let (object_offset, object_grazing) = triangle_offsets_conditioned(q, f1, f2, u, v, &shape);
-        let object = ObjectLeaving {
-            point: V3::from(triangle_point(q, f1, f2, u, v)),
-            error: triangle_point_error_conditioned(q, f1, f2, u, v, &shape),
-            offset: object_offset,
-            grazing: object_grazing,
-            normal: V3::from(shape.normal),
-            weight_sum: shape.weights.element_sum(),
-            floor: shape.floor,
-        };
+        let object = ObjectLeaving::of_triangle((q, f1, f2), (u, v), &shape);
         let world = (V3::from(p), V3::from(n), world_normal.length());
         let every = instanced_offset_v3(&inst, (object.point, object.error), world, object.grazing);
         // The plane height for every ray, whatever the map (the gate forced open).
@@ -572,9 +562,7 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
 #[test]
 fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
     use glam::{DMat3, DMat4};
-    use kernel::geometry::{
-        triangle_offsets_conditioned, triangle_point_error_conditioned, TriangleShape,
-    };
+    use kernel::geometry::TriangleShape;
     use kernel::hit::SurfaceHit;
     use kernel::instance::{
         instanced_offset_v3, instanced_plane_height_v3, normal_to_world, point_to_world,
@@ -634,16 +622,7 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
             (worst_case_watertight_hit(oo, od, own, n_object, f32::INFINITY)
                 && !ray_leaves_triangle_plane(oo, od, q, f1, f2)) as usize
         };
-        let (object_offset, object_grazing) = triangle_offsets_conditioned(q, f1, f2, u, v, &shape);
-        let object = ObjectLeaving {
-            point: V3::from(triangle_point(q, f1, f2, u, v)),
-            error: triangle_point_error_conditioned(q, f1, f2, u, v, &shape),
-            offset: object_offset,
-            grazing: object_grazing,
-            normal: V3::from(shape.normal),
-            weight_sum: shape.weights.element_sum(),
-            floor: shape.floor,
-        };
+        let object = ObjectLeaving::of_triangle((q, f1, f2), (u, v), &shape);
         let world = (
             V3::from(p),
             V3::from(n),
