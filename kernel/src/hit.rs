@@ -137,8 +137,9 @@ impl SurfaceHit {
     /// flattened into world space, whose winding a mirroring transform reverses), the heights
     /// of `instance::instanced_offsets_v3` (the object triangle's own offset carried to world
     /// space where the map turns directions little, else the object point's bound and its
-    /// grazing offset for every ray), and the side by the sign of `normal . dir`. Barycentrics and the shading record stay the object-space
-    /// triangle's (an affine map keeps barycentrics). Both backends build instanced hits here.
+    /// grazing offset for every ray), and the side by the sign of `normal . dir`. Barycentrics
+    /// and the shading record stay the object-space triangle's (an affine map keeps
+    /// barycentrics). Both backends build instanced hits here.
     #[inline]
     #[allow(clippy::too_many_arguments)]
     pub fn instanced_triangle(

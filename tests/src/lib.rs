@@ -163,6 +163,36 @@ pub fn shade_at(
     kernel::surface::shade(kernel::features::Dynamic(0), &scene, &hit)
 }
 
+/// An OBJ of an n x n grid of quads, two triangles each: the vertices are
+/// `corner + (i / n) edges[0] + (j / n) edges[1]` for i, j in 0..=n, and the triangles are
+/// wound so that they face along `edges[0] x edges[1]`.
+pub fn grid_obj(n: usize, corner: [f64; 3], edges: [[f64; 3]; 2]) -> String {
+    let mut s = String::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            let at = |c: usize| {
+                corner[c] + edges[0][c] * i as f64 / n as f64 + edges[1][c] * j as f64 / n as f64
+            };
+            s += &format!("v {} {} {}\n", at(0), at(1), at(2));
+        }
+    }
+    let k = |i: usize, j: usize| i * (n + 1) + j + 1;
+    for i in 0..n {
+        for j in 0..n {
+            s += &format!(
+                "f {} {} {}\nf {} {} {}\n",
+                k(i, j),
+                k(i + 1, j),
+                k(i + 1, j + 1),
+                k(i, j),
+                k(i + 1, j + 1),
+                k(i, j + 1)
+            );
+        }
+    }
+    s
+}
+
 pub mod ball_arithmetic;
 pub mod cubature;
 pub mod device_class;

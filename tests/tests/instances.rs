@@ -84,31 +84,7 @@ fn torus_obj(rings: usize, sides: usize) -> String {
 
 /// An OBJ grid of n x n quads over [-1, 1]^2 in the plane z = 0, front face +z.
 fn grid_obj(n: usize) -> String {
-    let mut s = String::new();
-    for i in 0..=n {
-        for j in 0..=n {
-            let (x, y) = (
-                2.0 * i as f64 / n as f64 - 1.0,
-                2.0 * j as f64 / n as f64 - 1.0,
-            );
-            s += &format!("v {x} {y} 0\n");
-        }
-    }
-    let k = |i: usize, j: usize| i * (n + 1) + j + 1;
-    for i in 0..n {
-        for j in 0..n {
-            s += &format!(
-                "f {} {} {}\nf {} {} {}\n",
-                k(i, j),
-                k(i + 1, j),
-                k(i + 1, j + 1),
-                k(i, j),
-                k(i + 1, j + 1),
-                k(i, j + 1)
-            );
-        }
-    }
-    s
+    twinpath_tests::grid_obj(n, [-1.0, -1.0, 0.0], [[2.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
 }
 
 fn load(dir: &Path, text: &str) -> SceneFile {

@@ -14,7 +14,7 @@
 
 use twinpath::render::Backend;
 use twinpath_tests::{
-    image_mean_z, render_film, scene_from_toml, with_independent_samples, z_critical,
+    grid_obj, image_mean_z, render_film, scene_from_toml, with_independent_samples, z_critical,
 };
 
 /// The floor `width` wide in y = 0 under a 2 x 2 lamp 1 above it (facing down), seen straight
@@ -81,26 +81,9 @@ fn a_floor_ten_thousand_wide_is_lit_as_a_small_one_on_both_backends() {
 
 /// An OBJ of the floor `width` wide in y = 0 as a 4 x 4 grid of quads, 32 triangles (enough to
 /// be instanced, `scene::instancing::INSTANCE_MIN_TRIANGLES`), facing +y.
-fn grid_floor_obj(width: f32) -> String {
-    let (n, h) = (4, width / 2.0);
-    let mut obj = String::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, z) = (
-                -h + width * i as f32 / n as f32,
-                -h + width * j as f32 / n as f32,
-            );
-            obj += &format!("v {x} 0 {z}\n");
-        }
-    }
-    for j in 0..n {
-        for i in 0..n {
-            let a = j * (n + 1) + i + 1;
-            let (b, c, d) = (a + 1, a + n + 2, a + n + 1);
-            obj += &format!("f {a} {d} {c}\nf {a} {c} {b}\n");
-        }
-    }
-    obj
+fn grid_floor_obj(width: f64) -> String {
+    let h = width / 2.0;
+    grid_obj(4, [-h, 0.0, -h], [[0.0, 0.0, width], [width, 0.0, 0.0]])
 }
 
 /// The floor 10^4 wide as a mesh placed twice (at the origin and 10^5 below, so that it is
