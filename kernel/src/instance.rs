@@ -112,8 +112,11 @@ pub fn ray_to_object_v3<R: real::Real>(
 /// Bound on the transforms' rounding, in units of eps times the magnitudes of their terms: an
 /// affine map rounds each component at most gamma(3) ~ 3 eps of the sum of its terms' magnitudes
 /// (three products, three sums), and a stored inverse is within eps/2 of the exact one per
-/// entry; a factor of four spare covers a device that inverts the matrix itself in `f32`
-/// (Vulkan takes only `object_to_world`).
+/// entry. The rest is room for the device's own inverse, which Vulkan does not specify (it
+/// takes only `object_to_world`): an assumption, not a proof. A backward-stable `f32` inversion
+/// errs in the worst case by about eps times the condition number ||M|| ||M^-1||, which 16 eps
+/// covers only to conditions of a few; measured, such an inverse (lavapipe's kind) mapped under
+/// Vulkan's arithmetic errs by at most 2.1 eps on maps of conditions to 136 (docs/instancing.md).
 pub const INSTANCE_ERROR_EPS: f32 = 16.0;
 
 /// Absolute error bound (per component) of the world point `p_world` =
@@ -165,48 +168,64 @@ pub fn world_point_error_v3<R: real::Real>(
 }
 
 /// The world height along an instance's unit world normal that is at least `object_height`
-/// along its object triangle's normal n_o, where `normal_length` is the computed length of
-/// [`normal_to_world_v3`]`(n_o)`, which the world normal is normalised from. A world move H n_w
-/// maps back to H |M^-T n_o| along n_o (n_w is M^-T n_o normalised; a computed n_w a small angle
-/// off loses only the square of it), so H = `object_height` / |M^-T n_o| serves. The computed
-/// length is within about 3.5 sqrt(3) eps ||M^-1|| of |M^-T n_o| (the stored inverse's entries
-/// within eps / 2 of the exact ones, three roundings per component) and a few eps of itself
-/// (the norm's roundings), so |M^-T n_o| >= L (1 - 8 eps) - 8 eps ||M^-1||. Where that is not
-/// positive, or larger than the bound it improves on, |M^-T n_o| >= 1 / ||M||_2 >=
-/// 1 / (sqrt(3) ||M||_inf) serves instead. Spares of 4 eps for the division and 16 eps for the
-/// product's rounding.
+/// along its object triangle's exact normal n_o, where `normal_length` is the computed length of
+/// [`normal_to_world_v3`] of the triangle's computed normal (whose plane weights sum to
+/// `weight_sum`), which the world normal n_w is normalised from. A world move H n_w maps back,
+/// by X, the exact inverse of the stored `object_to_world` (the map the device places the mesh
+/// by), to H n_w . X^T n_o along n_o. The computed vector v is within `deviation` of X^T n_o
+/// ([`normal_length_bounds`]), so v . X^T n_o >= |v|^2 - |v| `deviation` and
+/// n_w . X^T n_o >= |v| - `deviation`, which the bound L_low of [`normal_length_bounds`] holds
+/// with the length's rounding: H = (1 + 4 eps) `object_height` / L_low serves, the spare for
+/// the division and the normalisation's rounding. This bounds the projection, not only the
+/// length, so a computed normal turned off X^T n_o is paid for, not assumed away.
+///
+/// Where L_low is not positive (a map or a sliver whose computed world normal may be turned
+/// past a right angle), no height along n_w is proven to move the point off the plane; the
+/// height is then sqrt(3) ||M||_inf `object_height` (>= `object_height` / |X^T n_o|, as
+/// 1 / |X^T n_o| <= ||M||_2), right where the normal is, and the host names such triangles
+/// (`grazing_domain`, via [`carries_heights`]).
 #[inline]
 pub fn world_height_v3<R: real::Real>(
     instance: &Instance,
     normal_length: R,
+    weight_sum: R,
     object_height: R,
 ) -> R {
     let eps = f32::EPSILON;
+    let (low, _) = normal_length_bounds(instance, normal_length, weight_sum);
     let loose = R::splat(instance.forward_norm * (1.732_051 * (1.0 + 16.0 * eps)));
-    let shrunk =
-        normal_length * R::splat(1.0 - 8.0 * eps) - R::splat(8.0 * eps * instance.inverse_norm);
-    let tight = R::splat(1.0 + 4.0 * eps) / shrunk;
-    let factor = real::select(shrunk.greater_than(R::splat(0.0)), tight.min(loose), loose);
+    let tight = R::splat(1.0 + 4.0 * eps) / low;
+    let factor = real::select(low.greater_than(R::splat(0.0)), tight, loose);
     factor * object_height
+}
+
+/// Whether [`world_height_v3`] is proven for a triangle whose plane weights sum to
+/// `weight_sum` and whose computed world normal had length `normal_length`: its lower bound
+/// L_low of the normal's projection is positive.
+#[inline]
+pub fn carries_heights(instance: &Instance, normal_length: f32, weight_sum: f32) -> bool {
+    normal_length_bounds(instance, normal_length, weight_sum).0 > 0.0
 }
 
 /// The height rays leaving an instanced triangle start at, along world normal `n_world`
 /// (normalised from a vector of length `normal_length`, [`world_height_v3`]): the world point's
-/// bound ([`world_point_error_v3`] of `p_object`, known to within `object_error`, mapped to
-/// `p_world`) times |n_world|_1, plus the object triangle's grazing offset `object_grazing`
-/// (`geometry::triangle_grazing_offset_v3`) carried to world space ([`world_height_v3`]). Every
-/// ray lifts by the grazing offset, not only the grazing ones: a map turns directions by up to
-/// its condition number ||M|| ||M^-1||, so a world direction at `geometry::GRAZING_COS` or more
-/// from the world plane may graze the object triangle, where the device tests it.
+/// bound ([`world_point_error_v3`] of the object point, known to within its error, mapped to
+/// `p_world`) times |n_world|_1, plus the object triangle's grazing offset
+/// (`geometry::triangle_grazing_offset_v3`) carried to world space ([`world_height_v3`], which
+/// reads the triangle's weight sum). It reads `object`'s point, error, grazing offset and weight
+/// sum. Every ray lifts by the grazing offset, not only the grazing ones: a map turns
+/// directions by up to its condition number ||M|| ||M^-1||, so a world direction at
+/// `geometry::GRAZING_COS` or more from the world plane may graze the object triangle, where
+/// the device tests it.
 #[inline]
 pub fn instanced_offset_v3<R: real::Real>(
     instance: &Instance,
-    (p_object, object_error): (V3<R>, R),
+    object: &ObjectLeaving<R>,
     (p_world, n_world, normal_length): (V3<R>, V3<R>, R),
-    object_grazing: R,
 ) -> R {
-    let error = world_point_error_v3(instance, p_object, object_error, p_world);
-    error * normal_l1(n_world) + world_height_v3(instance, normal_length, object_grazing)
+    let error = world_point_error_v3(instance, object.point, object.error, p_world);
+    error * normal_l1(n_world)
+        + world_height_v3(instance, normal_length, object.weight_sum, object.grazing)
 }
 
 /// What the offsets of a ray leaving an instanced triangle read of the object triangle: the
@@ -390,12 +409,7 @@ pub fn instanced_offsets_v3<R: real::Real<Bits = u32>>(
     object: &ObjectLeaving<R>,
     world: (V3<R>, V3<R>, R),
 ) -> (R, R) {
-    let every = instanced_offset_v3(
-        instance,
-        (object.point, object.error),
-        world,
-        object.grazing,
-    );
+    let every = instanced_offset_v3(instance, object, world);
     let plane = instanced_plane_height_v3(instance, object, world);
     let steady = turns_directions_little(instance, object, world.2) & plane.at_most(every);
     let offset = real::select(steady, plane, every);

@@ -488,10 +488,15 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         let world_normal = normal_to_world(&inst, shape.normal);
         let object = ObjectLeaving::of_triangle((q, f1, f2), (u, v), &shape);
         let world = (V3::from(p), V3::from(n), world_normal.length());
-        let every = instanced_offset_v3(&inst, (object.point, object.error), world, object.grazing);
+        let every = instanced_offset_v3(&inst, &object, world);
         // The plane height for every ray, whatever the map (the gate forced open).
         let ungated = instanced_plane_height_v3(&inst, &object, world);
-        let carried = world_height_v3(&inst, world_normal.length(), shape.grazing);
+        let carried = world_height_v3(
+            &inst,
+            world_normal.length(),
+            object.weight_sum,
+            object.grazing,
+        );
         let bare = every - carried;
         steady += (hit.offset < every) as usize;
         without += met_from(continuation_origin(p, n_side, w, bare, 0.0));
@@ -628,7 +633,7 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
             V3::from(n),
             normal_to_world(&inst, shape.normal).length(),
         );
-        let every = instanced_offset_v3(&inst, (object.point, object.error), world, object.grazing);
+        let every = instanced_offset_v3(&inst, &object, world);
         let ungated = instanced_plane_height_v3(&inst, &object, world);
         tested += 1;
         plane_height += (hit.offset < every) as usize;

@@ -20,11 +20,12 @@
 use super::flat_scene::{Scene, TriangleGroup};
 use glam::Vec3;
 use kernel::geometry::{
-    triangle_offsets_v3, triangle_point, triangle_point_error_conditioned,
-    triangle_watertight_error_bound, ShapeFactors, TriangleShape, GRAZING_DOMAIN,
+    triangle_offsets_v3, triangle_point, triangle_watertight_error_bound, ShapeFactors,
+    TriangleShape, GRAZING_DOMAIN,
 };
 use kernel::instance::{
-    instanced_offset_v3, normal_to_world, point_to_world, world_point_error_v3,
+    carries_heights, instanced_offset_v3, normal_to_world, point_to_world, world_point_error_v3,
+    ObjectLeaving,
 };
 use kernel::real::V3;
 use kernel::scene::{Instance, Triangle};
@@ -85,15 +86,18 @@ impl LeavingHeight {
 /// ([`InstancedBound::may_be_beyond`]); a scene placing a mesh 10^3 times would otherwise spend
 /// seconds in the exact check.
 pub struct InstancedBound {
-    /// The corners, each with the object point's error bound there plus the watertight term at
-    /// its largest.
-    corners: [(Vec3, f32); 3],
+    /// What the offsets read of the triangle at its corners, each point's error bound with the
+    /// watertight term at its largest added.
+    corners: [ObjectLeaving<f32>; 3],
     /// The largest of the corners' error bounds.
     error: f32,
     /// The largest absolute coordinate of the corners.
     coordinates: f32,
     normal: Vec3,
     grazing: f32,
+    /// The sum of the triangle's plane weights (`kernel::geometry::TriangleShape`), which the
+    /// carried height reads.
+    weight_sum: f32,
     longest: f32,
 }
 
@@ -103,43 +107,50 @@ impl InstancedBound {
         let shape = TriangleShape::of(e1, e2);
         let watertight = triangle_watertight_error_bound(e1, e2);
         let corners = CORNERS.map(|(u, v)| {
-            let error = triangle_point_error_conditioned(p0, e1, e2, u, v, &shape) + watertight;
-            (triangle_point(p0, e1, e2, u, v), error)
+            let mut corner = ObjectLeaving::of_triangle((p0, e1, e2), (u, v), &shape);
+            corner.error += watertight;
+            corner
         });
         Self {
             corners,
-            error: corners.iter().fold(0.0, |m, c| c.1.max(m)),
+            error: corners.iter().fold(0.0, |m, c| c.error.max(m)),
             coordinates: corners
                 .iter()
-                .fold(0.0, |m, c| c.0.abs().max_element().max(m)),
+                .fold(0.0, |m, c| Vec3::from(c.point).abs().max_element().max(m)),
             normal: shape.normal,
             grazing: shape.grazing,
+            weight_sum: shape.weights.element_sum(),
             longest: longest_edge(e1, e2),
         }
     }
 
     /// The height under `instance`, in object units: the world height of
     /// `kernel::instance::instanced_offset_v3` at the corners times the length of the world
-    /// normal before normalising (a world move H along it maps back to H |M^-T n_o| along the
-    /// object normal).
+    /// normal before normalising (a world move H along it maps back to at most about H |M^-T n_o|
+    /// along the object normal). Infinite where the carried height is not proven
+    /// (`kernel::instance::carries_heights`): the map or the triangle's shape may turn its
+    /// computed world normal too far.
     pub fn exact(&self, instance: &Instance) -> LeavingHeight {
         let world_normal = normal_to_world(instance, self.normal);
         let length = world_normal.length();
         let normal = world_normal / length;
         let (mut rounding, mut lifted) = (0.0f32, 0.0f32);
-        for (p_object, error) in self.corners {
-            let p_world = point_to_world(instance, p_object);
+        for corner in self.corners {
+            let p_world = point_to_world(instance, Vec3::from(corner.point));
             let at = |grazing: f32| {
+                let object = ObjectLeaving { grazing, ..corner };
                 instanced_offset_v3(
                     instance,
-                    (V3::from(p_object), error),
+                    &object,
                     (V3::from(p_world), V3::from(normal), length),
-                    grazing,
                 )
             };
             let bare = at(0.0);
             rounding = rounding.max(bare);
             lifted = lifted.max(at(self.grazing) - bare);
+        }
+        if !carries_heights(instance, length, self.weight_sum) {
+            lifted = f32::INFINITY;
         }
         LeavingHeight {
             rounding: 2.0 * rounding * length,
@@ -155,9 +166,12 @@ impl InstancedBound {
     /// - the world point, |p_w| <= m |p_o| + |T| (`kernel::instance::world_point_error_v3`
     ///   depends on the points only through their largest components);
     /// - |n_world|_1 times the normal's length, |M^-T n_o|_1 <= sqrt(3) w;
-    /// - the grazing offset's carried factor times that length: at most `world_height_v3`'s
-    ///   tight factor, (1 + 4 eps) / (1 - 8 eps - 8 eps w sqrt(3) m) (as 1 / length <= ||M||_2
-    ///   <= sqrt(3) m), and at most its loose one times sqrt(3) w, 3 m w (1 + 16 eps).
+    /// - the grazing offset's carried factor times the normal's computed length L:
+    ///   (1 + 4 eps) L / L_low, with L_low = L (1 - 4 eps - b) - a, a = eps w (16 + 7 s) (s the
+    ///   weight sum), b = 2 eps m w (`kernel::instance::world_height_v3`), which falls as L
+    ///   grows; and L >= (l - a) (1 - 4 eps) / (1 + b), l = 1 / (sqrt(3) m) <= 1 / ||M||_2
+    ///   <= |M^-T n_o|, less the computed vector's deviation and the length's rounding. Where
+    ///   that leaves no positive L_low the triangle may be beyond (the exact check decides).
     ///
     /// Each carries a spare of 16 to 64 eps for its own rounding.
     pub fn may_be_beyond(&self, instance: &Instance) -> bool {
@@ -173,13 +187,15 @@ impl InstancedBound {
             V3::from(Vec3::new(world, 0.0, 0.0)),
         );
         let normal = 1.732_051 * w * (1.0 + 16.0 * eps);
-        let loose = 3.0 * m * w * (1.0 + 16.0 * eps) * (1.0 + 16.0 * eps);
-        let shrunk = (1.0 - 8.0 * eps) - 8.0 * eps * w * 1.732_051 * m * (1.0 + 16.0 * eps);
-        let carried = if shrunk > 0.0 {
-            ((1.0 + 4.0 * eps) / shrunk * (1.0 + 16.0 * eps)).min(loose)
-        } else {
-            loose
-        };
+        let spare = 1.0 + 16.0 * eps;
+        let a = eps * w * (16.0 + 7.0 * self.weight_sum) * spare;
+        let b = 2.0 * eps * m * w * spare;
+        let shortest = (1.0 / (1.732_051 * m * spare) - a) * (1.0 - 4.0 * eps) / (1.0 + b) / spare;
+        let shrunk = (1.0 - 4.0 * eps - b) - a / shortest;
+        if !(shortest > 0.0 && shrunk > 0.0) {
+            return true;
+        }
+        let carried = (1.0 + 4.0 * eps) / shrunk * spare;
         let height = (2.0 * error * normal + self.grazing * carried) * (1.0 + 64.0 * eps);
         !(height <= GRAZING_DOMAIN * self.longest)
     }
