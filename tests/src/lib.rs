@@ -196,6 +196,7 @@ pub fn grid_obj(n: usize, corner: [f64; 3], edges: [[f64; 3]; 2]) -> String {
 pub mod ball_arithmetic;
 pub mod cubature;
 pub mod device_class;
+pub mod device_inverse;
 pub mod exact;
 pub mod ggx_table;
 pub mod gltf_writer;

@@ -1,0 +1,53 @@
+//! A device's own world-to-object map: Vulkan takes only an instance's `object_to_world`
+//! ("Ray Traversal" asks only that it be invertible) and leaves how the implementation inverts
+//! it unspecified. Lavapipe inverts the 4 x 4 matrix in `f32` by Gaussian elimination with
+//! partial pivoting (Mesa's `util_invert_mat4x4`); [`gaussian_elimination_inverse`] does the
+//! same kind of computation (not its operation order), so that the tests can map rays back as
+//! such a device does instead of by the stored inverse, which is rounded from an `f64` one.
+
+/// The inverse of the affine map `object_to_world` (3 x 4, row-major, `[linear | translation]`,
+/// as `kernel::scene::Instance` stores it), in the same layout, computed in `f32`: the 4 x 4
+/// matrix with bottom row (0, 0, 0, 1) reduced by Gauss-Jordan elimination with partial
+/// pivoting (each column's largest remaining entry is the pivot), the identity carried along.
+pub fn gaussian_elimination_inverse(object_to_world: &[f32; 12]) -> [f32; 12] {
+    let mut rows = [[0f32; 8]; 4];
+    for (i, row) in rows.iter_mut().enumerate() {
+        if i < 3 {
+            row[..4].copy_from_slice(&object_to_world[4 * i..4 * i + 4]);
+        } else {
+            row[3] = 1.0;
+        }
+        row[4 + i] = 1.0;
+    }
+    for c in 0..4 {
+        let pivot = (c..4)
+            .max_by(|&a, &b| rows[a][c].abs().total_cmp(&rows[b][c].abs()))
+            .unwrap_or(c);
+        rows.swap(c, pivot);
+        let pivot_row = rows[c];
+        for row in rows.iter_mut().skip(c + 1) {
+            let factor = row[c] / pivot_row[c];
+            for (x, p) in row.iter_mut().zip(pivot_row).skip(c) {
+                *x -= factor * p;
+            }
+        }
+    }
+    for c in (0..4).rev() {
+        let scale = 1.0 / rows[c][c];
+        for x in rows[c].iter_mut() {
+            *x *= scale;
+        }
+        let pivot_row = rows[c];
+        for row in rows.iter_mut().take(c) {
+            let factor = row[c];
+            for (x, p) in row.iter_mut().zip(pivot_row) {
+                *x -= factor * p;
+            }
+        }
+    }
+    let mut inverse = [0f32; 12];
+    for i in 0..3 {
+        inverse[4 * i..4 * i + 4].copy_from_slice(&rows[i][4..]);
+    }
+    inverse
+}
