@@ -112,12 +112,35 @@ pub fn ray_to_object_v3<R: real::Real>(
 /// Bound on the transforms' rounding, in units of eps times the magnitudes of their terms: an
 /// affine map rounds each component at most gamma(3) ~ 3 eps of the sum of its terms' magnitudes
 /// (three products, three sums), and a stored inverse is within eps/2 of the exact one per
-/// entry. The rest is room for the device's own inverse, which Vulkan does not specify (it
-/// takes only `object_to_world`): an assumption, not a proof. A backward-stable `f32` inversion
-/// errs in the worst case by about eps times the condition number ||M|| ||M^-1||, which 16 eps
-/// covers only to conditions of a few; measured, such an inverse (lavapipe's kind) mapped under
-/// Vulkan's arithmetic errs by at most 2.1 eps on maps of conditions to 136 (docs/instancing.md).
+/// entry; a factor of four spare. The device's own inverse adds
+/// [`DEVICE_INVERSE_EPS_PER_CONDITION`].
 pub const INSTANCE_ERROR_EPS: f32 = 16.0;
+
+/// What a device's own inverse of `object_to_world` adds to the round trip's bound, in eps of
+/// its magnitudes per unit of the condition number ||M|| ||W||. Vulkan takes only
+/// `object_to_world` and does not say how the implementation inverts it: this is an assumption
+/// about the device, not a proof. A backward-stable inversion's error is first order in
+/// eps ||M|| ||W|| (Higham, "Accuracy and Stability of Numerical Algorithms", 2nd ed., ch. 14:
+/// the inverse by Gaussian elimination with partial pivoting satisfies
+/// |X^ - X| <= c_n u |X| |L^| |U^| |X^|), so no constant count of eps covers it at every
+/// condition. Measured against an `f32` inverse by Gaussian elimination (lavapipe's kind) under
+/// Vulkan's arithmetic, on maps that stretch space along a direction by up to 10^4: at most
+/// 0.20 eps per unit of condition beyond conditions of 10, and the constant 16 alone falls
+/// short by 11 times (`vulkan_precision.rs`,
+/// `the_round_trip_model_holds_a_device_that_inverts_in_f32`); 1 holds that five times over.
+pub const DEVICE_INVERSE_EPS_PER_CONDITION: f32 = 1.0;
+
+/// The largest condition number ||M|| ||W|| of an instance at which the heights of rays leaving
+/// its triangles are shown to hold a device's own inverse. The device's object direction is off
+/// by about eps ||M|| ||W|| of it too, and a direction that grazes the object triangle (as one
+/// refused by [`turns_directions_little`] may) can be turned toward the plane by that much and
+/// meet it within the triangle, a drift of up to eps (||M|| ||W||)^2 of its size that no height
+/// derived from rounding holds. Measured, not derived: against an `f32` inverse by Gaussian
+/// elimination, on maps that stretch a triangle along its normal by up to 10^4, no ray was met
+/// below a condition of 3,571 (`tests/tests/reintersection.rs`,
+/// `rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height`; docs/instancing.md).
+/// The loader names the meshes of instances beyond it (`scene::grazing_domain`).
+pub const DEVICE_INVERSE_CONDITION_LIMIT: f32 = 1000.0;
 
 /// Absolute error bound (per component) of the world point `p_world` =
 /// [`point_to_world`]`(p_object)`, where `p_object` is known to within `object_error`, as the
@@ -126,7 +149,8 @@ pub const INSTANCE_ERROR_EPS: f32 = 16.0;
 /// 2. the forward map's rounding, a few eps of ||M|| |p_o| + |T|;
 /// 3. the round trip: a ray leaving from `p_world` is mapped back by an inverse (ours, or the
 ///    device's), which rounds its origin by a few eps of ||W|| |p_w| + |T_w| in object space,
-///    up to ||M|| times that in world space. A ray leaving from beyond this bound along the
+///    and the device's inverse by [`DEVICE_INVERSE_EPS_PER_CONDITION`] eps ||M|| ||W|| of it
+///    more, up to ||M|| times that in world space. A ray leaving from beyond this bound along the
 ///    normal starts, once mapped back, on the side it leaves toward (pbrt-v4's
 ///    `Transform::operator()(Ray)` moves a mapped origin by its error for the same reason).
 ///
@@ -164,7 +188,13 @@ pub fn world_point_error_v3<R: real::Real>(
     let forward = m * max_abs(p_object) + R::splat(translation_norm(&instance.object_to_world));
     let round_trip =
         m * (w * max_abs(p_world) + R::splat(translation_norm(&instance.world_to_object)));
-    carried + eps * (forward + round_trip)
+    let device = R::splat(
+        DEVICE_INVERSE_EPS_PER_CONDITION
+            * f32::EPSILON
+            * instance.forward_norm
+            * instance.inverse_norm,
+    );
+    carried + eps * (forward + round_trip) + device * round_trip
 }
 
 /// The world height along an instance's unit world normal that is at least `object_height`
@@ -317,8 +347,8 @@ fn normal_length_bounds<R: real::Real>(
 /// 3. The computed world normal is within 2^-12 of the exact one in angle: 2 `deviation`
 ///    <= 2^-12 L. So a computed cosine of `GRAZING_COS` is an exact one of at least
 ///    3/4 `GRAZING_COS`, and the world normal's components are within 2^-12 of the exact ones.
-/// 4. The object direction the device tests, X d (each component within
-///    [`INSTANCE_ERROR_EPS`] eps w of it, as the round trip's model allows), has
+/// 4. The object direction the plane-side test reads, X d mapped by the stored inverse (each
+///    component within [`MAPPED_BACK_EPS`] eps w of it, which 16 eps w holds), has
 ///    X d . n_o >= c |X^T n_o| for a world cosine c, less sqrt(3) 16 eps w; the plane-side test
 ///    is sure of a direction d_o with d_o . n_o >= 25 eps |w_o|_1 |d_o|_inf plus its denormal
 ///    terms (`geometry::GRAZING_COS`'s derivation), with |d_o|_inf <= w (1 + 2^-12); those
@@ -347,13 +377,13 @@ pub fn turns_directions_little<R: real::Real<Bits = u32>>(
 /// The height rays leaving an instanced triangle start at where the map turns directions
 /// little ([`turns_directions_little`]) and the ray does not graze the world plane: the object
 /// triangle's own offset h_o (`geometry::triangle_offsets_v3`, which decides the origin's side
-/// for the CPU's test and the plane-side test) and the round trip's rounding along n_o, carried
+/// for the CPU's test and the plane-side test) and the map back's rounding along n_o, carried
 /// to world space by the lower bound L of |X^T n_o|, plus the world point's rounding along the
 /// world normal:
 /// H = (1 + 2^-8) ((h_o + r) / L + sum_i (|n_i| + 2^-10) 8 eps a_i), where
-/// - r = [`INSTANCE_ERROR_EPS`] eps (w |p_w|_inf + |T_w|_inf) |n_o|_1: the origin mapped back
-///   into object space (by the stored inverse or the device's) is within the round trip's bound
-///   per component, of which n_o takes |n_o|_1;
+/// - r = [`MAPPED_BACK_EPS`] eps sum_i |n_o_i| (sum_j |W_ij| |p_w_j| + |T_w_i|): the origin
+///   mapped back into object space by the stored inverse W (as both backends decide its side)
+///   is within that per component i, of which n_o takes |n_o_i|;
 /// - a_i = sum_j |M_ij| |p_o_j| + |T_i|: the world point is M p_o + T rounded by at most 4 eps
 ///   of a_i per component, and the stored inverse pairs with M up to eps / 2 of M's entries and
 ///   T's, which a move along n_o sees as a world move along the exact world normal (a world
@@ -364,9 +394,9 @@ pub fn turns_directions_little<R: real::Real<Bits = u32>>(
 /// - (1 + 2^-8): what the origin's own distance from the point adds to the round trip's and the
 ///   plane-side test's rounding, at most 10^-3 of the height under conditions 3 and 4.
 ///
-/// On the identity instance of a floor in y = 0 every a_i along y is 0 and h_o is its floor:
-/// H is the round trip's 16 eps of the point's coordinates (docs/robustness.md, "Instanced
-/// large triangles").
+/// On the identity instance of a floor in y = 0 every a_i along y is 0, W's row along y reads
+/// only the point's own y, and h_o is its floor: H is the floor's offset, as for the plain
+/// floor, wherever the point lies (docs/robustness.md, "Instanced large triangles").
 #[inline]
 pub fn instanced_plane_height_v3<R: real::Real<Bits = u32>>(
     instance: &Instance,
@@ -375,12 +405,34 @@ pub fn instanced_plane_height_v3<R: real::Real<Bits = u32>>(
 ) -> R {
     let (low, _) = normal_length_bounds(instance, normal_length, object.weight_sum);
     let eps = f32::EPSILON;
-    let round_trip = R::splat(INSTANCE_ERROR_EPS * eps)
-        * (R::splat(instance.inverse_norm) * max_abs(p_world)
-            + R::splat(translation_norm(&instance.world_to_object)))
-        * normal_l1(object.normal);
-    let m = &instance.object_to_world;
-    let p = object.point;
+    let mapped = magnitude_rows(&instance.world_to_object, p_world);
+    let n = object.normal;
+    let round_trip = R::splat(MAPPED_BACK_EPS * eps)
+        * (real::abs(n.x) * mapped.x + real::abs(n.y) * mapped.y + real::abs(n.z) * mapped.z);
+    let placed = magnitude_rows(&instance.object_to_world, object.point);
+    let turn = R::splat(1.0 / 1024.0);
+    let point = (real::abs(n_world.x) + turn) * placed.x
+        + (real::abs(n_world.y) + turn) * placed.y
+        + (real::abs(n_world.z) + turn) * placed.z;
+    R::splat(1.0 + 1.0 / 256.0) * ((object.offset + round_trip) / low + R::splat(8.0 * eps) * point)
+}
+
+/// The rounding of a point mapped back into object space by the stored inverse
+/// ([`ray_to_object_v3`]), per eps of sum_j |W_ij| |p_j| + |T_i| in component i: the CPU maps
+/// rays so, and the GPU's instanced any-hit shader maps the world ray so before the plane-side
+/// test, so that the test decides the side of the same origin on both backends and not of the
+/// device's own object ray, whose inverse Vulkan does not specify. Three products and three
+/// sums, each rounded by at most one ULP (eps relative; a device may round toward zero, and a
+/// fused multiply-add only removes a rounding): (1 + eps)^4 - 1 < 4.01 eps of the terms'
+/// magnitudes; the stored inverse's entries are within eps / 2 of the inverse of the `f64`
+/// matrix, whose pairing with M the world point's term of [`instanced_plane_height_v3`]
+/// counts. 4.5 eps, doubled for the bound's own rounding and the origin's lift.
+pub const MAPPED_BACK_EPS: f32 = 8.0;
+
+/// Per row i of the 3 x 4 matrix `m`: sum_j |m_ij| |p_j| + |m_i3|, the magnitudes that the
+/// affine map's rounding in component i is a multiple of.
+#[inline]
+fn magnitude_rows<R: real::Real>(m: &[f32; 12], p: V3<R>) -> V3<R> {
     let p = V3::new(real::abs(p.x), real::abs(p.y), real::abs(p.z));
     let row = |i: usize| {
         R::splat(m[i].abs()) * p.x
@@ -388,11 +440,7 @@ pub fn instanced_plane_height_v3<R: real::Real<Bits = u32>>(
             + R::splat(m[i + 2].abs()) * p.z
             + R::splat(m[i + 3].abs())
     };
-    let turn = R::splat(1.0 / 1024.0);
-    let point = (real::abs(n_world.x) + turn) * row(0)
-        + (real::abs(n_world.y) + turn) * row(4)
-        + (real::abs(n_world.z) + turn) * row(8);
-    R::splat(1.0 + 1.0 / 256.0) * ((object.offset + round_trip) / low + R::splat(8.0 * eps) * point)
+    V3::new(row(0), row(4), row(8))
 }
 
 /// The heights rays leaving an instanced triangle start at, as (offset, grazing offset) like

@@ -26,6 +26,7 @@ use crate::features::{Dynamic, FeatureSet};
 use crate::film_sample::{classify, sample_use};
 use crate::geometry::{intersect_sphere, TriangleShape};
 use crate::hit::SurfaceHit;
+use crate::instance::ray_to_object;
 use crate::medium::Medium;
 use crate::opacity::{covers, CandidateRay, HoleTables};
 use crate::path::Tracer;
@@ -373,7 +374,9 @@ pub fn any_hit_triangle(
 
 /// Any hit on an instanced triangle: as [`any_hit_triangle`], the triangle from the instance's
 /// mesh (`instance_custom_index` is the instance's record) and its plane tested against the
-/// object-space ray, the one the device met the mesh's triangle with.
+/// world ray mapped into object space by the stored inverse (`instance::ray_to_object`), as the
+/// CPU maps it: not the device's object ray, whose inverse Vulkan does not specify, so that the
+/// plane height (`instance::instanced_plane_height_v3`) needs only that map's rounding.
 #[spirv(any_hit)]
 pub fn any_hit_instance(
     #[spirv(spec_constant(id = 0, default = 0))] features: u32,
@@ -382,8 +385,6 @@ pub fn any_hit_instance(
     #[spirv(instance_custom_index)] index: u32,
     #[spirv(world_ray_origin)] origin: Vec3,
     #[spirv(world_ray_direction)] dir: Vec3,
-    #[spirv(object_ray_origin)] object_origin: Vec3,
-    #[spirv(object_ray_direction)] object_dir: Vec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] materials: &[Material],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] shading: &[ShadingTriangle],
@@ -396,7 +397,9 @@ pub fn any_hit_instance(
         triangle: primitive,
         instance: index,
     };
-    let tri = &triangles[(instances[index as usize].first_triangle + primitive) as usize];
+    let instance = &instances[index as usize];
+    let tri = &triangles[(instance.first_triangle + primitive) as usize];
+    let (object_origin, object_dir) = ray_to_object(instance, origin, dir);
     let tables = HoleTables {
         materials,
         shading,
@@ -413,8 +416,9 @@ pub fn any_hit_instance(
     );
 }
 
-/// Ignores the candidate hit of `ray` on `tri` at barycentrics `bary` where the ray as the
-/// device met the triangle (`origin`, `dir`, in the triangle's space) certainly leaves its plane,
+/// Ignores the candidate hit of `ray` on `tri` at barycentrics `bary` where the ray in the
+/// triangle's space (`origin`, `dir`: the world ray, or for an instance the world ray mapped by
+/// the stored inverse) certainly leaves its plane,
 /// or, where `features` says a material may have holes, where `opacity::covers` says the
 /// surface is not there (asked the generic path's questions, `Dynamic(0)`: the same answers as
 /// specialized); what both any-hit shaders do.

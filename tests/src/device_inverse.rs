@@ -51,3 +51,13 @@ pub fn gaussian_elimination_inverse(object_to_world: &[f32; 12]) -> [f32; 12] {
     }
     inverse
 }
+
+/// `instance` as such a device holds it: its `world_to_object` replaced by
+/// [`gaussian_elimination_inverse`] of its `object_to_world`, so that
+/// `kernel::instance::ray_to_object` maps a ray as the device's traversal does.
+pub fn as_the_device_inverts(instance: &kernel::scene::Instance) -> kernel::scene::Instance {
+    kernel::scene::Instance {
+        world_to_object: gaussian_elimination_inverse(&instance.object_to_world),
+        ..*instance
+    }
+}

@@ -226,3 +226,11 @@ impl TriangleCase {
             .collect()
     }
 }
+
+/// The linear map that stretches space by `stretch` along unit `normal` and keeps the plane
+/// normal to it: I + (stretch - 1) n n^T. A triangle in that plane keeps its shape while its
+/// normal's world direction is squeezed, so directions near the plane turn toward it.
+pub fn stretch_along(normal: glam::DVec3, stretch: f64) -> glam::DMat3 {
+    let n = normal;
+    glam::DMat3::IDENTITY + glam::DMat3::from_cols(n * n.x, n * n.y, n * n.z) * (stretch - 1.0)
+}

@@ -25,7 +25,7 @@ use kernel::geometry::{
 };
 use kernel::instance::{
     carries_heights, instanced_offset_v3, normal_to_world, point_to_world, world_point_error_v3,
-    ObjectLeaving,
+    ObjectLeaving, DEVICE_INVERSE_CONDITION_LIMIT,
 };
 use kernel::real::V3;
 use kernel::scene::{Instance, Triangle};
@@ -128,8 +128,10 @@ impl InstancedBound {
     /// `kernel::instance::instanced_offset_v3` at the corners times the length of the world
     /// normal before normalising (a world move H along it maps back to at most about H |M^-T n_o|
     /// along the object normal). Infinite where the carried height is not proven
-    /// (`kernel::instance::carries_heights`): the map or the triangle's shape may turn its
-    /// computed world normal too far.
+    /// (`kernel::instance::carries_heights`: the map or the triangle's shape may turn its
+    /// computed world normal too far), or where the instance is conditioned beyond what the
+    /// heights are shown to hold of a device's own inverse
+    /// (`kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT`).
     pub fn exact(&self, instance: &Instance) -> LeavingHeight {
         let world_normal = normal_to_world(instance, self.normal);
         let length = world_normal.length();
@@ -149,7 +151,8 @@ impl InstancedBound {
             rounding = rounding.max(bare);
             lifted = lifted.max(at(self.grazing) - bare);
         }
-        if !carries_heights(instance, length, self.weight_sum) {
+        if !carries_heights(instance, length, self.weight_sum) || beyond_the_device_limit(instance)
+        {
             lifted = f32::INFINITY;
         }
         LeavingHeight {
@@ -175,6 +178,9 @@ impl InstancedBound {
     ///
     /// Each carries a spare of 16 to 64 eps for its own rounding.
     pub fn may_be_beyond(&self, instance: &Instance) -> bool {
+        if beyond_the_device_limit(instance) {
+            return true;
+        }
         let eps = f32::EPSILON;
         let (m, w) = (instance.forward_norm, instance.inverse_norm);
         let f = &instance.object_to_world;
@@ -208,6 +214,12 @@ impl InstancedBound {
         }
         Some(self.exact(instance)).filter(LeavingHeight::beyond_domain)
     }
+}
+
+/// Whether `instance`'s condition number ||M|| ||W|| (infinity norms) exceeds
+/// `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT`.
+fn beyond_the_device_limit(instance: &Instance) -> bool {
+    !(instance.forward_norm * instance.inverse_norm <= DEVICE_INVERSE_CONDITION_LIMIT)
 }
 
 /// A triangle's p0 and edges.
