@@ -789,9 +789,27 @@ fn triangles_beyond_the_grazing_domain_are_noted() {
             "[[mesh]]\nfile = \"mm16.obj\"\nmaterial = \"white\"\ntranslate = [{x}, 0, 0]\n"
         );
     }
+    // A well-shaped mesh placed twice under a map of condition 2000, beyond
+    // `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT`; and twice under one of 500, within.
+    let stack: Vec<_> = (0..16)
+        .map(|k| fine.map(|[x, y, z]| [x + k as f64, y, z]))
+        .collect();
+    write("squashed.obj", &stack);
+    write("squeezed.obj", &stack);
+    for (file, z) in [("squashed.obj", 2000), ("squeezed.obj", 500)] {
+        for x in [0, 10] {
+            scene += &format!(
+                "[[mesh]]\nfile = \"{file}\"\nmaterial = \"white\"\nscale = [1, 1, {z}]\ntranslate = [{x}, 0, 0]\n"
+            );
+        }
+    }
     std::fs::write(dir.join("s.toml"), &scene).unwrap();
     let loaded = SceneFile::load(&dir.join("s.toml")).unwrap();
-    assert_eq!(loaded.scene.instances.len(), 2, "mm16.obj is instanced");
+    assert_eq!(
+        loaded.scene.instances.len(),
+        6,
+        "mm16.obj, squashed.obj and squeezed.obj are instanced"
+    );
     let notes = &loaded.scene.notes;
     for n in notes {
         println!("note: {n}");
@@ -815,8 +833,12 @@ fn triangles_beyond_the_grazing_domain_are_noted() {
     let instanced = about("mm16.obj");
     assert_eq!(instanced.len(), 1, "{notes:?}");
     assert!(instanced[0].contains("16 of 16 triangles (object space, under 2 instances)"));
+    let squashed = about("squashed.obj");
+    assert_eq!(squashed.len(), 1, "{notes:?}");
+    assert!(squashed[0].contains("16 of 16 triangles") && squashed[0].contains("above 1000"));
     assert!(about("thin.obj").is_empty() && about("near.obj").is_empty());
-    assert_eq!(notes.len(), 3, "{notes:?}");
+    assert!(about("squeezed.obj").is_empty(), "{notes:?}");
+    assert_eq!(notes.len(), 4, "{notes:?}");
     let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
     let gltf = std::fs::read_dir(scenes.join("gltf")).unwrap();
     for entry in std::fs::read_dir(&scenes).unwrap().chain(gltf) {

@@ -258,7 +258,7 @@ impl Flagged {
             corner.y,
             corner.z,
             height.longest,
-            reason(&triangle)
+            reason(&triangle, &height)
         ))
     }
 
@@ -282,10 +282,16 @@ impl Flagged {
     }
 }
 
-/// Which kind of triangle `tri` is, for the note: a needle where it is beyond the domain even
-/// with its first corner at the origin (its shape alone), else one small against the rounding
-/// of its coordinates (or, instanced, of its placement).
-fn reason(tri: &Triangle) -> &'static str {
+/// Which kind of triangle `tri` (found at `height`) is, for the note: one whose placement is not
+/// proven at all where its grazing height is infinite ([`InstancedBound::exact`]), a needle where
+/// it is beyond the domain even with its first corner at the origin (its shape alone), else one
+/// small against the rounding of its coordinates (or, instanced, of its placement).
+fn reason(tri: &Triangle, height: &LeavingHeight) -> &'static str {
+    if height.grazing == f32::INFINITY {
+        return "its placement's map is conditioned beyond what the offsets are shown for \
+                (||M|| ||M^-1|| above 1000, a device's own inverse turning directions) or turns \
+                its normal too far";
+    }
     let at_origin = Triangle {
         p0: [0.0; 3],
         ..*tri
