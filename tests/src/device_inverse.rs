@@ -61,3 +61,16 @@ pub fn as_the_device_inverts(instance: &kernel::scene::Instance) -> kernel::scen
         ..*instance
     }
 }
+
+/// `instance`'s stored `object_to_world` as an exact `f64` matrix: the map the device places the
+/// mesh by, whose inverse (in `f64`) is the exact X the kernel's bounds are stated against.
+pub fn stored_object_to_world(instance: &kernel::scene::Instance) -> glam::DMat4 {
+    use glam::DVec4;
+    let f = instance.object_to_world.map(|x| x as f64);
+    glam::DMat4::from_cols(
+        DVec4::new(f[0], f[4], f[8], 0.0),
+        DVec4::new(f[1], f[5], f[9], 0.0),
+        DVec4::new(f[2], f[6], f[10], 0.0),
+        DVec4::new(f[3], f[7], f[11], 1.0),
+    )
+}

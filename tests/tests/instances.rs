@@ -331,9 +331,9 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
 /// below 1.
 #[test]
 fn world_heights_carry_object_heights_tightly_under_every_map() {
-    use glam::{DMat4, DVec4};
     use kernel::geometry::{TriangleShape, WELL_CONDITIONED_WEIGHTS};
     use kernel::instance::{carries_heights, normal_to_world, world_height_v3};
+    use twinpath_tests::device_inverse::stored_object_to_world;
     let mut g = Placements(SplitMix(77));
     let (mut lowest, mut highest, mut refused, mut slivers) = (f64::INFINITY, 0f64, 0, 0);
     // The three mutations: no rounding spares (1 / length), sqrt(3) ||M|| alone, and the
@@ -343,14 +343,7 @@ fn world_heights_carry_object_heights_tightly_under_every_map() {
     for _ in 0..400 {
         let (transform, _) = random_transform(&mut g);
         let inst = instance_record(&transform, 0);
-        let f = inst.object_to_world.map(|x| x as f64);
-        let stored = DMat4::from_cols(
-            DVec4::new(f[0], f[4], f[8], 0.0),
-            DVec4::new(f[1], f[5], f[9], 0.0),
-            DVec4::new(f[2], f[6], f[10], 0.0),
-            DVec4::new(f[3], f[7], f[11], 1.0),
-        );
-        let inverse_transpose = stored.inverse().transpose();
+        let inverse_transpose = stored_object_to_world(&inst).inverse().transpose();
         for k in 0..250 {
             let e1 = g.dir() * g.pow10(-1.0, 1.0);
             let e2 = if k % 4 == 0 {

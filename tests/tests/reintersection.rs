@@ -381,6 +381,25 @@ fn grazing_rays_leave_at_the_watertight_height() {
     );
 }
 
+/// The kernel's instanced hit (`hit::SurfaceHit::instanced_triangle`) on `tri` (of shape
+/// `shape`) under `inst` at barycentrics (`u`, `v`), and the side a ray leaves toward, drawn at
+/// random: (the hit, the unit world normal on that side, the object normal on that side).
+fn instanced_hit_on_a_side(
+    g: &mut Gen,
+    tri: &kernel::scene::Triangle,
+    shape: kernel::geometry::TriangleShape,
+    inst: &kernel::scene::Instance,
+    (u, v): (f32, f32),
+) -> (kernel::hit::SurfaceHit, Vec3, Vec3) {
+    let hit = kernel::hit::SurfaceHit::instanced_triangle(tri, shape, inst, 0, g.dir(), 1.0, u, v);
+    let n = hit.normal;
+    if g.unit() < 0.5 {
+        (hit, n, shape.normal)
+    } else {
+        (hit, -n, -shape.normal)
+    }
+}
+
 /// The grazing rays of `grazing_rays_leave_at_the_watertight_height`, leaving a triangle of an
 /// instance: the kernel's instanced hit (`hit::SurfaceHit::instanced_triangle`) at a point near
 /// a corner, a world ray within 10^-10 to 10^-2.5 of the world plane from
@@ -405,7 +424,6 @@ fn grazing_rays_leave_at_the_watertight_height() {
 #[test]
 fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
     use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
-    use kernel::hit::SurfaceHit;
     use kernel::instance::{
         instanced_offset_v3, instanced_plane_height_v3, normal_to_world, point_to_world,
         ray_to_object, world_height_v3, ObjectLeaving,
@@ -438,14 +456,8 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         };
         let tri = plain_triangle(q, f1, f2);
         let shape = TriangleShape::of(f1, f2);
-        let hit = SurfaceHit::instanced_triangle(&tri, shape, &inst, 0, g.dir(), 1.0, u, v);
+        let (hit, n_side, n_object) = instanced_hit_on_a_side(&mut g, &tri, shape, &inst, (u, v));
         let (p, n) = (hit.position, hit.normal);
-        let toward_n = g.unit() < 0.5;
-        let (n_side, n_object) = if toward_n {
-            (n, shape.normal)
-        } else {
-            (-n, -shape.normal)
-        };
         let a = if k % 5 < 2 {
             g.dir()
         } else {
@@ -580,7 +592,6 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
 fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
     use glam::DMat4;
     use kernel::geometry::TriangleShape;
-    use kernel::hit::SurfaceHit;
     use kernel::instance::{
         instanced_offset_v3, instanced_plane_height_v3, normal_to_world, point_to_world,
         ray_to_object, ObjectLeaving, DEVICE_INVERSE_CONDITION_LIMIT,
@@ -617,13 +628,8 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
             continue;
         }
         let tri = plain_triangle(q, f1, f2);
-        let hit = SurfaceHit::instanced_triangle(&tri, shape, &inst, 0, g.dir(), 1.0, u, v);
+        let (hit, n_side, n_object) = instanced_hit_on_a_side(&mut g, &tri, shape, &inst, (u, v));
         let (p, n) = (hit.position, hit.normal);
-        let (n_side, n_object) = if g.unit() < 0.5 {
-            (n, shape.normal)
-        } else {
-            (-n, -shape.normal)
-        };
         let a = if k % 2 == 0 {
             g.dir()
         } else {
@@ -691,7 +697,6 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
 fn rays_leaving_far_instanced_triangles_are_sided_by_the_stored_inverse() {
     use glam::{DMat4, DVec3};
     use kernel::geometry::TriangleShape;
-    use kernel::hit::SurfaceHit;
     use kernel::instance::{instanced_offset_v3, normal_to_world, ray_to_object, ObjectLeaving};
     use kernel::real::V3;
     use twinpath::scene::instancing::instance_record;
@@ -725,13 +730,8 @@ fn rays_leaving_far_instanced_triangles_are_sided_by_the_stored_inverse() {
             (u, v)
         };
         let tri = plain_triangle(q, f1, f2);
-        let hit = SurfaceHit::instanced_triangle(&tri, shape, &inst, 0, g.dir(), 1.0, u, v);
+        let (hit, n_side, n_object) = instanced_hit_on_a_side(&mut g, &tri, shape, &inst, (u, v));
         let (p, n) = (hit.position, hit.normal);
-        let (n_side, n_object) = if g.unit() < 0.5 {
-            (n, shape.normal)
-        } else {
-            (-n, -shape.normal)
-        };
         let tangent = (g.dir() - n_side * g.dir().dot(n_side)).normalize();
         let cos = g.pow10(GRAZING_COS.log10(), 0.0);
         let w = (n_side * cos + tangent * (1.0 - cos * cos).sqrt()).normalize();

@@ -462,12 +462,11 @@ fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic
 /// worst error in units of eps (w |p_w| + |T_w|).
 #[test]
 fn the_round_trip_model_holds_a_device_that_inverts_in_f32() {
-    use glam::{DMat4, DVec4};
     use kernel::instance::{point_to_world, DEVICE_INVERSE_EPS_PER_CONDITION, INSTANCE_ERROR_EPS};
     use kernel::scene::Instance;
     use twinpath::scene::instancing::instance_record;
     use twinpath::scene::transform::Transform;
-    use twinpath_tests::device_inverse::as_the_device_inverts;
+    use twinpath_tests::device_inverse::{as_the_device_inverts, stored_object_to_world};
     use twinpath_tests::placements::stretch_along;
     seed(12);
     let mut g = Gen(SplitMix(43));
@@ -495,14 +494,7 @@ fn the_round_trip_model_holds_a_device_that_inverts_in_f32() {
         maps += 1;
         let inst = instance_record(&transform, 0);
         let device = as_the_device_inverts(&inst);
-        let f = inst.object_to_world.map(|x| x as f64);
-        let exact = DMat4::from_cols(
-            DVec4::new(f[0], f[4], f[8], 0.0),
-            DVec4::new(f[1], f[5], f[9], 0.0),
-            DVec4::new(f[2], f[6], f[10], 0.0),
-            DVec4::new(f[3], f[7], f[11], 1.0),
-        )
-        .inverse();
+        let exact = stored_object_to_world(&inst).inverse();
         let t = &inst.world_to_object;
         let translation = t[3].abs().max(t[7].abs()).max(t[11].abs()) as f64;
         let w = inst.inverse_norm as f64;
