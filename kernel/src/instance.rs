@@ -142,6 +142,14 @@ pub const DEVICE_INVERSE_EPS_PER_CONDITION: f32 = 1.0;
 /// The loader names the meshes of instances beyond it (`scene::grazing_domain`).
 pub const DEVICE_INVERSE_CONDITION_LIMIT: f32 = 1000.0;
 
+/// The condition number ||M|| ||W|| of `instance`'s map, in infinity norms
+/// (`Instance::forward_norm`, `inverse_norm`): what a device's own inverse's error and the
+/// limit of what is shown of it ([`DEVICE_INVERSE_CONDITION_LIMIT`]) are measured against.
+#[inline]
+pub fn condition_number(instance: &Instance) -> f32 {
+    instance.forward_norm * instance.inverse_norm
+}
+
 /// Absolute error bound (per component) of the world point `p_world` =
 /// [`point_to_world`]`(p_object)`, where `p_object` is known to within `object_error`, as the
 /// origin of a ray that will be mapped back into object space to meet this instance again:
@@ -188,12 +196,8 @@ pub fn world_point_error_v3<R: real::Real>(
     let forward = m * max_abs(p_object) + R::splat(translation_norm(&instance.object_to_world));
     let round_trip =
         m * (w * max_abs(p_world) + R::splat(translation_norm(&instance.world_to_object)));
-    let device = R::splat(
-        DEVICE_INVERSE_EPS_PER_CONDITION
-            * f32::EPSILON
-            * instance.forward_norm
-            * instance.inverse_norm,
-    );
+    let device =
+        R::splat(DEVICE_INVERSE_EPS_PER_CONDITION * f32::EPSILON * condition_number(instance));
     carried + eps * (forward + round_trip) + device * round_trip
 }
 

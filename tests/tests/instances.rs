@@ -26,6 +26,7 @@ use twinpath::render::Backend;
 use twinpath::scene::instancing::instance_record;
 use twinpath::scene::transform::Transform;
 use twinpath::scene::{parse_scene, SceneFile};
+use twinpath_tests::device_inverse::stored_object_to_world;
 use twinpath_tests::gpu::assert_validation_clean;
 use twinpath_tests::placements::Placements;
 use twinpath_tests::{
@@ -267,15 +268,8 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
         // The exact plane of the hit triangle under the exact map of the stored matrix.
         let h_inst = scene.scene.instances[hit.instance as usize];
         let t = mesh[hit.prim as usize];
-        let m = |p: Vec3| -> DVec3 {
-            let r = &h_inst.object_to_world;
-            let p = p.as_dvec3();
-            DVec3::new(
-                r[0] as f64 * p.x + r[1] as f64 * p.y + r[2] as f64 * p.z + r[3] as f64,
-                r[4] as f64 * p.x + r[5] as f64 * p.y + r[6] as f64 * p.z + r[7] as f64,
-                r[8] as f64 * p.x + r[9] as f64 * p.y + r[10] as f64 * p.z + r[11] as f64,
-            )
-        };
+        let stored = stored_object_to_world(&h_inst);
+        let m = |p: Vec3| -> DVec3 { stored.transform_point3(p.as_dvec3()) };
         let p0 = Vec3::from(t.p0);
         let (q0, q1, q2) = (
             m(p0),
@@ -333,7 +327,6 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
 fn world_heights_carry_object_heights_tightly_under_every_map() {
     use kernel::geometry::{TriangleShape, WELL_CONDITIONED_WEIGHTS};
     use kernel::instance::{carries_heights, normal_to_world, world_height_v3};
-    use twinpath_tests::device_inverse::stored_object_to_world;
     let mut g = Placements(SplitMix(77));
     let (mut lowest, mut highest, mut refused, mut slivers) = (f64::INFINITY, 0f64, 0, 0);
     // The three mutations: no rounding spares (1 / length), sqrt(3) ||M|| alone, and the

@@ -593,8 +593,8 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
     use glam::DMat4;
     use kernel::geometry::TriangleShape;
     use kernel::instance::{
-        instanced_offset_v3, instanced_plane_height_v3, normal_to_world, point_to_world,
-        ray_to_object, ObjectLeaving, DEVICE_INVERSE_CONDITION_LIMIT,
+        condition_number, instanced_offset_v3, instanced_plane_height_v3, normal_to_world,
+        point_to_world, ray_to_object, ObjectLeaving, DEVICE_INVERSE_CONDITION_LIMIT,
     };
     use kernel::real::V3;
     use kernel::scene::Instance;
@@ -661,7 +661,7 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
         let met_here = met_from(&device, hit.offset, hit.grazing_offset);
         accurate_met += met_from(&inst, hit.offset, hit.grazing_offset);
         open += met_from(&inst, ungated, every - ungated);
-        if inst.forward_norm * inst.inverse_norm > DEVICE_INVERSE_CONDITION_LIMIT {
+        if condition_number(&inst) > DEVICE_INVERSE_CONDITION_LIMIT {
             beyond += 1;
             beyond_met += met_here;
             if met_here > 0 {

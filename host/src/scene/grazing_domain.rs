@@ -24,8 +24,8 @@ use kernel::geometry::{
     TriangleShape, GRAZING_DOMAIN,
 };
 use kernel::instance::{
-    carries_heights, instanced_offset_v3, normal_to_world, point_to_world, world_point_error_v3,
-    ObjectLeaving, DEVICE_INVERSE_CONDITION_LIMIT,
+    carries_heights, condition_number, instanced_offset_v3, normal_to_world, point_to_world,
+    world_point_error_v3, ObjectLeaving, DEVICE_INVERSE_CONDITION_LIMIT,
 };
 use kernel::real::V3;
 use kernel::scene::{Instance, Triangle};
@@ -216,10 +216,10 @@ impl InstancedBound {
     }
 }
 
-/// Whether `instance`'s condition number ||M|| ||W|| (infinity norms) exceeds
+/// Whether `instance`'s condition number (`kernel::instance::condition_number`) exceeds
 /// `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT`.
 fn beyond_the_device_limit(instance: &Instance) -> bool {
-    !(instance.forward_norm * instance.inverse_norm <= DEVICE_INVERSE_CONDITION_LIMIT)
+    !(condition_number(instance) <= DEVICE_INVERSE_CONDITION_LIMIT)
 }
 
 /// A triangle's p0 and edges.
@@ -286,20 +286,22 @@ impl Flagged {
 /// proven at all where its grazing height is infinite ([`InstancedBound::exact`]), a needle where
 /// it is beyond the domain even with its first corner at the origin (its shape alone), else one
 /// small against the rounding of its coordinates (or, instanced, of its placement).
-fn reason(tri: &Triangle, height: &LeavingHeight) -> &'static str {
+fn reason(tri: &Triangle, height: &LeavingHeight) -> String {
     if height.grazing == f32::INFINITY {
-        return "its placement's map is conditioned beyond what the offsets are shown for \
-                (||M|| ||M^-1|| above 1000, a device's own inverse turning directions) or turns \
-                its normal too far";
+        return format!(
+            "its placement's map is conditioned beyond what the offsets are shown for \
+             (||M|| ||M^-1|| above {DEVICE_INVERSE_CONDITION_LIMIT}, a device's own inverse \
+             turning directions) or turns its normal too far"
+        );
     }
     let at_origin = Triangle {
         p0: [0.0; 3],
         ..*tri
     };
     if LeavingHeight::of_world(&at_origin).beyond_domain() {
-        "a needle, narrow against its length"
+        "a needle, narrow against its length".into()
     } else {
-        "small against the rounding of its coordinates or its placement"
+        "small against the rounding of its coordinates or its placement".into()
     }
 }
 
