@@ -646,11 +646,7 @@ pub fn triangle_grazing_offset_v3<R: real::Real<Bits = u32>>(
     watertight_scale: R,
 ) -> R {
     let big = R::splat(f32::MAX);
-    let longest = edge1
-        .length()
-        .max(edge2.length())
-        .max((edge2 - edge1).length());
-    let reach = longest * R::splat(1.0 + GRAZING_DOMAIN);
+    let reach = longest_edge_v3(edge1, edge2) * R::splat(1.0 + GRAZING_DOMAIN);
     let watertight = watertight_bound_of(reach, watertight_scale);
     (watertight + R::splat(VERTEX_MOVE_EPS * f32::EPSILON) * reach).min(big)
 }
@@ -679,12 +675,25 @@ pub fn triangle_light_point_error(p0: Vec3, edge1: Vec3, edge2: Vec3) -> f32 {
 /// E^3 / |edge1 x edge2|.
 #[inline]
 pub fn triangle_watertight_error_bound(edge1: Vec3, edge2: Vec3) -> f32 {
-    let longest = edge1
+    let scale = triangle_watertight_scale_v3(V3::from(edge1), V3::from(edge2));
+    watertight_bound_of(longest_edge(edge1, edge2), scale)
+}
+
+/// The longest edge E of a triangle with edges `edge1` and `edge2` from its first vertex: the
+/// length every grazing and watertight bound measures distances on the triangle by (no two of
+/// its points are further apart).
+#[inline]
+pub fn longest_edge(edge1: Vec3, edge2: Vec3) -> f32 {
+    longest_edge_v3(V3::from(edge1), V3::from(edge2))
+}
+
+/// [`longest_edge`] over any [`real::Real`].
+#[inline]
+pub fn longest_edge_v3<R: real::Real>(edge1: V3<R>, edge2: V3<R>) -> R {
+    edge1
         .length()
         .max(edge2.length())
-        .max((edge2 - edge1).length());
-    let scale = triangle_watertight_scale_v3(V3::from(edge1), V3::from(edge2));
-    watertight_bound_of(longest, scale)
+        .max((edge2 - edge1).length())
 }
 
 /// Absolute error bound of a point on a sphere (centre `center`, radius `radius`), re-projected

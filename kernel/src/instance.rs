@@ -42,9 +42,13 @@ fn affine<R: real::Real>(m: &[f32; 12], p: V3<R>) -> V3<R> {
     linear(m, p) + V3::new(R::splat(m[3]), R::splat(m[7]), R::splat(m[11]))
 }
 
-/// The largest absolute translation component of `m`.
+/// An `f32` at or above sqrt(3) (1.7320508...): the most a 3-vector's 2-norm exceeds its
+/// infinity norm by, and a 3 x 3 matrix's 2-norm its infinity norm by.
+pub const SQRT_3_ABOVE: f32 = 1.732_051;
+
+/// The largest absolute translation component of `m` (a 3 x 4 row-major matrix).
 #[inline]
-fn translation_norm(m: &[f32; 12]) -> f32 {
+pub fn translation_norm(m: &[f32; 12]) -> f32 {
     m[3].abs().max(m[7].abs()).max(m[11].abs())
 }
 
@@ -227,7 +231,7 @@ pub fn world_height_v3<R: real::Real>(
 ) -> R {
     let eps = f32::EPSILON;
     let (low, _) = normal_length_bounds(instance, normal_length, weight_sum);
-    let loose = R::splat(instance.forward_norm * (1.732_051 * (1.0 + 16.0 * eps)));
+    let loose = R::splat(instance.forward_norm * (SQRT_3_ABOVE * (1.0 + 16.0 * eps)));
     let tight = R::splat(1.0 + 4.0 * eps) / low;
     let factor = real::select(low.greater_than(R::splat(0.0)), tight, loose);
     factor * object_height
@@ -322,8 +326,7 @@ impl ObjectLeaving<f32> {
 ///
 /// So `deviation` = eps w (16 + 7 |w_o|_1 + 2 m `normal_length`) holds them (the length for
 /// |X^T n_o|, first order), and the length's own rounding (the dot product and the square
-/// root) is within 4 eps of it. (`world_height_v3`, older, counts neither the pairing of W with
-/// M nor the normal's rounding: docs/instancing.md.)
+/// root) is within 4 eps of it.
 #[inline]
 fn normal_length_bounds<R: real::Real>(
     instance: &Instance,

@@ -326,7 +326,7 @@ fn instanced_hits_lie_within_their_error_bound_and_rays_leaving_them_never_retur
 #[test]
 fn world_heights_carry_object_heights_tightly_under_every_map() {
     use kernel::geometry::{TriangleShape, WELL_CONDITIONED_WEIGHTS};
-    use kernel::instance::{carries_heights, normal_to_world, world_height_v3};
+    use kernel::instance::{carries_heights, normal_to_world, world_height_v3, SQRT_3_ABOVE};
     let mut g = Placements(SplitMix(77));
     let (mut lowest, mut highest, mut refused, mut slivers) = (f64::INFINITY, 0f64, 0, 0);
     // The three mutations: no rounding spares (1 / length), sqrt(3) ||M|| alone, and the
@@ -367,7 +367,8 @@ fn world_heights_carry_object_heights_tightly_under_every_map() {
             previous_lowest = previous_lowest.min((1.0 + 4.0 * eps) / previous * along);
             if weight_sum <= WELL_CONDITIONED_WEIGHTS {
                 highest = highest.max(height * along);
-                loose_highest = loose_highest.max(1.732_051 * inst.forward_norm as f64 * along);
+                loose_highest =
+                    loose_highest.max(SQRT_3_ABOVE as f64 * inst.forward_norm as f64 * along);
             } else {
                 slivers += 1;
             }

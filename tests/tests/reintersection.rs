@@ -423,7 +423,7 @@ fn instanced_hit_on_a_side(
 /// `rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height` draws them).
 #[test]
 fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
-    use kernel::geometry::{TriangleShape, GRAZING_DOMAIN};
+    use kernel::geometry::{longest_edge, TriangleShape, GRAZING_DOMAIN};
     use kernel::instance::{
         instanced_offset_v3, instanced_plane_height_v3, normal_to_world, point_to_world,
         ray_to_object, world_height_v3, ObjectLeaving,
@@ -483,7 +483,7 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
         let m = met_from(origin);
         // How far above the object triangle's plane the origin lies, in object space.
         let height = (ray_to_object(&inst, origin, w).0 - q).dot(n_object);
-        let longest = f1.length().max(f2.length()).max((f2 - f1).length());
+        let longest = longest_edge(f1, f2);
         if height > GRAZING_DOMAIN * longest {
             beyond += 1;
             beyond_met += m;

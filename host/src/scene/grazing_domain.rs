@@ -20,12 +20,13 @@
 use super::flat_scene::{Scene, TriangleGroup};
 use glam::Vec3;
 use kernel::geometry::{
-    triangle_offsets_v3, triangle_point, triangle_watertight_error_bound, ShapeFactors,
-    TriangleShape, GRAZING_DOMAIN,
+    longest_edge, triangle_offsets_v3, triangle_point, triangle_watertight_error_bound,
+    ShapeFactors, TriangleShape, GRAZING_DOMAIN,
 };
 use kernel::instance::{
     carries_heights, condition_number, instanced_offset_v3, normal_to_world, point_to_world,
-    world_point_error_v3, ObjectLeaving, DEVICE_INVERSE_CONDITION_LIMIT,
+    translation_norm, world_point_error_v3, ObjectLeaving, DEVICE_INVERSE_CONDITION_LIMIT,
+    SQRT_3_ABOVE,
 };
 use kernel::real::V3;
 use kernel::scene::{Instance, Triangle};
@@ -183,8 +184,7 @@ impl InstancedBound {
         }
         let eps = f32::EPSILON;
         let (m, w) = (instance.forward_norm, instance.inverse_norm);
-        let f = &instance.object_to_world;
-        let translation = f[3].abs().max(f[7].abs()).max(f[11].abs());
+        let translation = translation_norm(&instance.object_to_world);
         let world = (m * self.coordinates + translation) * (1.0 + 8.0 * eps);
         let error = world_point_error_v3(
             instance,
@@ -192,11 +192,12 @@ impl InstancedBound {
             self.error,
             V3::from(Vec3::new(world, 0.0, 0.0)),
         );
-        let normal = 1.732_051 * w * (1.0 + 16.0 * eps);
+        let normal = SQRT_3_ABOVE * w * (1.0 + 16.0 * eps);
         let spare = 1.0 + 16.0 * eps;
         let a = eps * w * (16.0 + 7.0 * self.weight_sum) * spare;
         let b = 2.0 * eps * m * w * spare;
-        let shortest = (1.0 / (1.732_051 * m * spare) - a) * (1.0 - 4.0 * eps) / (1.0 + b) / spare;
+        let shortest =
+            (1.0 / (SQRT_3_ABOVE * m * spare) - a) * (1.0 - 4.0 * eps) / (1.0 + b) / spare;
         let shrunk = (1.0 - 4.0 * eps - b) - a / shortest;
         if !(shortest > 0.0 && shrunk > 0.0) {
             return true;
@@ -229,11 +230,6 @@ fn corners(tri: &Triangle) -> (Vec3, Vec3, Vec3) {
         Vec3::from(tri.edge1),
         Vec3::from(tri.edge2),
     )
-}
-
-/// The longest of a triangle's edges, as the kernel's grazing offset measures it.
-fn longest_edge(e1: Vec3, e2: Vec3) -> f32 {
-    e1.length().max(e2.length()).max((e2 - e1).length())
 }
 
 /// What the check found in one group of triangles: how many it flagged, and the first.
