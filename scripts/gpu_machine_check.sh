@@ -35,7 +35,8 @@ if timeout -k 5 60 $B/twinpath info | grep -q "gpu backend: unavailable"; then e
 # own limit and none started after the step's QEND s, so that nothing outlives the step; and the
 # two-thread hang itself, sobol's two GPU tests in two threads of one process, with the
 # validation layers and without (TWINPATH_TESTS_NO_VALIDATION), a stuck fence saying so every
-# minute. Each log ends with its exit status and time.
+# minute. Each log ends with its exit status and time. tests/tests/gpu_machine_check.rs fails
+# when a test file with a GPU part is missing from the queues or from the prepared binaries.
 if [ -z "${SKIP_TESTS:-}" ]; then
 echo "== tests (issue 35)"
 rm -rf /tmp/tl && mkdir -p /tmp/tl
@@ -47,10 +48,10 @@ run() { local n=$1 l=$2 s=$(date +%s); shift 2; timeout -k 5 $l "$@" > /tmp/tl/$
 end=$(( $(date +%s) + ${QEND:-200} ))
 queue() { for t in "$@"; do [ $(date +%s) -ge $end ] && { echo "-- $t: not run, the step's time is up" >> $T; continue; }; run $t ${QT:-150} $B/$t --test-threads=1; done; }
 run gpu_functions 150 $B/gpu_functions --test-threads=1 --nocapture &
-(queue spirv_module gpu_render; TWINPATH_FURNACE_GPU_SPP=24576 run furnace 90 $B/furnace gpu --nocapture) &
+(queue spirv_module gpu_render cycles; TWINPATH_FURNACE_GPU_SPP=24576 run furnace 90 $B/furnace gpu --nocapture) &
 QT=235 queue specialize_adaptive &
 queue gltf sobol media_grids normal_maps camera vertex_colours split &
-queue instances opacity light_selection textures reflecting_lights &
+queue instances large_floor device_limits opacity light_selection textures reflecting_lights &
 queue media punctual_lights closed_form_materials hard_lighting scene_scale triangle_lights environment texture_sets shading_normals &
 (run hang_validation 75 $B/sobol gpu both_backends --test-threads=2
  TWINPATH_TESTS_NO_VALIDATION=1 run hang_no_validation 75 $B/sobol gpu both_backends --test-threads=2) &

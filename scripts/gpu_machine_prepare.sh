@@ -23,7 +23,8 @@ for rev in ${STATS_REVS:-5de8811}; do git show "$rev:kernel/shipped/kernel.spv" 
 for t in gpu_functions gpu_render spirv_module furnace scene_scale specialize_adaptive \
   hard_lighting light_selection sobol closed_form_materials opacity texture_sets media media_grids \
   triangle_lights environment textures normal_maps gltf instances punctual_lights \
-  reflecting_lights vertex_colours shading_normals camera split; do
+  reflecting_lights vertex_colours shading_normals camera split large_floor device_limits \
+  cycles; do
   f=$(cargo test -p twinpath-tests --test "$t" --no-run 2>&1 | sed -n 's/.*Executable .*(\(.*\))/\1/p')
   strip -o ".gpu/bin/$t" "$f"
 done
