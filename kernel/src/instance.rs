@@ -116,8 +116,7 @@ pub fn ray_to_object_v3<R: real::Real>(
 /// Bound on the transforms' rounding, in units of eps times the magnitudes of their terms: an
 /// affine map rounds each component at most gamma(3) ~ 3 eps of the sum of its terms' magnitudes
 /// (three products, three sums), and a stored inverse is within eps/2 of the exact one per
-/// entry; a factor of four spare. The device's own inverse adds
-/// [`DEVICE_INVERSE_EPS_PER_CONDITION`].
+/// entry; a factor of four spare. The device's own inverse adds [`device_inverse_eps`].
 pub const INSTANCE_ERROR_EPS: f32 = 16.0;
 
 /// What a device's own inverse of `object_to_world` adds to the round trip's bound, in eps of
@@ -127,12 +126,40 @@ pub const INSTANCE_ERROR_EPS: f32 = 16.0;
 /// eps ||M|| ||W|| (Higham, "Accuracy and Stability of Numerical Algorithms", 2nd ed., ch. 14:
 /// the inverse by Gaussian elimination with partial pivoting satisfies
 /// |X^ - X| <= c_n u |X| |L^| |U^| |X^|), so no constant count of eps covers it at every
-/// condition. Measured against an `f32` inverse by Gaussian elimination (lavapipe's kind) under
-/// Vulkan's arithmetic, on maps that stretch space along a direction by up to 10^4: at most
-/// 0.20 eps per unit of condition beyond conditions of 10, and the constant 16 alone falls
-/// short by 11 times (`vulkan_precision.rs`,
-/// `the_round_trip_model_holds_a_device_that_inverts_in_f32`); 1 holds that five times over.
+/// condition. Measured against an `f32` inverse by Gaussian elimination (lavapipe's kind) on
+/// maps that stretch or scale space along turned axes by up to 10^4: at most 0.21 eps per unit
+/// of condition beyond conditions of 10, and the constant 16 alone falls short
+/// (`vulkan_precision.rs`, `the_round_trip_model_holds_a_device_that_inverts_in_f32`); 1 holds
+/// that almost five times over. An inverse by the adjugate is not backward stable: what it
+/// loses to the determinant is [`DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION`]'s term.
 pub const DEVICE_INVERSE_EPS_PER_CONDITION: f32 = 1.0;
+
+/// What a device's own inverse of the instance's map adds to the round trip's bound
+/// ([`world_point_error_v3`]), in eps of (||W|| |p_w| + |T_w|): [`DEVICE_INVERSE_EPS_PER_CONDITION`]
+/// times the condition number, plus [`DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION`] times
+/// the determinant's condition (`Instance::determinant_condition`).
+#[inline]
+pub fn device_inverse_eps(instance: &Instance) -> f32 {
+    DEVICE_INVERSE_EPS_PER_CONDITION * condition_number(instance)
+        + DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION * instance.determinant_condition
+}
+
+/// What a device that inverts by the adjugate over the determinant adds to the round trip's
+/// bound, in eps of (||W|| |p_w| + |T_w|) per unit of the determinant's condition
+/// H = perm(|A|) / |det A| (`Instance::determinant_condition`). RADV and ANV invert so, in their
+/// acceleration-structure build shaders (GLSL's `inverse()`). The determinant, expanded along a
+/// row as sum_k a_2k C_2k with each cofactor a 2 x 2 minor, is formed by at most six roundings
+/// of at most eps (Vulkan allows rounding toward zero; a fused multiply-add only removes one),
+/// each of a term bounded by perm(|A|): its relative error is at most 6 eps H to first order.
+/// That error scales the whole computed inverse, so a point p_w maps to (1 + rho) X p_w with
+/// |rho| <= 6 eps H plus the quotient's 2.5 ULP, and |X p_w| <= ||W|| |p_w| + |T_w| up to the
+/// stored inverse's rounding: 8 covers it. H is about 1 under a rotation after or before a
+/// scale along the axes, where the 2 x 2 minors do not cancel, and grows to about c^2 under a
+/// scale along a turned axis, where the determinant's terms cancel: there an adjugate inverse
+/// errs, at points the map does not stretch, by up to 47 times the bound without this term
+/// (`vulkan_precision.rs`,
+/// `the_round_trip_model_holds_a_device_that_inverts_in_f32`; docs/instancing.md).
+pub const DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION: f32 = 8.0;
 
 /// The largest condition number ||M|| ||W|| of an instance at which the heights of rays leaving
 /// its triangles are shown to hold a device's own inverse. The device's object direction is off
@@ -141,9 +168,12 @@ pub const DEVICE_INVERSE_EPS_PER_CONDITION: f32 = 1.0;
 /// meet it within the triangle, a drift of up to eps (||M|| ||W||)^2 of its size that no height
 /// derived from rounding holds. Measured, not derived: against an `f32` inverse by Gaussian
 /// elimination, on maps that stretch a triangle along its normal by up to 10^4, no ray was met
-/// below a condition of 3,571 (`tests/tests/reintersection.rs`,
+/// below a condition of 3,571, and against the adjugate under Vulkan's arithmetic (RADV's and
+/// ANV's kind) without [`DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION`]'s term, below 1,168
+/// (`tests/tests/reintersection.rs`,
 /// `rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height`; docs/instancing.md).
-/// The loader names the meshes of instances beyond it (`scene::grazing_domain`).
+/// The loaders flatten placements beyond it into world space (`scene::instancing`), and the
+/// grazing-domain check names the meshes of any instance beyond it (`scene::grazing_domain`).
 pub const DEVICE_INVERSE_CONDITION_LIMIT: f32 = 1000.0;
 
 /// The condition number ||M|| ||W|| of `instance`'s map, in infinity norms
@@ -161,8 +191,9 @@ pub fn condition_number(instance: &Instance) -> f32 {
 /// 2. the forward map's rounding, a few eps of ||M|| |p_o| + |T|;
 /// 3. the round trip: a ray leaving from `p_world` is mapped back by an inverse (ours, or the
 ///    device's), which rounds its origin by a few eps of ||W|| |p_w| + |T_w| in object space,
-///    and the device's inverse by [`DEVICE_INVERSE_EPS_PER_CONDITION`] eps ||M|| ||W|| of it
-///    more, up to ||M|| times that in world space. A ray leaving from beyond this bound along the
+///    and the device's inverse by [`device_inverse_eps`] eps of it more (a term in the
+///    condition number ||M|| ||W|| and one in the determinant's condition), up to ||M|| times
+///    that in world space. A ray leaving from beyond this bound along the
 ///    normal starts, once mapped back, on the side it leaves toward (pbrt-v4's
 ///    `Transform::operator()(Ray)` moves a mapped origin by its error for the same reason).
 ///
@@ -200,8 +231,7 @@ pub fn world_point_error_v3<R: real::Real>(
     let forward = m * max_abs(p_object) + R::splat(translation_norm(&instance.object_to_world));
     let round_trip =
         m * (w * max_abs(p_world) + R::splat(translation_norm(&instance.world_to_object)));
-    let device =
-        R::splat(DEVICE_INVERSE_EPS_PER_CONDITION * f32::EPSILON * condition_number(instance));
+    let device = R::splat(device_inverse_eps(instance) * f32::EPSILON);
     carried + eps * (forward + round_trip) + device * round_trip
 }
 

@@ -111,7 +111,7 @@ impl ShadingTriangle {
 /// One placement of a shared mesh: the mesh's triangles, stored once in object space in the
 /// triangle table, seen through an affine transform (`crate::instance`). Both backends read the
 /// same record: the GPU's TLAS instance carries `object_to_world` and its custom index names
-/// the record; the CPU's two-level BVH maps rays by `world_to_object`. 112 bytes.
+/// the record; the CPU's two-level BVH maps rays by `world_to_object`. 116 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(not(target_arch = "spirv"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C)]
@@ -130,6 +130,12 @@ pub struct Instance {
     /// 1, or -1 where the transform mirrors (a negative determinant): the sign a tangent
     /// frame's handedness takes in world space.
     pub handedness: f32,
+    /// perm(|A|) / |det A| for the linear part A of `object_to_world` (computed in f64, rounded
+    /// up; at least 1): how much the determinant's computed value may cancel, which a device
+    /// that inverts by the adjugate over the determinant loses to
+    /// (`crate::instance::DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION`). About 1 for a
+    /// rotation after or before an axis scale; up to about c^2 for a scale along a turned axis.
+    pub determinant_condition: f32,
 }
 
 /// The material parameters a texture can give (`Material::textures[slot]`).

@@ -98,6 +98,18 @@ fn model() -> Model {
     MODEL.with(|m| m.get())
 }
 
+/// `f`'s result computed under `model`, leaning `direction` ([`lean`]), this thread's model and
+/// lean restored afterwards (its stream of choices goes on).
+pub fn with_model<T>(model: Model, direction: i32, f: impl FnOnce() -> T) -> T {
+    let (before, lean_before) = (MODEL.with(|m| m.get()), LEAN.with(|l| l.get()));
+    set_model(model);
+    lean(direction);
+    let result = f();
+    set_model(before);
+    lean(lean_before);
+    result
+}
+
 /// The next 64 random bits of this thread's stream (splitmix64).
 fn bits() -> u64 {
     STATE.with(|s| {

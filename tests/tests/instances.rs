@@ -517,6 +517,45 @@ fn gltf_meshes_shared_by_nodes_are_instanced_and_render_as_their_copies() {
     assert_validation_clean();
 }
 
+/// A glTF mesh shared by three nodes: placed as it is, by a stretch of 29.5 along (1, 1, 1)
+/// (`matrix`; condition 39, determinant condition 194) and by a scale of 2000 along z
+/// (condition 2000). Only the first is instanced; the other two are flattened into world space
+/// (`instancing::flattening_reason`), with one note naming the mesh and the first's reason.
+#[test]
+fn gltf_placements_a_device_inverse_may_not_keep_are_flattened() {
+    use serde_json::json;
+    let mut g = twinpath_tests::gltf_writer::GltfWriter::new();
+    let (p, n, uv, idx) = torus(16, 8);
+    let mesh = g.mesh(&p, Some(&n), Some(&uv), &idx, None);
+    let stretch = [
+        10.5, 9.5, 9.5, 0.0, 9.5, 10.5, 9.5, 0.0, 9.5, 9.5, 10.5, 0.0, 0.0, 0.0, 0.0, 1.0,
+    ];
+    for node in [
+        json!({ "mesh": mesh }),
+        json!({ "mesh": mesh, "matrix": stretch }),
+        json!({ "mesh": mesh, "scale": [1, 1, 2000] }),
+    ] {
+        g.push("nodes", node);
+    }
+    g.push("scenes", json!({ "nodes": [0, 1, 2] }));
+    let scene = twinpath::scene::gltf::load_bytes(Path::new("placed.glb"), &g.glb(), None, None)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((scene.meshes.len(), scene.instances.len()), (1, 1));
+    assert_eq!(scene.world_triangle_count(), 2 * 16 * 8 * 2);
+    let flattened: Vec<_> = scene
+        .notes
+        .iter()
+        .filter(|n| n.contains("flattened"))
+        .collect();
+    println!("{flattened:?}");
+    assert_eq!(flattened.len(), 1, "{:?}", scene.notes);
+    assert!(
+        flattened[0].contains("meshes[0]: 2 placements flattened")
+            && flattened[0].contains("determinant condition perm(|A|) / |det A| is 194"),
+        "{flattened:?}"
+    );
+}
+
 #[test]
 fn emissive_and_small_shared_meshes_are_flattened() {
     let dir = temp_dir("policy");

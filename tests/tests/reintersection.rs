@@ -28,7 +28,7 @@ use kernel::geometry::{
 use kernel::plane_side::ray_leaves_triangle_plane;
 use kernel::sampling::{sample_cosine_hemisphere, sample_sphere_cone};
 
-use twinpath_tests::device_inverse::as_the_device_inverts;
+use twinpath_tests::device_inverse::as_devices_invert;
 use twinpath_tests::placements::Placements as Gen;
 use twinpath_tests::watertight::{watertight_triangle, worst_case_watertight_hit};
 
@@ -403,8 +403,9 @@ fn instanced_hit_on_a_side(
 /// The grazing rays of `grazing_rays_leave_at_the_watertight_height`, leaving a triangle of an
 /// instance: the kernel's instanced hit (`hit::SurfaceHit::instanced_triangle`) at a point near
 /// a corner, a world ray within 10^-10 to 10^-2.5 of the world plane from
-/// `continuation_origin`, mapped into object space as a device that inverts in `f32` maps it
-/// (`twinpath_tests::device_inverse`), against the worst-case watertight test there, kept where
+/// `continuation_origin`, mapped into object space as each kind of device the tests model maps
+/// it (`twinpath_tests::device_inverse::as_devices_invert`: Gaussian elimination in `f32`, the
+/// adjugate under Vulkan arithmetic), against the worst-case watertight test there, kept where
 /// the plane-side test, on the ray mapped by the stored inverse as the any-hit shader maps it
 /// (`instance::ray_to_object`), does not reject it. Transforms as `instances.rs` draws them: scale
 /// 10^U(-3, 3), anisotropy up to 100, any rotation, mirrored in half, translated. Rays start at
@@ -471,12 +472,14 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
             continue;
         }
         let own = [q, q + f1, q + f2];
-        let device = as_the_device_inverts(&inst);
+        let devices = as_devices_invert(&inst);
         let met_along = |o: Vec3, d: Vec3, t_max: f32| {
-            let (device_o, device_d) = ray_to_object(&device, o, d);
             let (oo, od) = ray_to_object(&inst, o, d);
-            worst_case_watertight_hit(device_o, device_d, own, n_object, t_max)
-                && !ray_leaves_triangle_plane(oo, od, q, f1, f2)
+            !ray_leaves_triangle_plane(oo, od, q, f1, f2)
+                && devices.iter().any(|device| {
+                    let (device_o, device_d) = ray_to_object(device, o, d);
+                    worst_case_watertight_hit(device_o, device_d, own, n_object, t_max)
+                })
         };
         let met_from = |o: Vec3| met_along(o, w, f32::INFINITY) as usize;
         let origin = continuation_origin(p, n_side, w, hit.offset, hit.grazing_offset);
@@ -577,7 +580,8 @@ fn grazing_rays_leave_instanced_triangles_at_the_watertight_height() {
 /// and the device's own test decides. Well-shaped triangles of unit size, rotated and
 /// translated, points anywhere on them, world rays in a random tangent direction or back along
 /// the direction from the corner p0 (where the backward line crosses the triangle). The device
-/// maps the ray by its own `f32` inverse (`twinpath_tests::device_inverse`) and tests it at the
+/// maps the ray by its own inverse (each kind `twinpath_tests::device_inverse::as_devices_invert`
+/// models: Gaussian elimination in `f32`, the adjugate under Vulkan arithmetic) and tests it at the
 /// worst rounding ([`worst_case_watertight_hit`]); its any-hit shader rejects the hit where the
 /// ray mapped by the stored inverse certainly leaves the plane. Asserted for maps conditioned
 /// to `instance::DEVICE_INVERSE_CONDITION_LIMIT`: none is met at the kernel's heights
@@ -605,6 +609,7 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
     let mut g = Gen(twinpath_tests::SplitMix(12));
     let (mut tested, mut met, mut open, mut plane_height) = (0, 0, 0, 0);
     let (mut beyond, mut beyond_met, mut beyond_unflagged, mut accurate_met) = (0, 0, 0, 0);
+    let mut least_met = f32::INFINITY;
     for k in 0..cases() / 4 {
         let (q, f1, f2) = (g.dir() * 0.3, g.dir(), g.dir());
         let q = if k % 3 == 0 { q } else { Vec3::ZERO };
@@ -642,7 +647,7 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
             continue;
         }
         let own = [q, q + f1, q + f2];
-        let device = as_the_device_inverts(&inst);
+        let devices = as_devices_invert(&inst);
         let met_from = |device: &Instance, offset: f32, grazing: f32| {
             let o = continuation_origin(p, n_side, w, offset, grazing);
             let (device_o, device_d) = ray_to_object(device, o, w);
@@ -658,12 +663,18 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
         );
         let every = instanced_offset_v3(&inst, &object, world);
         let ungated = instanced_plane_height_v3(&inst, &object, world);
-        let met_here = met_from(&device, hit.offset, hit.grazing_offset);
+        let met_here = devices
+            .iter()
+            .any(|device| met_from(device, hit.offset, hit.grazing_offset) > 0)
+            as usize;
         accurate_met += met_from(&inst, hit.offset, hit.grazing_offset);
         open += met_from(&inst, ungated, every - ungated);
         if condition_number(&inst) > DEVICE_INVERSE_CONDITION_LIMIT {
             beyond += 1;
             beyond_met += met_here;
+            if met_here > 0 {
+                least_met = least_met.min(condition_number(&inst));
+            }
             if met_here > 0 {
                 beyond_unflagged += InstancedBound::of(&tri).beyond(&inst).is_none() as usize;
             }
@@ -673,7 +684,7 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
         plane_height += (hit.offset < every) as usize;
         met += met_here;
     }
-    println!("rays a map turns toward the object plane (stretched 10^0 to 10^4 along its normal, world cosines 1 to 4 GRAZING_COS): mapped back by a device's f32 inverse, conditions to DEVICE_INVERSE_CONDITION_LIMIT: {tested}, of which {plane_height} leave at the plane height, met at the worst rounding and not rejected: {met}; beyond the limit {beyond}, met {beyond_met}, of which not flagged by the loader's check {beyond_unflagged}. Mapped back by the stored inverse, every condition: met {accurate_met}; at the plane height whatever the map: {open}");
+    println!("rays a map turns toward the object plane (stretched 10^0 to 10^4 along its normal, world cosines 1 to 4 GRAZING_COS): mapped back by each device's inverse (Gaussian elimination in f32, the adjugate under Vulkan arithmetic), conditions to DEVICE_INVERSE_CONDITION_LIMIT: {tested}, of which {plane_height} leave at the plane height, met at the worst rounding and not rejected: {met}; beyond the limit {beyond}, met {beyond_met} (the least condition met {least_met:.0}), of which not flagged by the loader's check {beyond_unflagged}. Mapped back by the stored inverse, every condition: met {accurate_met}; at the plane height whatever the map: {open}");
     assert!(tested > cases() / 16, "{tested}");
     assert!(plane_height > 0 && plane_height < tested, "{plane_height}");
     assert_eq!((met, accurate_met, beyond_unflagged), (0, 0, 0));
@@ -685,7 +696,8 @@ fn rays_a_map_turns_toward_the_object_plane_start_at_the_grazing_height() {
 /// `instance::DEVICE_INVERSE_CONDITION_LIMIT`; the world normal keeps the object normal's
 /// direction, so `turns_directions_little` passes), rotated and translated 10^U(2, 4) away.
 /// Rays at world cosines 10^U(log10 `GRAZING_COS`, 0) toward a random side. The device maps the
-/// ray by its own `f32` inverse (`twinpath_tests::device_inverse`) and tests it at the worst
+/// ray by its own inverse (each kind `twinpath_tests::device_inverse::as_devices_invert` models)
+/// and tests it at the worst
 /// rounding ([`worst_case_watertight_hit`]); the any-hit shader rejects the hit where the ray
 /// mapped by the stored inverse certainly leaves the plane (`shaders::any_hit_instance`).
 /// Asserted: none is met at the kernel's heights; and some are met where the plane-side test
@@ -739,12 +751,18 @@ fn rays_leaving_far_instanced_triangles_are_sided_by_the_stored_inverse() {
             continue;
         }
         let own = [q, q + f1, q + f2];
-        let device = as_the_device_inverts(&inst);
         let o = continuation_origin(p, n_side, w, hit.offset, hit.grazing_offset);
-        let (device_o, device_d) = ray_to_object(&device, o, w);
         let (oo, od) = ray_to_object(&inst, o, w);
-        let device_met =
-            worst_case_watertight_hit(device_o, device_d, own, n_object, f32::INFINITY);
+        // Whether some device meets the ray, and whether one meets it on a ray its own object
+        // ray does not certainly leave the plane along.
+        let (mut device_met, mut met_on_its_own_side) = (false, false);
+        for device in as_devices_invert(&inst) {
+            let (device_o, device_d) = ray_to_object(&device, o, w);
+            if worst_case_watertight_hit(device_o, device_d, own, n_object, f32::INFINITY) {
+                device_met = true;
+                met_on_its_own_side |= !ray_leaves_triangle_plane(device_o, device_d, q, f1, f2);
+            }
+        }
         let object = ObjectLeaving::of_triangle((q, f1, f2), (u, v), &shape);
         let world = (
             V3::from(p),
@@ -754,10 +772,9 @@ fn rays_leaving_far_instanced_triangles_are_sided_by_the_stored_inverse() {
         tested += 1;
         plane_height += (hit.offset < instanced_offset_v3(&inst, &object, world)) as usize;
         met += (device_met && !ray_leaves_triangle_plane(oo, od, q, f1, f2)) as usize;
-        device_sided +=
-            (device_met && !ray_leaves_triangle_plane(device_o, device_d, q, f1, f2)) as usize;
+        device_sided += met_on_its_own_side as usize;
     }
-    println!("rays leaving far instanced triangles (maps stretched in the plane by 10^0 to 10^3, 10^2 to 10^4 from the origin): {tested}, of which {plane_height} leave at the plane height; met at the worst rounding of a device that inverts in f32 and not rejected: {met}; with the plane-side test on the device's object ray: {device_sided}");
+    println!("rays leaving far instanced triangles (maps stretched in the plane by 10^0 to 10^3, 10^2 to 10^4 from the origin): {tested}, of which {plane_height} leave at the plane height; met at the worst rounding of a device (inverting by Gaussian elimination or the adjugate) and not rejected: {met}; with the plane-side test on the device's object ray: {device_sided}");
     assert!(tested > cases() / 4, "{tested}");
     assert!(plane_height > tested / 2, "{plane_height}");
     assert_eq!(met, 0);

@@ -790,12 +790,16 @@ fn triangles_beyond_the_grazing_domain_are_noted() {
         );
     }
     // A well-shaped mesh placed twice under a map of condition 2000, beyond
-    // `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT`; and twice under one of 500, within.
+    // `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT`, and twice under one of 500, within;
+    // and placed twice by a stretch of 29.5 along (1, 1, 1) (condition 39, determinant
+    // condition 194, beyond `instancing::DETERMINANT_CONDITION_LIMIT`) and once more unmoved.
+    // The placements beyond a limit are flattened, with a note, and none is beyond the domain.
     let stack: Vec<_> = (0..16)
         .map(|k| fine.map(|[x, y, z]| [x + k as f64, y, z]))
         .collect();
     write("squashed.obj", &stack);
     write("squeezed.obj", &stack);
+    write("turned.obj", &stack);
     for (file, z) in [("squashed.obj", 2000), ("squeezed.obj", 500)] {
         for x in [0, 10] {
             scene += &format!(
@@ -803,12 +807,19 @@ fn triangles_beyond_the_grazing_domain_are_noted() {
             );
         }
     }
+    for x in [0, 100] {
+        scene += &format!(
+            "[[mesh]]\nfile = \"turned.obj\"\nmaterial = \"white\"\nmatrix = [[10.5, 9.5, 9.5, {x}], [9.5, 10.5, 9.5, 0], [9.5, 9.5, 10.5, 0], [0, 0, 0, 1]]\n"
+        );
+    }
+    scene += "[[mesh]]\nfile = \"turned.obj\"\nmaterial = \"white\"\ntranslate = [0, 0, 300]\n";
     std::fs::write(dir.join("s.toml"), &scene).unwrap();
     let loaded = SceneFile::load(&dir.join("s.toml")).unwrap();
     assert_eq!(
         loaded.scene.instances.len(),
-        6,
-        "mm16.obj, squashed.obj and squeezed.obj are instanced"
+        5,
+        "mm16.obj, squeezed.obj and the unmoved turned.obj are instanced, squashed.obj and \
+         the stretched turned.obj flattened"
     );
     let notes = &loaded.scene.notes;
     for n in notes {
@@ -825,7 +836,13 @@ fn triangles_beyond_the_grazing_domain_are_noted() {
     assert!(needle_notes[0].contains("1 of 2 triangles") && needle_notes[0].contains("a needle"));
     // What marks these notes, in the shipped scenes below.
     let marker = "beyond the domain";
-    assert!(notes.iter().all(|n| n.contains(marker)), "{notes:?}");
+    let flattened = "flattened into world space";
+    assert!(
+        notes
+            .iter()
+            .all(|n| n.contains(marker) || n.contains(flattened)),
+        "{notes:?}"
+    );
     let far_notes = about("far.obj");
     assert_eq!(far_notes.len(), 1, "{notes:?}");
     assert!(far_notes[0].contains("1 of 2 triangles") && far_notes[0].contains("(3000, 0, 0)"));
@@ -835,10 +852,21 @@ fn triangles_beyond_the_grazing_domain_are_noted() {
     assert!(instanced[0].contains("16 of 16 triangles (object space, under 2 instances)"));
     let squashed = about("squashed.obj");
     assert_eq!(squashed.len(), 1, "{notes:?}");
-    assert!(squashed[0].contains("16 of 16 triangles") && squashed[0].contains("above 1000"));
+    assert!(
+        squashed[0].contains("2 placements flattened")
+            && squashed[0].contains("condition number ||M|| ||M^-1|| is 2000, above 1000"),
+        "{squashed:?}"
+    );
+    let turned = about("turned.obj");
+    assert_eq!(turned.len(), 1, "{notes:?}");
+    assert!(
+        turned[0].contains("2 placements flattened")
+            && turned[0].contains("determinant condition perm(|A|) / |det A| is 194, above 125"),
+        "{turned:?}"
+    );
     assert!(about("thin.obj").is_empty() && about("near.obj").is_empty());
     assert!(about("squeezed.obj").is_empty(), "{notes:?}");
-    assert_eq!(notes.len(), 4, "{notes:?}");
+    assert_eq!(notes.len(), 5, "{notes:?}");
     let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
     let gltf = std::fs::read_dir(scenes.join("gltf")).unwrap();
     for entry in std::fs::read_dir(&scenes).unwrap().chain(gltf) {
@@ -852,7 +880,7 @@ fn triangles_beyond_the_grazing_domain_are_noted() {
                 .scene
                 .notes
                 .iter()
-                .filter(|n| n.contains(marker))
+                .filter(|n| n.contains(marker) || n.contains(flattened))
                 .collect();
             assert!(beyond.is_empty(), "{}: {beyond:?}", path.display());
         }

@@ -351,7 +351,8 @@ fn shared_structs_have_the_same_layout_on_host_and_device() {
                     first_triangle,
                     forward_norm,
                     inverse_norm,
-                    handedness
+                    handedness,
+                    determinant_condition
                 ],
                 true
             ),

@@ -357,7 +357,7 @@ fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic
     };
     use twinpath::scene::instancing::instance_record;
     use twinpath::scene::transform::Transform;
-    use twinpath_tests::device_inverse::as_the_device_inverts;
+    use twinpath_tests::device_inverse::as_devices_invert;
     set_model(Model::VULKAN);
     seed(4);
     let mut g = Gen(SplitMix(41));
@@ -369,7 +369,7 @@ fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic
             continue;
         };
         let inst = instance_record(&transform, 0);
-        let device = as_the_device_inverts(&inst);
+        let devices = as_devices_invert(&inst);
         // An object-space triangle of unit size, a point on it, and a world ray toward it.
         let (q, f1, f2) = (g.dir() * 0.3, g.dir(), g.dir());
         if f1.cross(f2).length() < 1e-2 {
@@ -394,12 +394,14 @@ fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic
         let hit = |o: V, d: V, t_max: Vk32| {
             let (oo, od) = ray_to_object_v3(&inst, o, d);
             let (t, _, _) = intersect::triangle(oo, od, v(q), v(f1), v(f2), f(0.0), t_max);
-            let (device_o, device_d) = ray_to_object_v3(&device, o, d);
-            let (device_t, _, _) =
-                intersect::triangle(device_o, device_d, v(q), v(f1), v(f2), f(0.0), t_max);
+            let device_met = devices.iter().any(|device| {
+                let (device_o, device_d) = ray_to_object_v3(device, o, d);
+                let (device_t, _, _) =
+                    intersect::triangle(device_o, device_d, v(q), v(f1), v(f2), f(0.0), t_max);
+                device_t.value >= 0.0
+            });
             t.value >= 0.0
-                || (device_t.value >= 0.0
-                    && !ray_leaves_triangle_plane_v3(oo, od, v(q), v(f1), v(f2)))
+                || (device_met && !ray_leaves_triangle_plane_v3(oo, od, v(q), v(f1), v(f2)))
         };
         let (oo, od) = ray_to_object_v3(&inst, v(origin), v(dir));
         let (t, hu, hv) = intersect::triangle(oo, od, v(q), v(f1), v(f2), f(0.0), f(f32::INFINITY));
@@ -459,13 +461,15 @@ fn rays_leaving_instanced_triangles_never_hit_them_again_under_vulkan_arithmetic
 #[test]
 fn the_round_trip_model_holds_a_device_that_inverts_in_f32() {
     use kernel::instance::{
-        condition_number, point_to_world, translation_norm, DEVICE_INVERSE_EPS_PER_CONDITION,
-        INSTANCE_ERROR_EPS,
+        condition_number, device_inverse_eps, point_to_world, translation_norm,
+        DEVICE_INVERSE_EPS_PER_CONDITION, INSTANCE_ERROR_EPS,
     };
     use kernel::scene::Instance;
     use twinpath::scene::instancing::instance_record;
     use twinpath::scene::transform::Transform;
-    use twinpath_tests::device_inverse::{as_the_device_inverts, stored_object_to_world};
+    use twinpath_tests::device_inverse::{
+        as_devices_invert, stored_object_to_world, DEVICE_INVERSES,
+    };
     use twinpath_tests::placements::stretch_along;
     seed(12);
     let mut g = Gen(SplitMix(43));
@@ -474,33 +478,54 @@ fn the_round_trip_model_holds_a_device_that_inverts_in_f32() {
     // Worst device error against the model, in eps (w |p_w| + |T_w|), per unit of condition
     // beyond 10, and the stored inverse's.
     let (mut worst_share, mut worst_device, mut per_condition, mut worst_stored) =
-        (0f64, 0f64, 0f64, 0f64);
-    for case in 0..6000 {
-        let m = if case % 2 == 0 {
-            g.instance_map().0
-        } else {
-            let stretch = 10f64.powf(4.0 * g.unit() as f64);
-            glam::DMat4::from_translation(g.dir().as_dvec3() * 10.0 * g.unit() as f64)
-                * glam::DMat4::from_axis_angle(
-                    g.dir().as_dvec3(),
-                    g.unit() as f64 * std::f64::consts::TAU,
-                )
-                * glam::DMat4::from_mat3(stretch_along(g.dir().as_dvec3(), stretch))
+        ([0f64; 4], [0f64; 4], [0f64; 4], 0f64);
+    // The worst share of the model without the determinant's term.
+    let mut worst_without = [0f64; 4];
+    for case in 0..9000 {
+        let shift = glam::DMat4::from_translation(g.dir().as_dvec3() * 10.0 * g.unit() as f64);
+        let turn = |g: &mut Gen| {
+            let axis = g.dir().as_dvec3();
+            glam::DMat4::from_axis_angle(axis, g.unit() as f64 * std::f64::consts::TAU)
+        };
+        let m = match case % 3 {
+            0 => g.instance_map().0,
+            1 => {
+                let stretch = 10f64.powf(4.0 * g.unit() as f64);
+                let turned = turn(&mut g);
+                shift * turned * glam::DMat4::from_mat3(stretch_along(g.dir().as_dvec3(), stretch))
+            }
+            _ => {
+                let scale = glam::DVec3::new(
+                    10f64.powf(4.0 * g.unit() as f64),
+                    10f64.powf(4.0 * g.unit() as f64),
+                    1.0,
+                );
+                shift * turn(&mut g) * glam::DMat4::from_scale(scale) * turn(&mut g)
+            }
         };
         let Ok(Some(transform)) = Transform::affine(m) else {
             continue;
         };
         maps += 1;
         let inst = instance_record(&transform, 0);
-        let device = as_the_device_inverts(&inst);
+        let devices = as_devices_invert(&inst);
         let exact = stored_object_to_world(&inst).inverse();
         let translation = translation_norm(&inst.world_to_object) as f64;
         let w = inst.inverse_norm as f64;
         let condition = condition_number(&inst) as f64;
         worst_condition = worst_condition.max(condition);
-        let model = INSTANCE_ERROR_EPS as f64 + DEVICE_INVERSE_EPS_PER_CONDITION as f64 * condition;
-        for _ in 0..20 {
-            let p_object = Vec3::new(g.unit(), g.unit(), g.unit()) * 2.0 - 1.0;
+        let model = (INSTANCE_ERROR_EPS + device_inverse_eps(&inst)) as f64;
+        let without_determinant =
+            INSTANCE_ERROR_EPS as f64 + DEVICE_INVERSE_EPS_PER_CONDITION as f64 * condition;
+        let linear = glam::DMat3::from_mat4(exact);
+        for j in 0..20 {
+            // Half the points where the map stretches least: the object images of world
+            // directions, where |p_w| carries no factor of the condition number.
+            let p_object = if j % 2 == 1 {
+                (linear * g.dir().as_dvec3()).normalize().as_vec3()
+            } else {
+                Vec3::new(g.unit(), g.unit(), g.unit()) * 2.0 - 1.0
+            };
             let p_world = point_to_world(&inst, p_object);
             let unit = eps * (w * p_world.abs().max_element() as f64 + translation);
             let want = exact.transform_point3(p_world.as_dvec3());
@@ -509,21 +534,33 @@ fn the_round_trip_model_holds_a_device_that_inverts_in_f32() {
                 let (o, _) = kernel::instance::ray_to_object_v3(map, v(p_world), v(Vec3::Z));
                 (back(o).as_dvec3() - want).abs().max_element() / unit
             };
-            let device_error = apart(&device);
-            worst_share = worst_share.max(device_error / model);
-            worst_device = worst_device.max(device_error);
-            if condition > 10.0 {
-                per_condition = per_condition.max(device_error / condition);
+            for (k, device) in devices.iter().enumerate() {
+                let device_error = apart(device);
+                worst_share[k] = worst_share[k].max(device_error / model);
+                worst_without[k] = worst_without[k].max(device_error / without_determinant);
+                worst_device[k] = worst_device[k].max(device_error);
+                if condition > 10.0 {
+                    per_condition[k] = per_condition[k].max(device_error / condition);
+                }
             }
             worst_stored = worst_stored.max(apart(&inst));
         }
     }
-    println!("origins mapped back by a device's f32 inverse (Gaussian elimination), {maps} maps (conditions to {worst_condition:.0}) x 20 points: worst error {worst_device:.1} eps (w |p_w| + |T_w|), {per_condition:.3} eps per unit of condition beyond 10, at most {worst_share:.3} of the model's bound; by the stored inverse at most {worst_stored:.2} eps");
-    assert!(maps > 5000, "{maps}");
-    assert!(worst_share <= 1.0, "{worst_share}");
+    println!("origins mapped back by a device's own inverse, {maps} maps (conditions to {worst_condition:.0}) x 20 points, in eps (w |p_w| + |T_w|); by the stored inverse at most {worst_stored:.2}:");
+    for (k, name) in DEVICE_INVERSES.iter().enumerate() {
+        println!("  by {name}: worst error {:.1}, {:.3} per unit of condition beyond 10, at most {:.3} of the model's bound ({:.2} of it without the determinant's term)", worst_device[k], per_condition[k], worst_share[k], worst_without[k]);
+    }
+    assert!(maps > 8000, "{maps}");
+    assert!(worst_share.iter().all(|&s| s <= 1.0), "{worst_share:?}");
     assert!(
-        worst_device > INSTANCE_ERROR_EPS as f64,
-        "the condition's term is not shown to be needed"
+        worst_device.iter().all(|&d| d > INSTANCE_ERROR_EPS as f64),
+        "the condition's term is not shown to be needed: {worst_device:?}"
+    );
+    // Gaussian elimination needs no determinant's term; the adjugate does.
+    assert!(worst_without[0] <= 1.0, "{worst_without:?}");
+    assert!(
+        worst_without[1..].iter().all(|&w| w > 1.0),
+        "the determinant's term is not shown to be needed: {worst_without:?}"
     );
 }
 

@@ -44,6 +44,9 @@ pub(super) struct SceneTables {
     pub mesh_boxes: Vec<(Vec3, Vec3)>,
     pub instances: Vec<Instance>,
     pub instance_meshes: Vec<u32>,
+    /// Meshes of which placements were flattened instead of instanced
+    /// (`instancing::flattening_reason`): the mesh's name, how many, the first one's reason.
+    pub flattened: Vec<(String, usize, String)>,
     /// The media table (`kernel::medium`): vacuum first once any medium is added
     /// ([`SceneTables::add_medium`]), and the medium filling the scene (0: vacuum).
     pub media: Vec<Medium>,
@@ -322,6 +325,15 @@ impl SceneTables {
         Ok(())
     }
 
+    /// Records that a placement of mesh `name`, which would have been instanced, is flattened
+    /// into world space for `reason`: `finish` turns the records into one note per mesh.
+    pub fn note_flattened(&mut self, name: &str, reason: String) {
+        match self.flattened.iter_mut().find(|(n, _, _)| n == name) {
+            Some((_, count, _)) => *count += 1,
+            None => self.flattened.push((name.to_string(), 1, reason)),
+        }
+    }
+
     /// Places instanced mesh `mesh` by `transform` (nothing for a mesh without triangles).
     /// Err: the mesh's placed box leaves the supported coordinate range, or the scene has
     /// [`MAX_INSTANCES`] already.
@@ -511,7 +523,17 @@ impl SceneTables {
             },
             medium: self.scene_medium,
             grids: self.grids,
-            notes: Vec::new(),
+            notes: self
+                .flattened
+                .into_iter()
+                .map(|(name, count, reason)| {
+                    format!(
+                        "{name}: {count} placements flattened into world space instead of \
+                         instanced: {reason}, beyond what a device's own inverse of an \
+                         instance's map is shown to keep (docs/instancing.md)"
+                    )
+                })
+                .collect(),
             inputs: Vec::new(),
         }
     }

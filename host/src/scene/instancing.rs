@@ -1,19 +1,57 @@
 //! Instancing: a mesh used in several places is stored once, in object space, and placed by
-//! instance records (`kernel::scene::Instance`). Here are when a loader instances a mesh, the
-//! record of a placement, and the world-space box the instances fill.
+//! instance records (`kernel::scene::Instance`). Here are when a loader instances a mesh (and
+//! when it flattens a placement of it instead), the record of a placement, and the world-space
+//! box the instances fill.
 
 use super::transform::Transform;
 use glam::{DMat4, Vec3};
+use kernel::instance::{
+    condition_number, DEVICE_INVERSE_CONDITION_LIMIT, DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION,
+};
 use kernel::scene::{Instance, Triangle};
 
 /// Fewest triangles a mesh used more than once needs to be instanced rather than flattened
-/// into world space. An instance record (112 bytes) and the ray's map into object space cost
+/// into world space. An instance record (116 bytes) and the ray's map into object space cost
 /// about what a couple of flattened triangles do (48 bytes each and their BVH share), so a tiny
 /// mesh is cheaper flattened; from here on, instancing saves memory in proportion to the mesh.
 pub const INSTANCE_MIN_TRIANGLES: usize = 16;
 
 /// Most instances a scene may have: the GPU names an instance by its 24-bit custom index.
 pub const MAX_INSTANCES: usize = 1 << 24;
+
+/// The largest determinant condition (`kernel::scene::Instance::determinant_condition`) of a
+/// placement that is instanced: there the device's term for it
+/// (`kernel::instance::DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION` H eps) is at most what the
+/// condition number's term is at `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT`.
+pub const DETERMINANT_CONDITION_LIMIT: f32 =
+    DEVICE_INVERSE_CONDITION_LIMIT / DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION;
+
+/// Why a placement of a mesh by `transform` (None: the identity) is flattened into world space
+/// instead of instanced, or None where it is instanced. A device maps rays into an instance's
+/// object space by its own inverse of the map, which Vulkan does not specify: past a condition
+/// number of `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT` its error may turn a grazing
+/// ray into the triangle it leaves, and past a determinant condition of
+/// [`DETERMINANT_CONDITION_LIMIT`] an inverse by the adjugate (RADV's, ANV's) scales the mesh it
+/// sees by up to 6 eps H and the heights of leaving rays with it (docs/instancing.md). A
+/// flattened placement involves no device inverse.
+pub fn flattening_reason(transform: Option<&Transform>) -> Option<String> {
+    let record = instance_record(transform?, 0);
+    let condition = condition_number(&record);
+    if !(condition <= DEVICE_INVERSE_CONDITION_LIMIT) {
+        return Some(format!(
+            "its map's condition number ||M|| ||M^-1|| is {condition:.0}, above \
+             {DEVICE_INVERSE_CONDITION_LIMIT}"
+        ));
+    }
+    let determinant = record.determinant_condition;
+    if !(determinant <= DETERMINANT_CONDITION_LIMIT) {
+        return Some(format!(
+            "its map's determinant condition perm(|A|) / |det A| is {determinant:.0}, above \
+             {DETERMINANT_CONDITION_LIMIT} (a scale along turned axes)"
+        ));
+    }
+    None
+}
 
 /// The record of a placement of the mesh whose triangles start at `first_triangle`, by the
 /// affine `transform`: both matrices (the inverse computed in f64, then rounded), their
@@ -48,7 +86,38 @@ pub fn instance_record(transform: &Transform, first_triangle: u32) -> Instance {
         forward_norm: norm(&object_to_world),
         inverse_norm: norm(&world_to_object),
         handedness: if transform.mirrors() { -1.0 } else { 1.0 },
+        determinant_condition: determinant_condition(&object_to_world),
     }
+}
+
+/// perm(|A|) / |det A| for the linear part A of the stored 3 x 4 matrix `m`, in f64 and
+/// rounded up to the next `f32` (`kernel::scene::Instance::determinant_condition`): at least 1,
+/// since every term of the determinant is one of the permanent's. Infinite for a singular A.
+pub fn determinant_condition(m: &[f32; 12]) -> f32 {
+    let a = |r: usize, c: usize| m[4 * r + c] as f64;
+    // The six products of the determinant's expansion, one per permutation, with their signs.
+    let permutations = [
+        ([0, 1, 2], 1.0),
+        ([1, 2, 0], 1.0),
+        ([2, 0, 1], 1.0),
+        ([0, 2, 1], -1.0),
+        ([2, 1, 0], -1.0),
+        ([1, 0, 2], -1.0),
+    ];
+    let (mut permanent, mut determinant) = (0.0f64, 0.0f64);
+    for (p, sign) in permutations {
+        let term = a(0, p[0]) * a(1, p[1]) * a(2, p[2]);
+        permanent += term.abs();
+        determinant += sign * term;
+    }
+    let ratio = permanent / determinant.abs();
+    let rounded = ratio as f32;
+    if (rounded as f64) < ratio {
+        rounded.next_up()
+    } else {
+        rounded
+    }
+    .max(1.0)
 }
 
 /// The object-space box of `triangles`.

@@ -4,7 +4,7 @@
 use super::accessor::{read_colour, read_floats, read_indices, read_uv};
 use super::import::{Import, MAX_TRIANGLES};
 use crate::scene::closed_surface::check_closed_outward;
-use crate::scene::instancing::INSTANCE_MIN_TRIANGLES;
+use crate::scene::instancing::{flattening_reason, INSTANCE_MIN_TRIANGLES};
 use crate::scene::soup::TriangleSoup;
 use crate::scene::transform::Transform;
 use crate::scene::SceneError;
@@ -14,8 +14,9 @@ use gltf::mesh::Mode;
 impl Import<'_> {
     /// Adds every primitive of `mesh` as placed by `node` at `world`: flattened into world
     /// space, or as an instance of the mesh stored once where several nodes use it, it has at
-    /// least [`INSTANCE_MIN_TRIANGLES`] triangles and none of its materials emits (an emissive
-    /// triangle is a light, whose record is in world space).
+    /// least [`INSTANCE_MIN_TRIANGLES`] triangles, none of its materials emits (an emissive
+    /// triangle is a light, whose record is in world space) and the placement's map is one a
+    /// device's inverse is shown to keep (`instancing::flattening_reason`).
     pub(super) fn add_mesh(
         &mut self,
         node: &gltf::Node,
@@ -32,7 +33,13 @@ impl Import<'_> {
         })?;
         let shared = self.mesh_uses.get(&mesh.index()).copied().unwrap_or(0) >= 2;
         if shared && self.instanceable(mesh)? {
-            return self.add_instance(node, mesh, &transform.unwrap_or_default());
+            match flattening_reason(transform.as_ref()) {
+                None => return self.add_instance(node, mesh, &transform.unwrap_or_default()),
+                Some(reason) => {
+                    let name = format!("{}#meshes[{}]", self.path.display(), mesh.index());
+                    self.tables.note_flattened(&name, reason);
+                }
+            }
         }
         for p in mesh.primitives() {
             let field = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());

@@ -232,7 +232,7 @@ pub fn load_bytes(
         },
     };
     let mut scene = tables.finish(path.display().to_string(), desc, Vec3::ONE, None);
-    scene.notes = notes;
+    scene.notes.extend(notes);
     Ok(scene)
 }
 

@@ -8,7 +8,7 @@ use super::media::{with_media, Media};
 use super::transform::{parse_transform, transform_fields};
 use crate::scene::builder::SceneTables;
 use crate::scene::closed_surface::check_closed_outward;
-use crate::scene::instancing::INSTANCE_MIN_TRIANGLES;
+use crate::scene::instancing::{flattening_reason, INSTANCE_MIN_TRIANGLES};
 use crate::scene::mesh::load_mesh;
 use crate::scene::soup::TriangleSoup;
 use crate::scene::SceneError;
@@ -45,7 +45,9 @@ pub(super) fn add_meshes(
     tables: &mut SceneTables,
 ) -> Result<(), SceneError> {
     // A mesh file that several entries place with the same material is read once; from
-    // INSTANCE_MIN_TRIANGLES triangles on and unless it emits, it is stored once and instanced.
+    // INSTANCE_MIN_TRIANGLES triangles on and unless it emits, it is stored once and instanced,
+    // but for placements a device's own inverse is not shown to keep
+    // (`instancing::flattening_reason`), which are flattened with a note.
     let mesh_key = |mf: &MeshFile| {
         let interior = mf.interior.as_ref().map(|i| i.get_ref().as_str());
         let exterior = mf.exterior.as_ref().map(|i| i.get_ref().as_str());
@@ -89,7 +91,8 @@ pub(super) fn add_meshes(
             None
         };
         let key = mesh_key(mf);
-        if let Some(&mesh) = instanced.get(&key) {
+        let flattening = flattening_reason(transform.as_ref());
+        if let (Some(&mesh), None) = (instanced.get(&key), &flattening) {
             tables
                 .add_instance(mesh, &transform.unwrap_or_default())
                 .map_err(|msg| ck.err(m.span(), &field, msg))?;
@@ -123,19 +126,30 @@ pub(super) fn add_meshes(
         let triangle_err = |(k, msg): (usize, String)| {
             ck.err(mf.file.span(), &format!("{field} triangle {k}"), msg)
         };
-        if mesh_uses[&key] >= 2
+        let shared = mesh_uses[&key] >= 2
             && soup.triangles.len() >= INSTANCE_MIN_TRIANGLES
-            && !tables.is_emissive(material)
-        {
-            let mesh = tables.begin_instanced_mesh(mf.file.get_ref().clone());
-            tables
-                .push_mesh_part(&soup, material)
-                .map_err(triangle_err)?;
-            tables
-                .add_instance(mesh, &transform.unwrap_or_default())
-                .map_err(|msg| ck.err(m.span(), &field, msg))?;
-            instanced.insert(key, mesh);
-            continue;
+            && !tables.is_emissive(material);
+        match (shared, flattening) {
+            (true, None) => {
+                let mesh = match instanced.get(&key) {
+                    Some(&mesh) => mesh,
+                    None => {
+                        let mesh = tables.begin_instanced_mesh(mf.file.get_ref().clone());
+                        tables
+                            .push_mesh_part(&soup, material)
+                            .map_err(triangle_err)?;
+                        mesh
+                    }
+                };
+                tables
+                    .add_instance(mesh, &transform.unwrap_or_default())
+                    .map_err(|msg| ck.err(m.span(), &field, msg))?;
+                instanced.insert(key.clone(), mesh);
+                loaded.insert(key, soup);
+                continue;
+            }
+            (true, Some(reason)) => tables.note_flattened(mf.file.get_ref(), reason),
+            _ => {}
         }
         tables
             .push_mesh(

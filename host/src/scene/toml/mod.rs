@@ -98,6 +98,6 @@ pub fn parse_scene_with_camera(
         None => (Vec3::ZERO, None),
     };
     let mut scene = tables.finish(path.display().to_string(), camera, background, environment);
-    scene.notes = notes;
+    scene.notes.extend(notes);
     Ok(SceneFile { scene, settings })
 }
