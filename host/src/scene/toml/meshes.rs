@@ -131,16 +131,11 @@ pub(super) fn add_meshes(
             && !tables.is_emissive(material);
         match (shared, flattening) {
             (true, None) => {
-                let mesh = match instanced.get(&key) {
-                    Some(&mesh) => mesh,
-                    None => {
-                        let mesh = tables.begin_instanced_mesh(mf.file.get_ref().clone());
-                        tables
-                            .push_mesh_part(&soup, material)
-                            .map_err(triangle_err)?;
-                        mesh
-                    }
-                };
+                // The first placement to be instanced (later ones are placed above).
+                let mesh = tables.begin_instanced_mesh(mf.file.get_ref().clone());
+                tables
+                    .push_mesh_part(&soup, material)
+                    .map_err(triangle_err)?;
                 tables
                     .add_instance(mesh, &transform.unwrap_or_default())
                     .map_err(|msg| ck.err(m.span(), &field, msg))?;
