@@ -556,6 +556,46 @@ fn gltf_placements_a_device_inverse_may_not_keep_are_flattened() {
     );
 }
 
+/// Flattening for the device's inverse is bounded per mesh: a 16-triangle torus placed 70 times
+/// by a stretch of 29.5 along (1, 1, 1) (determinant condition 194) is flattened 64 times
+/// (`instancing::MAX_FLATTENED_PLACEMENTS`) and instanced 6 times; a 100,352-triangle grid placed
+/// 12 times so is flattened 10 times (1,003,520 triangles, within
+/// `instancing::MAX_FLATTENED_TRIANGLES` = 1,048,576; an 11th copy would pass it) and instanced
+/// twice. Each mesh gets one note saying both.
+#[test]
+fn flattened_copies_of_a_mesh_stay_within_their_budget() {
+    use twinpath::scene::instancing::{MAX_FLATTENED_PLACEMENTS, MAX_FLATTENED_TRIANGLES};
+    let dir = temp_dir("budget");
+    std::fs::write(dir.join("torus.obj"), torus_obj(4, 2)).unwrap();
+    std::fs::write(dir.join("grid.obj"), grid_obj(224)).unwrap();
+    let stretch =
+        "matrix = [[10.5, 9.5, 9.5, 0], [9.5, 10.5, 9.5, 0], [9.5, 9.5, 10.5, 0], [0, 0, 0, 1]]";
+    let mut text = String::from(
+        "[camera]\neye = [0, 0, 9]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 4\nheight = 4\n\
+         [materials]\nwhite = { kd = [0.5, 0.5, 0.5] }\n",
+    );
+    for (file, copies) in [("torus.obj", 70), ("grid.obj", 12)] {
+        for _ in 0..copies {
+            text += &format!("[[mesh]]\nfile = \"{file}\"\nmaterial = \"white\"\n{stretch}\n");
+        }
+    }
+    let scene = load(&dir, &text).scene;
+    let grid = 224 * 224 * 2;
+    assert_eq!(MAX_FLATTENED_PLACEMENTS, 64);
+    assert!(10 * grid <= MAX_FLATTENED_TRIANGLES && 11 * grid > MAX_FLATTENED_TRIANGLES);
+    assert_eq!((scene.meshes.len(), scene.instances.len()), (2, 6 + 2));
+    assert_eq!(scene.world_triangle_count(), 64 * 16 + 10 * grid);
+    for n in &scene.notes {
+        println!("note: {n}");
+    }
+    let note = |file: &str| scene.notes.iter().find(|n| n.starts_with(file)).unwrap();
+    assert!(note("torus.obj").contains("64 placements flattened"));
+    assert!(note("torus.obj").contains("; 6 more stay instanced"));
+    assert!(note("grid.obj").contains("10 placements flattened"));
+    assert!(note("grid.obj").contains("; 2 more stay instanced"));
+    assert_eq!(scene.notes.len(), 2);
+}
+
 #[test]
 fn emissive_and_small_shared_meshes_are_flattened() {
     let dir = temp_dir("policy");

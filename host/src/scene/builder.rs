@@ -5,7 +5,9 @@
 use super::density_grid::GridTable;
 use super::environment::EnvironmentMap;
 use super::ggx_albedo;
-use super::instancing::{instance_box, instance_record, instances_box, mesh_box, MAX_INSTANCES};
+use super::instancing::{
+    instance_box, instance_record, instances_box, mesh_box, FlattenedCopies, MAX_INSTANCES,
+};
 use super::light_table::{place_directional_lights, triangle_light};
 use super::limits::MAX_COORDINATE;
 use super::sheen_ltc;
@@ -44,9 +46,9 @@ pub(super) struct SceneTables {
     pub mesh_boxes: Vec<(Vec3, Vec3)>,
     pub instances: Vec<Instance>,
     pub instance_meshes: Vec<u32>,
-    /// Meshes of which placements were flattened instead of instanced
-    /// (`instancing::flattening_reason`): the mesh's name, how many, the first one's reason.
-    pub flattened: Vec<(String, usize, String)>,
+    /// Meshes of which placements would be flattened instead of instanced
+    /// (`instancing::flattening_reason`), with how many were.
+    pub flattened: Vec<FlattenedCopies>,
     /// The media table (`kernel::medium`): vacuum first once any medium is added
     /// ([`SceneTables::add_medium`]), and the medium filling the scene (0: vacuum).
     pub media: Vec<Medium>,
@@ -325,13 +327,25 @@ impl SceneTables {
         Ok(())
     }
 
-    /// Records that a placement of mesh `name`, which would have been instanced, is flattened
-    /// into world space for `reason`: `finish` turns the records into one note per mesh.
-    pub fn note_flattened(&mut self, name: &str, reason: String) {
-        match self.flattened.iter_mut().find(|(n, _, _)| n == name) {
-            Some((_, count, _)) => *count += 1,
-            None => self.flattened.push((name.to_string(), 1, reason)),
-        }
+    /// Whether a placement of mesh `name` (of `triangles` triangles), which would have been
+    /// instanced but for `reason`, is flattened into world space: while the mesh's flattened
+    /// copies stay within `instancing::MAX_FLATTENED_PLACEMENTS` and `MAX_FLATTENED_TRIANGLES`.
+    /// Recorded either way; `finish` turns the records into one note per mesh.
+    pub fn flattens(&mut self, name: &str, triangles: usize, reason: String) -> bool {
+        let at = match self.flattened.iter().position(|f| f.name == name) {
+            Some(k) => k,
+            None => {
+                self.flattened.push(FlattenedCopies {
+                    name: name.to_string(),
+                    reason,
+                    flattened: 0,
+                    triangles: 0,
+                    kept: 0,
+                });
+                self.flattened.len() - 1
+            }
+        };
+        self.flattened[at].admit(triangles)
     }
 
     /// Places instanced mesh `mesh` by `transform` (nothing for a mesh without triangles).
@@ -523,17 +537,7 @@ impl SceneTables {
             },
             medium: self.scene_medium,
             grids: self.grids,
-            notes: self
-                .flattened
-                .into_iter()
-                .map(|(name, count, reason)| {
-                    format!(
-                        "{name}: {count} placements flattened into world space instead of \
-                         instanced: {reason}, beyond what a device's own inverse of an \
-                         instance's map is shown to keep (docs/instancing.md)"
-                    )
-                })
-                .collect(),
+            notes: self.flattened.iter().map(FlattenedCopies::note).collect(),
             inputs: Vec::new(),
         }
     }

@@ -53,6 +53,59 @@ pub fn flattening_reason(transform: Option<&Transform>) -> Option<String> {
     None
 }
 
+/// The most placements of one mesh the loaders flatten for [`flattening_reason`], and the most
+/// triangles those copies may hold together: further placements stay instanced, so that what
+/// flattening costs stays within this per mesh. The heights of rays leaving them still hold a
+/// device's inverse by the determinant's term; past the condition limit the grazing-domain
+/// check names their meshes.
+pub const MAX_FLATTENED_PLACEMENTS: usize = 64;
+pub const MAX_FLATTENED_TRIANGLES: usize = 1 << 20;
+
+/// The placements of one mesh that [`flattening_reason`] would flatten: how many were flattened
+/// (within [`MAX_FLATTENED_PLACEMENTS`] and [`MAX_FLATTENED_TRIANGLES`]), how many stayed
+/// instanced beyond them, and the first one's reason.
+pub struct FlattenedCopies {
+    pub name: String,
+    pub reason: String,
+    pub flattened: usize,
+    pub triangles: usize,
+    pub kept: usize,
+}
+
+impl FlattenedCopies {
+    /// Whether one more placement, of `triangles` triangles, is flattened; counted either way.
+    pub fn admit(&mut self, triangles: usize) -> bool {
+        let fits = self.flattened < MAX_FLATTENED_PLACEMENTS
+            && self.triangles + triangles <= MAX_FLATTENED_TRIANGLES;
+        if fits {
+            self.flattened += 1;
+            self.triangles += triangles;
+        } else {
+            self.kept += 1;
+        }
+        fits
+    }
+
+    /// The note the loader shows for this mesh.
+    pub fn note(&self) -> String {
+        let kept = if self.kept > 0 {
+            format!(
+                "; {} more stay instanced, beyond the {MAX_FLATTENED_PLACEMENTS} copies or \
+                 {MAX_FLATTENED_TRIANGLES} triangles a mesh's flattened placements may take",
+                self.kept
+            )
+        } else {
+            String::new()
+        };
+        format!(
+            "{}: {} placements flattened into world space instead of instanced: {}, beyond \
+             what a device's own inverse of an instance's map is shown to keep{kept} \
+             (docs/instancing.md)",
+            self.name, self.flattened, self.reason
+        )
+    }
+}
+
 /// The record of a placement of the mesh whose triangles start at `first_triangle`, by the
 /// affine `transform`: both matrices (the inverse computed in f64, then rounded), their
 /// infinity norms and the handedness.

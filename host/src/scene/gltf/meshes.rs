@@ -16,7 +16,8 @@ impl Import<'_> {
     /// space, or as an instance of the mesh stored once where several nodes use it, it has at
     /// least [`INSTANCE_MIN_TRIANGLES`] triangles, none of its materials emits (an emissive
     /// triangle is a light, whose record is in world space) and the placement's map is one a
-    /// device's inverse is shown to keep (`instancing::flattening_reason`).
+    /// device's inverse is shown to keep (`instancing::flattening_reason`; beyond it, while the
+    /// mesh's flattened copies stay within their budget, `SceneTables::flattens`).
     pub(super) fn add_mesh(
         &mut self,
         node: &gltf::Node,
@@ -33,12 +34,16 @@ impl Import<'_> {
         })?;
         let shared = self.mesh_uses.get(&mesh.index()).copied().unwrap_or(0) >= 2;
         if shared && self.instanceable(mesh)? {
-            match flattening_reason(transform.as_ref()) {
-                None => return self.add_instance(node, mesh, &transform.unwrap_or_default()),
+            let flattened = match flattening_reason(transform.as_ref()) {
+                None => false,
                 Some(reason) => {
                     let name = format!("{}#meshes[{}]", self.path.display(), mesh.index());
-                    self.tables.note_flattened(&name, reason);
+                    let triangles = declared_triangles(mesh) as usize;
+                    self.tables.flattens(&name, triangles, reason)
                 }
+            };
+            if !flattened {
+                return self.add_instance(node, mesh, &transform.unwrap_or_default());
             }
         }
         for p in mesh.primitives() {

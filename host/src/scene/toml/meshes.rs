@@ -47,7 +47,8 @@ pub(super) fn add_meshes(
     // A mesh file that several entries place with the same material is read once; from
     // INSTANCE_MIN_TRIANGLES triangles on and unless it emits, it is stored once and instanced,
     // but for placements a device's own inverse is not shown to keep
-    // (`instancing::flattening_reason`), which are flattened with a note.
+    // (`instancing::flattening_reason`), which are flattened with a note while the mesh's
+    // flattened copies stay within their budget (`SceneTables::flattens`).
     let mesh_key = |mf: &MeshFile| {
         let interior = mf.interior.as_ref().map(|i| i.get_ref().as_str());
         let exterior = mf.exterior.as_ref().map(|i| i.get_ref().as_str());
@@ -129,22 +130,28 @@ pub(super) fn add_meshes(
         let shared = mesh_uses[&key] >= 2
             && soup.triangles.len() >= INSTANCE_MIN_TRIANGLES
             && !tables.is_emissive(material);
-        match (shared, flattening) {
-            (true, None) => {
-                // The first placement to be instanced (later ones are placed above).
-                let mesh = tables.begin_instanced_mesh(mf.file.get_ref().clone());
-                tables
-                    .push_mesh_part(&soup, material)
-                    .map_err(triangle_err)?;
-                tables
-                    .add_instance(mesh, &transform.unwrap_or_default())
-                    .map_err(|msg| ck.err(m.span(), &field, msg))?;
-                instanced.insert(key.clone(), mesh);
-                loaded.insert(key, soup);
-                continue;
-            }
-            (true, Some(reason)) => tables.note_flattened(mf.file.get_ref(), reason),
-            _ => {}
+        let instance = shared
+            && match flattening {
+                None => true,
+                Some(reason) => !tables.flattens(mf.file.get_ref(), soup.triangles.len(), reason),
+            };
+        if instance {
+            let mesh = match instanced.get(&key) {
+                Some(&mesh) => mesh,
+                None => {
+                    let mesh = tables.begin_instanced_mesh(mf.file.get_ref().clone());
+                    tables
+                        .push_mesh_part(&soup, material)
+                        .map_err(triangle_err)?;
+                    mesh
+                }
+            };
+            tables
+                .add_instance(mesh, &transform.unwrap_or_default())
+                .map_err(|msg| ck.err(m.span(), &field, msg))?;
+            instanced.insert(key.clone(), mesh);
+            loaded.insert(key, soup);
+            continue;
         }
         tables
             .push_mesh(
