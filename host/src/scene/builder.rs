@@ -5,9 +5,7 @@
 use super::density_grid::GridTable;
 use super::environment::EnvironmentMap;
 use super::ggx_albedo;
-use super::instancing::{
-    instance_box, instance_record, instances_box, mesh_box, FlattenedCopies, MAX_INSTANCES,
-};
+use super::instancing::{instance_box, instances_box, mesh_box, FlattenedCopies, MAX_INSTANCES};
 use super::light_table::{place_directional_lights, triangle_light};
 use super::limits::MAX_COORDINATE;
 use super::sheen_ltc;
@@ -348,10 +346,12 @@ impl SceneTables {
         self.flattened[at].admit(triangles)
     }
 
-    /// Places instanced mesh `mesh` by `transform` (nothing for a mesh without triangles).
+    /// Places instanced mesh `mesh` by `placement`, the record `instancing::instance_record`
+    /// makes of the placement's transform (its `first_triangle` is set here; nothing is placed
+    /// for a mesh without triangles).
     /// Err: the mesh's placed box leaves the supported coordinate range, or the scene has
     /// [`MAX_INSTANCES`] already.
-    pub fn add_instance(&mut self, mesh: u32, transform: &Transform) -> Result<(), String> {
+    pub fn add_instance(&mut self, mesh: u32, placement: Instance) -> Result<(), String> {
         if self.instances.len() >= MAX_INSTANCES {
             return Err(format!(
                 "more than {MAX_INSTANCES} instances (the GPU names them by 24 bits)"
@@ -363,7 +363,10 @@ impl SceneTables {
             return Ok(());
         }
         // The mesh's triangles move when `finish` appends them; it adds the offset.
-        let record = instance_record(transform, range.start as u32);
+        let record = Instance {
+            first_triangle: range.start as u32,
+            ..placement
+        };
         let (lo, hi) = instance_box(&record, self.mesh_boxes[mesh as usize]);
         if !(lo.abs().max(hi.abs()).max_element() <= MAX_COORDINATE) {
             return Err(format!("the placed mesh reaches beyond {MAX_COORDINATE:e}"));

@@ -26,24 +26,23 @@ pub const MAX_INSTANCES: usize = 1 << 24;
 pub const DETERMINANT_CONDITION_LIMIT: f32 =
     DEVICE_INVERSE_CONDITION_LIMIT / DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION;
 
-/// Why a placement of a mesh by `transform` (None: the identity) is flattened into world space
-/// instead of instanced, or None where it is instanced. A device maps rays into an instance's
+/// Why a placement of a mesh, whose record ([`instance_record`]) is `placement`, is flattened
+/// into world space instead of instanced, or None where it is instanced. A device maps rays into an instance's
 /// object space by its own inverse of the map, which Vulkan does not specify: past a condition
 /// number of `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT` its error may turn a grazing
 /// ray into the triangle it leaves, and past a determinant condition of
 /// [`DETERMINANT_CONDITION_LIMIT`] an inverse by the adjugate (RADV's, ANV's) scales the mesh it
 /// sees by up to 6 eps H and the heights of leaving rays with it (docs/instancing.md). A
 /// flattened placement involves no device inverse.
-pub fn flattening_reason(transform: Option<&Transform>) -> Option<String> {
-    let record = instance_record(transform?, 0);
-    let condition = condition_number(&record);
+pub fn flattening_reason(placement: &Instance) -> Option<String> {
+    let condition = condition_number(placement);
     if !(condition <= DEVICE_INVERSE_CONDITION_LIMIT) {
         return Some(format!(
             "its map's condition number ||M|| ||M^-1|| is {condition:.0}, above \
              {DEVICE_INVERSE_CONDITION_LIMIT}"
         ));
     }
-    let determinant = record.determinant_condition;
+    let determinant = placement.determinant_condition;
     if !(determinant <= DETERMINANT_CONDITION_LIMIT) {
         return Some(format!(
             "its map's determinant condition perm(|A|) / |det A| is {determinant:.0}, above \

@@ -4,12 +4,13 @@
 use super::accessor::{read_colour, read_floats, read_indices, read_uv};
 use super::import::{Import, MAX_TRIANGLES};
 use crate::scene::closed_surface::check_closed_outward;
-use crate::scene::instancing::{flattening_reason, INSTANCE_MIN_TRIANGLES};
+use crate::scene::instancing::{flattening_reason, instance_record, INSTANCE_MIN_TRIANGLES};
 use crate::scene::soup::TriangleSoup;
 use crate::scene::transform::Transform;
 use crate::scene::SceneError;
 use glam::DMat4;
 use gltf::mesh::Mode;
+use kernel::scene::Instance;
 
 impl Import<'_> {
     /// Adds every primitive of `mesh` as placed by `node` at `world`: flattened into world
@@ -34,7 +35,8 @@ impl Import<'_> {
         })?;
         let shared = self.mesh_uses.get(&mesh.index()).copied().unwrap_or(0) >= 2;
         if shared && self.instanceable(mesh)? {
-            let flattened = match flattening_reason(transform.as_ref()) {
+            let placement = instance_record(&transform.unwrap_or_default(), 0);
+            let flattened = match flattening_reason(&placement) {
                 None => false,
                 Some(reason) => {
                     let name = format!("{}#meshes[{}]", self.path.display(), mesh.index());
@@ -43,7 +45,7 @@ impl Import<'_> {
                 }
             };
             if !flattened {
-                return self.add_instance(node, mesh, &transform.unwrap_or_default());
+                return self.add_instance(node, mesh, placement);
             }
         }
         for p in mesh.primitives() {
@@ -93,13 +95,13 @@ impl Import<'_> {
         Ok(answer)
     }
 
-    /// Places the glTF mesh `mesh` (stored once, in object space, on its first use) at
-    /// `transform` as an instance.
+    /// Places the glTF mesh `mesh` (stored once, in object space, on its first use) as an
+    /// instance whose record is `placement` (`instancing::instance_record`).
     fn add_instance(
         &mut self,
         node: &gltf::Node,
         mesh: &gltf::Mesh,
-        transform: &Transform,
+        placement: Instance,
     ) -> Result<(), SceneError> {
         let index = match self.instanced.get(&mesh.index()) {
             Some(&i) => i,
@@ -121,7 +123,7 @@ impl Import<'_> {
                 index
             }
         };
-        self.tables.add_instance(index, transform).map_err(|msg| {
+        self.tables.add_instance(index, placement).map_err(|msg| {
             SceneError::new(&self.path, None, format!("nodes[{}]", node.index()), msg)
         })
     }

@@ -8,7 +8,7 @@ use super::media::{with_media, Media};
 use super::transform::{parse_transform, transform_fields};
 use crate::scene::builder::SceneTables;
 use crate::scene::closed_surface::check_closed_outward;
-use crate::scene::instancing::{flattening_reason, INSTANCE_MIN_TRIANGLES};
+use crate::scene::instancing::{flattening_reason, instance_record, INSTANCE_MIN_TRIANGLES};
 use crate::scene::mesh::load_mesh;
 use crate::scene::soup::TriangleSoup;
 use crate::scene::SceneError;
@@ -92,10 +92,11 @@ pub(super) fn add_meshes(
             None
         };
         let key = mesh_key(mf);
-        let flattening = flattening_reason(transform.as_ref());
+        let placement = instance_record(&transform.unwrap_or_default(), 0);
+        let flattening = flattening_reason(&placement);
         if let (Some(&mesh), None) = (instanced.get(&key), &flattening) {
             tables
-                .add_instance(mesh, &transform.unwrap_or_default())
+                .add_instance(mesh, placement)
                 .map_err(|msg| ck.err(m.span(), &field, msg))?;
             continue;
         }
@@ -147,7 +148,7 @@ pub(super) fn add_meshes(
                 }
             };
             tables
-                .add_instance(mesh, &transform.unwrap_or_default())
+                .add_instance(mesh, placement)
                 .map_err(|msg| ck.err(m.span(), &field, msg))?;
             instanced.insert(key.clone(), mesh);
             loaded.insert(key, soup);
