@@ -26,16 +26,43 @@ pub fn has_map(params: &RenderParams) -> bool {
     params.environment.width > 0
 }
 
-/// Where the marginal CDF starts in the environment table.
-#[inline]
-fn marginal_offset(params: &RenderParams) -> u32 {
-    3 * params.environment.width * params.environment.height
+/// The environment table's layout for a `width` x `height` map: where its parts start (module
+/// doc: texels, the marginal CDF, each row's conditional CDF) and its length. The one statement
+/// of the layout: the kernel reads by it, the host builds and sizes the table by it, and tests
+/// read the stored CDFs by it.
+#[derive(Clone, Copy)]
+pub struct TableLayout {
+    pub width: u32,
+    pub height: u32,
 }
 
-/// Where row `row`'s conditional CDF starts in the environment table.
-#[inline]
-fn conditional_offset(params: &RenderParams, row: u32) -> u32 {
-    marginal_offset(params) + params.environment.height + 1 + row * (params.environment.width + 1)
+impl TableLayout {
+    /// The layout of the render's map.
+    #[inline]
+    pub fn of(params: &RenderParams) -> Self {
+        Self {
+            width: params.environment.width,
+            height: params.environment.height,
+        }
+    }
+
+    /// Where the marginal CDF over rows (height + 1 numbers) starts: after the texels' RGB.
+    #[inline]
+    pub fn marginal(self) -> u32 {
+        3 * self.width * self.height
+    }
+
+    /// Where row `row`'s conditional CDF over its columns (width + 1 numbers) starts.
+    #[inline]
+    pub fn conditional(self, row: u32) -> u32 {
+        self.marginal() + self.height + 1 + row * (self.width + 1)
+    }
+
+    /// The number of entries: where a conditional CDF after the last row would start.
+    #[inline]
+    pub fn entries(self) -> u32 {
+        self.conditional(self.height)
+    }
 }
 
 /// World direction `d` in the map's frame: the map's rotation (cos, sin) about +y undone.
@@ -197,10 +224,11 @@ pub fn sample(params: &RenderParams, table: &[f32], mode: u32, u1: f32, u2: f32)
         };
     }
     let (w, h) = (params.environment.width, params.environment.height);
-    let m = marginal_offset(params);
+    let layout = TableLayout::of(params);
+    let m = layout.marginal();
     let row = find_interval(table, m, h, u2);
     let row_cdf = [table[(m + row) as usize], table[(m + row + 1) as usize]];
-    let c = conditional_offset(params, row);
+    let c = layout.conditional(row);
     let column = find_interval(table, c, w, u1);
     let column_cdf = [
         table[(c + column) as usize],
@@ -242,8 +270,9 @@ pub fn pdf(params: &RenderParams, table: &[f32], mode: u32, d: Vec3) -> f32 {
         return 0.0;
     }
     let (i, j) = texel_of(w, h, u, v);
-    let m = marginal_offset(params);
-    let c = conditional_offset(params, j);
+    let layout = TableLayout::of(params);
+    let m = layout.marginal();
+    let c = layout.conditional(j);
     let p_row = table[(m + j + 1) as usize] - table[(m + j) as usize];
     let p_column = table[(c + i + 1) as usize] - table[(c + i) as usize];
     texel_density(p_row, p_column, (w * h) as f32, sin_theta)

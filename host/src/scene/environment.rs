@@ -4,6 +4,7 @@
 
 use super::error::SceneError;
 use super::light_table::{scene_bounds, sphere_light};
+use kernel::environment::TableLayout;
 use kernel::scene::{light_kind, Light, Sphere, Triangle};
 use std::path::Path;
 
@@ -86,6 +87,7 @@ impl EnvironmentMap {
     /// unreachable (or, for an all-black map, harmless: it sends no light).
     pub fn table(&self) -> Vec<f32> {
         let (w, h) = (self.width as usize, self.height as usize);
+        let layout = self.layout();
         let mut out = Vec::with_capacity(self.table_len());
         out.extend(self.texels.iter().flatten());
         let luminance =
@@ -100,19 +102,28 @@ impl EnvironmentMap {
             })
             .collect();
         let row_sums: Vec<f64> = weights.iter().map(|r| r.iter().sum()).collect();
+        assert_eq!(out.len(), layout.marginal() as usize);
         out.extend(cdf(&row_sums));
-        for row in &weights {
+        for (j, row) in weights.iter().enumerate() {
+            assert_eq!(out.len(), layout.conditional(j as u32) as usize);
             out.extend(cdf(row));
         }
-        debug_assert_eq!(out.len(), self.table_len());
+        assert_eq!(out.len(), self.table_len());
         out
+    }
+
+    /// Where [`EnvironmentMap::table`]'s parts start, as the kernel reads them.
+    pub fn layout(&self) -> TableLayout {
+        TableLayout {
+            width: self.width,
+            height: self.height,
+        }
     }
 
     /// The number of entries of [`EnvironmentMap::table`]: the texels (3 w h), the marginal CDF
     /// (h + 1) and each row's conditional CDF (w + 1 each).
     pub fn table_len(&self) -> usize {
-        let (w, h) = (self.width as usize, self.height as usize);
-        3 * w * h + (h + 1) + h * (w + 1)
+        self.layout().entries() as usize
     }
 
     /// The environment map's entry in the light table: the sphere bounding the scene's geometry

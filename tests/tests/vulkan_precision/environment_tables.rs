@@ -117,10 +117,11 @@ fn hostile_maps() -> Vec<(&'static str, EnvironmentMap)> {
 /// The stored CDFs of `map`'s table: the marginal one and each row's conditional one.
 fn cdfs(map: &EnvironmentMap, table: &[f32]) -> Vec<Vec<f32>> {
     let (w, h) = (map.width as usize, map.height as usize);
-    let m = 3 * w * h;
+    let layout = map.layout();
+    let m = layout.marginal() as usize;
     let mut out = vec![table[m..m + h + 1].to_vec()];
-    for j in 0..h {
-        let c = m + h + 1 + j * (w + 1);
+    for j in 0..map.height {
+        let c = layout.conditional(j) as usize;
         out.push(table[c..c + w + 1].to_vec());
     }
     out
