@@ -87,11 +87,11 @@ for sc in scenes/materials.toml /tmp/gs/mesh_1000000.toml scenes/gltf_showcase.t
 # Splitting at the first vertex (docs/performance.md): what a split sample costs on this GPU
 # (two continuations halve Cornell's error; on the CPU's packets they cost 1.95x).
 for v in off 2 off 2; do gpu twinpath "scenes/cornell.toml --set split=$v"; done
-# Against Mitsuba 3 cuda_ad_rgb (gpu_machine_prepare.sh's bundle): both render the four Cornell
-# scenes at the same sample count; scripts/gpu_peer_table.py measures the images' error here
-# (from $OUT/peer.tar.gz: a run returns at most 8 files).
+# Against Mitsuba 3 cuda_ad_rgb (gpu_machine_prepare.sh's bundle): both render the scenes of
+# scripts/gpu_peer_scenes.txt at the same sample count; scripts/gpu_peer_table.py measures the
+# images' error here (from $OUT/peer.tar.gz: a run returns at most 8 files).
 rm -rf /tmp/peer && mkdir -p /tmp/peer
-for s in cornell cornell_materials cornell_fog cornell_smoke; do
+for s in $(awk '!/^#/ && NF { print $1 }' scripts/gpu_peer_scenes.txt); do
   timeout -k 5 40 $B/twinpath render scenes/$s.toml --backend gpu --spp ${PEER_SPP:-1024} -o /tmp/peer/twinpath_$s.exr > /tmp/peer/twinpath_$s.txt 2>&1; grep -E "backend|rror" /tmp/peer/twinpath_$s.txt
 done
 if [ -e .gpu/mitsuba.tar.xz ]; then

@@ -20,8 +20,9 @@ import os
 import re
 import subprocess
 
-REFERENCE = {"cornell": "cornell_spheres", "cornell_materials": "cornell_materials",
-             "cornell_fog": "cornell_fog", "cornell_smoke": "cornell_smoke"}
+from gpu_peer_scenes import scenes
+
+REFERENCE = {name: reference for name, (reference, _) in scenes().items()}
 TARGET = 0.002
 Z_AGREE = 4.0
 

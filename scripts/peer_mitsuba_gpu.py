@@ -7,6 +7,7 @@ machine reaches no package registry (scripts/gpu_machine_prepare.sh carries the 
 
 Usage: peer_mitsuba_gpu.py OUTDIR [--spp 1024] [--variant cuda_ad_rgb]
        [--scenes cornell,cornell_materials,...] [--samplers independent,ldsampler]
+(the scenes by default: scripts/gpu_peer_scenes.txt's)
 Prints one line per timed render: `mitsuba SCENE SAMPLER spp N seconds S warmup W`, where S is
 the render of N samples per pixel with the scene's kernels already compiled (mi.render, then the
 image evaluated and the device synchronised) and W the first render's time (as many samples, another
@@ -20,7 +21,9 @@ import time
 import drjit as dr
 import mitsuba as mi
 
-SCENES = ["cornell", "cornell_materials", "cornell_fog", "cornell_smoke"]
+from gpu_peer_scenes import scenes
+
+SCENES = scenes()
 
 
 def timed_render(scene, spp, seed):
@@ -42,10 +45,7 @@ def main():
     args = ap.parse_args()
     mi.set_variant(args.variant)
     import mitsuba_scenes
-    build = {"cornell": mitsuba_scenes.scene_dict,
-             "cornell_materials": mitsuba_scenes.cornell_materials_dict,
-             "cornell_fog": mitsuba_scenes.cornell_fog_dict,
-             "cornell_smoke": mitsuba_scenes.cornell_smoke_dict}
+    build = {name: getattr(mitsuba_scenes, builder) for name, (_, builder) in SCENES.items()}
     os.makedirs(args.out, exist_ok=True)
     for name in args.scenes.split(","):
         for sampler in args.samplers.split(","):

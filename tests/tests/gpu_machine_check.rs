@@ -3,7 +3,9 @@
 //! has a GPU part: a test file that names `Backend::Gpu`, `twinpath::vulkan` or
 //! `twinpath_tests::gpu` must be in the prepared list and in one of the check's queues, and
 //! every prepared name must be a test file. Such machines are lent rarely and briefly, so a GPU
-//! test added without them would go unrun on a real GPU for as long as nobody noticed.
+//! test added without them would go unrun on a real GPU for as long as nobody noticed. The same
+//! holds for the GPU peer's scenes (`scripts/gpu_peer_scenes.txt`): each row's scene,
+//! reference and Mitsuba builder must exist, or the peer table of that one run has a hole.
 
 use std::collections::BTreeSet;
 use twinpath_tests::repo_root;
@@ -116,5 +118,46 @@ fn the_lent_gpu_check_runs_every_test_with_a_gpu_part() {
     assert!(
         stray.is_empty(),
         "prepared names that are no test file: {stray:?}"
+    );
+}
+
+/// The rows of `scripts/gpu_peer_scenes.txt`: (name, reference, builder), comments and blank
+/// lines aside.
+fn peer_scenes(list: &str) -> Vec<[String; 3]> {
+    list.lines()
+        .map(|l| l.split('#').next().unwrap())
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let words: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!(
+                words.len(),
+                3,
+                "gpu_peer_scenes.txt: `{l}` is not NAME REFERENCE BUILDER"
+            );
+            std::array::from_fn(|i| words[i].to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn the_gpu_peer_scenes_exist_in_both_renderers() {
+    let root = repo_root();
+    let read = |f: &str| std::fs::read_to_string(root.join("scripts").join(f)).unwrap();
+    let rows = peer_scenes(&read("gpu_peer_scenes.txt"));
+    let builders = read("mitsuba_scenes.py");
+    assert!(!rows.is_empty(), "gpu_peer_scenes.txt lists no scene");
+    for [name, reference, builder] in &rows {
+        let scene = root.join(format!("scenes/{name}.toml"));
+        assert!(scene.exists(), "{}: no such scene", scene.display());
+        let image = root.join(format!("tests/reference/{reference}/mitsuba_ref.exr"));
+        assert!(image.exists(), "{}: no such reference", image.display());
+        assert!(
+            builders.contains(&format!("\ndef {builder}(")),
+            "scripts/mitsuba_scenes.py has no `def {builder}(`"
+        );
+    }
+    println!(
+        "{} GPU peer scenes, each with its scene, reference and builder",
+        rows.len()
     );
 }
