@@ -23,7 +23,7 @@ use kernel::sampling::sample_cosine_hemisphere;
 use std::path::{Path, PathBuf};
 use twinpath::cpu::Bvh;
 use twinpath::render::Backend;
-use twinpath::scene::instancing::instance_record;
+use twinpath::scene::instancing::{instance_record, DETERMINANT_CONDITION_LIMIT};
 use twinpath::scene::transform::Transform;
 use twinpath::scene::{parse_scene, SceneFile};
 use twinpath_tests::device_inverse::stored_object_to_world;
@@ -92,17 +92,21 @@ fn load(dir: &Path, text: &str) -> SceneFile {
     parse_scene(text, &dir.join("scene.toml")).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// The placements of test 1: rotation, anisotropic scale, a mirror, a shear matrix.
-const PLACEMENTS: [&str; 4] = [
+/// The placements of test 1: rotation, anisotropic scale, a mirror, a shear matrix, and a
+/// stretch by 23.2 along (1, 1, 1) scaled by 0.06 (0.06 (I + 7.4 J)): a determinant condition
+/// of 120, just within the loader's limit of 125 (`instancing::DETERMINANT_CONDITION_LIMIT`),
+/// where the offsets carry the most of a device's adjugate inverse.
+const PLACEMENTS: [&str; 5] = [
     "rotate = [35, 1, 0.3, 0]\ntranslate = [-1.3, 0.6, 0]",
     "scale = [0.6, 1.4, 0.8]\nrotate = [-20, 0, 0, 1]\ntranslate = [1.3, 0.6, 0.2]",
     "scale = [-0.8, 0.8, 0.8]\nrotate = [70, 1, 0, 0]\ntranslate = [0, 0.5, -1.4]",
     "matrix = [[0.7, 0.3, 0, 0.1], [0, 0.7, 0.2, 1.6], [0.1, 0, 0.7, -0.5], [0, 0, 0, 1]]",
+    "matrix = [[0.504, 0.444, 0.444, 0], [0.444, 0.504, 0.444, 0.9], [0.444, 0.444, 0.504, 1.3], [0, 0, 0, 1]]",
 ];
 
-/// Test 1's scene: a floor, a sphere light, and the torus placed four times, from the files
-/// `files` (one name four times: instanced; four names: flattened), with `placements`.
-fn tori_scene(dir: &Path, files: [&str; 4], placements: [&str; 4]) -> SceneFile {
+/// Test 1's scene: a floor, a sphere light, and the torus placed five times, from the files
+/// `files` (one name five times: instanced; five names: flattened), with `placements`.
+fn tori_scene(dir: &Path, files: [&str; 5], placements: [&str; 5]) -> SceneFile {
     let mut text = String::from(
         "[camera]\neye = [0, 3.5, 5.5]\nlook_at = [0, 0.5, 0]\nup = [0, 1, 0]\nvfov = 45\nwidth = 32\nheight = 24\n\
          [render]\nseed = 3\n[materials]\nfloor = { kd = [0.6, 0.6, 0.6] }\n\
@@ -149,17 +153,28 @@ fn an_instanced_mesh_renders_as_its_flattened_copies_on_both_backends() {
     let dir = temp_dir("tori");
     bumps_png(&dir);
     let obj = torus_obj(16, 8);
-    for name in ["torus.obj", "a.obj", "b.obj", "c.obj", "d.obj"] {
+    let copies = ["a.obj", "b.obj", "c.obj", "d.obj", "e.obj"];
+    for name in std::iter::once("torus.obj").chain(copies) {
         std::fs::write(dir.join(name), &obj).unwrap();
     }
-    let instanced = tori_scene(&dir, ["torus.obj"; 4], PLACEMENTS);
-    let flattened = tori_scene(&dir, ["a.obj", "b.obj", "c.obj", "d.obj"], PLACEMENTS);
+    let instanced = tori_scene(&dir, ["torus.obj"; 5], PLACEMENTS);
+    let flattened = tori_scene(&dir, copies, PLACEMENTS);
     assert_eq!(
         (
             instanced.scene.meshes.len(),
             instanced.scene.instances.len()
         ),
-        (1, 4)
+        (1, 5)
+    );
+    let conditions: Vec<f32> = (instanced.scene.instances.iter())
+        .map(|i| i.determinant_condition)
+        .collect();
+    println!("determinant conditions of the placements: {conditions:?}");
+    assert!(
+        conditions
+            .iter()
+            .any(|&h| h > 100.0 && h <= DETERMINANT_CONDITION_LIMIT),
+        "no placement near the determinant condition's limit: {conditions:?}"
     );
     assert_eq!(
         instanced.scene.triangles.len(),
@@ -167,13 +182,13 @@ fn an_instanced_mesh_renders_as_its_flattened_copies_on_both_backends() {
         "the torus once"
     );
     assert!(flattened.scene.instances.is_empty());
-    assert_eq!(flattened.scene.triangles.len(), 2 + 4 * 16 * 8 * 2);
+    assert_eq!(flattened.scene.triangles.len(), 2 + 5 * 16 * 8 * 2);
     assert_ne!(instanced.features() & kernel::features::INSTANCES, 0);
     assert_eq!(flattened.features() & kernel::features::INSTANCES, 0);
     // The first torus turned 10 degrees further: a placement the test must tell apart.
     let mut off = PLACEMENTS;
     off[0] = "rotate = [45, 1, 0.3, 0]\ntranslate = [-1.3, 0.6, 0]";
-    let wrong = tori_scene(&dir, ["a.obj", "b.obj", "c.obj", "d.obj"], off);
+    let wrong = tori_scene(&dir, copies, off);
     let pixels = (instanced.scene.camera.width * instanced.scene.camera.height) as usize;
     let bound = z_critical(1e-3, pixels);
     for backend in [Backend::Cpu, Backend::Gpu] {
