@@ -12,8 +12,8 @@
 //!
 //! Each grid has a coarse *majorant grid* over the same box: cell c's value bounds the density
 //! at every point of the cell from above (the maximum of the voxels the trilinear filter reads
-//! there, which the host computes and raises by 2^-13 of itself so that rounding of the filter
-//! on either backend cannot exceed it). Delta tracking draws tentative collisions against it,
+//! there, which the host computes; the filter's rounding never reads above its largest voxel,
+//! [`DensityGrid::density_inside_v3`]). Delta tracking draws tentative collisions against it,
 //! cell by cell (pbrt-v4, 4th ed., section 11.4.3, `DDAMajorantIterator`; Amanatides and Woo's
 //! 3D DDA, Eurographics 1987).
 //!
@@ -37,11 +37,6 @@ pub const RESOLUTION: usize = 6;
 pub const MAJORANT_RESOLUTION: usize = 9;
 pub const VOXELS: usize = 12;
 pub const MAJORANTS: usize = 13;
-/// How much the host raises each majorant cell above the largest voxel it covers: a factor
-/// 1 + 2^-13, far above the rounding of an eight-term convex combination in f32 (a few units
-/// in the last place, 2^-23 each), also under Vulkan's precision rules.
-pub const MAJORANT_MARGIN: f32 = 1.0 + 1.0 / 8192.0;
-
 /// One grid of the table: the record at word `record`.
 #[derive(Clone, Copy)]
 pub struct DensityGrid<'a> {
@@ -119,7 +114,13 @@ impl<'a> DensityGrid<'a> {
 
     /// [`DensityGrid::density_inside`] over any scalar [`Real`] (the `f32` instance is it,
     /// operation for operation): the voxel coordinate clamped to the outermost centres, its
-    /// floor as the first of the eight voxels read, and the trilinear blend.
+    /// floor as the first of the eight voxels read, and the trilinear blend as seven lerps
+    /// a + (b - a) t with t = x - floor(x) < 1 (exact). Invariant: the result lies between 0
+    /// and the largest of the eight voxels under any arithmetic whose subtraction, product and
+    /// sum are correctly rounded, to nearest or toward zero, fused or not (Vulkan's rules;
+    /// docs/robustness.md, "Under Vulkan's arithmetic"), so a majorant needs no margin for it.
+    /// The form matters: a (1 - t) + b t, the eight weights' products summed, or t = 1 may
+    /// read above it.
     pub fn density_inside_v3<R: Real<Bits = u32>>(&self, p: V3<R>) -> R {
         let (lo, hi) = self.bounds();
         let n = self.resolution();

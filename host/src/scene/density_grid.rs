@@ -12,7 +12,7 @@
 
 use glam::Vec3;
 use kernel::density_grid::{
-    MAJORANTS, MAJORANT_MARGIN, MAJORANT_RESOLUTION, MAX, MIN, RECORD_WORDS, RESOLUTION, VOXELS,
+    MAJORANTS, MAJORANT_RESOLUTION, MAX, MIN, RECORD_WORDS, RESOLUTION, VOXELS,
 };
 use std::path::Path;
 
@@ -279,8 +279,9 @@ impl DenseGrid {
 
     /// The majorant grid (`kernel::density_grid`): each cell the largest voxel the trilinear
     /// filter reads at any point of the cell, with one voxel more on every side (points the
-    /// kernel's cell walk places in a cell may lie a rounding error outside it), raised by
-    /// `MAJORANT_MARGIN`.
+    /// kernel's cell walk places in a cell may lie a rounding error outside it). Nothing is
+    /// added for the filter's rounding: it never reads above its largest voxel
+    /// (`kernel::density_grid::DensityGrid::density_inside_v3`).
     pub fn majorants(&self) -> Vec<f32> {
         let n = self.resolution;
         let m = self.majorant_resolution();
@@ -307,7 +308,7 @@ impl DenseGrid {
                             }
                         }
                     }
-                    out.push(most * MAJORANT_MARGIN);
+                    out.push(most);
                 }
             }
         }

@@ -10,10 +10,10 @@
 //! silently biasing the medium. A point's cell coordinate carries the rounding of the crossing
 //! parameters (a quotient, then one sum per cell stepped) and of `origin + t dir`, so it may lie
 //! a little beyond its cell's face; the host's majorants cover one voxel more on every side
-//! than the filter reads inside the cell, and a factor `MAJORANT_MARGIN` for the filter's own
-//! rounding (`twinpath::scene::density_grid::DenseGrid::majorants`). The test fails without the
-//! extra voxel, under IEEE arithmetic already (docs/robustness.md, "Under Vulkan's
-//! arithmetic", where the margin's share is also stated).
+//! than the filter reads inside the cell (`twinpath::scene::density_grid::DenseGrid::majorants`),
+//! and nothing for the filter's own rounding, which never reads above its largest voxel (the
+//! second test). The first test fails without the extra voxel, under IEEE arithmetic already
+//! (docs/robustness.md, "Under Vulkan's arithmetic").
 
 use super::{f, use_model, v};
 use glam::{UVec3, Vec3};
@@ -246,4 +246,107 @@ fn floor_is_exact_under_vulkan_arithmetic() {
             }
         }
     }
+}
+
+/// The voxel values of [`the_filter_never_reads_above_its_largest_voxel_under_vulkan_arithmetic`]
+/// for one binade: b, b's neighbours, half an ULP of b (b - that is a tie, which rounds up to b
+/// where b's last bit is even), smaller values down to a denormal, and 0; in a quarter of the
+/// grids all eight are b. A lerp a + (b - a) t rounds above b only if b - a rounds up by half
+/// an ULP of b and the sum rounds up again.
+fn adversarial_voxels(g: &mut SplitMix) -> [f32; 8] {
+    let b = 10f32.powf(12.0 * g.unit() - 6.0);
+    let half_ulp = (b.next_up() - b) / 2.0;
+    let set = [
+        b,
+        b.next_up(),
+        b.next_down(),
+        half_ulp,
+        b * g.unit(),
+        f32::MIN_POSITIVE * g.unit(),
+        0.0,
+        b - half_ulp * 3.0,
+    ];
+    if g.unit() < 0.25 {
+        return [b; 8];
+    }
+    [0; 8].map(|_| set[(g.u64() % set.len() as u64) as usize])
+}
+
+/// The eight voxels blended with the trilinear weights (1 - f) or f per axis, summed: a
+/// filter the kernel does not use, whose computed weights may sum above 1. It shows that the
+/// points of the test below find a filter that reads above its largest voxel.
+fn weighted_filter(voxels: [f32; 8], [fx, fy, fz]: [Vk32; 3]) -> Vk32 {
+    let one = f(1.0);
+    let mut sum = f(0.0);
+    for (i, &voxel) in voxels.iter().enumerate() {
+        let w = |bit: usize, t: Vk32| if i >> bit & 1 == 1 { t } else { one - t };
+        sum = sum + w(0, fx) * w(1, fy) * w(2, fz) * f(voxel);
+    }
+    sum
+}
+
+/// The trilinear filter (`DensityGrid::density_inside_v3`) reads at most its largest voxel and
+/// at least 0, under IEEE arithmetic and every device model, so a majorant cell's largest voxel
+/// is its majorant with nothing added (docs/robustness.md, "Under Vulkan's arithmetic"). Each
+/// of its seven lerps a + (b - a) t, with t in [0, 1] and a, b >= 0, stays within [min(a, b),
+/// max(a, b)] when the subtraction, the product and the sum are each correctly rounded, to
+/// nearest or toward zero, fused or not (Vulkan's rules), which the derivation there shows; a
+/// flushed denormal only lowers a value. Here: 2 x 2 x 2 grids of [`adversarial_voxels`],
+/// points between the voxel centres, half of them a few ULP from the far ones. Shown to fail: the same
+/// points through [`weighted_filter`] read above the largest voxel (asserted), so a filter
+/// written so would need a margin on its majorants.
+#[test]
+fn the_filter_never_reads_above_its_largest_voxel_under_vulkan_arithmetic() {
+    let mut g = SplitMix(0x6c65_7270);
+    let (mut points, mut weighted_above) = (0usize, 0usize);
+    let mut worst = 0.0f64;
+    for case in 0..super::cases() / 5 {
+        let voxels = adversarial_voxels(&mut g);
+        let dense = DenseGrid {
+            min: Vec3::ZERO,
+            max: Vec3::splat(2.0),
+            resolution: [2, 2, 2],
+            voxels: voxels.to_vec(),
+        };
+        let mut table = GridTable::default();
+        let record = table.add(&dense).expect("fits");
+        let grid = DensityGrid::at(&table.words, record);
+        let largest = voxels.iter().fold(0.0f32, |m, &x| m.max(x));
+        // Voxel coordinates in [0, 1): uniform, or a few ULP below 1.
+        let fraction = |g: &mut SplitMix| {
+            if g.unit() < 0.5 {
+                g.unit()
+            } else {
+                (0..g.u64() % 4).fold(1f32.next_down(), |t, _| t.next_down())
+            }
+        };
+        let t = [0; 3].map(|_| fraction(&mut g));
+        for model in 0..4 {
+            use_model(model);
+            seed((case * 4 + model) as u64);
+            // Centres at 0.5 and 1.5: the point 0.5 + t reads coordinate t (to rounding).
+            let p = Vec3::from(t.map(|t| 0.5 + t));
+            let rho = grid.density_inside_v3(v(p)).value;
+            points += 1;
+            assert!(
+                (0.0..=largest).contains(&rho),
+                "model {model}: the filter reads {rho:e} of voxels {voxels:?} (largest \
+                 {largest:e}) at coordinates {t:?}"
+            );
+            if largest > 0.0 {
+                worst = worst.max(rho as f64 / largest as f64);
+            }
+            if weighted_filter(voxels, t.map(f)).value > largest {
+                weighted_above += 1;
+            }
+        }
+    }
+    println!(
+        "{points} points of 2 x 2 x 2 grids: the filter reads at most {worst} of the largest \
+         voxel; the weighted filter read above it at {weighted_above}"
+    );
+    assert!(
+        weighted_above > 0,
+        "the points find no filter reading above its voxels"
+    );
 }
