@@ -367,26 +367,15 @@ pub fn equal_pixel_sums(a: &twinpath::film::Film, b: &twinpath::film::Film) -> u
 }
 
 /// z of the difference between two images' overall means (over pixels and channels), each
-/// with a bound on the variance of its mean: for independent renders. A pixel's three channels
-/// come from the same paths and may be fully correlated (a grey scene's are equal), so the
-/// variance of a pixel's channel mean is bounded by the square of the mean of the channels'
-/// standard errors (Cauchy-Schwarz), and the pixels, whose paths are independent, add. Summing
-/// the channels' variances as if independent understated it up to threefold: two renders of a
-/// grey scene on different seeds gave z with an RMS of 1.96 over 12 pairs, 1.00 per pixel.
+/// with a bound on the variance of its mean ([`stats::variance_of_channel_mean`]): for
+/// independent renders. Summing the channels' variances as if independent understated it up
+/// to threefold: two renders of a grey scene on different seeds gave z with an RMS of 1.96
+/// over 12 pairs, 1.00 per pixel.
 pub fn image_mean_z(a: &twinpath::film::Film, b: &twinpath::film::Film) -> f64 {
     let stats = |f: &twinpath::film::Film| {
         let n = f.count.len() as f64;
         let mean = f.mean().iter().flatten().map(|&x| x as f64).sum::<f64>() / (3.0 * n);
-        let var = f
-            .variance_of_mean()
-            .iter()
-            .map(|v| {
-                let se = v.iter().map(|&c| (c as f64).sqrt()).sum::<f64>() / 3.0;
-                se * se
-            })
-            .sum::<f64>()
-            / (n * n);
-        (mean, var)
+        (mean, stats::variance_of_channel_mean(&f.variance_of_mean()))
     };
     let ((ma, va), (mb, vb)) = (stats(a), stats(b));
     (ma - mb) / (va + vb).sqrt()

@@ -65,3 +65,20 @@ pub fn mean_and_variance_of_mean(samples: &[f64]) -> (f64, f64) {
     let var = samples.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
     (mean, var / n)
 }
+
+/// The variance of an image's mean over its pixels and channels, from each pixel's per-channel
+/// variances of the mean, for pixels whose estimates are independent. A pixel's three channels
+/// come from the same paths and may be fully correlated (a grey scene's are equal), so the
+/// variance of a pixel's channel mean is bounded by the square of the mean of the channels'
+/// standard errors (Cauchy-Schwarz); the pixels add. Summing the channels' variances as if
+/// independent understates it up to threefold.
+pub fn variance_of_channel_mean(var: &[[f32; 3]]) -> f64 {
+    let pixels = var.len().max(1) as f64;
+    var.iter()
+        .map(|v| {
+            let se = v.iter().map(|&c| (c as f64).sqrt()).sum::<f64>() / 3.0;
+            se * se
+        })
+        .sum::<f64>()
+        / (pixels * pixels)
+}

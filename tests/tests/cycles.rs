@@ -45,7 +45,7 @@ use twinpath::film::RgbImage;
 use twinpath::render::Backend;
 use twinpath::scene::{parse_scene, SceneFile};
 use twinpath_tests::gpu::assert_validation_clean;
-use twinpath_tests::stats::pixel_z_test;
+use twinpath_tests::stats::{pixel_z_test, variance_of_channel_mean};
 use twinpath_tests::{
     assert_films_identical, pixel_quadrature, render_film, repo_root, variance_of_mean_from,
     with_independent_samples, z_critical,
@@ -180,13 +180,16 @@ fn measure(
         Some(&theirs_var),
         z_critical(1e-3, 3),
     );
-    // The image means, each with the variance of its mean (pixels are independent).
+    // The image means, each with the variance of its mean: pixels are independent, a pixel's
+    // channels may be fully correlated (`variance_of_channel_mean`).
     let n = (3 * keep.len()) as f64;
     let sum = |img: &[[f32; 3]]| img.iter().flatten().map(|&x| x as f64).sum::<f64>() / n;
     let (m_ours, m_theirs) = (sum(&ours.pixels), sum(&theirs.pixels));
     // The floor is a systematic accuracy: averaging over pixels does not shrink it.
     let systematic = (floor as f64 * m_theirs).powi(2);
-    let v = (sum(&ours_var) + sum(&pick(&f.reference_var).pixels)) / n + systematic;
+    let v = variance_of_channel_mean(&ours_var)
+        + variance_of_channel_mean(&pick(&f.reference_var).pixels)
+        + systematic;
     let z_mean = (m_ours - m_theirs) / v.sqrt();
     println!(
         "{label} ({backend:?}, {} pixels): {:.2}% pass, max |z| {:.2}; mean {m_ours:.5} vs \

@@ -14,7 +14,7 @@ use statrs::distribution::{ContinuousCDF, StudentsT};
 use twinpath::cpu::CpuRenderer;
 use twinpath::film::{diff_images, Film, RgbImage};
 use twinpath::scene::SceneFile;
-use twinpath_tests::stats::pixel_z_test;
+use twinpath_tests::stats::{pixel_z_test, variance_of_channel_mean};
 use twinpath_tests::{repo_root, with_independent_samples, z_critical};
 
 const SPP: u32 = 1024;
@@ -168,7 +168,8 @@ fn agrees_with_mitsuba(scene_file: &str, reference_dir: &std::path::Path, spp: u
     );
     let d = diff_images(&image, &reference).unwrap();
     // The image means: ours from the spread of the batches' (t with BATCHES - 1 degrees of
-    // freedom), the reference's from its halves pixel by pixel.
+    // freedom), the reference's from its halves pixel by pixel, a pixel's channels taken as
+    // possibly fully correlated (`variance_of_channel_mean`).
     let n = (3 * image.pixels.len()) as f64;
     let batch_means: Vec<f64> = means
         .iter()
@@ -189,12 +190,7 @@ fn agrees_with_mitsuba(scene_file: &str, reference_dir: &std::path::Path, spp: u
         .map(|&x| x as f64)
         .sum::<f64>()
         / n;
-    let reference_mean_var = reference_var
-        .iter()
-        .flatten()
-        .map(|&v| v as f64)
-        .sum::<f64>()
-        / (n * n);
+    let reference_mean_var = variance_of_channel_mean(&reference_var);
     let z_mean = (ours - reference_mean) / (ours_var + reference_mean_var).sqrt();
     let t_max = StudentsT::new(0.0, 1.0, k - 1.0)
         .unwrap()
