@@ -91,7 +91,7 @@ for v in off 2 off 2; do gpu twinpath "scenes/cornell.toml --set split=$v"; done
 # scripts/gpu_peer_scenes.txt at the same sample count; scripts/gpu_peer_table.py measures the
 # images' error here (from $OUT/peer.tar.gz: a run returns at most 8 files).
 rm -rf /tmp/peer && mkdir -p /tmp/peer
-for s in $(awk '!/^#/ && NF { print $1 }' scripts/gpu_peer_scenes.txt); do
+for s in $(awk '{ sub(/#.*/, "") } NF { print $1 }' scripts/gpu_peer_scenes.txt); do
   timeout -k 5 40 $B/twinpath render scenes/$s.toml --backend gpu --spp ${PEER_SPP:-1024} -o /tmp/peer/twinpath_$s.exr > /tmp/peer/twinpath_$s.txt 2>&1; grep -E "backend|rror" /tmp/peer/twinpath_$s.txt
 done
 if [ -e .gpu/mitsuba.tar.xz ]; then

@@ -333,13 +333,7 @@ impl SceneTables {
         let at = match self.flattened.iter().position(|f| f.name == name) {
             Some(k) => k,
             None => {
-                self.flattened.push(FlattenedCopies {
-                    name: name.to_string(),
-                    reason,
-                    flattened: 0,
-                    triangles: 0,
-                    kept: 0,
-                });
+                self.flattened.push(FlattenedCopies::new(name, reason));
                 self.flattened.len() - 1
             }
         };

@@ -27,13 +27,13 @@ pub const DETERMINANT_CONDITION_LIMIT: f32 =
     DEVICE_INVERSE_CONDITION_LIMIT / DEVICE_INVERSE_EPS_PER_DETERMINANT_CONDITION;
 
 /// Why a placement of a mesh, whose record ([`instance_record`]) is `placement`, is flattened
-/// into world space instead of instanced, or None where it is instanced. A device maps rays into an instance's
-/// object space by its own inverse of the map, which Vulkan does not specify: past a condition
-/// number of `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT` its error may turn a grazing
-/// ray into the triangle it leaves, and past a determinant condition of
-/// [`DETERMINANT_CONDITION_LIMIT`] an inverse by the adjugate (RADV's, ANV's) scales the mesh it
-/// sees by up to 6 eps H and the heights of leaving rays with it (docs/instancing.md). A
-/// flattened placement involves no device inverse.
+/// into world space instead of instanced, or None where it is instanced. A device maps rays
+/// into an instance's object space by its own inverse of the map, which Vulkan does not
+/// specify: past a condition number of `kernel::instance::DEVICE_INVERSE_CONDITION_LIMIT` its
+/// error may turn a grazing ray into the triangle it leaves, and past a determinant condition
+/// of [`DETERMINANT_CONDITION_LIMIT`] an inverse by the adjugate (RADV's, ANV's) scales the
+/// mesh it sees by up to 6 eps H and the heights of leaving rays with it (docs/instancing.md).
+/// A flattened placement involves no device inverse.
 pub fn flattening_reason(placement: &Instance) -> Option<String> {
     let condition = condition_number(placement);
     if !(condition <= DEVICE_INVERSE_CONDITION_LIMIT) {
@@ -72,6 +72,17 @@ pub struct FlattenedCopies {
 }
 
 impl FlattenedCopies {
+    /// Mesh `name`'s record before any placement is counted, with the first one's `reason`.
+    pub fn new(name: &str, reason: String) -> Self {
+        Self {
+            name: name.to_string(),
+            reason,
+            flattened: 0,
+            triangles: 0,
+            kept: 0,
+        }
+    }
+
     /// Whether one more placement, of `triangles` triangles, is flattened; counted either way.
     pub fn admit(&mut self, triangles: usize) -> bool {
         let fits = self.flattened < MAX_FLATTENED_PLACEMENTS
